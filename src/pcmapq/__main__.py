@@ -1,0 +1,3 @@
+from pcmapq.cli import app
+
+app()

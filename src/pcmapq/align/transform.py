@@ -1,0 +1,55 @@
+"""Similarity2D: ``p_truth = s * R(yaw) * p_map + t``, the one frame convention of pcmapq."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class Similarity2D:
+    """A 2D similarity taking map-frame points to the truth frame.
+
+    scale: dimensionless; yaw: radians; tx, ty: metres.
+    """
+
+    tx: float = 0.0
+    ty: float = 0.0
+    yaw: float = 0.0
+    scale: float = 1.0
+
+    @property
+    def matrix(self) -> np.ndarray:
+        """3x3 homogeneous matrix, map frame -> truth frame."""
+        c, s = np.cos(self.yaw) * self.scale, np.sin(self.yaw) * self.scale
+        return np.array([[c, -s, self.tx], [s, c, self.ty], [0.0, 0.0, 1.0]])
+
+    @classmethod
+    def from_matrix(cls, m: np.ndarray) -> Similarity2D:
+        """From a 3x3 (or the top-left 2x3 of a 4x4 planar) similarity matrix."""
+        m = np.asarray(m, dtype=np.float64)
+        if m.shape == (4, 4):
+            m = np.array([[m[0, 0], m[0, 1], m[0, 3]], [m[1, 0], m[1, 1], m[1, 3]], [0, 0, 1.0]])
+        scale = float(np.hypot(m[0, 0], m[1, 0]))
+        yaw = float(np.arctan2(m[1, 0], m[0, 0]))
+        return cls(float(m[0, 2]), float(m[1, 2]), yaw, scale)
+
+    def apply(self, xy: np.ndarray) -> np.ndarray:
+        """Map-frame (N, 2) metres -> truth-frame (N, 2) metres."""
+        m = self.matrix
+        xy = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
+        return xy @ m[:2, :2].T + m[:2, 2]
+
+    def inverse(self) -> Similarity2D:
+        return Similarity2D.from_matrix(np.linalg.inv(self.matrix))
+
+    def compose(self, first: Similarity2D) -> Similarity2D:
+        """The transform that applies ``first``, then ``self``."""
+        return Similarity2D.from_matrix(self.matrix @ first.matrix)
+
+    @property
+    def yaw_deg(self) -> float:
+        """Yaw in degrees, wrapped to (-180, 180]."""
+        deg = float(np.degrees(self.yaw))
+        return 180.0 - (180.0 - deg) % 360.0
