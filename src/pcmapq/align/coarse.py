@@ -1,0 +1,119 @@
+"""Global 2D alignment without an initial guess: rotate the map, correlate rasters.
+
+For every yaw of a sweep the map is drawn as a binary template around its centroid and slid over
+a likelihood field of the truth, ``exp(-d^2 / 2 sigma^2)`` of the distance ``d`` to the nearest
+truth wall (cv2.matchTemplate, TM_CCORR). Dividing by the template's cell count gives the mean
+field value under the map's cells, in [0, 1]: a soft share of the map that lies on truth walls.
+The field saturates at 1 on a wall, so dense or cluttered truth regions cannot outscore the right
+place, and cells of a partial map that overhang the truth simply score 0.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+
+from pcmapq.align.transform import Similarity2D
+from pcmapq.grid import MetricGrid
+from pcmapq.raster.draw import hit_counts
+
+
+@dataclass(frozen=True)
+class Candidate:
+    """A coarse pose: map frame -> truth frame, with its correlation score in [0, 1]."""
+
+    transform: Similarity2D
+    score: float
+
+
+def likelihood_field(truth_xy: np.ndarray, grid: MetricGrid, sigma: float) -> np.ndarray:
+    """``exp(-d^2 / 2 sigma^2)`` on ``grid``, d = metres to the nearest cell holding a truth point
+    (N, 2, metres). (rows, cols) float32 in [0, 1]."""
+    free = (hit_counts(truth_xy, grid) == 0).astype(np.uint8)
+    dist = cv2.distanceTransform(free, cv2.DIST_L2, cv2.DIST_MASK_PRECISE) * grid.resolution
+    return np.exp(-0.5 * (dist / sigma) ** 2).astype(np.float32)
+
+
+def _template_grid(half: int, resolution: float) -> MetricGrid:
+    """A (2 half + 1)-cell square grid whose centre cell is centred on (0, 0)."""
+    corner = -(half + 0.5) * resolution
+    return MetricGrid(resolution, (corner, corner, 0.0), (2 * half + 1, 2 * half + 1))
+
+
+def _rotation(yaw: float) -> np.ndarray:
+    c, s = np.cos(yaw), np.sin(yaw)
+    return np.array([[c, -s], [s, c]])
+
+
+def _peaks(response: np.ndarray, count: int, radius: int) -> tuple[np.ndarray, np.ndarray]:
+    """Rows and columns of the ``count`` highest local maxima (within ``radius`` pixels)."""
+    size = 2 * radius + 1
+    local = cv2.dilate(response, np.ones((size, size), np.uint8))
+    v, u = np.nonzero(response >= local)
+    best = np.argsort(-response[v, u], kind="stable")[:count]
+    return v[best], u[best]
+
+
+def _suppress(poses: np.ndarray, top_k: int, min_angle: float, min_dist: float) -> np.ndarray:
+    """Greedy non-maximum suppression over rows (score, yaw, x, y) sorted by score, descending:
+    a pose within ``min_angle`` radians and ``min_dist`` metres of a kept one is dropped."""
+    kept: list[int] = []
+    for i in range(len(poses)):
+        if len(kept) == top_k:
+            break
+        if kept:
+            k = poses[kept]
+            dyaw = np.abs(np.angle(np.exp(1j * (k[:, 1] - poses[i, 1]))))
+            dxy = np.hypot(k[:, 2] - poses[i, 2], k[:, 3] - poses[i, 3])
+            if np.any((dyaw < min_angle) & (dxy < min_dist)):
+                continue
+        kept.append(i)
+    return poses[kept]
+
+
+def coarse_candidates(map_xy: np.ndarray, truth_xy: np.ndarray, *, resolution: float = 0.25,
+                      sigma: float | None = None, angle_step_deg: float | None = None,
+                      overhang: float = 2.0, top_k: int = 6,
+                      per_angle: int = 3) -> list[Candidate]:
+    """The ``top_k`` best distinct poses (map frame -> truth frame) of a yaw sweep over 360 degrees.
+
+    map_xy, truth_xy: (N, 2) metres, each in its own frame.
+    resolution: raster cell size, metres. sigma: likelihood field width, metres (default: the
+    resolution). angle_step_deg: yaw step, degrees (default: the angle that moves the map's
+    farthest point by sigma, clipped to [0.5, 3]). overhang: how far, metres, the map's centroid
+    may lie outside the truth's bounding box. per_angle: peaks kept from each yaw's response.
+    Candidates come best first; yaws within three steps and positions within 1 m of a better one
+    are dropped, so near-symmetric alternatives survive to be settled by refinement.
+    """
+    sigma = resolution if sigma is None else sigma
+    centre = map_xy.mean(axis=0)
+    centred = map_xy - centre
+    radius = float(np.sqrt((centred**2).sum(axis=1).max()))
+    if angle_step_deg is None:
+        angle_step_deg = float(np.clip(np.degrees(sigma / max(radius, 1e-6)), 0.5, 3.0))
+    half = int(np.ceil(radius / resolution)) + 1
+    tgrid = _template_grid(half, resolution)
+    fgrid = MetricGrid.covering(truth_xy, resolution, margin=(half + 1) * resolution + overhang)
+    field = likelihood_field(truth_xy, fgrid, sigma)
+    # Field pixel of the template's centre cell when the response peaks at (0, 0).
+    offset = fgrid.pixels_to_xy(np.array([[half, half]]))[0]
+    yaws = np.radians(np.arange(0.0, 360.0, angle_step_deg))
+    rows = []
+    for yaw in yaws:
+        template = (hit_counts(centred @ _rotation(yaw).T, tgrid) > 0).astype(np.float32)
+        response = cv2.matchTemplate(field, template, cv2.TM_CCORR) / template.sum()
+        v, u = _peaks(response, per_angle, radius=2)
+        xy = offset + np.column_stack([u, -v]) * resolution
+        rows.append(np.column_stack([response[v, u], np.full(len(v), yaw), xy]))
+    poses = np.vstack(rows)
+    poses = poses[np.argsort(-poses[:, 0], kind="stable")]
+    best = _suppress(poses, top_k, np.radians(3 * angle_step_deg), 1.0)
+    return [Candidate(_pose(yaw, xy, centre), float(score)) for score, yaw, *xy in best]
+
+
+def _pose(yaw: float, centre_truth: np.ndarray, centre_map: np.ndarray) -> Similarity2D:
+    """The rigid transform turning the map by ``yaw`` and putting its centroid on the truth point."""
+    t = np.asarray(centre_truth) - _rotation(yaw) @ centre_map
+    return Similarity2D(float(t[0]), float(t[1]), float(yaw))

@@ -1,0 +1,42 @@
+"""Settings: every option of a run in one object, every length in metres."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from pcmapq.align.transform import Similarity2D
+
+DETECTOR_NAMES = ("harris", "hough", "sift")
+
+
+@dataclass(frozen=True)
+class Settings:
+    """Options of ``pcmapq eval``; defaults are the documented ones.
+
+    map_resolution, truth_resolution: metres per pixel of an image that has no YAML (overrides
+        the YAML's); for a cloud truth, the cell size of its grid (default ``cloud_resolution``).
+    cloud_resolution: cell size used for a point-cloud truth when none is given, metres.
+    band_low, band_high: the wall band of a 3D cloud, metres above the floor.
+    init: initial guess of the map -> truth transform; skips the global step.
+    align: False trusts the map's frame (``--no-align``): no global step, no ICP.
+    fit_tolerance: a map point is an inlier of the alignment within this distance, metres.
+    min_fitness: below this share of inliers the map is taken to show another place.
+    force: evaluate even when the fitness is below ``min_fitness``.
+    threshold: largest distance between matched features, metres.
+    min_hits: a cloud cell is occupied when it holds at least this many points.
+    detectors: which detectors to run.
+    """
+
+    map_resolution: float | None = None
+    truth_resolution: float | None = None
+    cloud_resolution: float = 0.05
+    band_low: float = 0.3
+    band_high: float = 2.0
+    init: Similarity2D | None = None
+    align: bool = True
+    fit_tolerance: float = 0.2
+    min_fitness: float = 0.2
+    force: bool = False
+    threshold: float = 0.5
+    min_hits: int = 2
+    detectors: tuple[str, ...] = DETECTOR_NAMES

@@ -1,0 +1,199 @@
+"""What every detector shares: the Features type, the Detector record, and the working image.
+
+Detectors never look at the input raster directly. They see it resampled onto a *working grid*
+(same origin and yaw as the input grid, a fixed cell size in metres) by exact area averaging, so
+a plan drawn at 0.025 m and at 0.05 m gives the same working image up to rasterisation noise,
+and every length parameter (all in metres) means the same number of working pixels.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+from scipy import sparse
+from scipy.spatial import cKDTree
+
+from pcmapq.grid import MetricGrid
+
+#: Candidate pairs: truth indices, map indices, costs, displacements (M, 2) in metres.
+Candidates = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
+
+
+@dataclass(frozen=True)
+class Features:
+    """Features of one map, in the metric frame of the grid they were detected on.
+
+    xy: (N, 2) feature positions, metres.
+    strength: (N,) detector response (Harris response, segment length in metres, SIFT response).
+    strong: (N,) bool, true above the detection threshold; the others are above the lower
+        support threshold only: they may confirm a strong feature of the other map but are
+        never counted on their own.
+    descriptors: SIFT descriptors (N, 128) float32, else None.
+    segments: Hough segments (N, 4) ``x0, y0, x1, y1`` in metres, else None.
+    """
+
+    xy: np.ndarray
+    strength: np.ndarray
+    strong: np.ndarray
+    descriptors: np.ndarray | None = None
+    segments: np.ndarray | None = None
+
+    def __len__(self) -> int:
+        return len(self.xy)
+
+
+@dataclass(frozen=True)
+class Detector:
+    """A feature detector: how to find features, and which pairs of features may match.
+
+    detect: ``detect(occupied, grid, **params) -> Features``; ``occupied`` is a (rows, cols)
+        bool raster on ``grid`` (walls true).
+    candidates: ``candidates(truth, map_, threshold) -> (i, j, cost, displacement)``: the pairs
+        (truth ``i``, map ``j``) that may match under ``threshold`` metres, their costs (lower is
+        better) and displacements (M, 2) in metres, from the truth feature to the map feature.
+    """
+
+    name: str
+    detect: Callable[..., Features]
+    candidates: Callable[[Features, Features, float], Candidates]
+
+
+def empty_features(with_descriptors: bool = False, with_segments: bool = False) -> Features:
+    """Features with no feature in them."""
+    return Features(
+        xy=np.zeros((0, 2)),
+        strength=np.zeros(0),
+        strong=np.zeros(0, dtype=bool),
+        descriptors=np.zeros((0, 128), dtype=np.float32) if with_descriptors else None,
+        segments=np.zeros((0, 4)) if with_segments else None,
+    )
+
+
+def sorted_features(
+    xy: np.ndarray,
+    strength: np.ndarray,
+    strong: np.ndarray,
+    descriptors: np.ndarray | None = None,
+    segments: np.ndarray | None = None,
+) -> Features:
+    """Features in a canonical order (by x, then y, then strength), so the output depends on
+    the features only, not on the order a detector found them in."""
+    order = np.lexsort((strength, xy[:, 1], xy[:, 0])) if len(xy) else np.zeros(0, dtype=int)
+    return Features(
+        xy=np.asarray(xy, dtype=np.float64)[order].reshape(-1, 2),
+        strength=np.asarray(strength, dtype=np.float64)[order],
+        strong=np.asarray(strong, dtype=bool)[order],
+        descriptors=None if descriptors is None else descriptors[order],
+        segments=None if segments is None else np.asarray(segments, np.float64)[order],
+    )
+
+
+def _overlap_matrix(n_out: int, out_size: float, n_in: int, in_size: float) -> sparse.csr_array:
+    """(n_out, n_in) weights of 1D area averaging: the fraction of output cell ``i`` (length
+    ``out_size``) covered by input cell ``j`` (length ``in_size``); both start at 0."""
+    edges = np.union1d(np.arange(n_out + 1) * out_size, np.arange(n_in + 1) * in_size)
+    edges = edges[edges <= min(n_out * out_size, n_in * in_size) + 1e-12]
+    mid = 0.5 * (edges[1:] + edges[:-1])
+    length = np.diff(edges)
+    i = np.minimum((mid / out_size).astype(np.int64), n_out - 1)
+    j = np.minimum((mid / in_size).astype(np.int64), n_in - 1)
+    return sparse.csr_array((length / out_size, (i, j)), shape=(n_out, n_in))
+
+
+def resample(image: np.ndarray, grid: MetricGrid, resolution: float) -> tuple[np.ndarray, MetricGrid]:
+    """Resample ``image`` (rows, cols, on ``grid``) to cells of ``resolution`` metres by exact
+    area averaging over a grid with the same origin and yaw.
+
+    Returns the float32 image and its grid; the area beyond the input's extent reads 0.
+    """
+    image = np.asarray(image, dtype=np.float32)
+    if abs(grid.resolution - resolution) < 1e-9 * resolution:
+        return image, grid
+    work = grid.resampled(resolution)
+    ax = _overlap_matrix(work.shape[1], resolution, grid.shape[1], grid.resolution)
+    # rows count from the top, the origin is at the bottom: average the flipped rows
+    ay = _overlap_matrix(work.shape[0], resolution, grid.shape[0], grid.resolution)
+    out = ay @ image[::-1].astype(np.float64)
+    out = (ax @ out.T).T[::-1]
+    return np.ascontiguousarray(out, dtype=np.float32), work
+
+
+def disk(radius_px: float) -> np.ndarray:
+    """A disk-shaped uint8 structuring element of ``radius_px`` pixels (at least 3x3)."""
+    r = max(1, int(round(radius_px)))
+    v, u = np.mgrid[-r : r + 1, -r : r + 1]
+    return (u * u + v * v <= radius_px * radius_px + 0.5).astype(np.uint8)
+
+
+def gaussian(image: np.ndarray, sigma_px: float) -> np.ndarray:
+    """Gaussian blur with ``sigma_px`` pixels, kernel to 4 sigma, reflected borders."""
+    if sigma_px <= 0:
+        return image
+    k = 2 * int(np.ceil(4 * sigma_px)) + 1
+    return cv2.GaussianBlur(image, (k, k), sigma_px, borderType=cv2.BORDER_REFLECT)
+
+
+def working_image(
+    occupied: np.ndarray, grid: MetricGrid, resolution: float, closing: float
+) -> tuple[np.ndarray, MetricGrid]:
+    """The occupied fraction of each working cell, after a grey-level closing.
+
+    Parameters
+    ----------
+    occupied : (rows, cols) bool raster on ``grid``, walls true.
+    grid : the raster's grid.
+    resolution : working cell size, metres.
+    closing : radius of the closing disk, metres. It fills gaps narrower than about twice this,
+        so a wall drawn as its two laser-seen faces looks like the filled wall of a plan.
+
+    Returns
+    -------
+    image : (rows, cols) float32 in [0, 1] on the working grid.
+    work : the working grid (same origin and yaw as ``grid``).
+    """
+    image, work = resample(occupied, grid, resolution)
+    if closing > 0:
+        kernel = disk(closing / resolution)
+        image = cv2.morphologyEx(image, cv2.MORPH_CLOSE, kernel, borderType=cv2.BORDER_REFLECT)
+    return image, work
+
+
+def suppress(xy: np.ndarray, strength: np.ndarray, radius: float) -> np.ndarray:
+    """Non-maximum suppression of points: keep a point (N, 2, metres) unless a stronger one
+    lies within ``radius`` metres (ties: the later one in canonical order is dropped).
+
+    Returns the (N,) bool mask of kept points.
+    """
+    keep = np.ones(len(xy), dtype=bool)
+    if len(xy) < 2 or radius <= 0:
+        return keep
+    pairs = cKDTree(xy).query_pairs(radius, output_type="ndarray")
+    rank = np.empty(len(xy), dtype=np.int64)
+    rank[np.lexsort((xy[:, 1], xy[:, 0], -strength))] = np.arange(len(xy))  # 0 = strongest
+    a, b = pairs[:, 0], pairs[:, 1]
+    keep[np.where(rank[a] > rank[b], a, b)] = False
+    return keep
+
+
+def point_candidates(truth: Features, map_: Features, threshold: float) -> Candidates:
+    """Pairs of point features within ``threshold`` metres, at least one of them strong.
+
+    cost = Euclidean distance, metres; displacement = map xy - truth xy, metres.
+    """
+    if len(truth) == 0 or len(map_) == 0:
+        return no_candidates()
+    dist = cKDTree(truth.xy).sparse_distance_matrix(
+        cKDTree(map_.xy), threshold, output_type="ndarray"
+    )
+    i, j = dist["i"].astype(np.int64), dist["j"].astype(np.int64)
+    keep = truth.strong[i] | map_.strong[j]
+    i, j = i[keep], j[keep]
+    return i, j, dist["v"][keep], map_.xy[j] - truth.xy[i]
+
+
+def no_candidates() -> Candidates:
+    """The empty candidate set."""
+    return np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0), np.zeros((0, 2))

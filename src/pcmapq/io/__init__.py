@@ -1,0 +1,35 @@
+"""Loading maps: occupancy images (with their ROS map_server YAML) and point clouds.
+
+``load_map`` picks the loader from the file extension. Every problem with an input raises
+:class:`pcmapq.errors.InputError` with one line naming the file; inputs are never modified.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from pcmapq.errors import InputError
+from pcmapq.io.clouds import CLOUD_SUFFIXES, PointMap, load_cloud
+from pcmapq.io.occupancy import IMAGE_SUFFIXES, YAML_SUFFIXES, OccupancyMap, load_occupancy
+
+__all__ = ["OccupancyMap", "PointMap", "load_map"]
+
+#: The formats named in the error for an unknown extension (others are accepted quietly).
+_ADVERTISED = (".png", ".pgm", ".yaml", ".ply", ".pcd", ".xyz", ".txt", ".npy", ".bin")
+
+
+def load_map(path: str | Path, resolution: float | None = None) -> OccupancyMap | PointMap:
+    """Load a map file by its extension.
+
+    Occupancy images (.png, .pgm, .jpg, .bmp) and ROS map_server YAML (.yaml, .yml) give an
+    :class:`OccupancyMap`; ``resolution`` (metres per cell) overrides the YAML's. Point clouds
+    (.ply, .pcd, .xyz, .txt, .npy, KITTI .bin) give a :class:`PointMap`; ``resolution`` is
+    ignored for them.
+    """
+    path = Path(path)
+    suffix = path.suffix.lower()
+    if suffix in IMAGE_SUFFIXES or suffix in YAML_SUFFIXES:
+        return load_occupancy(path, resolution)
+    if suffix in CLOUD_SUFFIXES:
+        return load_cloud(path)
+    raise InputError(f"{path}: unsupported format '{suffix}' (expected {', '.join(_ADVERTISED)})")

@@ -1,0 +1,176 @@
+"""Occupancy images and ROS map_server YAML, read with exactly map_server's semantics.
+
+A pixel's grey value ``v`` (colour: mean of the colour channels; 16-bit images scaled to 0..255)
+gives ``p = (255 - v) / 255`` (``v / 255`` when ``negate``); the cell is occupied if
+``p > occupied_thresh``, free if ``p < free_thresh`` and unknown otherwise. A transparent pixel
+(alpha 0) is unknown. The grid's frame is the map_server one: ``origin`` is the pose of the
+image's lower-left corner (see :mod:`pcmapq.grid`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import cv2
+import numpy as np
+import yaml
+
+from pcmapq.errors import InputError
+from pcmapq.grid import MetricGrid
+from pcmapq.raster.draw import FREE, OCCUPIED, UNKNOWN
+
+IMAGE_SUFFIXES = (".png", ".pgm", ".jpg", ".jpeg", ".bmp")
+YAML_SUFFIXES = (".yaml", ".yml")
+MODES = ("trinary", "scale", "raw")
+
+
+@dataclass(frozen=True)
+class OccupancyMap:
+    """An occupancy image with its metric frame.
+
+    path: the file given (image or YAML).
+    grid: cell size and pose of the image in the map's metric frame.
+    state: (rows, cols) int8, OCCUPIED (1), FREE (0) or UNKNOWN (-1); row 0 is the image's top.
+    """
+
+    path: Path
+    grid: MetricGrid
+    state: np.ndarray
+    kind: str = "image"
+
+
+@dataclass(frozen=True)
+class MapMeta:
+    """The map_server YAML fields that matter here. Thresholds are probabilities in [0, 1]."""
+
+    resolution: float | None
+    origin: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    negate: bool = False
+    occupied_thresh: float = 0.65
+    free_thresh: float = 0.196
+    mode: str = "trinary"
+
+
+def load_occupancy(path: Path, resolution: float | None = None) -> OccupancyMap:
+    """Load an occupancy image or a map_server YAML. ``resolution`` (metres per cell), if given,
+    overrides the YAML's; an image without a YAML beside it (same stem) needs it."""
+    if path.suffix.lower() in YAML_SUFFIXES:
+        meta, image = read_yaml(path)
+    else:
+        image = path
+        beside = [path.with_suffix(s) for s in YAML_SUFFIXES if path.with_suffix(s).is_file()]
+        meta = read_yaml(beside[0])[0] if beside else MapMeta(resolution=None)
+    if resolution is not None:
+        meta = MapMeta(_resolution(path, resolution), meta.origin, meta.negate,
+                       meta.occupied_thresh, meta.free_thresh, meta.mode)
+    if meta.resolution is None:
+        raise InputError(f"{path}: no resolution: give --map-resolution/--truth-resolution "
+                         "or a YAML beside it")
+    state = classify(read_grey(image), meta)
+    return OccupancyMap(path, MetricGrid(meta.resolution, meta.origin, state.shape), state)
+
+
+def read_yaml(path: Path) -> tuple[MapMeta, Path]:
+    """Parse and check a map_server YAML: its metadata and the path of the image it names."""
+    try:
+        doc = yaml.safe_load(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, yaml.YAMLError) as exc:
+        raise InputError(f"{path}: cannot be read as YAML: {_first_line(exc)}") from None
+    if not isinstance(doc, dict):
+        raise InputError(f"{path}: not a map_server YAML (expected a mapping of keys)")
+    for key in ("image", "resolution", "origin"):
+        if key not in doc:
+            raise InputError(f"{path}: no '{key}' key")
+    if not isinstance(doc["image"], str) or not doc["image"]:
+        raise InputError(f"{path}: 'image' must be a file name")
+    image = path.parent / doc["image"]
+    if not image.is_file():
+        raise InputError(f"{path}: image '{doc['image']}' not found")
+    mode = doc.get("mode", "trinary")
+    if mode not in MODES:
+        raise InputError(f"{path}: unknown mode {mode!r} (expected one of {', '.join(MODES)})")
+    meta = MapMeta(
+        resolution=_resolution(path, doc["resolution"]),
+        origin=_origin(path, doc["origin"]),
+        negate=bool(_number(path, "negate", doc.get("negate", 0))),
+        occupied_thresh=_probability(path, "occupied_thresh", doc.get("occupied_thresh", 0.65)),
+        free_thresh=_probability(path, "free_thresh", doc.get("free_thresh", 0.196)),
+        mode=mode,
+    )
+    return meta, image
+
+
+def read_grey(path: Path) -> tuple[np.ndarray, np.ndarray]:
+    """An image as grey values on the 0..255 scale, float64 (rows, cols), and a bool mask of
+    transparent (alpha 0) pixels."""
+    try:
+        img = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
+    except cv2.error:
+        img = None
+    if img is None or img.size == 0:
+        raise InputError(f"{path}: cannot be read as an image")
+    if img.dtype not in (np.uint8, np.uint16):
+        raise InputError(f"{path}: unsupported pixel type {img.dtype} (expected 8 or 16 bit)")
+    scale = 255.0 / np.iinfo(img.dtype).max
+    if img.ndim == 2:
+        return img * scale, np.zeros(img.shape, dtype=bool)
+    channels = img.shape[2]
+    has_alpha = channels in (2, 4)
+    colour = img[:, :, : channels - 1] if has_alpha else img
+    transparent = img[:, :, -1] == 0 if has_alpha else np.zeros(img.shape[:2], dtype=bool)
+    return colour.mean(axis=2) * scale, transparent
+
+
+def classify(grey: tuple[np.ndarray, np.ndarray], meta: MapMeta) -> np.ndarray:
+    """Cell states (int8 OCCUPIED/FREE/UNKNOWN) from grey values and transparency, by map_server's
+    rule. ``raw`` mode reads the value itself as occupancy in percent (above 100: unknown)."""
+    value, transparent = grey
+    if meta.mode == "raw":
+        p = value / 100.0
+        transparent = transparent | (value > 100.0)
+    else:
+        p = value / 255.0 if meta.negate else (255.0 - value) / 255.0
+    state = np.full(value.shape, UNKNOWN, dtype=np.int8)
+    state[p < meta.free_thresh] = FREE
+    state[p > meta.occupied_thresh] = OCCUPIED
+    state[transparent] = UNKNOWN
+    return state
+
+
+def _first_line(exc: BaseException) -> str:
+    """An exception's message, reduced to one line."""
+    text = str(exc).strip()
+    return text.splitlines()[0] if text else type(exc).__name__
+
+
+def _number(path: Path, key: str, value: object) -> float:
+    """A YAML value that must be a finite number."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        raise InputError(f"{path}: '{key}' must be a finite number, got {value!r}")
+    return float(value)
+
+
+def _resolution(path: Path, value: object) -> float:
+    """A cell size in metres: a positive finite number."""
+    res = _number(path, "resolution", value)
+    if res <= 0:
+        raise InputError(f"{path}: 'resolution' must be positive, got {value!r}")
+    return res
+
+
+def _probability(path: Path, key: str, value: object) -> float:
+    """A threshold in [0, 1]."""
+    p = _number(path, key, value)
+    if not 0.0 <= p <= 1.0:
+        raise InputError(f"{path}: '{key}' must be between 0 and 1, got {value!r}")
+    return p
+
+
+def _origin(path: Path, value: object) -> tuple[float, float, float]:
+    """``[x, y]`` or ``[x, y, yaw]`` (metres, metres, radians) -> (x, y, yaw)."""
+    if not isinstance(value, (list, tuple)) or len(value) not in (2, 3):
+        raise InputError(f"{path}: 'origin' must be a list [x, y, yaw], got {value!r}")
+    x, y, yaw = (*(_number(path, "origin", v) for v in value), 0.0)[:3]
+    return x, y, yaw

@@ -1,0 +1,34 @@
+"""The terminal view of a Result: the alignment and one row per detector."""
+
+from __future__ import annotations
+
+from rich.console import Console
+from rich.table import Table
+
+from pcmapq.result import Result
+
+
+def _m(value: float | None) -> str:
+    return "-" if value is None else f"{value:.3f}"
+
+
+def print_table(result: Result, console: Console) -> None:
+    """Print the alignment and the per-detector qualities (metres, degrees)."""
+    a = result.alignment
+    tf = a.transform
+    console.print(
+        f"[bold]{result.map_path}[/] -> [bold]{result.truth_path}[/]  "
+        f"x {tf.tx:.3f} m  y {tf.ty:.3f} m  yaw {tf.yaw_deg:.2f} deg  scale {tf.scale:.4f}  "
+        f"fitness {a.fitness:.3f} (within {a.tolerance_m} m)  rmse {a.rmse_m:.3f} m")
+    table = Table(title=f"feature matching within {result.threshold} m")
+    for col in ("detector", "quality", "precision", "f1", "truth", "map", "matched"):
+        table.add_column(col, justify="right")
+    for col in ("mean m", "median m", "rmse m", "max m"):
+        table.add_column(f"disp. {col}", justify="right")
+    for name, det in result.detectors.items():
+        m = det.matching
+        stats = det.displacement_stats()
+        table.add_row(name, f"{m.quality:.3f}", f"{m.precision:.3f}", f"{m.f1:.3f}",
+                      str(m.truth_features), str(m.map_features), str(m.matched),
+                      *(_m(stats[k]) for k in ("mean", "median", "rmse", "max")))
+    console.print(table)

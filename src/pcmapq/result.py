@@ -1,0 +1,123 @@
+"""Result: everything a run found. The JSON, the table and the CSV are views of it."""
+
+from __future__ import annotations
+
+import io
+import json
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from pcmapq.align import Alignment
+from pcmapq.features import Features
+from pcmapq.grid import MetricGrid
+from pcmapq.match import Matching
+
+#: Decimals kept in saved numbers: micrometres, so reruns give byte-identical files.
+DECIMALS = 6
+
+
+@dataclass(frozen=True)
+class DetectorResult:
+    """One detector's features on both sides (truth frame, metres) and their matching."""
+
+    truth: Features
+    map: Features
+    matching: Matching
+
+    @property
+    def truth_xy(self) -> np.ndarray:
+        """Matched truth features, (M, 2) metres."""
+        return self.truth.xy[self.matching.truth_idx]
+
+    @property
+    def map_xy(self) -> np.ndarray:
+        """Where each matched truth feature is in the map: truth_xy + displacement, (M, 2) m."""
+        return self.truth_xy + self.matching.displacement
+
+    @property
+    def distances(self) -> np.ndarray:
+        """Length of each displacement, (M,) metres."""
+        return np.linalg.norm(self.matching.displacement, axis=1)
+
+    def displacement_stats(self) -> dict[str, float | None]:
+        """mean, median, rmse and max of the displacement lengths, metres (None if no match)."""
+        d = self.distances
+        if len(d) == 0:
+            return {"mean": None, "median": None, "rmse": None, "max": None}
+        return {"mean": float(d.mean()), "median": float(np.median(d)),
+                "rmse": float(np.sqrt(np.mean(d**2))), "max": float(d.max())}
+
+
+@dataclass(frozen=True)
+class Result:
+    """A finished evaluation; all coordinates in the truth frame, metres."""
+
+    map_path: Path
+    map_kind: str
+    truth_path: Path
+    truth_kind: str
+    grid: MetricGrid
+    alignment: Alignment
+    threshold: float
+    detectors: dict[str, DetectorResult]
+    truth_occupied: np.ndarray
+    map_occupied: np.ndarray
+
+    def to_dict(self) -> dict:
+        """The JSON document (see README): plain types, floats rounded to DECIMALS."""
+        tf = self.alignment.transform
+        doc = {
+            "map": {"path": str(self.map_path), "kind": self.map_kind},
+            "truth": {"path": str(self.truth_path), "kind": self.truth_kind,
+                      "resolution_m": self.grid.resolution},
+            "alignment": {"x_m": tf.tx, "y_m": tf.ty, "yaw_deg": tf.yaw_deg, "scale": tf.scale,
+                          "matrix": tf.matrix.tolist(), "fitness": self.alignment.fitness,
+                          "rmse_m": self.alignment.rmse_m,
+                          "tolerance_m": self.alignment.tolerance_m,
+                          "method": self.alignment.method},
+            "detectors": {},
+            "matches": [], "missing": [], "extra": [],
+        }
+        for name, det in self.detectors.items():
+            m = det.matching
+            doc["detectors"][name] = {
+                "quality": m.quality, "precision": m.precision, "f1": m.f1,
+                "truth_features": m.truth_features, "map_features": m.map_features,
+                "matched": m.matched, "threshold_m": self.threshold,
+                "displacement_m": det.displacement_stats(),
+            }
+            doc["matches"] += [
+                {"detector": name, "truth_xy_m": t, "map_xy_m": p, "displacement_m": d}
+                for t, p, d in zip(det.truth_xy.tolist(), det.map_xy.tolist(),
+                                   det.distances.tolist())]
+            doc["missing"] += [{"detector": name, "truth_xy_m": t}
+                               for t in det.truth.xy[m.missing].tolist()]
+            doc["extra"] += [{"detector": name, "map_xy_m": p}
+                             for p in det.map.xy[m.extra].tolist()]
+        return _rounded(doc)
+
+    def to_json(self) -> str:
+        return json.dumps(self.to_dict(), indent=2) + "\n"
+
+    def vectors_csv(self) -> str:
+        """One row per matched feature: truth and map position and displacement, metres."""
+        out = io.StringIO()
+        out.write("detector,truth_x_m,truth_y_m,map_x_m,map_y_m,dx_m,dy_m,displacement_m\n")
+        for name, det in self.detectors.items():
+            rows = np.column_stack([det.truth_xy, det.map_xy, det.matching.displacement,
+                                    det.distances])
+            np.savetxt(out, rows + 0.0, fmt=",".join([name] + [f"%.{DECIMALS}f"] * 7))
+        return out.getvalue()
+
+
+def _rounded(value):
+    """Round every float in a nested structure to DECIMALS (and turn -0.0 into 0.0)."""
+    if isinstance(value, float):
+        return round(value, DECIMALS) + 0.0
+    if isinstance(value, dict):
+        return {k: _rounded(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return [_rounded(v) for v in value]
+    return value

@@ -1,0 +1,54 @@
+"""Write the shipped sample: a building plan as a ROS map (truth.png + truth.yaml) and a 3D
+LiDAR-like scan of the same building in the robot's own frame (scan.ply).
+
+The scan differs from the plan in known ways, so the sample's result can be checked by eye:
+it is turned and shifted (p_truth = R(yaw) * p_scan + t with the values in SCAN_POSE), one wall
+is moved by 0.3 m, furniture-like boxes stand in the rooms, and it has noise and outliers.
+
+    python tools/make_sample.py [OUT_DIR]     (default: data/sample)
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import cv2
+import numpy as np
+import open3d as o3d
+
+from pcmapq import synth
+from pcmapq.align.transform import Similarity2D
+
+#: The scan frame's pose in the truth frame: x, y metres, yaw degrees.
+SCAN_POSE = (6.0, 8.0, 37.0)
+RESOLUTION = 0.05
+MOVED_WALL, MOVED_BY = 5, (0.3, 0.0)  # the room wall at x = 8.0 m moves to 8.3 m
+
+
+def main(out: Path) -> None:
+    out.mkdir(parents=True, exist_ok=True)
+    plan = synth.building_plan(seed=0)
+    grid = synth.plan_grid(plan, RESOLUTION)
+    cv2.imwrite(str(out / "truth.png"), synth.render(plan, grid))
+    ox, oy, _ = grid.origin
+    (out / "truth.yaml").write_text(
+        "image: truth.png\n"
+        f"resolution: {RESOLUTION}\n"
+        f"origin: [{ox:.3f}, {oy:.3f}, 0.0]\n"
+        "negate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n")
+
+    seen = synth.clutter(synth.move_wall(plan, MOVED_WALL, MOVED_BY), count=6, seed=3)
+    cloud = synth.lidar_cloud(seen, spacing=0.07, noise=0.01, seed=1)
+    x, y, yaw = SCAN_POSE
+    to_scan = Similarity2D(x, y, np.radians(yaw)).inverse()
+    cloud[:, :2] = to_scan.apply(cloud[:, :2])
+    cloud[:, 2] -= 0.8  # the sensor's frame: floor 0.8 m below it
+    pcd = o3d.t.geometry.PointCloud(o3d.core.Tensor(cloud.astype(np.float32)))
+    o3d.t.io.write_point_cloud(str(out / "scan.ply"), pcd)
+    print(f"wrote {out}/truth.png, truth.yaml, scan.ply ({len(cloud)} points); "
+          f"scan pose in truth frame: x {x} m, y {y} m, yaw {yaw} deg")
+
+
+if __name__ == "__main__":
+    main(Path(sys.argv[1]) if len(sys.argv) > 1 else Path("data/sample"))
