@@ -27,6 +27,10 @@ def load_map(path: str | Path, resolution: float | None = None) -> OccupancyMap 
     ignored for them.
     """
     path = Path(path)
+    if not path.exists():
+        raise InputError(f"{path}: not found")
+    if not path.is_file():
+        raise InputError(f"{path}: not a file")
     suffix = path.suffix.lower()
     if suffix in IMAGE_SUFFIXES or suffix in YAML_SUFFIXES:
         return load_occupancy(path, resolution)

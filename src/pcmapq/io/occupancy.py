@@ -10,7 +10,7 @@ image's lower-left corner (see :mod:`pcmapq.grid`).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import cv2
@@ -19,6 +19,7 @@ import yaml
 
 from pcmapq.errors import InputError
 from pcmapq.grid import MetricGrid
+from pcmapq.io.writers import one_line
 from pcmapq.raster.draw import FREE, OCCUPIED, UNKNOWN
 
 IMAGE_SUFFIXES = (".png", ".pgm", ".jpg", ".jpeg", ".bmp")
@@ -58,26 +59,29 @@ def load_occupancy(path: Path, resolution: float | None = None) -> OccupancyMap:
     overrides the YAML's; an image without a YAML beside it (same stem) needs it."""
     if path.suffix.lower() in YAML_SUFFIXES:
         meta, image = read_yaml(path)
+        if not image.is_file():
+            raise InputError(f"{path}: image '{image.name}' not found")
     else:
         image = path
         beside = [path.with_suffix(s) for s in YAML_SUFFIXES if path.with_suffix(s).is_file()]
         meta = read_yaml(beside[0])[0] if beside else MapMeta(resolution=None)
     if resolution is not None:
-        meta = MapMeta(_resolution(path, resolution), meta.origin, meta.negate,
-                       meta.occupied_thresh, meta.free_thresh, meta.mode)
+        meta = replace(meta, resolution=_resolution(path, resolution))
+    grey, transparent = read_grey(image)
     if meta.resolution is None:
         raise InputError(f"{path}: no resolution: give --map-resolution/--truth-resolution "
                          "or a YAML beside it")
-    state = classify(read_grey(image), meta)
+    state = classify(grey, transparent, meta)
     return OccupancyMap(path, MetricGrid(meta.resolution, meta.origin, state.shape), state)
 
 
 def read_yaml(path: Path) -> tuple[MapMeta, Path]:
-    """Parse and check a map_server YAML: its metadata and the path of the image it names."""
+    """Parse and check a map_server YAML: its metadata and the path of the image it names
+    (relative to the YAML's folder; not checked here)."""
     try:
         doc = yaml.safe_load(path.read_text(encoding="utf-8"))
     except (OSError, UnicodeDecodeError, yaml.YAMLError) as exc:
-        raise InputError(f"{path}: cannot be read as YAML: {_first_line(exc)}") from None
+        raise InputError(f"{path}: cannot be read as YAML: {_yaml_problem(exc)}") from None
     if not isinstance(doc, dict):
         raise InputError(f"{path}: not a map_server YAML (expected a mapping of keys)")
     for key in ("image", "resolution", "origin"):
@@ -85,21 +89,18 @@ def read_yaml(path: Path) -> tuple[MapMeta, Path]:
             raise InputError(f"{path}: no '{key}' key")
     if not isinstance(doc["image"], str) or not doc["image"]:
         raise InputError(f"{path}: 'image' must be a file name")
-    image = path.parent / doc["image"]
-    if not image.is_file():
-        raise InputError(f"{path}: image '{doc['image']}' not found")
     mode = doc.get("mode", "trinary")
     if mode not in MODES:
         raise InputError(f"{path}: unknown mode {mode!r} (expected one of {', '.join(MODES)})")
     meta = MapMeta(
         resolution=_resolution(path, doc["resolution"]),
         origin=_origin(path, doc["origin"]),
-        negate=bool(_number(path, "negate", doc.get("negate", 0))),
+        negate=_flag(path, "negate", doc.get("negate", 0)),
         occupied_thresh=_probability(path, "occupied_thresh", doc.get("occupied_thresh", 0.65)),
         free_thresh=_probability(path, "free_thresh", doc.get("free_thresh", 0.196)),
         mode=mode,
     )
-    return meta, image
+    return meta, path.parent / doc["image"]
 
 
 def read_grey(path: Path) -> tuple[np.ndarray, np.ndarray]:
@@ -123,10 +124,10 @@ def read_grey(path: Path) -> tuple[np.ndarray, np.ndarray]:
     return colour.mean(axis=2) * scale, transparent
 
 
-def classify(grey: tuple[np.ndarray, np.ndarray], meta: MapMeta) -> np.ndarray:
-    """Cell states (int8 OCCUPIED/FREE/UNKNOWN) from grey values and transparency, by map_server's
-    rule. ``raw`` mode reads the value itself as occupancy in percent (above 100: unknown)."""
-    value, transparent = grey
+def classify(value: np.ndarray, transparent: np.ndarray, meta: MapMeta) -> np.ndarray:
+    """Cell states (int8 OCCUPIED/FREE/UNKNOWN) from grey values (0..255) and a transparency
+    mask, by map_server's rule. ``raw`` mode reads the value itself as occupancy in percent
+    (above 100: unknown) and ignores ``negate``."""
     if meta.mode == "raw":
         p = value / 100.0
         transparent = transparent | (value > 100.0)
@@ -139,10 +140,12 @@ def classify(grey: tuple[np.ndarray, np.ndarray], meta: MapMeta) -> np.ndarray:
     return state
 
 
-def _first_line(exc: BaseException) -> str:
-    """An exception's message, reduced to one line."""
-    text = str(exc).strip()
-    return text.splitlines()[0] if text else type(exc).__name__
+
+def _yaml_problem(exc: Exception) -> str:
+    """One line for a YAML read error: the parser's problem and line, or the OS error."""
+    if isinstance(exc, yaml.MarkedYAMLError) and exc.problem and exc.problem_mark:
+        return f"{exc.problem} (line {exc.problem_mark.line + 1})"
+    return one_line(exc)
 
 
 def _number(path: Path, key: str, value: object) -> float:
@@ -150,6 +153,11 @@ def _number(path: Path, key: str, value: object) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
         raise InputError(f"{path}: '{key}' must be a finite number, got {value!r}")
     return float(value)
+
+
+def _flag(path: Path, key: str, value: object) -> bool:
+    """A YAML yes/no: a boolean or a number (non-zero is true)."""
+    return value if isinstance(value, bool) else _number(path, key, value) != 0.0
 
 
 def _resolution(path: Path, value: object) -> float:
@@ -172,5 +180,5 @@ def _origin(path: Path, value: object) -> tuple[float, float, float]:
     """``[x, y]`` or ``[x, y, yaw]`` (metres, metres, radians) -> (x, y, yaw)."""
     if not isinstance(value, (list, tuple)) or len(value) not in (2, 3):
         raise InputError(f"{path}: 'origin' must be a list [x, y, yaw], got {value!r}")
-    x, y, yaw = (*(_number(path, "origin", v) for v in value), 0.0)[:3]
-    return x, y, yaw
+    xyz = [_number(path, "origin", v) for v in value]
+    return xyz[0], xyz[1], xyz[2] if len(xyz) == 3 else 0.0

@@ -2,11 +2,15 @@
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import cv2
 import numpy as np
 
-from pcmapq.align.transform import Similarity2D
 from pcmapq.grid import MetricGrid
+
+if TYPE_CHECKING:
+    from pcmapq.align.transform import Similarity2D
 
 #: Cell states of an occupancy raster.
 UNKNOWN, FREE, OCCUPIED = -1, 0, 1

@@ -1,0 +1,115 @@
+"""Point-cloud maps: PLY, PCD, text (.xyz, .txt), NumPy .npy and KITTI .bin.
+
+Points are (N, 3) float64 metres in the file's own frame. Rows with a non-finite coordinate are
+dropped. A cloud whose z is constant (to 1e-6 m) is 2D: its z is set to 0.
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import open3d as o3d
+
+from pcmapq.errors import InputError
+from pcmapq.io.writers import one_line
+
+CLOUD_SUFFIXES = (".ply", ".pcd", ".xyz", ".txt", ".npy", ".bin")
+
+#: z range (metres) above which a cloud counts as 3D.
+FLAT_TOLERANCE = 1e-6
+
+
+@dataclass(frozen=True)
+class PointMap:
+    """A point-cloud map.
+
+    path: the file given.
+    points: (N, 3) float64 metres; z = 0 for 2D clouds.
+    is_3d: False when z is constant (a 2D cloud).
+    """
+
+    path: Path
+    points: np.ndarray
+    is_3d: bool
+    kind: str = "cloud"
+
+
+def load_cloud(path: Path) -> PointMap:
+    """Load a point cloud, choosing the reader by extension."""
+    readers: dict[str, Callable[[Path], np.ndarray]] = {
+        ".ply": read_open3d, ".pcd": read_open3d, ".xyz": read_text, ".txt": read_text,
+        ".npy": read_npy, ".bin": read_kitti_bin,
+    }
+    try:
+        raw = readers[path.suffix.lower()](path)
+    except OSError as exc:
+        raise InputError(f"{path}: cannot read: {one_line(exc)}") from None
+    points = with_z(path, raw)
+    points = points[np.isfinite(points).all(axis=1)]
+    if len(points) == 0:
+        raise InputError(f"{path}: no points")
+    is_3d = bool(np.ptp(points[:, 2]) > FLAT_TOLERANCE)
+    if not is_3d:
+        points[:, 2] = 0.0
+    return PointMap(path, points, is_3d)
+
+
+def with_z(path: Path, table: np.ndarray) -> np.ndarray:
+    """(N, 2) or (N, 3+) numbers -> (N, 3) float64 x, y, z (z = 0 when absent); a fresh array."""
+    if table.ndim != 2 or (table.shape[1] < 2 and table.size > 0):
+        raise InputError(f"{path}: expected N x 2 or N x 3 numbers, got shape {table.shape}")
+    if not (np.issubdtype(table.dtype, np.integer) or np.issubdtype(table.dtype, np.floating)):
+        raise InputError(f"{path}: expected numbers, got {table.dtype} values")
+    out = np.zeros((len(table), 3), dtype=np.float64)
+    cols = min(table.shape[1], 3)
+    out[:, :cols] = table[:, :cols]
+    return out
+
+
+def read_open3d(path: Path) -> np.ndarray:
+    """PLY or PCD via Open3D. Open3D reports unreadable files by returning no points."""
+    with path.open("rb") as f:
+        head = f.read(3)
+    if path.suffix.lower() == ".ply" and head != b"ply":
+        raise InputError(f"{path}: not a PLY file")
+    with o3d.utility.VerbosityContextManager(o3d.utility.VerbosityLevel.Error):
+        cloud = o3d.io.read_point_cloud(str(path))
+    if not cloud.has_points():
+        raise InputError(f"{path}: no points (empty or unreadable)")
+    return np.asarray(cloud.points, dtype=np.float64)
+
+
+def read_text(path: Path) -> np.ndarray:
+    """Whitespace- or comma-separated columns x, y[, z, ...]; ``#`` starts a comment."""
+    try:
+        with path.open(encoding="utf-8") as f, warnings.catch_warnings():
+            warnings.simplefilter("ignore", UserWarning)  # "input contained no data"
+            lines = (line.replace(",", " ") for line in f)
+            return np.loadtxt(lines, dtype=np.float64, comments="#", ndmin=2)
+    except ValueError as exc:  # includes UnicodeDecodeError
+        raise InputError(f"{path}: not a table of numbers: {one_line(exc)}") from None
+
+
+def read_npy(path: Path) -> np.ndarray:
+    """A NumPy array N x 2 or N x 3+ of numbers (no pickles)."""
+    with path.open("rb") as f:
+        if f.read(6) != b"\x93NUMPY":
+            raise InputError(f"{path}: not a .npy file")
+    try:
+        return np.load(path, allow_pickle=False)
+    except (ValueError, EOFError) as exc:
+        raise InputError(f"{path}: cannot be read as .npy: {one_line(exc)}") from None
+
+
+def read_kitti_bin(path: Path) -> np.ndarray:
+    """KITTI Velodyne scan: little-endian float32 records x, y, z, reflectance."""
+    size = path.stat().st_size
+    if size % 16:
+        raise InputError(f"{path}: size {size} bytes is not a multiple of 16 "
+                         "(expected float32 x, y, z, reflectance records)")
+    return np.fromfile(path, dtype="<f4").reshape(-1, 4)[:, :3]
+

@@ -1,0 +1,126 @@
+"""The wall band of a 3D cloud: the points between two heights above the floor, seen from above.
+
+Clouds are assumed roughly gravity aligned (z up, as LiDAR SLAM maps are); a small tilt is
+removed first. All heights are metres.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import open3d as o3d
+
+#: Height histogram bin for finding the floor, metres.
+FLOOR_BIN = 0.05
+#: A histogram peak is "strong" when it holds at least this share of the largest bin's count.
+PEAK_SHARE = 1.0 / 3.0
+#: Planes whose normal is further than this from +z are not floors or ceilings, degrees.
+MAX_TILT_DEG = 30.0
+#: Voxel size of the copy searched for the floor plane, and plane inlier distance, metres.
+PLANE_VOXEL = 0.1
+PLANE_DISTANCE = 0.05
+#: At most this many points (a seeded random subset of the voxel copy) go into RANSAC.
+PLANE_POINTS = 20_000
+#: How many planes (largest first) to try before giving up on levelling.
+PLANE_TRIES = 3
+
+
+def wall_band(points: np.ndarray, low: float = 0.3, high: float = 2.0) -> np.ndarray:
+    """The points between ``low`` and ``high`` metres above the floor, projected onto the floor.
+
+    points: (N, 3) metres, z roughly up. The cloud is first levelled with :func:`level_rotation`
+    (a rotation about the horizontal axis only, so x, y and yaw are kept as far as the tilt
+    allows), then the floor is found with :func:`floor_height`. Returns (M, 2) x, y in metres of
+    the levelled cloud. Raises ValueError if there are no points or the band is empty.
+    """
+    if not low < high:
+        raise ValueError(f"wall band: low ({low} m) must be below high ({high} m)")
+    pts = _finite_points(points)
+    levelled = pts @ level_rotation(pts).T
+    floor = floor_height(levelled)
+    z = levelled[:, 2] - floor
+    band = levelled[(z >= low) & (z <= high), :2]
+    if len(band) == 0:
+        raise ValueError(f"no points between {low} and {high} m above the floor "
+                         f"(floor found at z = {floor:.2f} m)")
+    return band
+
+
+def level_rotation(points: np.ndarray) -> np.ndarray:
+    """The 3x3 rotation that makes the cloud's dominant near-horizontal plane horizontal.
+
+    Open3D RANSAC (seeded, on a voxel-downsampled and randomly thinned copy) finds the largest
+    plane; planes whose normal is more than MAX_TILT_DEG from +z (walls) are set aside and the
+    next largest tried, up to PLANE_TRIES. The accepted plane's normal is refitted to its
+    inliers by least squares, and the result is the smallest rotation taking it to +z (about the
+    axis normal x z). The identity if no such plane is found.
+    """
+    cloud = o3d.geometry.PointCloud(o3d.utility.Vector3dVector(_finite_points(points)))
+    voxels = np.asarray(cloud.voxel_down_sample(PLANE_VOXEL).points)
+    if len(voxels) > PLANE_POINTS:
+        voxels = np.random.default_rng(0).choice(voxels, PLANE_POINTS, replace=False)
+    cloud = o3d.geometry.PointCloud(o3d.utility.Vector3dVector(voxels))
+    for _ in range(PLANE_TRIES):
+        if len(cloud.points) < 3:
+            break
+        o3d.utility.random.seed(0)
+        model, inliers = cloud.segment_plane(PLANE_DISTANCE, 3, 1000)
+        normal = np.asarray(model[:3]) / np.linalg.norm(model[:3])
+        if abs(normal[2]) >= np.cos(np.radians(MAX_TILT_DEG)):
+            return _rotation_to_z(_fit_normal(np.asarray(cloud.points)[inliers]))
+        cloud = cloud.select_by_index(inliers, invert=True)
+    return np.eye(3)
+
+
+def floor_height(points: np.ndarray) -> float:
+    """The floor's z, metres, of a levelled cloud (N, 3): the lowest strong peak of the height
+    histogram.
+
+    Heights are binned every FLOOR_BIN metres; a peak is a bin at least as full as both
+    neighbours, strong if it holds at least PEAK_SHARE of the fullest bin's count. The floor is
+    the median z of the lowest strong peak and its two neighbour bins. Ceilings and tables are
+    higher peaks; sparse points below the floor (noise, reflections) are not strong peaks.
+    """
+    z = _finite_points(points)[:, 2]
+    idx = np.floor(z / FLOOR_BIN).astype(np.int64)
+    bins, counts = np.unique(idx, return_counts=True)  # sparse histogram: sorted bin indices
+    left = _count_of(bins, counts, bins - 1)
+    right = _count_of(bins, counts, bins + 1)
+    strong = (counts >= PEAK_SHARE * counts.max()) & (counts >= left) & (counts >= right)
+    peak = bins[np.argmax(strong)]  # lowest, as bins are sorted
+    near = np.abs(idx - peak) <= 1
+    return float(np.median(z[near]))
+
+
+def _count_of(bins: np.ndarray, counts: np.ndarray, wanted: np.ndarray) -> np.ndarray:
+    """Counts of the bins ``wanted`` in the sparse histogram (bins sorted), 0 where absent."""
+    pos = np.clip(np.searchsorted(bins, wanted), 0, len(bins) - 1)
+    return np.where(bins[pos] == wanted, counts[pos], 0)
+
+
+def _fit_normal(points: np.ndarray) -> np.ndarray:
+    """Least-squares unit normal of a plane through (N, 3) points, pointing to +z."""
+    centred = points - points.mean(axis=0)
+    normal = np.linalg.svd(centred, full_matrices=False)[2][2]
+    return normal if normal[2] >= 0 else -normal
+
+
+def _rotation_to_z(normal: np.ndarray) -> np.ndarray:
+    """The smallest rotation (Rodrigues, about normal x z) taking unit ``normal`` to +z."""
+    z = np.array([0.0, 0.0, 1.0])
+    axis = np.cross(normal, z)
+    s, c = np.linalg.norm(axis), float(normal @ z)
+    if s < 1e-12:
+        return np.eye(3)
+    k = np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]], [-axis[1], axis[0], 0.0]])
+    return np.eye(3) + k + k @ k * ((1.0 - c) / s**2)
+
+
+def _finite_points(points: np.ndarray) -> np.ndarray:
+    """(N, 3) float64 rows with finite coordinates; ValueError if the shape is wrong or none."""
+    pts = np.asarray(points, dtype=np.float64)
+    if pts.ndim != 2 or pts.shape[1] != 3:
+        raise ValueError(f"expected (N, 3) points, got shape {pts.shape}")
+    pts = pts[np.isfinite(pts).all(axis=1)]
+    if len(pts) == 0:
+        raise ValueError("no points")
+    return pts

@@ -1,0 +1,98 @@
+"""The wall band of a 3D cloud: levelling, floor height, and which points come out."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.spatial import cKDTree
+
+from pcmapq import synth
+from pcmapq.raster.slice import floor_height, level_rotation, wall_band
+
+FLOOR_Z = 1.7
+TILT_DEG = 5.0
+WALL_HEIGHT = 2.6  # synth.lidar_cloud's default
+
+
+def rot_x(degrees: float) -> np.ndarray:
+    a = np.radians(degrees)
+    return np.array([[1.0, 0.0, 0.0], [0.0, np.cos(a), -np.sin(a)], [0.0, np.sin(a), np.cos(a)]])
+
+
+def angle_deg(r: np.ndarray) -> float:
+    """The rotation angle of a 3x3 rotation, degrees."""
+    return float(np.degrees(np.arccos(np.clip((np.trace(r) - 1.0) / 2.0, -1.0, 1.0))))
+
+
+@pytest.fixture(scope="module")
+def plan() -> np.ndarray:
+    return synth.building_plan(0)
+
+
+@pytest.fixture(scope="module")
+def cloud(plan: np.ndarray) -> np.ndarray:
+    """The synthetic building, plan frame, floor at z = 0."""
+    return synth.lidar_cloud(plan)
+
+
+@pytest.fixture(scope="module")
+def tilted(cloud: np.ndarray) -> np.ndarray:
+    """The building raised to a floor at FLOOR_Z, then tilted TILT_DEG about x: levelling it
+    gives back the plan's x, y with the floor at FLOOR_Z."""
+    return (cloud + [0.0, 0.0, FLOOR_Z]) @ rot_x(TILT_DEG).T
+
+
+@pytest.fixture(scope="module")
+def walls(plan: np.ndarray) -> cKDTree:
+    return cKDTree(synth.wall_points(plan, spacing=0.01))
+
+
+def test_level_rotation_undoes_the_tilt(tilted: np.ndarray) -> None:
+    r = level_rotation(tilted)
+    assert angle_deg(r @ rot_x(TILT_DEG)) < 0.1
+    assert abs(r[0, 1] - r[1, 0]) < 1e-9  # no yaw: rotation about the horizontal axis only
+
+
+def test_floor_height(tilted: np.ndarray) -> None:
+    levelled = tilted @ level_rotation(tilted).T
+    assert floor_height(levelled) == pytest.approx(FLOOR_Z, abs=0.02)
+
+
+def test_wall_band_is_walls_only(tilted: np.ndarray, cloud: np.ndarray, walls: cKDTree) -> None:
+    band = wall_band(tilted, 0.3, 2.0)
+    assert band.shape[1] == 2
+    dist, _ = walls.query(band)
+    # floor or ceiling points (38k each) would be ~14% of the band, mostly far from walls
+    assert np.mean(dist < 0.05) > 0.99
+    expected = np.count_nonzero((cloud[:, 2] >= 0.3) & (cloud[:, 2] <= 2.0))
+    assert len(band) == pytest.approx(expected, rel=0.01)
+
+
+def test_wall_band_is_deterministic(tilted: np.ndarray) -> None:
+    np.testing.assert_array_equal(wall_band(tilted), wall_band(tilted))
+
+
+def test_floor_below_a_stronger_ceiling_and_below_noise(cloud: np.ndarray) -> None:
+    rng = np.random.default_rng(1)
+    floor = np.abs(cloud[:, 2]) < 0.05
+    thinned = cloud[~floor | (rng.random(len(cloud)) < 0.5)]  # ceiling now twice the floor
+    sparse_below = np.column_stack([rng.uniform(0, 20, (300, 2)), rng.uniform(-3, -0.2, 300)])
+    pts = np.vstack([thinned, sparse_below]) + [0.0, 0.0, -0.5]
+    assert floor_height(pts) == pytest.approx(-0.5, abs=0.02)
+    band = wall_band(pts)
+    assert len(band) == pytest.approx(np.count_nonzero((cloud[:, 2] >= 0.3)
+                                                       & (cloud[:, 2] <= 2.0)), rel=0.01)
+
+
+def test_walls_only_cloud_is_not_levelled_to_a_wall(cloud: np.ndarray) -> None:
+    walls_only = cloud[(cloud[:, 2] > 0.1) & (cloud[:, 2] < WALL_HEIGHT - 0.1)]
+    assert angle_deg(level_rotation(walls_only)) < 1.0
+
+
+def test_empty_band_raises(cloud: np.ndarray) -> None:
+    with pytest.raises(ValueError, match="no points between 3.0 and 4.0 m above the floor"):
+        wall_band(cloud, 3.0, 4.0)
+    with pytest.raises(ValueError, match="no points"):
+        wall_band(np.full((5, 3), np.nan))
+    with pytest.raises(ValueError, match=r"expected \(N, 3\) points"):
+        wall_band(cloud[:, :2])
