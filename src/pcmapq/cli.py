@@ -84,8 +84,8 @@ def eval_command(
                         align=not no_align, force=force, threshold=threshold, min_hits=min_hits,
                         detectors=_parse_detectors(detectors))
     quiet = json_path == "-"
-    out = Console(quiet=quiet)
     err = Console(stderr=True)
+    out = Console(quiet=quiet, width=None if err.is_terminal else 132)
     try:
         if quiet or not err.is_terminal:
             result = evaluate(map_path, truth_path, settings)

@@ -73,24 +73,37 @@ def _suppress(poses: np.ndarray, top_k: int, min_angle: float, min_dist: float) 
     return poses[kept]
 
 
-def coarse_candidates(map_xy: np.ndarray, truth_xy: np.ndarray, *, resolution: float = 0.25,
-                      sigma: float | None = None, angle_step_deg: float | None = None,
-                      overhang: float = 2.0, top_k: int = 6,
-                      per_angle: int = 3) -> list[Candidate]:
+def _radius(centred: np.ndarray) -> float:
+    """Largest distance, metres, of points (N, 2) from the origin."""
+    return float(np.sqrt((centred**2).sum(axis=1).max()))
+
+
+def auto_resolution(map_xy: np.ndarray) -> float:
+    """Raster cell size, metres, for the sweep: the map's radius about its centroid over 40,
+    at least 0.25 m. The template is then about 80 cells wide whatever the map's size."""
+    return max(0.25, _radius(map_xy - map_xy.mean(axis=0)) / 40.0)
+
+
+def coarse_candidates(map_xy: np.ndarray, truth_xy: np.ndarray, *,
+                      resolution: float | None = None, sigma: float | None = None,
+                      angle_step_deg: float | None = None, overhang: float = 2.0,
+                      top_k: int = 6, per_angle: int = 3) -> list[Candidate]:
     """The ``top_k`` best distinct poses (map frame -> truth frame) of a yaw sweep over 360 degrees.
 
     map_xy, truth_xy: (N, 2) metres, each in its own frame.
-    resolution: raster cell size, metres. sigma: likelihood field width, metres (default: the
-    resolution). angle_step_deg: yaw step, degrees (default: the angle that moves the map's
-    farthest point by sigma, clipped to [0.5, 3]). overhang: how far, metres, the map's centroid
-    may lie outside the truth's bounding box. per_angle: peaks kept from each yaw's response.
-    Candidates come best first; yaws within three steps and positions within 1 m of a better one
+    resolution: raster cell size, metres (default: :func:`auto_resolution`). sigma: likelihood
+    field width, metres (default: the resolution). angle_step_deg: yaw step, degrees (default:
+    the angle that moves the map's farthest point by sigma, clipped to [0.5, 3]). overhang: how
+    far, metres, the map's centroid may lie outside the truth's bounding box. per_angle: peaks
+    kept from each yaw's response.
+    Candidates come best first; yaws within three steps and positions within 4 cells of a better one
     are dropped, so near-symmetric alternatives survive to be settled by refinement.
     """
+    resolution = auto_resolution(map_xy) if resolution is None else resolution
     sigma = resolution if sigma is None else sigma
     centre = map_xy.mean(axis=0)
     centred = map_xy - centre
-    radius = float(np.sqrt((centred**2).sum(axis=1).max()))
+    radius = _radius(centred)
     if angle_step_deg is None:
         angle_step_deg = float(np.clip(np.degrees(sigma / max(radius, 1e-6)), 0.5, 3.0))
     half = int(np.ceil(radius / resolution)) + 1
@@ -109,11 +122,11 @@ def coarse_candidates(map_xy: np.ndarray, truth_xy: np.ndarray, *, resolution: f
         rows.append(np.column_stack([response[v, u], np.full(len(v), yaw), xy]))
     poses = np.vstack(rows)
     poses = poses[np.argsort(-poses[:, 0], kind="stable")]
-    best = _suppress(poses, top_k, np.radians(3 * angle_step_deg), 1.0)
+    best = _suppress(poses, top_k, np.radians(3 * angle_step_deg), 4 * resolution)
     return [Candidate(_pose(yaw, xy, centre), float(score)) for score, yaw, *xy in best]
 
 
 def _pose(yaw: float, centre_truth: np.ndarray, centre_map: np.ndarray) -> Similarity2D:
-    """The rigid transform turning the map by ``yaw`` and putting its centroid on the truth point."""
+    """The rigid transform turning the map by ``yaw``, moving its centroid to ``centre_truth``."""
     t = np.asarray(centre_truth) - _rotation(yaw) @ centre_map
     return Similarity2D(float(t[0]), float(t[1]), float(yaw))

@@ -19,9 +19,10 @@ def voxel_downsample(xy: np.ndarray, voxel: float) -> np.ndarray:
     xy = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
     if voxel <= 0 or len(xy) == 0:
         return xy
-    keys = np.floor(xy / voxel).astype(np.int64)
-    _, inverse, counts = np.unique(keys, axis=0, return_inverse=True, return_counts=True)
-    inverse = inverse.reshape(-1)
+    cells = np.floor(xy / voxel).astype(np.int64)
+    cells -= cells.min(axis=0)
+    keys = cells[:, 0] * (cells[:, 1].max() + 1) + cells[:, 1]
+    _, inverse, counts = np.unique(keys, return_inverse=True, return_counts=True)
     sums = np.column_stack([np.bincount(inverse, weights=xy[:, k]) for k in range(2)])
     return sums / counts[:, None]
 

@@ -1,0 +1,151 @@
+"""2D alignment: global search + ICP on synthetic plans with known transforms."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from pcmapq import synth
+from pcmapq.align import Alignment, align, score
+from pcmapq.align.coarse import coarse_candidates
+from pcmapq.align.icp import voxel_downsample
+from pcmapq.align.transform import Similarity2D
+
+PLAN = synth.building_plan(0)  # 24 m x 16 m
+WIDTH, HEIGHT = 24.0, 16.0
+
+
+@pytest.fixture(scope="module")
+def truth() -> np.ndarray:
+    return synth.wall_points(PLAN, spacing=0.05)
+
+
+@pytest.fixture(scope="module")
+def scan() -> np.ndarray:
+    """The same walls sampled again with 1.5 cm noise, in the plan frame."""
+    return synth.wall_points(PLAN, spacing=0.05, noise=0.015, seed=1)
+
+
+def to_map_frame(points: np.ndarray, yaw_deg: float, tx: float, ty: float):
+    """(T_true, points in a map frame such that T_true maps them back to the plan frame)."""
+    t_true = Similarity2D(tx, ty, np.radians(yaw_deg))
+    return t_true, t_true.inverse().apply(points)
+
+
+def pose_error(expected: Similarity2D, got: Similarity2D) -> tuple[float, float]:
+    """(translation error in metres, yaw error in degrees)."""
+    dyaw = abs((np.degrees(got.yaw - expected.yaw) + 180.0) % 360.0 - 180.0)
+    return float(np.hypot(got.tx - expected.tx, got.ty - expected.ty)), float(dyaw)
+
+
+def inside(points: np.ndarray, box: tuple[float, float, float, float]) -> np.ndarray:
+    x0, y0, x1, y1 = box
+    keep = (points[:, 0] >= x0) & (points[:, 0] <= x1) & (points[:, 1] >= y0) & (points[:, 1] <= y1)
+    return points[keep]
+
+
+@pytest.mark.parametrize(("yaw", "tx", "ty"), [(15, 5.0, -3.0), (90, -20.0, 12.0),
+                                               (172, 35.0, 40.0), (-47, -12.0, -30.0)])
+def test_rigid_full_map(truth, scan, yaw, tx, ty):
+    t_true, map_xy = to_map_frame(scan, yaw, tx, ty)
+    result = align(map_xy, truth)
+    dxy, dyaw = pose_error(t_true, result.transform)
+    assert dxy < 0.1 and dyaw < 0.5
+    assert result.fitness > 0.9 and result.rmse_m < 0.05
+    assert result.method == "coarse+icp" and result.tolerance_m == 0.2
+    assert result.transform.scale == 1.0
+
+
+@pytest.mark.parametrize(("box", "yaw", "tx", "ty"), [
+    ((-1.0, -1.0, 0.5 * WIDTH, 17.0), 33, 8.0, -6.0),                             # left half
+    ((0.42 * WIDTH, 0.42 * HEIGHT, 25.0, 17.0), -120, -15.0, 25.0),               # top-right third
+    ((-1.0, -1.0, 0.775 * WIDTH, 0.775 * HEIGHT), 200, 22.0, 4.0),                 # 60 % corner
+    ((-1.0, -1.0, 25.0, 0.3 * HEIGHT), 71, -3.0, -18.0),                           # bottom 30 %
+])
+def test_partial_map(truth, scan, box, yaw, tx, ty):
+    t_true, map_xy = to_map_frame(inside(scan, box), yaw, tx, ty)
+    result = align(map_xy, truth)
+    dxy, dyaw = pose_error(t_true, result.transform)
+    assert dxy < 0.1 and dyaw < 0.5
+    assert result.fitness > 0.9
+
+
+def test_partial_map_against_cluttered_truth(scan):
+    """Boxes crowd the truth; the map's own part, not the densest region, must still win."""
+    truth = synth.wall_points(synth.clutter(PLAN, 40, seed=4), spacing=0.05)
+    t_true, map_xy = to_map_frame(inside(scan, (0.5 * WIDTH, -1.0, 25.0, 17.0)), 140, 30.0, 10.0)
+    dxy, dyaw = pose_error(t_true, align(map_xy, truth).transform)
+    assert dxy < 0.1 and dyaw < 0.5
+
+
+def test_bent_map_still_aligns(truth):
+    bent = synth.wall_points(synth.bend_segments(PLAN, 0.3), spacing=0.05, noise=0.015, seed=2)
+    t_true, map_xy = to_map_frame(bent, 60, 10.0, 5.0)
+    result = align(map_xy, truth)
+    # The bend turns the far end by 7 degrees: most of the map fits, not all of it.
+    assert 0.5 < result.fitness < 0.9
+    dxy, dyaw = pose_error(t_true, result.transform)
+    assert dyaw < 8.0
+
+
+def test_other_building_scores_low(truth, scan):
+    other = synth.wall_points(synth.building_plan(7, 18.0, 20.0), spacing=0.05, noise=0.015,
+                              seed=3)
+    _, map_xy = to_map_frame(other, 30, 3.0, 3.0)
+    wrong = align(map_xy, truth)
+    right = align(to_map_frame(scan, 30, 3.0, 3.0)[1], truth)
+    assert wrong.fitness < 0.6 < 0.9 < right.fitness
+    assert isinstance(wrong, Alignment) and wrong.method == "coarse+icp"
+
+
+def test_init_skips_global_search(truth, scan):
+    t_true, map_xy = to_map_frame(scan, 172, 35.0, 40.0)
+    # Off by 3 degrees about the plan's centre, then by (0.5, -0.4) m, in the truth frame.
+    turn = np.radians(3.0)
+    centre = np.array([WIDTH / 2, HEIGHT / 2])
+    rot = np.array([[np.cos(turn), -np.sin(turn)], [np.sin(turn), np.cos(turn)]])
+    shift = centre - rot @ centre + [0.5, -0.4]
+    init = Similarity2D(shift[0], shift[1], turn).compose(t_true)
+    result = align(map_xy, truth, init=init)
+    dxy, dyaw = pose_error(t_true, result.transform)
+    assert result.method == "init+icp" and dxy < 0.05 and dyaw < 0.2 and result.fitness > 0.9
+
+
+def test_no_refine_scores_identity(truth, scan):
+    result = align(scan, truth, refine=False)
+    assert result.method == "none" and result.transform == Similarity2D()
+    assert result.fitness > 0.99
+    turned = align(to_map_frame(scan, 90, 0.0, 0.0)[1], truth, refine=False)
+    assert turned.fitness < 0.3
+
+
+def test_deterministic(truth, scan):
+    _, map_xy = to_map_frame(inside(scan, (-1.0, -1.0, 14.0, 17.0)), -47, -12.0, -30.0)
+    assert align(map_xy, truth) == align(map_xy, truth)
+
+
+def test_coarse_candidates_rank_right_pose_first(truth, scan):
+    t_true, map_xy = to_map_frame(scan, 90, -20.0, 12.0)
+    best = coarse_candidates(voxel_downsample(map_xy, 0.05), voxel_downsample(truth, 0.05))[0]
+    dxy, dyaw = pose_error(t_true, best.transform)
+    assert dxy < 0.6 and dyaw < 2.0 and 0.0 < best.score <= 1.0
+
+
+def test_score_counts_inliers_and_rmse():
+    truth = np.array([[0.0, 0.0], [1.0, 0.0]])
+    map_xy = np.array([[0.1, 0.0], [1.0, 0.0], [5.0, 5.0], [-0.15, 0.0]])
+    fitness, rmse = score(map_xy, truth, Similarity2D(), tolerance=0.2)
+    assert fitness == pytest.approx(0.75)
+    assert rmse == pytest.approx(np.sqrt((0.1**2 + 0.0 + 0.15**2) / 3))
+    assert score(map_xy, truth, Similarity2D(tx=100.0)) == (0.0, 0.0)
+
+
+def test_voxel_downsample_takes_cell_centroids():
+    xy = np.array([[0.01, 0.01], [0.03, 0.03], [0.51, 0.0], [0.52, 0.02]])
+    out = voxel_downsample(xy, 0.1)
+    np.testing.assert_allclose(out, [[0.02, 0.02], [0.515, 0.01]])
+
+
+def test_empty_map_scores_zero(truth):
+    result = align(np.empty((0, 2)), truth)
+    assert result.fitness == 0.0 and result.transform == Similarity2D()
