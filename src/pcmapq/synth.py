@@ -149,13 +149,15 @@ def render(segments: np.ndarray, grid: MetricGrid, thickness: float = 0.15,
 
     def fill(polys: np.ndarray, value: int) -> None:
         uv = grid.xy_to_pixels(polys.reshape(-1, 2)).reshape(polys.shape)
-        # OpenCV's subpixel polygons treat pixel centres as integers; +0.5 puts edges on cell edges
-        fixed = np.round((uv + 0.5) * (1 << shift) - 0.5).astype(np.int32)
+        # pixel centres are at integer (u, v): a cell is filled when its centre is inside
+        fixed = np.round(uv * (1 << shift)).astype(np.int32)
         for poly in fixed:  # one call each: fillPoly's even-odd rule would punch out overlaps
             cv2.fillConvexPoly(img, poly, int(value), lineType=cv2.LINE_8, shift=shift)
 
     fill(box, FREE)
-    fill(wall_quads(segments, thickness), OCCUPIED)
+    # OpenCV also fills the cells its polygon edges touch: inset by half a cell so that a cell is
+    # filled when its centre is inside the wall, at any resolution
+    fill(wall_quads(segments, max(thickness - grid.resolution, 1e-6)), OCCUPIED)
     return img
 
 

@@ -103,7 +103,8 @@ def _overlap_matrix(n_out: int, out_size: float, n_in: int, in_size: float) -> s
     return sparse.csr_array((length / out_size, (i, j)), shape=(n_out, n_in))
 
 
-def resample(image: np.ndarray, grid: MetricGrid, resolution: float) -> tuple[np.ndarray, MetricGrid]:
+def resample(image: np.ndarray, grid: MetricGrid,
+             resolution: float) -> tuple[np.ndarray, MetricGrid]:
     """Resample ``image`` (rows, cols, on ``grid``) to cells of ``resolution`` metres by exact
     area averaging over a grid with the same origin and yaw.
 

@@ -1,0 +1,285 @@
+"""Hough wall segments, in metres.
+
+Detection: the working image (see :mod:`pcmapq.features.base`) is smoothed with a Gaussian of
+``sigma`` metres and thinned to its ridge lines (pixels that are the maximum of the smoothed
+image across the ridge, given by the Hessian), so a filled plan wall, a wall seen as two laser
+faces and a wall seen as one face all give one centre line. Probabilistic Hough
+(``cv2.HoughLinesP``, rho = one working cell) finds segments on it, and collinear fragments are
+merged into maximal wall segments, so one straight wall (between doors) is one feature.
+``xy`` is the segment midpoint, ``strength`` its length in metres; strong segments are at least
+``min_length`` long, support-level ones at least ``support * min_length``.
+
+Matching rule: a truth segment and a map segment are candidates when their directions differ
+by less than ``MAX_ANGLE`` (10) degrees, the map segment projected on the truth segment's line
+overlaps the truth segment, and the perpendicular offset, the larger of the two
+midpoint-to-other-line distances, is within the threshold; that offset is the cost. The
+displacement is the vector from the truth midpoint to its orthogonal projection on the map
+segment's line: a wall moved by 0.5 m shows 0.5 m, whatever the segments' extents.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import cv2
+import numpy as np
+
+from pcmapq.features.base import (
+    Candidates,
+    Detector,
+    Features,
+    empty_features,
+    gaussian,
+    no_candidates,
+    sorted_features,
+    working_image,
+)
+from pcmapq.grid import MetricGrid
+
+#: Largest direction difference of matching segments, degrees.
+MAX_ANGLE = 10.0
+
+
+def ridges(image: np.ndarray, sigma_px: float, floor: float) -> np.ndarray:
+    """One-pixel centre lines of the bright ridges of ``image`` (Steger's detector).
+
+    A pixel is on a ridge when the maximum of the smoothed image across the ridge (along the
+    Hessian's most negative eigenvector, to second order) lies inside the pixel: the line is
+    one pixel wide wherever the wall's centre falls between pixels. Blob-like points (curved as
+    much along as across, i.e. wall ends) are left out, so the lines stop short of wall ends
+    and T junctions instead of fanning out.
+
+    Parameters
+    ----------
+    image : (rows, cols) float32 in [0, 1].
+    sigma_px : smoothing scale, pixels.
+    floor : least ridge strength ``-sigma^2 * lambda`` (scale-normalised second derivative
+        across the ridge), dimensionless.
+
+    Returns
+    -------
+    (rows, cols) bool mask of ridge pixels.
+    """
+    s = gaussian(image, sigma_px)
+
+    def diff(du: int, dv: int, scale: float) -> np.ndarray:
+        return cv2.Sobel(s, cv2.CV_32F, du, dv, ksize=3, borderType=cv2.BORDER_REFLECT) / scale
+
+    gu, gv = diff(1, 0, 8.0), diff(0, 1, 8.0)
+    a, c, b = diff(2, 0, 4.0), diff(0, 2, 4.0), diff(1, 1, 4.0)
+    root = np.sqrt(0.25 * (a - c) ** 2 + b * b)
+    lam, along = 0.5 * (a + c) - root, 0.5 * (a + c) + root  # across and along the ridge
+    theta = 0.5 * np.arctan2(2 * b, a - c) + 0.5 * np.pi  # eigenvector of lam: across
+    nu, nv = np.cos(theta), np.sin(theta)
+    t = -(gu * nu + gv * nv) / np.minimum(lam, -1e-12)  # distance to the maximum, pixels
+    inside = (np.abs(t * nu) <= 0.5) & (np.abs(t * nv) <= 0.5)
+    line_like = np.abs(along) <= 0.5 * np.abs(lam)  # not a blob (a wall end)
+    return inside & line_like & (-lam * sigma_px**2 >= floor)
+
+
+def _directions(seg: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Unit directions (N, 2) and lengths (N,) of segments (N, 4)."""
+    d = seg[:, 2:] - seg[:, :2]
+    length = np.hypot(d[:, 0], d[:, 1])
+    return d / np.maximum(length, 1e-12)[:, None], length
+
+
+#: Regroup-and-refit rounds of one merged segment.
+_REFITS = 4
+#: Smoothed occupied fraction above which a cell is inside a wall, for bridging.
+_SOLID = 0.3
+#: Points tested along a gap to bridge.
+_BRIDGE_SAMPLES = 16
+
+
+def _line(ends: np.ndarray, weight: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Weighted total-least-squares line through segment endpoints ``ends`` (K, 2, 2), each
+    segment weighted by ``weight`` (K,): a point on it (2,) and its unit direction (2,)."""
+    pts = ends.reshape(-1, 2)
+    w = np.repeat(weight, 2)
+    centre = np.average(pts, axis=0, weights=w)
+    r = pts - centre
+    cov = (r * w[:, None]).T @ r
+    _, vec = np.linalg.eigh(cov)
+    return centre, vec[:, 1]
+
+
+def _grow(t: np.ndarray, fits: np.ndarray, group: np.ndarray, max_gap: float,
+          bridged: Callable[[np.ndarray, np.ndarray], np.ndarray]) -> np.ndarray:
+    """The group extended by every fitting segment near its extent along the line, repeatedly,
+    as the extent grows.
+
+    ``t`` (N, 2) are the endpoint positions along the line, metres. A segment is near when the
+    gap between it and the group is at most ``max_gap``, or when ``bridged(start, end)`` says
+    the wall is solid over the gap (positions along the line, metres, one pair per segment).
+    """
+    a, b = t.min(axis=1), t.max(axis=1)
+    while True:
+        lo, hi = t[group].min(), t[group].max()
+        above = a > hi
+        start, end = np.where(above, hi, b), np.where(above, a, lo)
+        gap = np.where(above | (b < lo), end - start, 0.0)
+        near = fits & ~group & (gap <= max_gap)
+        far = np.flatnonzero(fits & ~group & ~near)
+        if len(far):
+            near[far] = bridged(start[far], end[far])
+        if not near.any():
+            return group
+        group = group | near
+
+
+def merge(seg: np.ndarray, max_angle: float, max_offset: float, max_gap: float,
+          solid: Callable[[np.ndarray], np.ndarray] | None = None,
+          max_bridge: float = 0.0) -> np.ndarray:
+    """Merge collinear fragments into maximal segments.
+
+    Longest first, each remaining segment seeds a group that absorbs every fragment within
+    ``max_angle`` of the group's line direction, ``max_offset`` of the line and ``max_gap`` of
+    its extent along it (or up to ``max_bridge`` away when the wall is solid all along the gap);
+    the line is then refitted to the group (weighted total least squares of the endpoints) and
+    the group regathered, a few rounds. Fragments are compared with the group's line, not with
+    each other, so a chain of slightly turning fragments cannot drift. The merged segments are
+    merged again until nothing changes.
+
+    Parameters
+    ----------
+    seg : (N, 4) segments, metres.
+    max_angle : largest direction difference, degrees.
+    max_offset : largest distance of a fragment's endpoints from the group's line, metres.
+    max_gap : largest gap along the line between the group's extent and a fragment, metres.
+    solid : ``solid(xy)``: whether the points (..., 2), metres, are inside a wall (bool, same
+        leading shape); None: never.
+    max_bridge : largest gap bridged where ``solid`` holds all along it, metres.
+
+    Returns
+    -------
+    (M, 4) merged segments: each group's fitted line, spanning all of its endpoints. Metres,
+    M <= N.
+    """
+    d, length = _directions(seg)
+    ends = np.stack([seg[:, :2], seg[:, 2:]], axis=1)  # (N, 2, 2)
+    cos_max = np.cos(np.radians(max_angle))
+    steps = np.linspace(0.0, 1.0, _BRIDGE_SAMPLES)
+    left = np.ones(len(seg), dtype=bool)
+    out = []
+    for seed in np.lexsort((seg[:, 1], seg[:, 0], -length)):  # longest first
+        if not left[seed]:
+            continue
+        group = np.zeros(len(seg), dtype=bool)
+        group[seed] = True
+        for _ in range(_REFITS):
+            centre, u = _line(ends[group], length[group])
+
+            def bridged(start: np.ndarray, end: np.ndarray, centre=centre, u=u) -> np.ndarray:
+                if solid is None:
+                    return np.zeros(len(start), dtype=bool)
+                pos = start[:, None] + (end - start)[:, None] * steps  # (K, S) along the line
+                return (end - start <= max_bridge) & solid(centre + pos[..., None] * u).all(1)
+
+            t = (ends - centre) @ u  # (N, 2) along the line
+            off = np.abs((ends - centre) @ np.array([-u[1], u[0]])).max(axis=1)
+            fits = left & (np.abs(d @ u) >= cos_max) & (off <= max_offset)
+            grown = _grow(t, fits, group, max_gap, bridged)
+            if np.array_equal(grown, group):
+                break
+            group = grown
+        left &= ~group
+        centre, u = _line(ends[group], length[group])
+        t = (ends[group] - centre) @ u
+        out.append(np.concatenate([centre + t.min() * u, centre + t.max() * u]))
+    merged = np.asarray(out).reshape(-1, 4)
+    # merged segments are better fitted than the fragments: merge them again until stable
+    if len(merged) == len(seg):
+        return merged
+    return merge(merged, max_angle, max_offset, max_gap, solid, max_bridge)
+
+
+def wall_test(image: np.ndarray, work: MetricGrid,
+              level: float) -> Callable[[np.ndarray], np.ndarray]:
+    """``solid(xy)``: whether points (..., 2), metres, fall on cells of ``image`` (on grid
+    ``work``) of at least ``level``; points outside the image are not solid."""
+
+    def solid(xy: np.ndarray) -> np.ndarray:
+        uv = np.floor(work.xy_to_pixels(xy.reshape(-1, 2)) + 0.5).astype(np.int64)
+        rows, cols = image.shape
+        inside = (uv[:, 0] >= 0) & (uv[:, 0] < cols) & (uv[:, 1] >= 0) & (uv[:, 1] < rows)
+        out = np.zeros(len(uv), dtype=bool)
+        out[inside] = image[uv[inside, 1], uv[inside, 0]] >= level
+        return out.reshape(xy.shape[:-1])
+
+    return solid
+
+
+def detect(occupied: np.ndarray, grid: MetricGrid, *, resolution: float = 0.05,
+           closing: float = 0.1, sigma: float = 0.1, ridge: float = 0.05, min_length: float = 0.5,
+           max_gap: float = 0.2, support: float = 0.5, angle_step: float = 0.5,
+           merge_angle: float = 15.0, merge_offset: float = 0.15,
+           max_bridge: float = 1.5) -> Features:
+    """Maximal wall segments of a binary map.
+
+    Parameters
+    ----------
+    occupied : (rows, cols) bool raster on ``grid``, walls true.
+    grid : the raster's grid; segments are returned in its metric frame.
+    resolution : working cell size, metres; also the Hough rho step.
+    closing : closing radius, metres (see :func:`pcmapq.features.base.working_image`).
+    sigma : smoothing scale of the ridge (centre line) detection, metres.
+    ridge : least scale-normalised ridge strength; a one-cell (0.05 m) line scores about 0.2.
+    min_length : length of a strong segment, metres.
+    max_gap : largest gap bridged inside one segment, metres.
+    support : support-level segments are at least ``support * min_length`` long.
+    angle_step : Hough theta step, degrees.
+    merge_angle, merge_offset : collinear fragments within this angle (degrees) and
+        perpendicular offset (metres) are merged when at most ``max_gap`` apart along the line,
+        or at most ``max_bridge`` (metres) apart with the wall solid all along the gap: this
+        joins a wall across the break of its centre line at a T junction, but not across a
+        door.
+
+    Returns
+    -------
+    Features with ``segments`` (N, 4), ``xy`` the midpoints and ``strength`` the lengths.
+    """
+    image, work = working_image(occupied, grid, resolution, closing)
+    thin = ridges(image, sigma / resolution, ridge).astype(np.uint8) * 255
+    shortest = support * min_length / resolution
+    lines = cv2.HoughLinesP(thin, 1.0, np.radians(angle_step), max(2, int(0.8 * shortest)),
+                            minLineLength=shortest, maxLineGap=max_gap / resolution)
+    if lines is None:
+        return empty_features(with_segments=True)
+    seg = work.pixels_to_xy(lines.reshape(-1, 2).astype(np.float64)).reshape(-1, 4)
+    solid = wall_test(gaussian(image, sigma / resolution), work, _SOLID)
+    seg = merge(seg, merge_angle, merge_offset, max_gap, solid, max_bridge)
+    _, length = _directions(seg)
+    seg = seg[length >= support * min_length]
+    length = length[length >= support * min_length]
+    # canonical endpoint order: the lexicographically smaller endpoint first
+    flip = (seg[:, 0] > seg[:, 2]) | ((seg[:, 0] == seg[:, 2]) & (seg[:, 1] > seg[:, 3]))
+    seg[flip] = seg[flip][:, [2, 3, 0, 1]]
+    mid = 0.5 * (seg[:, :2] + seg[:, 2:])
+    return sorted_features(mid, length, length >= min_length, segments=seg)
+
+
+def candidates(truth: Features, map_: Features, threshold: float) -> Candidates:
+    """Candidate segment pairs under the rule of the module docstring; cost in metres."""
+    if len(truth) == 0 or len(map_) == 0:
+        return no_candidates()
+    dt, lt = _directions(truth.segments)
+    dm, _ = _directions(map_.segments)
+    i, j = np.nonzero(np.abs(dt @ dm.T) >= np.cos(np.radians(MAX_ANGLE)))
+    either = truth.strong[i] | map_.strong[j]
+    i, j = i[either], j[either]
+    mt, mm = truth.xy[i], map_.xy[j]
+    nt = np.column_stack([-dt[i, 1], dt[i, 0]])
+    nm = np.column_stack([-dm[j, 1], dm[j, 0]])
+    along_m = np.einsum("ij,ij->i", mm - mt, nm)  # truth midpoint to map line, signed
+    cost = np.maximum(np.abs(along_m), np.abs(np.einsum("ij,ij->i", mm - mt, nt)))
+    # the map segment's endpoints on the truth line, truth segment from -L/2 to L/2
+    a = np.einsum("ij,ij->i", map_.segments[j, :2] - mt, dt[i])
+    b = np.einsum("ij,ij->i", map_.segments[j, 2:] - mt, dt[i])
+    overlap = np.minimum(np.maximum(a, b), 0.5 * lt[i]) - np.maximum(np.minimum(a, b), -0.5 * lt[i])
+    keep = (overlap > 0) & (cost <= threshold)
+    disp = along_m[keep, None] * nm[keep]
+    return i[keep], j[keep], cost[keep], disp
+
+
+DETECTOR = Detector("hough", detect, candidates)

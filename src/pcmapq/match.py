@@ -1,0 +1,166 @@
+"""One-to-one matching of map features to truth features, and the paper's quality q.
+
+The detector proposes candidate pairs within the metric threshold (see each detector's
+``candidates``); only pairs with at least one strong feature are candidates, so a strong feature
+may be confirmed by a support-level one on the other side, but two support-level features never
+match. One optimal assignment is then solved over the candidate graph, per connected component
+(scipy ``linear_sum_assignment``), with lexicographic objectives:
+
+1. most strong features matched (the numerators of quality and precision together),
+2. then most pairs,
+3. then least total cost.
+
+quality = matched strong truth / strong truth features (the paper's q = RMF / GTF);
+precision = matched strong map / strong map features; f1 = their harmonic mean. A ratio with
+nothing to count (no strong feature on that side) is 0, and f1 is 0 when quality and precision
+are both 0.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import sparse
+from scipy.optimize import linear_sum_assignment
+from scipy.sparse.csgraph import connected_components
+
+from pcmapq.errors import InputError
+from pcmapq.features import DETECTORS, Features
+
+
+@dataclass(frozen=True)
+class Matching:
+    """The matched pairs of one detector and the scores they give.
+
+    truth_idx, map_idx: (M,) indices of matched pairs, sorted by truth index.
+    displacement: (M, 2) metres, from the truth feature to its map feature (the paper's
+        "vectorial map"), in the truth/map metric frame.
+    cost: (M,) the detector's cost of each pair (metres, or descriptor distance for SIFT).
+    quality: matched strong truth / strong truth features (the paper's q), in [0, 1].
+    precision: matched strong map / strong map features, in [0, 1].
+    f1: harmonic mean of quality and precision; 0 when both are 0.
+    truth_features, map_features: numbers of strong truth and strong map features.
+    matched: number of strong truth features matched (quality's numerator).
+    matched_map: number of strong map features matched (precision's numerator).
+    missing: indices of strong truth features left unmatched.
+    extra: indices of strong map features left unmatched.
+    """
+
+    truth_idx: np.ndarray
+    map_idx: np.ndarray
+    displacement: np.ndarray
+    cost: np.ndarray
+    quality: float
+    precision: float
+    f1: float
+    truth_features: int
+    map_features: int
+    matched: int
+    matched_map: int
+    missing: np.ndarray
+    extra: np.ndarray
+
+
+def assign(i: np.ndarray, j: np.ndarray, cost: np.ndarray, weight: np.ndarray) -> np.ndarray:
+    """Optimal one-to-one selection among candidate pairs.
+
+    Parameters
+    ----------
+    i, j : (K,) left and right node indices of the candidate pairs (no duplicate pairs).
+    cost : (K,) pair costs, lower is better, finite.
+    weight : (K,) int priority of each pair (here: its number of strong features); the total
+        weight is maximised first, then the number of pairs, then the total cost is minimised.
+
+    Returns
+    -------
+    (K,) bool mask of the selected pairs.
+    """
+    chosen = np.zeros(len(i), dtype=bool)
+    if len(i) == 0:
+        return chosen
+    # nodes: left i -> i, right j -> n_left + j; components of the candidate graph
+    left, li = np.unique(i, return_inverse=True)
+    right, rj = np.unique(j, return_inverse=True)
+    n = len(left) + len(right)
+    graph = sparse.coo_array((np.ones(len(i)), (li, len(left) + rj)), shape=(n, n))
+    _, label = connected_components(graph, directed=False)
+    comp = label[li]
+    # a component with one pair is that pair
+    sizes = np.bincount(comp)
+    single = sizes[comp] == 1
+    chosen[single] = True
+    for c in np.unique(comp[~single]):
+        k = np.flatnonzero(comp == c)
+        chosen[k[_assign_component(li[k], rj[k], cost[k], weight[k])]] = True
+    return chosen
+
+
+def _assign_component(i: np.ndarray, j: np.ndarray, cost: np.ndarray,
+                      weight: np.ndarray) -> np.ndarray:
+    """:func:`assign` on one connected component (dense, exact). Returns the chosen pair
+    positions."""
+    rows, ri = np.unique(i, return_inverse=True)
+    cols, cj = np.unique(j, return_inverse=True)
+    pairs = min(len(rows), len(cols))
+    # scores so that weight > pair count > cost lexicographically, all candidates > 0
+    span = np.ptp(cost) if len(cost) > 1 else 0.0
+    tie = (cost - cost.min()) / (span * (pairs + 1)) if span > 0 else np.zeros_like(cost)
+    score = weight * (pairs + 1.0) + 1.0 - tie  # tie < 1 / (pairs + 1) summed < 1
+    matrix = np.zeros((len(rows), len(cols)))
+    matrix[ri, cj] = score
+    r, c = linear_sum_assignment(matrix, maximize=True)
+    picked = np.full((len(rows), len(cols)), -1, dtype=np.int64)
+    picked[ri, cj] = np.arange(len(i))
+    sel = picked[r, c]
+    return sel[sel >= 0]
+
+
+def _ratio(num: int, den: int) -> float:
+    return float(num) / den if den > 0 else 0.0
+
+
+def match(name: str, truth: Features, map_: Features, threshold: float = 0.5) -> Matching:
+    """Match ``map_`` features to ``truth`` features of detector ``name``, one to one.
+
+    Parameters
+    ----------
+    name : detector name, a key of :data:`pcmapq.features.DETECTORS`.
+    truth, map_ : features of the truth and of the map, in the same metric frame (metres).
+    threshold : largest distance between matched features, metres (its exact meaning is the
+        detector's: point distance, or perpendicular offset of segments for Hough).
+
+    Returns
+    -------
+    The :class:`Matching`.
+    """
+    if name not in DETECTORS:
+        raise InputError(f"unknown feature detector {name!r}; known: {', '.join(DETECTORS)}")
+    i, j, cost, disp = DETECTORS[name].candidates(truth, map_, threshold)
+    weight = truth.strong[i].astype(np.int64) + map_.strong[j].astype(np.int64)
+    keep = weight > 0
+    i, j, cost, disp, weight = i[keep], j[keep], cost[keep], disp[keep], weight[keep]
+    chosen = assign(i, j, np.asarray(cost, dtype=np.float64), weight)
+    order = np.argsort(i[chosen], kind="stable")
+    ti, mj = i[chosen][order], j[chosen][order]
+    t_strong, m_strong = np.flatnonzero(truth.strong), np.flatnonzero(map_.strong)
+    matched = int(truth.strong[ti].sum())
+    matched_map = int(map_.strong[mj].sum())
+    quality = _ratio(matched, len(t_strong))
+    precision = _ratio(matched_map, len(m_strong))
+    f1 = 2 * quality * precision / (quality + precision) if quality + precision > 0 else 0.0
+    return Matching(
+        truth_idx=ti,
+        map_idx=mj,
+        displacement=np.asarray(disp, dtype=np.float64)[chosen][order].reshape(-1, 2),
+        cost=np.asarray(cost, dtype=np.float64)[chosen][order],
+        quality=quality,
+        precision=precision,
+        f1=f1,
+        truth_features=len(t_strong),
+        map_features=len(m_strong),
+        matched=matched,
+        matched_map=matched_map,
+        missing=np.setdiff1d(t_strong, ti),
+        extra=np.setdiff1d(m_strong, mj),
+    )
