@@ -149,3 +149,13 @@ def test_voxel_downsample_takes_cell_centroids():
 def test_empty_map_scores_zero(truth):
     result = align(np.empty((0, 2)), truth)
     assert result.fitness == 0.0 and result.transform == Similarity2D()
+
+
+def test_gridded_map_equal_to_truth_aligns_exactly():
+    """Two identical gridded clouds: point-to-point ICP alone locked onto the lattice 6 cm off;
+    the point-to-line stage must bring it back to the identity."""
+    plan = synth.building_plan(0)
+    grid = synth.plan_grid(plan, 0.05)
+    xy = grid.cell_centres(synth.render(plan, grid) == synth.OCCUPIED)
+    tf = align(xy, xy).transform
+    assert np.hypot(tf.tx, tf.ty) < 1e-3 and abs(tf.yaw_deg) < 0.01

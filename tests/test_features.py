@@ -110,7 +110,9 @@ def test_moved_wall_shows_its_displacement(plan, grid, truth):
         np.testing.assert_allclose(dist[near], 0.5, atol=0.1, err_msg=name)
         assert np.all(dist[~near] < 0.1), name
     hough = match("hough", truth["hough"], detect("hough", occ, grid), threshold=1.0)
-    moved_wall = np.flatnonzero(np.abs(truth["hough"].xy[hough.truth_idx, 0] - x0) < 0.2)
+    seg = truth["hough"].segments[hough.truth_idx]
+    vertical = np.abs(seg[:, 2] - seg[:, 0]) < np.abs(seg[:, 3] - seg[:, 1])
+    moved_wall = np.flatnonzero(vertical & (np.abs(truth["hough"].xy[hough.truth_idx, 0] - x0) < 0.2))
     np.testing.assert_allclose(hough.displacement[moved_wall], [[0.5, 0.0]], atol=0.1)
 
 

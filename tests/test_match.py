@@ -17,15 +17,24 @@ def points(xy, strong=None) -> Features:
 
 
 def test_optimal_not_greedy():
-    # greedy closest-first pairs truth 0 with map 0 (0.1 m) and leaves truth 1 alone;
-    # the optimum pairs truth 0 - map 1 and truth 1 - map 0
+    # greedy closest-first pairs truth 0 with map 0 (0.2 m) and leaves truth 1 alone;
+    # the optimum pairs truth 0 - map 1 and truth 1 - map 0 (0.25 m each)
     truth = points([[0.0, 0.0], [0.45, 0.0]])
-    map_ = points([[0.1, 0.0], [-0.3, 0.0]])
-    m = match("harris", truth, map_, threshold=0.4)
+    map_ = points([[0.2, 0.0], [-0.25, 0.0]])
+    m = match("harris", truth, map_, threshold=0.5)
     assert m.matched == 2 and m.quality == 1.0 and m.precision == 1.0
     np.testing.assert_array_equal(m.truth_idx, [0, 1])
     np.testing.assert_array_equal(m.map_idx, [1, 0])
-    np.testing.assert_allclose(m.displacement, [[-0.3, 0.0], [-0.35, 0.0]])
+    np.testing.assert_allclose(m.displacement, [[-0.25, 0.0], [-0.25, 0.0]])
+
+
+def test_one_close_pair_beats_two_stretched_ones():
+    # matching both would pair 0.35 m and 0.4 m apart; one pair 0.05 m apart is the better map
+    truth = points([[0.0, 0.0], [0.4, 0.0]])
+    map_ = points([[0.05, 0.0], [-0.35, 0.0]])
+    m = match("harris", truth, map_, threshold=0.5)
+    np.testing.assert_array_equal(m.truth_idx, [0])
+    np.testing.assert_array_equal(m.map_idx, [0])
 
 
 def test_least_cost_among_maximum_matchings():
@@ -33,7 +42,7 @@ def test_least_cost_among_maximum_matchings():
     map_ = points([[0.9, 0.0], [0.1, 0.0]])
     m = match("harris", truth, map_, threshold=1.0)
     np.testing.assert_array_equal(m.map_idx, [1, 0])
-    np.testing.assert_allclose(m.cost, [0.1, 0.1])
+    np.testing.assert_allclose(m.cost, [0.1, 0.1])  # 0.1 m over a 1 m threshold
 
 
 def test_threshold_respected_and_one_to_one():

@@ -20,11 +20,16 @@ class Settings:
     init: initial guess of the map -> truth transform; skips the global step.
     align: False trusts the map's frame (``--no-align``): no global step, no ICP.
     fit_tolerance: a map point is an inlier of the alignment within this distance, metres.
-    min_fitness: below this share of inliers the map is taken to show another place.
-    force: evaluate even when the fitness is below ``min_fitness``.
+    min_agreement: the map is taken to show another place when the share of its points near the
+        truth (fitness) times the share of the truth it covers that lies near the map is below
+        this.
+    force: evaluate even when the agreement is below ``min_agreement``.
+    footprint_margin: the map's footprint is grown by this much, metres.
     threshold: largest distance between matched features, metres.
     min_hits: a cloud cell is occupied when it holds at least this many points.
     detectors: which detectors to run.
+    full: score against the whole truth; by default truth features outside the map's footprint
+        (the area it observed) are not counted as missing.
     """
 
     map_resolution: float | None = None
@@ -35,8 +40,10 @@ class Settings:
     init: Similarity2D | None = None
     align: bool = True
     fit_tolerance: float = 0.2
-    min_fitness: float = 0.2
+    min_agreement: float = 0.2
     force: bool = False
+    footprint_margin: float = 0.3
     threshold: float = 0.5
     min_hits: int = 2
     detectors: tuple[str, ...] = DETECTOR_NAMES
+    full: bool = False

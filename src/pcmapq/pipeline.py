@@ -8,15 +8,17 @@ from pathlib import Path
 import numpy as np
 
 from pcmapq.align import align
+from pcmapq.align.transform import Similarity2D
 from pcmapq.config import Settings
 from pcmapq.errors import EvaluationError, InputError
-from pcmapq.features import detect
+from pcmapq.features import Features, detect
 from pcmapq.grid import MetricGrid
 from pcmapq.io import OccupancyMap, PointMap, load_map
 from pcmapq.match import match
-from pcmapq.raster.draw import OCCUPIED, points_to_grid, warp_state
+from pcmapq.raster.draw import OCCUPIED, UNKNOWN, points_to_grid, warp_state
+from pcmapq.raster.footprint import map_footprint, near
 from pcmapq.raster.slice import wall_band
-from pcmapq.result import DetectorResult, Result
+from pcmapq.result import DetectorResult, Overlap, Result
 
 Progress = Callable[[str], None]
 
@@ -48,12 +50,33 @@ def truth_raster(truth: OccupancyMap | PointMap, truth_xy: np.ndarray,
     return grid, points_to_grid(truth_xy, grid, settings.min_hits)
 
 
-def map_raster(source: OccupancyMap | PointMap, map_xy: np.ndarray, transform, grid: MetricGrid,
-               settings: Settings) -> np.ndarray:
-    """The aligned map drawn into the truth's grid: occupied cells, bool."""
+def map_raster(source: OccupancyMap | PointMap, map_xy: np.ndarray, transform: Similarity2D,
+               grid: MetricGrid, settings: Settings) -> tuple[np.ndarray, np.ndarray]:
+    """The aligned map drawn into the truth's grid: its occupied cells and its footprint (the
+    area it observed, see :mod:`pcmapq.raster.footprint`), both bool."""
     if isinstance(source, OccupancyMap):
-        return warp_state(source.state, source.grid, transform, grid) == OCCUPIED
-    return points_to_grid(transform.apply(map_xy), grid, settings.min_hits)
+        state = warp_state(source.state, source.grid, transform, grid)
+        occupied, known = state == OCCUPIED, state != UNKNOWN
+    else:
+        occupied, known = points_to_grid(transform.apply(map_xy), grid, settings.min_hits), None
+    return occupied, map_footprint(known, occupied, grid, settings.footprint_margin)
+
+
+def overlap(truth_occ: np.ndarray, map_occ: np.ndarray, footprint: np.ndarray, grid: MetricGrid,
+            fitness: float, tolerance: float) -> Overlap:
+    """How much of the truth the map covers, and how well the two agree there."""
+    seen = truth_occ & footprint
+    coverage = float(seen.sum() / truth_occ.sum()) if truth_occ.any() else 0.0
+    recall = float(near(map_occ, grid, tolerance)[seen].mean()) if seen.any() else 0.0
+    return Overlap(footprint, coverage, recall, fitness * recall)
+
+
+def inside(features: Features, area: np.ndarray, grid: MetricGrid) -> np.ndarray:
+    """(N,) bool: which features lie in the cells where ``area`` is true."""
+    uv = np.floor(grid.xy_to_pixels(features.xy) + 0.5).astype(int)
+    rows, cols = area.shape
+    ok = (uv[:, 0] >= 0) & (uv[:, 0] < cols) & (uv[:, 1] >= 0) & (uv[:, 1] < rows)
+    return ok & area[np.clip(uv[:, 1], 0, rows - 1), np.clip(uv[:, 0], 0, cols - 1)]
 
 
 def evaluate(map_path: str | Path, truth_path: str | Path, settings: Settings = Settings(),
@@ -67,22 +90,28 @@ def evaluate(map_path: str | Path, truth_path: str | Path, settings: Settings = 
     progress("aligning")
     alignment = align(map_xy, truth_xy, init=settings.init, refine=settings.align,
                       tolerance=settings.fit_tolerance)
-    if alignment.fitness < settings.min_fitness and not settings.force:
-        raise EvaluationError(
-            f"{map_path}: does not match {truth_path}: only {alignment.fitness:.0%} of the map "
-            f"lies within {settings.fit_tolerance} m of the truth after alignment (minimum "
-            f"{settings.min_fitness:.0%}); a map of another place? --force evaluates anyway")
 
     progress("rasterising")
     grid, truth_occ = truth_raster(truth, truth_xy, settings)
-    map_occ = map_raster(source, map_xy, alignment.transform, grid, settings)
+    map_occ, footprint = map_raster(source, map_xy, alignment.transform, grid, settings)
+    cover = overlap(truth_occ, map_occ, footprint, grid, alignment.fitness,
+                    settings.fit_tolerance)
+    if cover.agreement < settings.min_agreement and not settings.force:
+        raise EvaluationError(
+            f"{map_path}: does not match {truth_path}: agreement {cover.agreement:.2f} < "
+            f"{settings.min_agreement} ({alignment.fitness:.0%} of the map lies near the truth, "
+            f"{cover.truth_recall:.0%} of the truth it covers lies near the map); "
+            "a map of another place? --force scores it anyway")
 
     detectors = {}
     for name in settings.detectors:
         progress(f"detecting {name}")
         truth_f, map_f = detect(name, truth_occ, grid), detect(name, map_occ, grid)
+        if not settings.full:  # truth features the map never saw are not missing
+            truth_f = truth_f.counted_where(inside(truth_f, footprint, grid))
         detectors[name] = DetectorResult(truth_f, map_f,
                                          match(name, truth_f, map_f, settings.threshold))
     return Result(map_path=Path(map_path), map_kind=source.kind, truth_path=Path(truth_path),
-                  truth_kind=truth.kind, grid=grid, alignment=alignment, threshold=settings.threshold,
-                  detectors=detectors, truth_occupied=truth_occ, map_occupied=map_occ)
+                  truth_kind=truth.kind, grid=grid, alignment=alignment, overlap=cover,
+                  threshold=settings.threshold, full=settings.full, detectors=detectors,
+                  truth_occupied=truth_occ, map_occupied=map_occ)

@@ -51,6 +51,22 @@ class DetectorResult:
 
 
 @dataclass(frozen=True)
+class Overlap:
+    """What part of the truth the map covers and how well they agree there.
+
+    footprint: (rows, cols) bool on the truth's grid, the area the map observed.
+    coverage: share of the truth's occupied cells inside the footprint, [0, 1].
+    truth_recall: share of those within the fit tolerance of a map occupied cell, [0, 1].
+    agreement: alignment fitness times truth_recall: low for a map of another place.
+    """
+
+    footprint: np.ndarray
+    coverage: float
+    truth_recall: float
+    agreement: float
+
+
+@dataclass(frozen=True)
 class Result:
     """A finished evaluation; all coordinates in the truth frame, metres."""
 
@@ -60,7 +76,9 @@ class Result:
     truth_kind: str
     grid: MetricGrid
     alignment: Alignment
+    overlap: Overlap
     threshold: float
+    full: bool
     detectors: dict[str, DetectorResult]
     truth_occupied: np.ndarray
     map_occupied: np.ndarray
@@ -76,7 +94,11 @@ class Result:
                           "matrix": tf.matrix.tolist(), "fitness": self.alignment.fitness,
                           "rmse_m": self.alignment.rmse_m,
                           "tolerance_m": self.alignment.tolerance_m,
-                          "method": self.alignment.method},
+                          "method": self.alignment.method,
+                          "truth_recall": self.overlap.truth_recall,
+                          "agreement": self.overlap.agreement},
+            "coverage": self.overlap.coverage,
+            "scored_against": "whole truth" if self.full else "footprint",
             "detectors": {},
             "matches": [], "missing": [], "extra": [],
         }

@@ -12,7 +12,12 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from pcmapq.align.coarse import auto_resolution, coarse_candidates
-from pcmapq.align.icp import DEFAULT_SCHEDULE, IcpTarget, voxel_downsample
+from pcmapq.align.icp import (
+    DEFAULT_SCHEDULE,
+    IcpTarget,
+    refine_point_to_line,
+    voxel_downsample,
+)
 from pcmapq.align.icp import refine as icp_refine
 from pcmapq.align.transform import Similarity2D
 
@@ -84,6 +89,7 @@ def align(map_xy: np.ndarray, truth_xy: np.ndarray, *, init: Similarity2D | None
         return _result(map_ds, tree, tf, tolerance, "none" if init is None else "init")
     if init is not None:
         tf = icp_refine(map_ds, IcpTarget(truth_ds), init)
+        tf = refine_point_to_line(map_ds, truth_ds, tf, DEFAULT_SCHEDULE[-1][0])
         return _result(map_ds, tree, tf, tolerance, "init+icp")
     resolution = auto_resolution(map_ds) if resolution is None else resolution
     starts = coarse_candidates(map_ds, truth_ds, resolution=resolution, top_k=top_k)
@@ -94,7 +100,9 @@ def align(map_xy: np.ndarray, truth_xy: np.ndarray, *, init: Similarity2D | None
               for c in starts]
     finals = [_result(map_ds, tree, icp_refine(map_ds, fine, r.transform), tolerance,
                       "coarse+icp") for r in sorted(firsts, key=_rank)[:finalists]]
-    return min(finals, key=_rank)
+    best = min(finals, key=_rank).transform
+    best = refine_point_to_line(map_ds, truth_ds, best, DEFAULT_SCHEDULE[-1][0])
+    return _result(map_ds, tree, best, tolerance, "coarse+icp")
 
 
 def _rank(a: Alignment) -> tuple[float, float]:

@@ -1,9 +1,15 @@
-"""Local 2D refinement: Open3D ICP on points embedded at z = 0, projected back to SE(2)."""
+"""Local 2D refinement: Open3D point-to-point ICP on points embedded at z = 0, projected back to
+SE(2), then a final 2D point-to-line stage.
+
+Point-to-point ICP has a wide basin but locks onto the lattice of two gridded clouds (a map equal
+to its truth stopped 6 cm off); point-to-line lets points slide along walls and converges
+exactly, so it finishes every refinement."""
 
 from __future__ import annotations
 
 import numpy as np
 import open3d as o3d
+from scipy.spatial import cKDTree
 
 from pcmapq.align.transform import Similarity2D
 
@@ -74,4 +80,42 @@ def refine(map_xy: np.ndarray, target: IcpTarget, init: Similarity2D,
         result = o3d.pipelines.registration.registration_icp(
             source, truth, max_dist, _matrix4(tf), method, criteria)
         tf = _to_se2(np.asarray(result.transformation))
+    return tf
+
+
+def line_normals(xy: np.ndarray, neighbours: int = 8) -> np.ndarray:
+    """Unit normal (N, 2) of the local line through each point (N, 2, metres): the direction of
+    least spread of its nearest neighbours (PCA)."""
+    _, idx = cKDTree(xy).query(xy, k=min(neighbours, len(xy)))
+    near = xy[idx] - xy[idx].mean(axis=1, keepdims=True)
+    _, vectors = np.linalg.eigh(np.einsum("nki,nkj->nij", near, near))
+    return vectors[:, :, 0]
+
+
+def refine_point_to_line(map_xy: np.ndarray, truth_xy: np.ndarray, init: Similarity2D,
+                         max_distance: float = 0.2, iterations: int = 30) -> Similarity2D:
+    """2D point-to-line ICP (Gauss-Newton with Tukey weights) of the map (N, 2, metres, map
+    frame) onto the truth (M, 2, metres, truth frame), from ``init``; pairs farther apart than
+    ``max_distance`` metres are ignored. Returns the map -> truth transform (scale 1)."""
+    if len(truth_xy) < 3:
+        return init
+    normals, tree = line_normals(truth_xy), cKDTree(truth_xy)
+    tf = Similarity2D(init.tx, init.ty, init.yaw)
+    for _ in range(iterations):
+        p = tf.apply(map_xy)
+        dist, j = tree.query(p, distance_upper_bound=max_distance)
+        ok = np.isfinite(dist)
+        if ok.sum() < 3:
+            break
+        p, n = p[ok], normals[j[ok]]
+        r = np.einsum("ni,ni->n", p - truth_xy[j[ok]], n)
+        # residual change for a step (dx, dy, dyaw) about the origin: n . (d + dyaw * perp(p))
+        jac = np.column_stack([n[:, 0], n[:, 1], n[:, 1] * p[:, 0] - n[:, 0] * p[:, 1]])
+        scale = max(1.4826 * float(np.median(np.abs(r))), 1e-3)
+        w = np.clip(1.0 - (r / (4.685 * scale)) ** 2, 0.0, None) ** 2
+        step = np.linalg.lstsq(jac.T @ (jac * w[:, None]), -jac.T @ (w * r), rcond=None)[0]
+        tf = Similarity2D.from_matrix(Similarity2D(*step).matrix @ tf.matrix)
+        tf = Similarity2D(tf.tx, tf.ty, tf.yaw)  # keep scale exactly 1
+        if np.abs(step[:2]).max() < 1e-6 and abs(step[2]) < 1e-7:
+            break
     return tf

@@ -9,7 +9,7 @@ and every length parameter (all in metres) means the same number of working pixe
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import cv2
 import numpy as np
@@ -44,6 +44,11 @@ class Features:
     def __len__(self) -> int:
         return len(self.xy)
 
+    def counted_where(self, keep: np.ndarray) -> Features:
+        """The same features with only those where ``keep`` (N,) is true left strong: the
+        others may still confirm a feature of the other map but are not counted."""
+        return replace(self, strong=self.strong & keep)
+
 
 @dataclass(frozen=True)
 class Detector:
@@ -52,8 +57,9 @@ class Detector:
     detect: ``detect(occupied, grid, **params) -> Features``; ``occupied`` is a (rows, cols)
         bool raster on ``grid`` (walls true).
     candidates: ``candidates(truth, map_, threshold) -> (i, j, cost, displacement)``: the pairs
-        (truth ``i``, map ``j``) that may match under ``threshold`` metres, their costs (lower is
-        better) and displacements (M, 2) in metres, from the truth feature to the map feature.
+        (truth ``i``, map ``j``) that may match under ``threshold`` metres, their costs in
+        [0, 1] (0 a perfect pair, 1 the worst acceptable one) and displacements (M, 2) in
+        metres, from the truth feature to the map feature.
     """
 
     name: str
@@ -182,7 +188,7 @@ def suppress(xy: np.ndarray, strength: np.ndarray, radius: float) -> np.ndarray:
 def point_candidates(truth: Features, map_: Features, threshold: float) -> Candidates:
     """Pairs of point features within ``threshold`` metres, at least one of them strong.
 
-    cost = Euclidean distance, metres; displacement = map xy - truth xy, metres.
+    cost = Euclidean distance / threshold; displacement = map xy - truth xy, metres.
     """
     if len(truth) == 0 or len(map_) == 0:
         return no_candidates()
@@ -192,7 +198,7 @@ def point_candidates(truth: Features, map_: Features, threshold: float) -> Candi
     i, j = dist["i"].astype(np.int64), dist["j"].astype(np.int64)
     keep = truth.strong[i] | map_.strong[j]
     i, j = i[keep], j[keep]
-    return i, j, dist["v"][keep], map_.xy[j] - truth.xy[i]
+    return i, j, dist["v"][keep] / threshold, map_.xy[j] - truth.xy[i]
 
 
 def no_candidates() -> Candidates:

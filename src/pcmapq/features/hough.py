@@ -12,7 +12,8 @@ merged into maximal wall segments, so one straight wall (between doors) is one f
 Matching rule: a truth segment and a map segment are candidates when their directions differ
 by less than ``MAX_ANGLE`` (10) degrees, the map segment projected on the truth segment's line
 overlaps the truth segment, and the perpendicular offset, the larger of the two
-midpoint-to-other-line distances, is within the threshold; that offset is the cost. The
+midpoint-to-other-line distances, is within the threshold; the cost is that offset divided by
+the threshold. The
 displacement is the vector from the truth midpoint to its orthogonal projection on the map
 segment's line: a wall moved by 0.5 m shows 0.5 m, whatever the segments' extents.
 """
@@ -260,7 +261,8 @@ def detect(occupied: np.ndarray, grid: MetricGrid, *, resolution: float = 0.05,
 
 
 def candidates(truth: Features, map_: Features, threshold: float) -> Candidates:
-    """Candidate segment pairs under the rule of the module docstring; cost in metres."""
+    """Candidate segment pairs under the rule of the module docstring; cost = offset /
+    threshold."""
     if len(truth) == 0 or len(map_) == 0:
         return no_candidates()
     dt, lt = _directions(truth.segments)
@@ -279,7 +281,7 @@ def candidates(truth: Features, map_: Features, threshold: float) -> Candidates:
     overlap = np.minimum(np.maximum(a, b), 0.5 * lt[i]) - np.maximum(np.minimum(a, b), -0.5 * lt[i])
     keep = (overlap > 0) & (cost <= threshold)
     disp = along_m[keep, None] * nm[keep]
-    return i[keep], j[keep], cost[keep], disp
+    return i[keep], j[keep], cost[keep] / threshold, disp
 
 
 DETECTOR = Detector("hough", detect, candidates)

@@ -124,11 +124,16 @@ def _keypoints(grey: np.ndarray, layers: int, contrast: float, edge: float, sigm
     return uv[small], value[small], desc[small]
 
 
+#: Largest L2 distance between two OpenCV SIFT descriptors (each normalised to 512).
+DESCRIPTOR_MAX = 512.0 * np.sqrt(2.0)
+
 def candidates(truth: Features, map_: Features, threshold: float) -> Candidates:
-    """Keypoint pairs within ``threshold`` metres; cost = descriptor L2 distance."""
-    i, j, _, disp = point_candidates(truth, map_, threshold)
-    cost = np.linalg.norm(truth.descriptors[i] - map_.descriptors[j], axis=1)
-    return i, j, cost, disp
+    """Keypoint pairs within ``threshold`` metres; cost = the mean of their distance over the
+    threshold and their descriptor distance over its largest value, so that among nearby
+    candidates the descriptor decides, and no far pair is taken for a near one."""
+    i, j, dist, disp = point_candidates(truth, map_, threshold)
+    desc = np.linalg.norm(truth.descriptors[i] - map_.descriptors[j], axis=1)
+    return i, j, 0.5 * (dist + np.minimum(desc / DESCRIPTOR_MAX, 1.0)), disp
 
 
 DETECTOR = Detector("sift", detect, candidates)

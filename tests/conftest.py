@@ -1,0 +1,54 @@
+"""Shared fixtures: synthetic maps written as real files, with known answers."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pytest
+
+from pcmapq import synth
+from pcmapq.align.transform import Similarity2D
+
+SHARED_DATA = Path(__file__).resolve().parents[2] / "shared" / "data"
+
+
+def write_image_map(segments: np.ndarray, path: Path, resolution: float = 0.05) -> Path:
+    """Render wall segments (metres) as a ROS map: ``path`` (.png) plus a YAML beside it."""
+    grid = synth.plan_grid(segments, resolution)
+    cv2.imwrite(str(path), synth.render(segments, grid))
+    ox, oy, _ = grid.origin
+    path.with_suffix(".yaml").write_text(
+        f"image: {path.name}\nresolution: {resolution}\norigin: [{ox}, {oy}, 0.0]\n"
+        "negate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n")
+    return path
+
+
+def write_cloud_map(points: np.ndarray, path: Path) -> Path:
+    """Save points (N, 2 or 3, metres) as .npy."""
+    np.save(path, points)
+    return path
+
+
+def in_map_frame(segments: np.ndarray, tf: Similarity2D) -> np.ndarray:
+    """The plan as seen in a map frame, where ``p_truth = tf(p_map)``."""
+    return synth.transform_segments(segments, tf.inverse())
+
+
+@pytest.fixture(scope="session")
+def plan() -> np.ndarray:
+    return synth.building_plan(seed=0)
+
+
+@pytest.fixture(scope="session")
+def truth_png(plan, tmp_path_factory) -> Path:
+    return write_image_map(plan, tmp_path_factory.mktemp("truth") / "truth.png")
+
+
+def shared(*parts: str) -> Path:
+    """A file of ../shared/data, or skip the test saying it is absent."""
+    path = SHARED_DATA.joinpath(*parts)
+    if not path.exists():
+        pytest.skip(f"{path} is absent (real data lives in ../shared/data)")
+    return path

@@ -1,0 +1,108 @@
+"""The command line: outputs, exit codes and one-line errors."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+SAMPLE = ROOT / "data" / "sample"
+
+
+def run(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "pcmapq", *args], capture_output=True,
+                          text=True, cwd=cwd, timeout=600)
+
+
+@pytest.fixture(scope="module")
+def sample_json(tmp_path_factory) -> tuple[dict, Path, Path]:
+    out = tmp_path_factory.mktemp("out")
+    proc = run("eval", str(SAMPLE / "scan.ply"), str(SAMPLE / "truth.png"),
+               "--json", str(out / "r.json"), "--vectors", str(out / "v.csv"))
+    assert proc.returncode == 0, proc.stderr
+    assert "harris" in proc.stdout and "quality" in proc.stdout
+    return json.loads((out / "r.json").read_text()), out / "r.json", out / "v.csv"
+
+
+def test_sample_json_has_the_documented_fields(sample_json):
+    doc, _, _ = sample_json
+    assert {"map", "truth", "alignment", "detectors", "matches", "missing", "extra"} <= set(doc)
+    assert doc["map"]["kind"] == "cloud" and doc["truth"]["kind"] == "image"
+    assert doc["truth"]["resolution_m"] == 0.05
+    a = doc["alignment"]
+    assert {"x_m", "y_m", "yaw_deg", "scale", "matrix", "fitness", "rmse_m"} <= set(a)
+    # tools/make_sample.py places the scan frame at x 6, y 8, yaw 37 degrees in the truth frame
+    assert abs(a["x_m"] - 6.0) < 0.1 and abs(a["y_m"] - 8.0) < 0.1
+    assert abs(a["yaw_deg"] - 37.0) < 0.5
+    for name in ("harris", "hough", "sift"):
+        det = doc["detectors"][name]
+        assert {"quality", "precision", "f1", "truth_features", "map_features", "matched",
+                "threshold_m", "displacement_m"} <= set(det)
+        # matched counts the matched truth features above the detection threshold; the matches
+        # list also holds pairs where only the map side is above it (see docs/method.md)
+        assert det["matched"] <= sum(m["detector"] == name for m in doc["matches"])
+        assert det["quality"] == round(det["matched"] / det["truth_features"], 6)
+        assert 0.5 < det["quality"] <= 1.0
+
+
+def test_vectors_csv_has_one_row_per_match(sample_json):
+    doc, _, csv = sample_json
+    lines = csv.read_text().splitlines()
+    assert lines[0].startswith("detector,truth_x_m,truth_y_m,map_x_m,map_y_m")
+    assert len(lines) - 1 == len(doc["matches"])
+
+
+def test_json_is_byte_identical_between_runs(sample_json, tmp_path):
+    _, first, _ = sample_json
+    proc = run("eval", str(SAMPLE / "scan.ply"), str(SAMPLE / "truth.png"), "--json", "-")
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout == first.read_text()  # also: nothing but the JSON on stdout
+
+
+@pytest.mark.parametrize("case", ["missing", "garbage_png", "yaml_without_resolution",
+                                  "png_without_resolution", "unsupported"])
+def test_bad_input_exits_2_with_one_line(case, tmp_path):
+    truth = str(SAMPLE / "truth.png")
+    if case == "missing":
+        bad = tmp_path / "nope.ply"
+    elif case == "garbage_png":
+        bad = tmp_path / "junk.png"
+        bad.write_bytes(b"not an image at all")
+        (tmp_path / "junk.yaml").write_text("image: junk.png\nresolution: 0.05\norigin: [0,0,0]\n")
+    elif case == "yaml_without_resolution":
+        bad = tmp_path / "m.yaml"
+        bad.write_text("image: truth.png\norigin: [0, 0, 0]\n")
+        (tmp_path / "truth.png").write_bytes((SAMPLE / "truth.png").read_bytes())
+    elif case == "png_without_resolution":
+        bad = tmp_path / "plain.png"
+        bad.write_bytes((SAMPLE / "truth.png").read_bytes())
+    else:
+        bad = tmp_path / "map.abc"
+        bad.write_text("1 2 3\n")
+    proc = run("eval", str(bad), truth)
+    assert proc.returncode == 2
+    assert "Traceback" not in proc.stderr
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1 and bad.name in lines[0], proc.stderr
+
+
+def test_map_of_another_place_exits_1_unless_forced(tmp_path):
+    from .conftest import write_image_map
+
+    ring = np.linspace(0, 2 * np.pi, 60, endpoint=False)
+    rooms = []  # another place: three round rooms, nothing like the sample's building
+    for cx, cy, r in ((6, 6, 5), (16, 8, 4), (11, 15, 3)):
+        p = np.column_stack([cx + r * np.cos(ring), cy + r * np.sin(ring)])
+        rooms.append(np.hstack([p, np.roll(p, -1, axis=0)]))
+    other = write_image_map(np.vstack(rooms), tmp_path / "other.png")
+    proc = run("eval", str(other), str(SAMPLE / "truth.png"))
+    assert proc.returncode == 1, proc.stdout + proc.stderr
+    assert "Traceback" not in proc.stderr and "other.png" in proc.stderr
+    forced = run("eval", str(other), str(SAMPLE / "truth.png"), "--force", "--json", "-")
+    assert forced.returncode == 0
+    assert json.loads(forced.stdout)["alignment"]["agreement"] < 0.2
