@@ -27,13 +27,16 @@ from tests.conftest import in_map_frame, write_cloud_map, write_image_map
 
 case, out = sys.argv[2], Path(sys.argv[3])
 if case == "sample":
-    map_path, truth_path = Path(sys.argv[1]) / "data/sample/scan.ply", Path(sys.argv[1]) / "data/sample/truth.png"
+    root = Path(sys.argv[1])
+    map_path, truth_path = root / "data/sample/scan.ply", root / "data/sample/truth.png"
 else:
-    width, height = {"plan 24x16 m": (24, 16), "plan 60x40 m": (60, 40), "plan 120x80 m": (120, 80)}[case]
+    sizes = {"plan 24x16 m": (24, 16), "plan 60x40 m": (60, 40), "plan 120x80 m": (120, 80)}
+    width, height = sizes[case]
     plan = synth.building_plan(seed=1, width=width, height=height)
     truth_path = write_image_map(plan, out / "truth.png")
     tf = Similarity2D(5.0, -3.0, np.radians(33.0))
-    map_path = write_cloud_map(synth.wall_points(in_map_frame(plan, tf), 0.03, noise=0.01), out / "map.npy")
+    cloud = synth.wall_points(in_map_frame(plan, tf), 0.03, noise=0.01)
+    map_path = write_cloud_map(cloud, out / "map.npy")
 times, last = {}, [time.perf_counter(), "start"]
 def progress(step):
     now = time.perf_counter()

@@ -112,7 +112,8 @@ def test_moved_wall_shows_its_displacement(plan, grid, truth):
     hough = match("hough", truth["hough"], detect("hough", occ, grid), threshold=1.0)
     seg = truth["hough"].segments[hough.truth_idx]
     vertical = np.abs(seg[:, 2] - seg[:, 0]) < np.abs(seg[:, 3] - seg[:, 1])
-    moved_wall = np.flatnonzero(vertical & (np.abs(truth["hough"].xy[hough.truth_idx, 0] - x0) < 0.2))
+    on_wall = np.abs(truth["hough"].xy[hough.truth_idx, 0] - x0) < 0.2
+    moved_wall = np.flatnonzero(vertical & on_wall)
     np.testing.assert_allclose(hough.displacement[moved_wall], [[0.5, 0.0]], atol=0.1)
 
 

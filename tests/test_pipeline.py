@@ -71,7 +71,7 @@ def _falls(rows, column: int) -> None:
     """Each step scores below the one before on ``column`` (0 quality, 1 precision, 2 f1)."""
     for name in DETECTORS:
         values = [row[name][column] for row in rows]
-        assert all(b < a for a, b in zip(values, values[1:])), (name, column, values)
+        assert all(b < a for a, b in zip(values, values[1:], strict=False)), (name, column, values)
 
 
 def test_ladder_missing_walls(plan, truth_png, tmp_path):
@@ -97,7 +97,8 @@ def test_ladder_clutter(plan, truth_png, tmp_path):
 
 def test_ladder_position_noise(plan, truth_png, tmp_path):
     rows = _ladder(plan, truth_png, tmp_path,
-                   [synth.wall_points(plan, 0.02, noise=s, seed=4) for s in (0.0, 0.02, 0.03, 0.05)])
+                   [synth.wall_points(plan, 0.02, noise=s, seed=4)
+                    for s in (0.0, 0.02, 0.03, 0.05)])
     _falls(rows, 1)
     _falls(rows, 2)
 

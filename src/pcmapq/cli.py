@@ -53,7 +53,8 @@ def eval_command(
                         "with its ROS YAML), YAML, or cloud (.ply/.pcd/.xyz/.npy/.bin).")],
     truth_path: Annotated[Path, typer.Argument(metavar="TRUTH", help="Ground truth, same kinds.")],
     map_resolution: Annotated[float | None, typer.Option(
-        help="Metres per pixel of a map image without YAML (overrides its YAML).", min=1e-6)] = None,
+        help="Metres per pixel of a map image without YAML (overrides its YAML).",
+        min=1e-6)] = None,
     truth_resolution: Annotated[float | None, typer.Option(
         help="Metres per pixel of a truth image without YAML; cell size for a cloud truth "
         "(default 0.05).", min=1e-6)] = None,
@@ -69,8 +70,9 @@ def eval_command(
         help="Wall band of a 3D cloud: lower bound, metres above the floor.")] = 0.3,
     band_high: Annotated[float, typer.Option(
         help="Wall band of a 3D cloud: upper bound, metres above the floor.")] = 2.0,
-    min_hits: Annotated[int, typer.Option(
-        help="Points needed to mark a cloud's cell occupied.", min=1)] = 2,
+    min_hits: Annotated[int | None, typer.Option(
+        help="Points needed to mark a cloud's cell occupied [default: 2 for a 3D cloud, 1 for "
+        "a 2D one].", min=1, show_default=False)] = None,
     detectors: Annotated[str, typer.Option(
         help="Comma-separated detectors to run.")] = ",".join(DETECTOR_NAMES),
     json_path: Annotated[str | None, typer.Option(

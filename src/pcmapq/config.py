@@ -26,7 +26,9 @@ class Settings:
     force: evaluate even when the agreement is below ``min_agreement``.
     footprint_margin: the map's footprint is grown by this much, metres.
     threshold: largest distance between matched features, metres.
-    min_hits: a cloud cell is occupied when it holds at least this many points.
+    min_hits: a cloud cell is occupied when it holds at least this many points; by default 2
+        for a 3D cloud (its wall band stacks many points on a wall cell, and a lone outlier is
+        dropped) and 1 for a 2D cloud (a laser map puts one or two points per wall cell).
     detectors: which detectors to run.
     full: score against the whole truth; by default truth features outside the map's footprint
         (the area it observed) are not counted as missing.
@@ -44,6 +46,6 @@ class Settings:
     force: bool = False
     footprint_margin: float = 0.3
     threshold: float = 0.5
-    min_hits: int = 2
+    min_hits: int | None = None
     detectors: tuple[str, ...] = DETECTOR_NAMES
     full: bool = False

@@ -40,6 +40,13 @@ def plan_points(source: OccupancyMap | PointMap, settings: Settings) -> np.ndarr
     return xy
 
 
+def min_hits(cloud: PointMap, settings: Settings) -> int:
+    """Points needed to mark a cell of this cloud occupied (see Settings.min_hits)."""
+    if settings.min_hits is not None:
+        return settings.min_hits
+    return 2 if cloud.is_3d else 1
+
+
 def truth_raster(truth: OccupancyMap | PointMap, truth_xy: np.ndarray,
                  settings: Settings) -> tuple[MetricGrid, np.ndarray]:
     """The truth's grid and its occupied cells. An image keeps its own grid; a cloud gets an
@@ -47,7 +54,7 @@ def truth_raster(truth: OccupancyMap | PointMap, truth_xy: np.ndarray,
     if isinstance(truth, OccupancyMap):
         return truth.grid, truth.state == OCCUPIED
     grid = MetricGrid.covering(truth_xy, settings.truth_resolution or settings.cloud_resolution)
-    return grid, points_to_grid(truth_xy, grid, settings.min_hits)
+    return grid, points_to_grid(truth_xy, grid, min_hits(truth, settings))
 
 
 def map_raster(source: OccupancyMap | PointMap, map_xy: np.ndarray, transform: Similarity2D,
@@ -58,7 +65,8 @@ def map_raster(source: OccupancyMap | PointMap, map_xy: np.ndarray, transform: S
         state = warp_state(source.state, source.grid, transform, grid)
         occupied, known = state == OCCUPIED, state != UNKNOWN
     else:
-        occupied, known = points_to_grid(transform.apply(map_xy), grid, settings.min_hits), None
+        occupied = points_to_grid(transform.apply(map_xy), grid, min_hits(source, settings))
+        known = None
     return occupied, map_footprint(known, occupied, grid, settings.footprint_margin)
 
 
@@ -79,9 +87,10 @@ def inside(features: Features, area: np.ndarray, grid: MetricGrid) -> np.ndarray
     return ok & area[np.clip(uv[:, 1], 0, rows - 1), np.clip(uv[:, 0], 0, cols - 1)]
 
 
-def evaluate(map_path: str | Path, truth_path: str | Path, settings: Settings = Settings(),
+def evaluate(map_path: str | Path, truth_path: str | Path, settings: Settings | None = None,
              progress: Progress = lambda step: None) -> Result:
     """Score the map at ``map_path`` against the truth at ``truth_path``."""
+    settings = Settings() if settings is None else settings
     progress("loading")
     source = load_map(map_path, settings.map_resolution)
     truth = load_map(truth_path, settings.truth_resolution)

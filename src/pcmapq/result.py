@@ -113,7 +113,7 @@ class Result:
             doc["matches"] += [
                 {"detector": name, "truth_xy_m": t, "map_xy_m": p, "displacement_m": d}
                 for t, p, d in zip(det.truth_xy.tolist(), det.map_xy.tolist(),
-                                   det.distances.tolist())]
+                                   det.distances.tolist(), strict=True)]
             doc["missing"] += [{"detector": name, "truth_xy_m": t}
                                for t in det.truth.xy[m.missing].tolist()]
             doc["extra"] += [{"detector": name, "map_xy_m": p}

@@ -68,7 +68,7 @@ def transform_segments(segments: np.ndarray, tf: Similarity2D) -> np.ndarray:
 
 
 def densify(segments: np.ndarray, step: float = 0.1) -> np.ndarray:
-    """Cut segments into pieces no longer than ``step`` metres, so a non-rigid warp can bend them."""
+    """Cut segments into pieces at most ``step`` metres long, so a non-rigid warp can bend them."""
     lengths = np.hypot(segments[:, 2] - segments[:, 0], segments[:, 3] - segments[:, 1])
     counts = np.maximum(1, np.ceil(lengths / step).astype(int))
     idx = np.repeat(np.arange(len(segments)), counts)

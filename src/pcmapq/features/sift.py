@@ -58,7 +58,7 @@ def detect(occupied: np.ndarray, grid: MetricGrid, *, resolution: float = 0.05,
            closing: float = 0.1, window: float = 0.15, threshold: float = 0.025,
            support: float = 0.5, radius: float = 0.3, octave_layers: int = 3,
            edge: float = 10.0, sigma: float = 1.6, max_size: float = 1.0,
-           support_edge: float = 2.0) -> Features:
+           support_edge: float = 2.0, precise: bool = False) -> Features:
     """SIFT keypoints and descriptors of the entropy image of a binary map.
 
     Parameters
@@ -86,9 +86,9 @@ def detect(occupied: np.ndarray, grid: MetricGrid, *, resolution: float = 0.05,
     grey = np.round(entropy(image, window / resolution) * 255).astype(np.uint8)
     # OpenCV drops keypoints below contrastThreshold / nOctaveLayers
     strict = _keypoints(grey, octave_layers, threshold * octave_layers, edge, sigma, max_size,
-                        resolution)
+                        resolution, precise)
     loose = _keypoints(grey, octave_layers, support * threshold * octave_layers,
-                       support_edge * edge, sigma, max_size, resolution)
+                       support_edge * edge, sigma, max_size, resolution, precise)
     if loose is None:
         return empty_features(with_descriptors=True)
     uv, value, desc = loose
@@ -107,12 +107,12 @@ def detect(occupied: np.ndarray, grid: MetricGrid, *, resolution: float = 0.05,
 
 
 def _keypoints(grey: np.ndarray, layers: int, contrast: float, edge: float, sigma: float,
-               max_size: float, resolution: float
+               max_size: float, resolution: float, precise=False
                ) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
     """SIFT on ``grey``: pixel positions (N, 2), responses (N,) and descriptors (N, 128) of
     the keypoints at most ``max_size`` metres across; None when there are none."""
     sift = cv2.SIFT_create(nOctaveLayers=layers, contrastThreshold=contrast,
-                           edgeThreshold=edge, sigma=sigma)
+                           edgeThreshold=edge, sigma=sigma, enable_precise_upscale=precise)
     keypoints, desc = sift.detectAndCompute(grey, None)
     if not keypoints:
         return None

@@ -1,0 +1,76 @@
+"""Real maps and scans from ../shared/data (skipped, saying why, where it is absent)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pytest
+
+from pcmapq.align.transform import Similarity2D
+from pcmapq.config import Settings
+from pcmapq.grid import MetricGrid
+from pcmapq.pipeline import evaluate
+
+from .conftest import shared
+
+#: Freiburg building 079's SLAM map has no resolution; 0.05 m per pixel is assumed.
+FR79_RES = 0.05
+
+
+def _write_ros_map(image: np.ndarray, path: Path, resolution: float,
+                   origin: tuple[float, float]) -> Path:
+    cv2.imwrite(str(path), image)
+    path.with_suffix(".yaml").write_text(
+        f"image: {path.name}\nresolution: {resolution}\norigin: [{origin[0]}, {origin[1]}, 0]\n"
+        "negate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n")
+    return path
+
+
+@pytest.fixture(scope="module")
+def fr79(tmp_path_factory) -> Path:
+    image = cv2.imread(str(shared("floorplans", "freiburg_building79.png")), cv2.IMREAD_GRAYSCALE)
+    return _write_ros_map(image, tmp_path_factory.mktemp("fr79") / "fr79.png", FR79_RES, (0, 0))
+
+
+def test_real_slam_map_against_itself(fr79):
+    result = evaluate(fr79, fr79)
+    for name, det in result.detectors.items():
+        assert det.matching.quality >= 0.98, name
+        assert det.matching.precision >= 0.98, name
+
+
+def test_real_slam_map_turned_and_shifted_is_recovered(fr79, tmp_path):
+    """The Freiburg 079 SLAM map turned by 123 degrees and moved: a known rigid transform on a
+    real map's texture (thin, broken, noisy walls)."""
+    image = cv2.imread(str(fr79), cv2.IMREAD_GRAYSCALE)
+    rows, cols = image.shape
+    src = MetricGrid(FR79_RES, (0.0, 0.0, 0.0), (rows, cols))
+    tf = Similarity2D(-3.0, 21.0, np.radians(123.0))  # src (truth) -> dst (map)
+    corners = src.pixels_to_xy([[0, 0], [cols, 0], [0, rows], [cols, rows]])
+    dst = MetricGrid.covering(tf.apply(corners), FR79_RES)
+    # map pixel -> map metres -> truth metres -> truth pixel
+    m = src.xy_to_pixel_matrix() @ tf.inverse().matrix @ dst.pixel_to_xy_matrix()
+    turned = cv2.warpAffine(image, m[:2], dst.shape[::-1], flags=cv2.INTER_NEAREST |
+                            cv2.WARP_INVERSE_MAP, borderValue=153)
+    path = _write_ros_map(turned, tmp_path / "turned.png", FR79_RES, dst.origin[:2])
+    result = evaluate(path, fr79)
+    got, want = result.alignment.transform, tf.inverse()
+    assert np.hypot(got.tx - want.tx, got.ty - want.ty) < 0.1, got
+    assert abs((got.yaw_deg - want.yaw_deg + 180) % 360 - 180) < 0.5, got
+    for name, det in result.detectors.items():
+        assert det.matching.quality >= 0.9, (name, det.matching.quality)
+
+
+def test_lidar_pair_aligns_in_2d_to_its_known_transform():
+    """registration/: two real LiDAR scans with their true transform; the wall bands of the two
+    clouds, aligned in 2D with no initial guess, give the true yaw and translation."""
+    source, target = shared("registration", "source.ply"), shared("registration", "target.ply")
+    truth = np.loadtxt(shared("registration", "T_target_source.txt"))
+    want = Similarity2D.from_matrix(truth)
+    result = evaluate(source, target, Settings(force=True))
+    got = result.alignment.transform
+    assert np.hypot(got.tx - want.tx, got.ty - want.ty) < 0.05, got
+    assert abs(got.yaw_deg - want.yaw_deg) < 0.5, got
+    assert result.alignment.fitness > 0.8
