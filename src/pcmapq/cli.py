@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import sys
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Annotated
 
@@ -25,6 +27,16 @@ app = typer.Typer(add_completion=False, no_args_is_help=True, pretty_exceptions_
 def main() -> None:
     """pcmapq: score a robot-made map against a ground-truth map (frame convention:
     p_truth = s * R(yaw) * p_map + t; metres and degrees)."""
+
+
+@contextmanager
+def _progress(console: Console, enabled: bool) -> Iterator[Callable[[str], None]]:
+    """A spinner on the terminal naming the current step; nothing when not a terminal."""
+    if not (enabled and console.is_terminal):
+        yield lambda step: None
+        return
+    with console.status("pcmapq") as status:
+        yield lambda step: status.update(f"{step}...")
 
 
 def _parse_init(text: str | None) -> Similarity2D | None:
@@ -79,28 +91,39 @@ def eval_command(
         "--json", help="Write the result as JSON to this path ('-' for stdout only).")] = None,
     vectors: Annotated[Path | None, typer.Option(
         help="Write the matched displacements (the vectorial map) as CSV.")] = None,
+    plot: Annotated[Path | None, typer.Option(
+        help="Draw the vectorial map, one panel per detector, as PNG.")] = None,
+    report: Annotated[Path | None, typer.Option(
+        help="Write a self-contained HTML report (figures embedded).")] = None,
+    full: Annotated[bool, typer.Option(
+        "--full", help="Score against the whole truth, not only the part the map covers.")
+    ] = False,
 ) -> None:
     """Align MAP to TRUTH, then score it with Harris, Hough and SIFT features."""
     settings = Settings(map_resolution=map_resolution, truth_resolution=truth_resolution,
                         band_low=band_low, band_high=band_high, init=_parse_init(init),
                         align=not no_align, force=force, threshold=threshold, min_hits=min_hits,
-                        detectors=_parse_detectors(detectors))
+                        detectors=_parse_detectors(detectors), full=full)
     quiet = json_path == "-"
     err = Console(stderr=True)
     out = Console(quiet=quiet, width=None if err.is_terminal else 132)
     try:
-        if quiet or not err.is_terminal:
-            result = evaluate(map_path, truth_path, settings)
-        else:
-            with err.status("pcmapq") as status:
-                result = evaluate(map_path, truth_path, settings,
-                                  progress=lambda step: status.update(f"{step}..."))
-        if json_path == "-":
-            sys.stdout.write(result.to_json())
-        elif json_path is not None:
-            write_atomic(Path(json_path), result.to_json())
-        if vectors is not None:
-            write_atomic(vectors, result.vectors_csv())
+        with _progress(err, enabled=not quiet) as progress:
+            result = evaluate(map_path, truth_path, settings, progress)
+            progress("writing outputs")
+            if json_path == "-":
+                sys.stdout.write(result.to_json())
+            elif json_path is not None:
+                write_atomic(Path(json_path), result.to_json())
+            if vectors is not None:
+                write_atomic(vectors, result.vectors_csv())
+            if plot is not None or report is not None:
+                from pcmapq.report.html import report_html
+                from pcmapq.report.plot import png_bytes, vectorial_figure
+            if plot is not None:
+                write_atomic(plot, png_bytes(vectorial_figure(result)))
+            if report is not None:
+                write_atomic(report, report_html(result))
     except (InputError, EvaluationError) as error:
         err.print(f"pcmapq: error: {error}", markup=False, highlight=False, soft_wrap=True)
         raise typer.Exit(error.exit_code) from None

@@ -1,0 +1,90 @@
+"""A self-contained HTML report of a Result: inputs, alignment, scores, figures (embedded)."""
+
+from __future__ import annotations
+
+import base64
+import html
+
+from pcmapq import __version__
+from pcmapq.report.plot import distance_heatmap, png_bytes, vectorial_figure
+from pcmapq.result import Result
+
+STYLE = """
+body { font-family: -apple-system, 'Segoe UI', Helvetica, Arial, sans-serif; margin: 2em auto;
+       max-width: 1500px; color: #222; padding: 0 1em; }
+h1 { font-size: 1.5em; margin-bottom: 0.2em; } h2 { font-size: 1.15em; margin-top: 1.6em;
+     border-bottom: 1px solid #ddd; padding-bottom: 0.2em; }
+.sub { color: #666; margin-top: 0; }
+table { border-collapse: collapse; margin: 0.6em 0; font-size: 0.95em; }
+th, td { padding: 0.3em 0.8em; text-align: right; border-bottom: 1px solid #e4e4e4; }
+th { background: #f5f5f5; } td:first-child, th:first-child { text-align: left; }
+img { max-width: 100%; border: 1px solid #eee; }
+.note { color: #555; font-size: 0.9em; max-width: 70em; }
+"""
+
+
+def _img(png: bytes, alt: str) -> str:
+    return f'<img alt="{html.escape(alt)}" src="data:image/png;base64,' \
+           f'{base64.b64encode(png).decode("ascii")}">'
+
+
+def _table(header: list[str], rows: list[list[str]]) -> str:
+    head = "".join(f"<th>{html.escape(h)}</th>" for h in header)
+    body = "".join("<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in row) + "</tr>"
+                   for row in rows)
+    return f"<table><tr>{head}</tr>{body}</table>"
+
+
+def _f(value: float | None, digits: int = 3) -> str:
+    return "-" if value is None else f"{value:.{digits}f}"
+
+
+def report_html(result: Result) -> str:
+    """The whole report as one HTML document (figures as embedded PNGs, no network needed)."""
+    a, tf, o = result.alignment, result.alignment.transform, result.overlap
+    inputs = _table(["", "path", "kind"], [
+        ["map", str(result.map_path), result.map_kind],
+        ["truth", str(result.truth_path),
+         f"{result.truth_kind}, {result.grid.resolution:g} m cells, "
+         f"{result.grid.size_m[0]:.1f} x {result.grid.size_m[1]:.1f} m"]])
+    alignment = _table(
+        ["x [m]", "y [m]", "yaw [deg]", "scale", "fitness", "inlier RMSE [m]", "method"],
+        [[_f(tf.tx), _f(tf.ty), _f(tf.yaw_deg, 2), _f(tf.scale, 4),
+          f"{_f(a.fitness)} (within {a.tolerance_m:g} m)", _f(a.rmse_m), a.method]])
+    cover = _table(["coverage", "truth recall in footprint", "agreement", "scored against"],
+                   [[_f(o.coverage), _f(o.truth_recall), _f(o.agreement),
+                     "whole truth" if result.full else "the map's footprint"]])
+    rows = []
+    for name, det in result.detectors.items():
+        m, s = det.matching, det.displacement_stats()
+        rows.append([name, _f(m.quality), _f(m.precision), _f(m.f1), str(m.truth_features),
+                     str(m.map_features), str(m.matched), _f(s["mean"]), _f(s["median"]),
+                     _f(s["rmse"]), _f(s["max"])])
+    scores = _table(["detector", "quality q", "precision", "f1", "truth features",
+                     "map features", "matched", "disp. mean [m]", "disp. median [m]",
+                     "disp. RMSE [m]", "disp. max [m]"], rows)
+    vectors = _img(png_bytes(vectorial_figure(result)), "vectorial map per detector")
+    heat = _img(png_bytes(distance_heatmap(result)), "map-to-truth distance heatmap")
+    title = f"pcmapq: {html.escape(result.map_path.name)} against " \
+            f"{html.escape(result.truth_path.name)}"
+    return f"""<!DOCTYPE html>
+<html lang="en"><head><meta charset="utf-8"><title>{title}</title>
+<style>{STYLE}</style></head><body>
+<h1>{title}</h1>
+<p class="sub">pcmapq {__version__}. Frame convention: p_truth = s R(yaw) p_map + t; all
+coordinates in the truth frame, metres and degrees.</p>
+<h2>Inputs</h2>{inputs}
+<h2>Alignment (map frame to truth frame)</h2>{alignment}
+<p class="note">Fitness: share of map points within the tolerance of a truth wall after
+alignment. A low fitness on a map of the right place measures its distortion.</p>
+<h2>Coverage</h2>{cover}
+<p class="note">Coverage: share of the truth's walls inside the area the map observed (its
+footprint). Truth features outside the footprint are not counted as missing.</p>
+<h2>Feature matching within {result.threshold:g} m</h2>{scores}
+<p class="note">quality q = matched truth features / truth features (the paper's measure, a
+recall); precision = matched map features / map features; f1 = their harmonic mean.
+Displacements are from each truth feature to its map feature.</p>
+<h2>Vectorial map</h2>{vectors}
+<h2>Distance heatmap</h2>{heat}
+</body></html>
+"""

@@ -1,0 +1,87 @@
+"""Partial maps: scored against the part of the truth they cover."""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+import pytest
+
+from pcmapq import synth
+from pcmapq.align.transform import Similarity2D
+from pcmapq.config import Settings
+from pcmapq.pipeline import evaluate
+
+from .conftest import in_map_frame, write_cloud_map
+
+#: Sub-rectangles of the 24 m x 16 m plan (x0, y0, x1, y1, metres) and map poses.
+CUTS = [((-1, -1, 12.5, 17), Similarity2D(4.0, -6.0, np.radians(63.0))),      # west half
+        ((9.5, 6.0, 25, 17), Similarity2D(-8.0, 3.0, np.radians(-128.0))),    # north-east third
+        ((-1, -1, 25, 7.2), Similarity2D(15.0, 12.0, np.radians(201.0))),     # south rooms
+        ((7.0, -1, 25, 11.0), Similarity2D(-3.0, -2.0, np.radians(17.0)))]    # a 45 % corner
+
+
+def true_share(plan: np.ndarray, box) -> float:
+    """Share of the truth's wall cells inside ``box``."""
+    grid = synth.plan_grid(plan, 0.05)
+    xy = grid.cell_centres(synth.render(plan, grid) == synth.OCCUPIED)
+    x0, y0, x1, y1 = box
+    return float(np.mean((xy[:, 0] >= x0) & (xy[:, 0] <= x1) & (xy[:, 1] >= y0) & (xy[:, 1] <= y1)))
+
+
+def write_partial_image(plan, box, tf: Similarity2D, path):
+    """The plan seen in the map frame, with everything outside ``box`` (truth frame) unknown."""
+    segments = in_map_frame(plan, tf)
+    grid = synth.plan_grid(segments, 0.05)
+    img = synth.render(segments, grid)
+    x0, y0, x1, y1 = box
+    corners = tf.inverse().apply(np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]]))
+    mask = np.zeros(grid.shape, np.uint8)
+    cv2.fillConvexPoly(mask, np.round(grid.xy_to_pixels(corners)).astype(np.int32), 1)
+    img[mask == 0] = synth.UNKNOWN
+    cv2.imwrite(str(path), img)
+    ox, oy, _ = grid.origin
+    path.with_suffix(".yaml").write_text(f"image: {path.name}\nresolution: 0.05\n"
+                                         f"origin: [{ox}, {oy}, 0.0]\n")
+    return path
+
+
+@pytest.mark.parametrize(("box", "tf"), CUTS)
+def test_partial_image_map(plan, truth_png, tmp_path, box, tf):
+    share = true_share(plan, box)
+    assert 0.3 <= share <= 0.62
+    result = evaluate(write_partial_image(plan, box, tf, tmp_path / "part.png"), truth_png)
+    got = result.alignment.transform
+    assert np.hypot(got.tx - tf.tx, got.ty - tf.ty) < 0.1
+    assert abs(result.overlap.coverage - share) < 0.1, (result.overlap.coverage, share)
+    for name, det in result.detectors.items():
+        assert det.matching.quality >= 0.85, (name, det.matching.quality)
+
+
+@pytest.mark.parametrize(("box", "tf"), CUTS)
+def test_partial_cloud_map(plan, truth_png, tmp_path, box, tf):
+    share = true_share(plan, box)
+    pts = synth.wall_points(plan, 0.02, noise=0.01, seed=3)
+    x0, y0, x1, y1 = box
+    pts = pts[(pts[:, 0] >= x0) & (pts[:, 0] <= x1) & (pts[:, 1] >= y0) & (pts[:, 1] <= y1)]
+    result = evaluate(write_cloud_map(tf.inverse().apply(pts), tmp_path / "part.npy"), truth_png)
+    assert abs(result.overlap.coverage - share) < 0.1, (result.overlap.coverage, share)
+    for name, det in result.detectors.items():
+        assert det.matching.quality >= 0.85, (name, det.matching.quality)
+
+
+def test_full_map_covers_the_truth(plan, truth_png, tmp_path):
+    tf = Similarity2D(2.0, 1.0, np.radians(30.0))
+    pts = synth.wall_points(in_map_frame(plan, tf), 0.02, noise=0.01)
+    result = evaluate(write_cloud_map(pts, tmp_path / "full.npy"), truth_png)
+    assert result.overlap.coverage >= 0.95
+
+
+def test_full_flag_scores_against_the_whole_truth(plan, truth_png, tmp_path):
+    box, tf = CUTS[0]
+    path = write_partial_image(plan, box, tf, tmp_path / "part.png")
+    part = evaluate(path, truth_png)
+    whole = evaluate(path, truth_png, Settings(full=True))
+    for name in part.detectors:
+        q_part = part.detectors[name].matching.quality
+        q_whole = whole.detectors[name].matching.quality
+        assert q_whole < 0.75 * q_part, (name, q_whole, q_part)
