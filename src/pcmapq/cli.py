@@ -16,6 +16,7 @@ from pcmapq.align.transform import Similarity2D
 from pcmapq.config import DETECTOR_NAMES, Settings
 from pcmapq.errors import EvaluationError, InputError
 from pcmapq.io.writers import write_atomic
+from pcmapq.metrics.distances import DEFAULT_TAUS
 from pcmapq.pipeline import evaluate
 from pcmapq.report.table import print_table
 
@@ -48,6 +49,17 @@ def _parse_init(text: str | None) -> Similarity2D | None:
         raise typer.BadParameter(f"expected x,y,yaw (metres, metres, degrees), got {text!r}",
                                  param_hint="--init") from None
     return Similarity2D(x, y, float(np.radians(yaw)))
+
+
+def _parse_taus(text: str) -> tuple[float, ...]:
+    try:
+        taus = tuple(float(v) for v in text.split(","))
+    except ValueError:
+        taus = ()
+    if not taus or min(taus) <= 0:
+        raise typer.BadParameter(f"expected positive distances in metres, got {text!r}",
+                                 param_hint="--tau")
+    return taus
 
 
 def _parse_detectors(text: str) -> tuple[str, ...]:
@@ -95,6 +107,9 @@ def eval_command(
         help="Draw the vectorial map, one panel per detector, as PNG.")] = None,
     report: Annotated[Path | None, typer.Option(
         help="Write a self-contained HTML report (figures embedded).")] = None,
+    tau: Annotated[str, typer.Option(
+        help="Distance thresholds of the F-score, metres, comma-separated.")
+    ] = ",".join(f"{t:g}" for t in DEFAULT_TAUS),
     full: Annotated[bool, typer.Option(
         "--full", help="Score against the whole truth, not only the part the map covers.")
     ] = False,
@@ -103,7 +118,7 @@ def eval_command(
     settings = Settings(map_resolution=map_resolution, truth_resolution=truth_resolution,
                         band_low=band_low, band_high=band_high, init=_parse_init(init),
                         align=not no_align, force=force, threshold=threshold, min_hits=min_hits,
-                        detectors=_parse_detectors(detectors), full=full)
+                        detectors=_parse_detectors(detectors), full=full, taus=_parse_taus(tau))
     quiet = json_path == "-"
     err = Console(stderr=True)
     out = Console(quiet=quiet, width=None if err.is_terminal else 132)

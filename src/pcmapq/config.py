@@ -5,6 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from pcmapq.align.transform import Similarity2D
+from pcmapq.metrics.distances import DEFAULT_TAUS
 
 DETECTOR_NAMES = ("harris", "hough", "sift")
 
@@ -30,6 +31,7 @@ class Settings:
         for a 3D cloud (its wall band stacks many points on a wall cell, and a lone outlier is
         dropped) and 1 for a 2D cloud (a laser map puts one or two points per wall cell).
     detectors: which detectors to run.
+    taus: distance thresholds of the F-score, metres.
     full: score against the whole truth; by default truth features outside the map's footprint
         (the area it observed) are not counted as missing.
     """
@@ -49,3 +51,4 @@ class Settings:
     min_hits: int | None = None
     detectors: tuple[str, ...] = DETECTOR_NAMES
     full: bool = False
+    taus: tuple[float, ...] = DEFAULT_TAUS

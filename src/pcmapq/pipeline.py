@@ -15,6 +15,7 @@ from pcmapq.features import Features, detect
 from pcmapq.grid import MetricGrid
 from pcmapq.io import OccupancyMap, PointMap, load_map
 from pcmapq.match import match
+from pcmapq.metrics.distances import distances
 from pcmapq.raster.draw import OCCUPIED, UNKNOWN, points_to_grid, warp_state
 from pcmapq.raster.footprint import map_footprint, near
 from pcmapq.raster.slice import wall_band
@@ -122,5 +123,6 @@ def evaluate(map_path: str | Path, truth_path: str | Path, settings: Settings | 
                                          match(name, truth_f, map_f, settings.threshold))
     return Result(map_path=Path(map_path), map_kind=source.kind, truth_path=Path(truth_path),
                   truth_kind=truth.kind, grid=grid, alignment=alignment, overlap=cover,
+                  distances=distances(truth_occ, map_occ, footprint, grid, settings.taus),
                   threshold=settings.threshold, full=settings.full, detectors=detectors,
                   truth_occupied=truth_occ, map_occupied=map_occ)

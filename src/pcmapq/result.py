@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import io
 import json
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 from pathlib import Path
 
 import numpy as np
@@ -13,6 +13,7 @@ from pcmapq.align import Alignment
 from pcmapq.features import Features
 from pcmapq.grid import MetricGrid
 from pcmapq.match import Matching
+from pcmapq.metrics.distances import Distances
 
 #: Decimals kept in saved numbers: micrometres, so reruns give byte-identical files.
 DECIMALS = 6
@@ -77,6 +78,7 @@ class Result:
     grid: MetricGrid
     alignment: Alignment
     overlap: Overlap
+    distances: Distances
     threshold: float
     full: bool
     detectors: dict[str, DetectorResult]
@@ -99,6 +101,7 @@ class Result:
                           "agreement": self.overlap.agreement},
             "coverage": self.overlap.coverage,
             "scored_against": "whole truth" if self.full else "footprint",
+            "distances": _distances_dict(self.distances),
             "detectors": {},
             "matches": [], "missing": [], "extra": [],
         }
@@ -132,6 +135,11 @@ class Result:
                                     det.distances])
             np.savetxt(out, rows + 0.0, fmt=",".join([name] + [f"%.{DECIMALS}f"] * 7))
         return out.getvalue()
+
+
+def _distances_dict(d: Distances) -> dict:
+    return {"accuracy_m": asdict(d.accuracy), "completeness_m": asdict(d.completeness),
+            "chamfer_m": d.chamfer_m, "f_score": [asdict(f) for f in d.fscores]}
 
 
 def _rounded(value):

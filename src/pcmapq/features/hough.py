@@ -41,8 +41,9 @@ from pcmapq.grid import MetricGrid
 MAX_ANGLE = 10.0
 
 
-def ridges(image: np.ndarray, sigma_px: float, floor: float) -> np.ndarray:
-    """One-pixel centre lines of the bright ridges of ``image`` (Steger's detector).
+def ridges(image: np.ndarray, sigma_px: float, floor: float) -> tuple[np.ndarray, np.ndarray]:
+    """One-pixel centre lines of the bright ridges of ``image`` (Steger's detector), and their
+    local direction.
 
     A pixel is on a ridge when the maximum of the smoothed image across the ridge (along the
     Hessian's most negative eigenvector, to second order) lies inside the pixel: the line is
@@ -59,7 +60,9 @@ def ridges(image: np.ndarray, sigma_px: float, floor: float) -> np.ndarray:
 
     Returns
     -------
-    (rows, cols) bool mask of ridge pixels.
+    mask : (rows, cols) bool mask of ridge pixels.
+    direction : (rows, cols) float32 direction along the ridge, radians in [0, pi) measured
+        from the pixel u axis towards v (meaningful on the mask only).
     """
     s = gaussian(image, sigma_px)
 
@@ -75,7 +78,63 @@ def ridges(image: np.ndarray, sigma_px: float, floor: float) -> np.ndarray:
     t = -(gu * nu + gv * nv) / np.minimum(lam, -1e-12)  # distance to the maximum, pixels
     inside = (np.abs(t * nu) <= 0.5) & (np.abs(t * nv) <= 0.5)
     line_like = np.abs(along) <= 0.5 * np.abs(lam)  # not a blob (a wall end)
-    return inside & line_like & (-lam * sigma_px**2 >= floor)
+    mask = inside & line_like & (-lam * sigma_px**2 >= floor)
+    return mask, np.mod(theta + 0.5 * np.pi, np.pi).astype(np.float32)
+
+
+#: Direction bins of one partition of the ridge pixels (30 degrees each).
+_BINS = 6
+
+
+def _label(mask: np.ndarray, direction: np.ndarray, offset: float) -> tuple[np.ndarray, int]:
+    """Connected pieces (8-connected) of ridge pixels whose directions fall in the same bin of
+    ``_BINS`` bins over [0, pi), the bins shifted by ``offset`` of a bin: (rows, cols) int32
+    labels (0 off the pieces) and the number of pieces."""
+    bins = np.floor(np.mod(direction * (_BINS / np.pi) + offset, _BINS)).astype(np.int32)
+    labels = np.zeros(mask.shape, dtype=np.int32)
+    count = 0
+    for k in range(_BINS):
+        n, lab = cv2.connectedComponents((mask & (bins == k)).astype(np.uint8), connectivity=8)
+        on = lab > 0
+        labels[on] = lab[on] + count
+        count += n - 1
+    return labels, count
+
+
+def pieces(mask: np.ndarray, direction: np.ndarray) -> np.ndarray:
+    """Straight pieces of the ridge lines, in pixels (u, v): (N, 4) ``u0, v0, u1, v1``.
+
+    The ridge pixels are split by their local direction into 30 degree bins; each connected run
+    of pixels of one bin is a piece, fitted by the principal axis of its pixels and spanning
+    them (to the outer edges of its end pixels). Two partitions, the second shifted by half a
+    bin, are used together, so a wall whose direction lies on a bin border is still whole in one
+    of them; the duplicates are merged later. A piece follows the ridge pixels themselves: it
+    neither jumps between parallel walls nor cuts across a curve, and a wall wavy by a pixel
+    stays one piece as long as its direction stays within the bin.
+    """
+    out = []
+    for offset in (0.0, 0.5):
+        labels, n = _label(mask, direction, offset)
+        v, u = np.nonzero(labels)
+        lab = labels[v, u]
+        count = np.bincount(lab, minlength=n + 1).astype(np.float64)
+        count[0] = 1.0
+        cu = np.bincount(lab, u, n + 1) / count
+        cv = np.bincount(lab, v, n + 1) / count
+        du, dv = u - cu[lab], v - cv[lab]
+        suu = np.bincount(lab, du * du, n + 1)
+        svv = np.bincount(lab, dv * dv, n + 1)
+        suv = np.bincount(lab, du * dv, n + 1)
+        angle = 0.5 * np.arctan2(2 * suv, suu - svv)  # principal axis of each piece
+        eu, ev = np.cos(angle), np.sin(angle)
+        t = du * eu[lab] + dv * ev[lab]
+        lo, hi = np.full(n + 1, np.inf), np.full(n + 1, -np.inf)
+        np.minimum.at(lo, lab, t)
+        np.maximum.at(hi, lab, t)
+        lo, hi = lo[1:] - 0.5, hi[1:] + 0.5  # pixel centres to pixel edges
+        cu, cv, eu, ev = cu[1:], cv[1:], eu[1:], ev[1:]
+        out.append(np.column_stack([cu + lo * eu, cv + lo * ev, cu + hi * eu, cv + hi * ev]))
+    return np.concatenate(out).reshape(-1, 4)
 
 
 def _directions(seg: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -241,13 +300,13 @@ def detect(occupied: np.ndarray, grid: MetricGrid, *, resolution: float = 0.05,
     Features with ``segments`` (N, 4), ``xy`` the midpoints and ``strength`` the lengths.
     """
     image, work = working_image(occupied, grid, resolution, closing)
-    thin = ridges(image, sigma / resolution, ridge).astype(np.uint8) * 255
-    shortest = support * min_length / resolution
-    lines = cv2.HoughLinesP(thin, 1.0, np.radians(angle_step), max(2, int(0.8 * shortest)),
-                            minLineLength=shortest, maxLineGap=max_gap / resolution)
-    if lines is None:
+    mask, direction = ridges(image, sigma / resolution, ridge)
+    px = pieces(mask, direction)
+    _, size = _directions(px)
+    px = px[size >= support * min_length / resolution]
+    if len(px) == 0:
         return empty_features(with_segments=True)
-    seg = work.pixels_to_xy(lines.reshape(-1, 2).astype(np.float64)).reshape(-1, 4)
+    seg = work.pixels_to_xy(px.reshape(-1, 2)).reshape(-1, 4)
     solid = wall_test(gaussian(image, sigma / resolution), work, _SOLID)
     seg = merge(seg, merge_angle, merge_offset, max_gap, solid, max_bridge)
     _, length = _directions(seg)

@@ -2,13 +2,25 @@
 
 As in the paper, a binary map is first turned into a grey image of its local entropy: with
 ``p`` the occupied fraction in a Gaussian window of ``window`` metres (on the working image, see
-:mod:`pcmapq.features.base`), ``H = -p log2 p - (1 - p) log2 (1 - p)`` bits, in [0, 1], scaled
-to uint8. ``cv2.SIFT`` runs on it with fixed parameters; the fixed working resolution makes its
-scales metric, and keypoints wider than ``max_size`` metres (room-sized blobs) are dropped.
-Hysteresis: SIFT runs twice, a loose run (support contrast, laxer edge test) giving the
-features and a strict run marking the strong ones, which must also be the strongest within
-``radius`` metres. SIFT returns one keypoint per dominant orientation: one is kept per place.
-``strength`` is the SIFT response (the DoG contrast of the keypoint, image scaled to [0, 1]).
+:mod:`pcmapq.features.base`), ``H = -p log2 p - (1 - p) log2 (1 - p)`` bits, in [0, 1].
+
+Keypoints are the extrema of SIFT's difference-of-Gaussians (DoG) scale space of that image,
+built as ``cv2.SIFT`` builds it (``octave_layers`` layers per octave, base blur ``sigma``
+pixels of the working image; no doubled first octave), so the fixed working resolution makes
+the scales metric. Detection is done here rather than by ``cv2.SIFT``, whose sub-pixel
+refinement drops an extremum when its quadratic fit keeps stepping between two samples: it
+happens when the extremum lies about half a sample from both, and so comes and goes with a
+half-cell shift of the map. Here every sample that is an extremum of its 26 neighbours is a
+keypoint, refined by one quadratic step clipped to half a sample in space and scale, so a
+keypoint exists wherever the DoG has an extremum. Its response is the refined DoG contrast
+(image in [0, 1]); keypoints wider than ``max_size`` metres (room-sized blobs) are dropped.
+Each keypoint gets the dominant orientation of its gradient histogram (as SIFT computes it),
+and ``cv2.SIFT`` computes the descriptors of these keypoints.
+
+Hysteresis: a keypoint is kept at ``support * threshold`` response and an edge ratio under
+``support_edge * edge``; it is strong at ``threshold`` and under ``edge``, if it is also the
+strongest keypoint within ``radius`` metres. Keypoints closer than 0.05 m are one (the
+strongest is kept). ``strength`` is the response.
 
 Matching: pairs within the threshold in metres are candidates; the cost is the descriptor
 (L2) distance, so among nearby keypoints the most alike are paired.
@@ -18,7 +30,7 @@ from __future__ import annotations
 
 import cv2
 import numpy as np
-from scipy.spatial import cKDTree
+from scipy import ndimage
 
 from pcmapq.features.base import (
     Candidates,
@@ -33,8 +45,12 @@ from pcmapq.features.base import (
 )
 from pcmapq.grid import MetricGrid
 
-#: Keypoints closer than this are one keypoint seen with several orientations, metres.
-_DUPLICATE = 0.05
+#: Keypoints closer than this are one keypoint, metres.
+_DUPLICATE = 0.1
+#: Samples this close to the image border are not searched for extrema (as in cv2.SIFT).
+_BORDER = 5
+#: Orientation histogram: bins, window radius and Gaussian weight in keypoint scales (as SIFT).
+_ORI_BINS, _ORI_RADIUS, _ORI_SIGMA = 36, 4.5, 1.5
 
 
 def entropy(image: np.ndarray, window_px: float) -> np.ndarray:
@@ -58,7 +74,7 @@ def detect(occupied: np.ndarray, grid: MetricGrid, *, resolution: float = 0.05,
            closing: float = 0.1, window: float = 0.15, threshold: float = 0.025,
            support: float = 0.5, radius: float = 0.3, octave_layers: int = 3,
            edge: float = 10.0, sigma: float = 1.6, max_size: float = 1.0,
-           support_edge: float = 2.0, precise: bool = False) -> Features:
+           support_edge: float = 2.0) -> Features:
     """SIFT keypoints and descriptors of the entropy image of a binary map.
 
     Parameters
@@ -68,64 +84,197 @@ def detect(occupied: np.ndarray, grid: MetricGrid, *, resolution: float = 0.05,
     resolution : working cell size, metres.
     closing : closing radius, metres (see :func:`pcmapq.features.base.working_image`).
     window : sigma of the entropy window, metres.
-    threshold : detection threshold on the SIFT response (DoG contrast, image in [0, 1]).
+    threshold : detection threshold on the response (DoG contrast, image in [0, 1]).
     support : support threshold, as a fraction of ``threshold``.
-    radius : only the strongest keypoint within this radius is kept, metres.
+    radius : a strong keypoint must be the strongest within this radius, metres.
+    octave_layers : DoG layers searched per octave (``cv2.SIFT_create``'s nOctaveLayers).
+    edge : edge test: a keypoint whose DoG principal curvatures differ by a ratio of ``edge``
+        or more is edge-like, not strong (``cv2.SIFT_create``'s edgeThreshold).
+    sigma : blur of the first scale, pixels of the working image (``cv2.SIFT_create``'s sigma).
     max_size : largest keypoint diameter kept, metres: room-sized blobs are not local
-        features, and whether SIFT finds them depends on the whole room.
-    support_edge : the support-level run accepts edge-like keypoints up to this multiple of
-        ``edge``: a keypoint near the edge test's limit is found on one side only.
-    octave_layers, edge, sigma : ``cv2.SIFT_create``'s nOctaveLayers, edgeThreshold and sigma
-        (pixels of the working image).
+        features, and whether they are found depends on the whole room.
+    support_edge : support-level keypoints may be edge-like up to a ratio of this multiple of
+        ``edge``: a keypoint near the edge test's limit passes it on one side only.
 
     Returns
     -------
-    Features with ``strength`` the SIFT response and ``descriptors`` (N, 128) float32.
+    Features with ``strength`` the response and ``descriptors`` (N, 128) float32.
     """
     image, work = working_image(occupied, grid, resolution, closing)
-    grey = np.round(entropy(image, window / resolution) * 255).astype(np.uint8)
-    # OpenCV drops keypoints below contrastThreshold / nOctaveLayers
-    strict = _keypoints(grey, octave_layers, threshold * octave_layers, edge, sigma, max_size,
-                        resolution, precise)
-    loose = _keypoints(grey, octave_layers, support * threshold * octave_layers,
-                       support_edge * edge, sigma, max_size, resolution, precise)
-    if loose is None:
+    ent = entropy(image, window / resolution)
+    # octaves whose smallest keypoint (layer 1, refined half a layer down) is under max_size
+    first = 2.0 * sigma * 2.0 ** (0.5 / octave_layers) * resolution
+    wanted = int(np.floor(np.log2(max_size / first))) + 1 if max_size >= first else 0
+    octaves = min(wanted, int(round(np.log2(max(min(ent.shape), 1)))) - 2)
+    if octaves < 1:
         return empty_features(with_descriptors=True)
-    uv, value, desc = loose
-    xy = work.pixels_to_xy(uv)
-    strong = np.zeros(len(xy), dtype=bool)
-    if strict is not None:  # the loose keypoints the strict run finds too
-        near = cKDTree(work.pixels_to_xy(strict[0])).query(xy, distance_upper_bound=_DUPLICATE)
-        strong = np.isfinite(near[0])
-    # one keypoint per place (SIFT repeats it per orientation); strong ones are also the
-    # strongest within radius. Support ones are not suppressed by neighbours, so a keypoint
-    # suppressed by a slightly stronger neighbour on one side still confirms the other's.
-    keep = suppress(xy, value, _DUPLICATE)
-    strong &= suppress(xy, value, radius)
-    return sorted_features(xy[keep], value[keep], strong[keep],
-                           descriptors=desc[keep].astype(np.float32))
+    gauss = _gaussian_pyramid(ent, sigma, octave_layers, octaves)
+    kp = _extrema(gauss, sigma, 0.5 * support * threshold)
+    size = kp["size"] * resolution
+    response = np.abs(kp["contrast"])
+    ratio = kp["edge_ratio"]
+
+    def edge_ok(r: float) -> np.ndarray:  # Lowe's test: tr^2 / det < (r + 1)^2 / r
+        return ratio < (r + 1.0) ** 2 / r
+
+    keep = (size <= max_size) & (response >= support * threshold) & edge_ok(support_edge * edge)
+    strong = (response >= threshold) & edge_ok(edge)
+    kp = {k: v[keep] for k, v in kp.items()}
+    response, strong = response[keep], strong[keep]
+    if not len(response):
+        return empty_features(with_descriptors=True)
+    xy = work.pixels_to_xy(kp["pt"])
+    # one keypoint per place; strong ones are also the strongest within radius. Support ones
+    # are not suppressed by neighbours, so a keypoint suppressed by a slightly stronger
+    # neighbour on one side still confirms the other's.
+    once = suppress(xy, response, _DUPLICATE)
+    strong &= suppress(xy, response, radius)
+    kp = {k: v[once] for k, v in kp.items()}
+    xy, response, strong = xy[once], response[once], strong[once]
+    angle = _orientations(gauss, kp)
+    grey = np.round(ent * 255).astype(np.uint8)
+    desc = _descriptors(grey, kp, angle, response, octave_layers, sigma)
+    return sorted_features(xy, response, strong, descriptors=desc)
 
 
-def _keypoints(grey: np.ndarray, layers: int, contrast: float, edge: float, sigma: float,
-               max_size: float, resolution: float, precise=False
-               ) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
-    """SIFT on ``grey``: pixel positions (N, 2), responses (N,) and descriptors (N, 128) of
-    the keypoints at most ``max_size`` metres across; None when there are none."""
-    sift = cv2.SIFT_create(nOctaveLayers=layers, contrastThreshold=contrast,
-                           edgeThreshold=edge, sigma=sigma, enable_precise_upscale=precise)
-    keypoints, desc = sift.detectAndCompute(grey, None)
-    if not keypoints:
-        return None
-    small = np.array([k.size for k in keypoints]) * resolution <= max_size
-    if not small.any():
-        return None
-    uv = np.array([k.pt for k in keypoints], dtype=np.float64)
-    value = np.array([k.response for k in keypoints], dtype=np.float64)
-    return uv[small], value[small], desc[small]
+def _gaussian_pyramid(image: np.ndarray, sigma: float, layers: int,
+                      octaves: int) -> list[np.ndarray]:
+    """SIFT's Gaussian scale space of ``image``, as ``cv2.SIFT`` builds it without doubling the
+    image: per octave a stack (layers + 4, rows, cols) float32 of blurs ``sigma 2^(i / layers)``
+    pixels of the octave, each octave starting from the previous one's layer ``layers``, halved.
+    ``cv2.SIFT`` has one layer fewer; the extra one makes consecutive octaves share a DoG layer
+    where extrema are searched, so an extremum at an octave's scale limit is not lost between
+    two octaves sampled differently."""
+    k = 2.0 ** (1.0 / layers)
+    step = [np.sqrt(max(sigma * sigma - 0.25, 0.01))]  # the input counts as blurred by 0.5 px
+    step += [sigma * k ** (i - 1) * np.sqrt(k * k - 1.0) for i in range(1, layers + 4)]
+    pyramid: list[np.ndarray] = []
+    for o in range(octaves):
+        if o == 0:
+            current = image.astype(np.float32)
+        else:
+            prev = pyramid[-1][layers]
+            current = np.ascontiguousarray(prev[: prev.shape[0] // 2 * 2 : 2,
+                                                : prev.shape[1] // 2 * 2 : 2])
+        stack = []
+        for i in range(layers + 4):
+            if i > 0 or o == 0:
+                current = cv2.GaussianBlur(current, (0, 0), step[i])
+            stack.append(current)
+        pyramid.append(np.stack(stack))
+        if min(current.shape) < 2 * _BORDER + 3:  # no sample left to search
+            break
+    return pyramid
+
+
+def _extrema(gauss: list[np.ndarray], sigma: float, floor: float) -> dict[str, np.ndarray]:
+    """Every DoG sample that is an extremum of its 26 neighbours with ``|DoG| >= floor``, in
+    layers 1 to ``layers + 1`` of each octave, refined by one quadratic step clipped to half a
+    sample in space and scale (a sample is an extremum's nearest one when the fit says more:
+    the fit overshoots, and stepping to the next sample is what loses keypoints).
+
+    Returns per keypoint: octave, layer, the integer sample (row, col), pt (N, 2) (u, v) in
+    working pixels, xi (scale offset, layers), size (diameter 2 * scale, working pixels),
+    contrast (refined DoG) and edge_ratio (trace^2 / det of the spatial Hessian, inf when
+    the curvatures differ in sign).
+    """
+    found = [_octave_extrema(stack[1:] - stack[:-1], o, sigma, floor)
+             for o, stack in enumerate(gauss)]
+    keys = ("octave", "layer", "row", "col", "pt", "xi", "size", "contrast", "edge_ratio")
+    return {k: np.concatenate([f[k] for f in found]) for k in keys}
+
+
+def _octave_extrema(dog: np.ndarray, octave: int, sigma: float,
+                    floor: float) -> dict[str, np.ndarray]:
+    """:func:`_extrema` in one octave's DoG stack (layers + 3, rows, cols)."""
+    layers = dog.shape[0] - 3
+    peak = (((dog >= floor) & (dog == ndimage.maximum_filter(dog, size=3, mode="nearest")))
+            | ((dog <= -floor) & (dog == ndimage.minimum_filter(dog, size=3, mode="nearest"))))
+    peak[[0, -1]] = False
+    peak[:, :_BORDER], peak[:, peak.shape[1] - _BORDER :] = False, False
+    peak[:, :, :_BORDER], peak[:, :, peak.shape[2] - _BORDER :] = False, False
+    lay, r, c = np.nonzero(peak)
+
+    def at(dl: int, dr: int, dc: int) -> np.ndarray:
+        return dog[lay + dl, r + dr, c + dc].astype(np.float64)
+
+    v = at(0, 0, 0)
+    grad = 0.5 * np.stack([at(0, 0, 1) - at(0, 0, -1), at(0, 1, 0) - at(0, -1, 0),
+                           at(1, 0, 0) - at(-1, 0, 0)], axis=1)
+    dxx = at(0, 0, 1) + at(0, 0, -1) - 2 * v
+    dyy = at(0, 1, 0) + at(0, -1, 0) - 2 * v
+    dss = at(1, 0, 0) + at(-1, 0, 0) - 2 * v
+    dxy = 0.25 * (at(0, 1, 1) - at(0, 1, -1) - at(0, -1, 1) + at(0, -1, -1))
+    dxs = 0.25 * (at(1, 0, 1) - at(1, 0, -1) - at(-1, 0, 1) + at(-1, 0, -1))
+    dys = 0.25 * (at(1, 1, 0) - at(1, -1, 0) - at(-1, 1, 0) + at(-1, -1, 0))
+    hess = np.stack([np.stack([dxx, dxy, dxs], 1), np.stack([dxy, dyy, dys], 1),
+                     np.stack([dxs, dys, dss], 1)], 1)
+    offset = np.clip(-np.einsum("nij,nj->ni", np.linalg.pinv(hess), grad), -0.5, 0.5)
+    det, trace = dxx * dyy - dxy * dxy, dxx + dyy
+    scale = 2.0 ** octave  # working pixels per pixel of the octave
+    return {
+        "octave": np.full(len(lay), octave),
+        "layer": lay,
+        "row": r,
+        "col": c,
+        "pt": np.column_stack([c + offset[:, 0], r + offset[:, 1]]) * scale,
+        "xi": offset[:, 2],
+        "size": 2.0 * sigma * 2.0 ** ((lay + offset[:, 2]) / layers) * scale,
+        "contrast": v + 0.5 * np.sum(grad * offset, axis=1),
+        "edge_ratio": np.where(det > 0, trace * trace / np.where(det > 0, det, 1.0), np.inf),
+    }
+
+
+def _orientations(gauss: list[np.ndarray], kp: dict[str, np.ndarray]) -> np.ndarray:
+    """The dominant gradient orientation of each keypoint, degrees, as ``cv2.SIFT`` computes
+    and encodes it (a 36-bin histogram of the Gaussian layer around the sample, smoothed, its
+    highest peak refined by a parabola; angle = 360 - peak, counter-clockwise in the image)."""
+    angles = np.zeros(len(kp["layer"]))
+    n = _ORI_BINS
+    for idx in range(len(angles)):
+        o, layer = int(kp["octave"][idx]), int(kp["layer"][idx])
+        img = gauss[o][layer]
+        r, c = int(kp["row"][idx]), int(kp["col"][idx])
+        scl = kp["size"][idx] / 2.0 / 2.0 ** o  # scale in pixels of the octave
+        rad = int(round(_ORI_RADIUS * scl))
+        r0, r1 = max(r - rad, 1), min(r + rad, img.shape[0] - 2)
+        c0, c1 = max(c - rad, 1), min(c + rad, img.shape[1] - 2)
+        dx = img[r0 : r1 + 1, c0 + 1 : c1 + 2] - img[r0 : r1 + 1, c0 - 1 : c1]
+        dy = img[r0 - 1 : r1, c0 : c1 + 1] - img[r0 + 1 : r1 + 2, c0 : c1 + 1]
+        vv, uu = np.mgrid[r0 - r : r1 - r + 1, c0 - c : c1 - c + 1]
+        weight = np.exp(-(uu * uu + vv * vv) / (2.0 * (_ORI_SIGMA * scl) ** 2))
+        ori = np.degrees(np.arctan2(dy, dx)) % 360.0
+        bins = np.round(ori * n / 360.0).astype(np.int64) % n
+        raw = np.bincount(bins.ravel(), weights=(weight * np.hypot(dx, dy)).ravel(), minlength=n)
+        hist = (np.roll(raw, 2) + np.roll(raw, -2)) / 16 + (np.roll(raw, 1) + np.roll(raw, -1)) * (
+            4 / 16) + raw * (6 / 16)
+        j = int(np.argmax(hist))
+        left, mid, right = hist[(j - 1) % n], hist[j], hist[(j + 1) % n]
+        curve = left - 2 * mid + right
+        peak = j + (0.5 * (left - right) / curve if curve < 0 else 0.0)
+        angle = 360.0 - (360.0 / n) * (peak % n)
+        angles[idx] = 0.0 if abs(angle - 360.0) < 1e-6 else angle
+    return angles
+
+
+def _descriptors(grey: np.ndarray, kp: dict[str, np.ndarray], angle: np.ndarray,
+                 response: np.ndarray, layers: int, sigma: float) -> np.ndarray:
+    """``cv2.SIFT`` descriptors (N, 128) float32 of the keypoints on the uint8 image."""
+    octave = (kp["octave"] + (kp["layer"] << 8)
+              + (np.round((kp["xi"] + 0.5) * 255).astype(np.int64) << 16))
+    points = [cv2.KeyPoint(float(u), float(v), float(s), float(a), float(r), int(oc))
+              for (u, v), s, a, r, oc in zip(kp["pt"], kp["size"], angle, response, octave,
+                                             strict=True)]
+    sift = cv2.SIFT_create(nOctaveLayers=layers, sigma=sigma)
+    got, desc = sift.compute(grey, points)
+    if len(got) != len(points):
+        raise RuntimeError("cv2.SIFT dropped keypoints it was given")
+    return np.asarray(desc, dtype=np.float32).reshape(-1, 128)
 
 
 #: Largest L2 distance between two OpenCV SIFT descriptors (each normalised to 512).
 DESCRIPTOR_MAX = 512.0 * np.sqrt(2.0)
+
 
 def candidates(truth: Features, map_: Features, threshold: float) -> Candidates:
     """Keypoint pairs within ``threshold`` metres; cost = the mean of their distance over the

@@ -34,3 +34,7 @@ def print_table(result: Result, console: Console) -> None:
                       str(m.truth_features), str(m.map_features), str(m.matched),
                       *(_m(stats[k]) for k in ("mean", "median", "rmse", "max")))
     console.print(table)
+    d = result.distances
+    f = "  ".join(f"F@{s.tau_m:g} m {s.f:.3f}" for s in d.fscores)
+    console.print(f"distances: accuracy mean {_m(d.accuracy.mean)} m, completeness mean "
+                  f"{_m(d.completeness.mean)} m, Chamfer {_m(d.chamfer_m)} m  {f}")

@@ -1,0 +1,79 @@
+"""Cloud-to-cloud style distance metrics on the truth's grid: accuracy, completeness, Chamfer
+distance and precision / recall / F-score at distance thresholds (definitions in
+docs/metrics.md). Exact Euclidean distance transforms; metres."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import ndimage
+
+from pcmapq.grid import MetricGrid
+
+#: Default distance thresholds of the F-score, metres.
+DEFAULT_TAUS = (0.05, 0.1, 0.2, 0.5)
+
+
+@dataclass(frozen=True)
+class DistanceStats:
+    """Statistics of a set of distances, metres (None when the set is empty or holds an
+    infinite distance: nothing on the other side to measure to)."""
+
+    mean: float | None
+    median: float | None
+    rmse: float | None
+    p95: float | None
+    count: int
+
+    @classmethod
+    def of(cls, d: np.ndarray) -> DistanceStats:
+        if len(d) == 0 or not np.isfinite(d).all():
+            return cls(None, None, None, None, int(len(d)))
+        return cls(float(d.mean()), float(np.median(d)), float(np.sqrt(np.mean(d**2))),
+                   float(np.percentile(d, 95)), int(len(d)))
+
+
+@dataclass(frozen=True)
+class FScore:
+    """Precision (map cells within tau of the truth), recall (covered truth cells within tau of
+    the map) and their harmonic mean, at threshold ``tau_m`` metres."""
+
+    tau_m: float
+    precision: float
+    recall: float
+    f: float
+
+
+@dataclass(frozen=True)
+class Distances:
+    accuracy: DistanceStats      # map -> truth
+    completeness: DistanceStats  # truth (inside the footprint) -> map
+    chamfer_m: float | None      # mean of the two means
+    fscores: tuple[FScore, ...]
+
+
+def nearest_distance(target: np.ndarray, grid: MetricGrid) -> np.ndarray:
+    """Distance in metres from every cell to the nearest true cell of ``target`` (inf if none)."""
+    if not target.any():
+        return np.full(target.shape, np.inf)
+    return ndimage.distance_transform_edt(~target) * grid.resolution
+
+
+def distances(truth_occ: np.ndarray, map_occ: np.ndarray, footprint: np.ndarray,
+              grid: MetricGrid, taus: tuple[float, ...] = DEFAULT_TAUS) -> Distances:
+    """Distance metrics between the occupied cells of the aligned map and of the truth.
+
+    truth_occ, map_occ, footprint: (rows, cols) bool on ``grid``. Completeness and recall only
+    count the truth cells inside ``footprint`` (the area the map observed).
+    """
+    acc = nearest_distance(truth_occ, grid)[map_occ]
+    comp = nearest_distance(map_occ, grid)[truth_occ & footprint]
+    a, c = DistanceStats.of(acc), DistanceStats.of(comp)
+    chamfer = None if a.mean is None or c.mean is None else 0.5 * (a.mean + c.mean)
+    scores = []
+    for tau in taus:
+        p = float(np.mean(acc <= tau)) if len(acc) else 0.0
+        r = float(np.mean(comp <= tau)) if len(comp) else 0.0
+        scores.append(FScore(tau, p, r, 2 * p * r / (p + r) if p + r > 0 else 0.0))
+    return Distances(a, c, chamfer, tuple(scores))

@@ -1,0 +1,48 @@
+"""Distance metrics with known answers."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from pcmapq.grid import MetricGrid
+from pcmapq.metrics.distances import distances
+
+GRID = MetricGrid(0.05, (0.0, 0.0, 0.0), (200, 200))
+
+
+def wall(col: int, rows=slice(20, 180)) -> np.ndarray:
+    occ = np.zeros(GRID.shape, bool)
+    occ[rows, col] = True
+    return occ
+
+
+def test_wall_shifted_by_a_known_distance():
+    truth, map_ = wall(50), wall(55)  # 5 cells = 0.25 m apart
+    d = distances(truth, map_, np.ones(GRID.shape, bool), GRID, taus=(0.2, 0.3))
+    for stats in (d.accuracy, d.completeness):
+        assert stats.mean == pytest.approx(0.25) and stats.median == pytest.approx(0.25)
+        assert stats.rmse == pytest.approx(0.25) and stats.p95 == pytest.approx(0.25)
+    assert d.chamfer_m == pytest.approx(0.25)
+    (at_02, at_03) = d.fscores
+    assert (at_02.precision, at_02.recall, at_02.f) == (0.0, 0.0, 0.0)
+    assert (at_03.precision, at_03.recall, at_03.f) == (1.0, 1.0, 1.0)
+
+
+def test_completeness_counts_only_the_footprint():
+    truth = wall(50) | wall(150)
+    map_ = wall(50)
+    footprint = np.zeros(GRID.shape, bool)
+    footprint[:, :100] = True
+    inside = distances(truth, map_, footprint, GRID)
+    assert inside.completeness.mean == 0.0 and inside.fscores[0].recall == 1.0
+    whole = distances(truth, map_, np.ones(GRID.shape, bool), GRID)
+    assert whole.completeness.mean == pytest.approx(0.5 * 5.0)  # half the truth is 5 m away
+    assert whole.fscores[-1].recall == pytest.approx(0.5)
+
+
+def test_missing_map_gives_no_accuracy():
+    d = distances(wall(50), np.zeros(GRID.shape, bool), np.ones(GRID.shape, bool), GRID)
+    assert d.accuracy.count == 0 and d.accuracy.mean is None and d.chamfer_m is None
+    assert d.completeness.mean is None and d.completeness.count == 160
+    assert all(f.f == 0.0 for f in d.fscores)
