@@ -7,23 +7,27 @@ As in the paper, a binary map is first turned into a grey image of its local ent
 Keypoints are the extrema of SIFT's difference-of-Gaussians (DoG) scale space of that image,
 built as ``cv2.SIFT`` builds it (``octave_layers`` layers per octave, base blur ``sigma``
 pixels of the working image; no doubled first octave), so the fixed working resolution makes
-the scales metric. Detection is done here rather than by ``cv2.SIFT``, whose sub-pixel
-refinement drops an extremum when its quadratic fit keeps stepping between two samples: it
-happens when the extremum lies about half a sample from both, and so comes and goes with a
-half-cell shift of the map. Here every sample that is an extremum of its 26 neighbours is a
-keypoint, refined by one quadratic step clipped to half a sample in space and scale, so a
-keypoint exists wherever the DoG has an extremum. Its response is the refined DoG contrast
-(image in [0, 1]); keypoints wider than ``max_size`` metres (room-sized blobs) are dropped.
-Each keypoint gets the dominant orientation of its gradient histogram (as SIFT computes it),
-and ``cv2.SIFT`` computes the descriptors of these keypoints.
+the scales metric. Detection is done here rather than by ``cv2.SIFT``, which loses keypoints
+in two ways that come and go with a half-cell shift of the map: its sub-pixel refinement drops
+an extremum whose quadratic fit keeps stepping between two samples (the extremum lies about
+half a sample from both), and an extremum at the scale limit of an octave can fail the test in
+both octaves, which sample it differently. Here every sample that is an extremum of its 26
+neighbours is a keypoint, refined by one quadratic step clipped to half a sample in space and
+scale, and each octave has one layer more than ``cv2.SIFT`` so that consecutive octaves share
+a searched DoG layer. Its response is the refined DoG contrast (image in [0, 1]); keypoints
+wider than ``max_size`` metres (room-sized blobs) are dropped. Each keypoint gets the dominant
+orientation of its gradient histogram (as SIFT computes it; one keypoint per place, not one
+per orientation), and ``cv2.SIFT`` computes the descriptors of these keypoints.
 
 Hysteresis: a keypoint is kept at ``support * threshold`` response and an edge ratio under
 ``support_edge * edge``; it is strong at ``threshold`` and under ``edge``, if it is also the
-strongest keypoint within ``radius`` metres. Keypoints closer than 0.05 m are one (the
-strongest is kept). ``strength`` is the response.
+strongest keypoint within ``radius`` metres. Keypoints closer than 0.1 m (one sample of the
+octave most keypoints are found in; an extremum shared by two octaves is found twice) are one,
+the strongest. ``strength`` is the response.
 
-Matching: pairs within the threshold in metres are candidates; the cost is the descriptor
-(L2) distance, so among nearby keypoints the most alike are paired.
+Matching: pairs within the threshold in metres are candidates; the cost is the mean of their
+distance over the threshold and their descriptor (L2) distance over its largest value, so
+among nearby keypoints the most alike are paired.
 """
 
 from __future__ import annotations

@@ -63,6 +63,14 @@ def report_html(result: Result) -> str:
     scores = _table(["detector", "quality q", "precision", "f1", "truth features",
                      "map features", "matched", "disp. mean [m]", "disp. median [m]",
                      "disp. RMSE [m]", "disp. max [m]"], rows)
+    d = result.distances
+    dist = _table(["", "mean [m]", "median [m]", "RMSE [m]", "95th pct [m]", "cells"],
+                  [[label, _f(s.mean), _f(s.median), _f(s.rmse), _f(s.p95), str(s.count)]
+                   for label, s in (("accuracy (map to truth)", d.accuracy),
+                                    ("completeness (truth to map)", d.completeness))])
+    fscore = _table(["threshold [m]", "precision", "recall", "F-score"],
+                    [[f"{f.tau_m:g}", _f(f.precision), _f(f.recall), _f(f.f)]
+                     for f in d.fscores])
     vectors = _img(png_bytes(vectorial_figure(result)), "vectorial map per detector")
     heat = _img(png_bytes(distance_heatmap(result)), "map-to-truth distance heatmap")
     title = f"pcmapq: {html.escape(result.map_path.name)} against " \
@@ -84,6 +92,9 @@ footprint). Truth features outside the footprint are not counted as missing.</p>
 <p class="note">quality q = matched truth features / truth features (the paper's measure, a
 recall); precision = matched map features / map features; f1 = their harmonic mean.
 Displacements are from each truth feature to its map feature.</p>
+<h2>Distances</h2>{dist}
+<p class="note">Chamfer distance {_f(d.chamfer_m)} m (mean of the two means). Definitions in
+docs/metrics.md.</p>{fscore}
 <h2>Vectorial map</h2>{vectors}
 <h2>Distance heatmap</h2>{heat}
 </body></html>
