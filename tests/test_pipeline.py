@@ -90,15 +90,15 @@ def test_ladder_bend(plan, truth_png, tmp_path):
 
 def test_ladder_clutter(plan, truth_png, tmp_path):
     rows = _ladder(plan, truth_png, tmp_path,
-                   [synth.clutter(plan, n, seed=5) for n in (0, 8, 20, 40)])
+                   [synth.clutter(plan, n, seed=5, size=0.8) for n in (0, 8, 20, 40)])
     _falls(rows, 1)
     _falls(rows, 2)
 
 
 def test_ladder_position_noise(plan, truth_png, tmp_path):
     rows = _ladder(plan, truth_png, tmp_path,
-                   [synth.wall_points(plan, 0.02, noise=s, seed=4)
-                    for s in (0.0, 0.02, 0.03, 0.05)])
+                   [synth.wall_points(plan, 0.05, noise=s, seed=4)
+                    for s in (0.0, 0.06, 0.1, 0.15)])
     _falls(rows, 1)
     _falls(rows, 2)
 
