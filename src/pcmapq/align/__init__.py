@@ -1,7 +1,8 @@
 """2D alignment of a map to the truth: a global raster search, then ICP.
 
 Frames: ``Alignment.transform`` takes map-frame points to the truth frame,
-``p_truth = s * R(yaw) * p_map + t`` (scale stays 1 here).
+``p_truth = s * R(yaw) * p_map + t``: scale 1, or with ``scale=True`` the estimated scale for a
+map of unknown unit (a scanned plan, a map exported as a picture).
 """
 
 from __future__ import annotations
@@ -11,17 +12,24 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
-from pcmapq.align.coarse import auto_resolution, coarse_candidates
+from pcmapq.align.coarse import (
+    auto_resolution,
+    coarse_candidates,
+    similarity_candidates,
+    similarity_resolution,
+)
 from pcmapq.align.icp import (
     DEFAULT_SCHEDULE,
     IcpTarget,
+    SimilarityTarget,
     refine_point_to_line,
+    refine_similarity,
     voxel_downsample,
 )
 from pcmapq.align.icp import refine as icp_refine
 from pcmapq.align.transform import Similarity2D
 
-__all__ = ["Alignment", "Similarity2D", "align", "score"]
+__all__ = ["Alignment", "Similarity2D", "align", "align_similarity", "score"]
 
 
 @dataclass(frozen=True)
@@ -30,7 +38,8 @@ class Alignment:
 
     transform: map frame -> truth frame. fitness: share of (voxel-downsampled) map points within
     ``tolerance_m`` of a truth point after alignment, [0, 1]. rmse_m: RMSE of those inlier
-    distances, metres. method: "coarse+icp", "init+icp" or "none".
+    distances, metres. method: "coarse+icp", "similarity+icp" (global search over scale too),
+    "init+icp", "init" or "none".
     """
 
     transform: Similarity2D
@@ -62,7 +71,8 @@ def score(map_xy: np.ndarray, truth_xy: np.ndarray, tf: Similarity2D,
 
 def align(map_xy: np.ndarray, truth_xy: np.ndarray, *, init: Similarity2D | None = None,
           refine: bool = True, tolerance: float = 0.2, voxel: float = 0.05,
-          resolution: float | None = None, top_k: int = 6, finalists: int = 2) -> Alignment:
+          resolution: float | None = None, top_k: int = 6, finalists: int = 2,
+          scale: bool = False, scale_range: tuple[float, float] = (0.2, 5.0)) -> Alignment:
     """Align a map to the truth with no initial guess needed; never fails on a bad match (an
     empty map or truth gives fitness 0).
 
@@ -78,7 +88,13 @@ def align(map_xy: np.ndarray, truth_xy: np.ndarray, *, init: Similarity2D | None
     at least 0.25). top_k: candidate poses of the global search, each refined by a first, coarse
     ICP stage; finalists: how many of those, by fitness, go through the fine ICP stages. The
     final pose with the highest fitness wins.
+    scale: also estimate the scale, for a map in an unknown unit (see :func:`align_similarity`);
+    scale_range: (lowest, highest) scale it may have, truth units per map unit.
     """
+    if scale:
+        return align_similarity(map_xy, truth_xy, init=init, refine=refine, tolerance=tolerance,
+                                voxel=voxel, resolution=resolution, top_k=top_k,
+                                finalists=finalists, scale_range=scale_range)
     map_ds = voxel_downsample(map_xy, voxel)
     truth_ds = voxel_downsample(truth_xy, voxel)
     if len(map_ds) == 0 or len(truth_ds) == 0:
@@ -115,3 +131,73 @@ def _result(map_xy: np.ndarray, tree: cKDTree, tf: Similarity2D, tolerance: floa
     """Score ``tf`` on the map against the truth tree."""
     fitness, rmse = _score_tree(map_xy, tree, tf, tolerance)
     return Alignment(tf, fitness, rmse, tolerance, method)
+
+
+def _map_at_scale(map_xy: np.ndarray, tf: Similarity2D, voxel: float) -> np.ndarray:
+    """The map (N, 2, map units) downsampled to ``voxel`` truth units under ``tf``'s scale."""
+    return voxel_downsample(map_xy, voxel / tf.scale)
+
+
+def similarity_schedule(resolution: float, tolerance: float,
+                        voxel: float) -> tuple[tuple[float, float], ...]:
+    """Scaled ICP stages, (max distance, voxel) in truth units: from twice the global search's
+    cell ``resolution`` down to twice ``tolerance``, the voxel shrinking towards ``voxel`` (the
+    point-to-line stage that follows uses ``voxel`` itself)."""
+    return ((2 * resolution, max(voxel, resolution / 4)),
+            (resolution / 2, max(voxel, resolution / 8)),
+            (2 * tolerance, max(voxel, tolerance / 2)))
+
+
+def align_similarity(map_xy: np.ndarray, truth_xy: np.ndarray, *,
+                     init: Similarity2D | None = None, refine: bool = True,
+                     tolerance: float = 0.2, voxel: float = 0.05,
+                     resolution: float | None = None, top_k: int = 6, finalists: int = 2,
+                     scale_range: tuple[float, float] = (0.2, 5.0)) -> Alignment:
+    """Align a map of unknown unit to the truth: scale, rotation and translation, with no
+    initial guess needed; never fails on a bad match.
+
+    map_xy: (N, 2) in the map's own unit, map frame; truth_xy: (M, 2) truth units (metres),
+    truth frame. Every length parameter is in truth units: ``tolerance`` and ``voxel`` as in
+    :func:`align`; the map is downsampled to ``voxel`` truth units at the current scale.
+    resolution: cell of the global search (default: the truth's radius / 20, see
+    :func:`~pcmapq.align.coarse.similarity_candidates`), which also sets the ICP schedule
+    (:func:`similarity_schedule`). The ``top_k`` candidates of the search over scale, yaw and
+    position are refined by a first scaled ICP stage, the best ``finalists`` by fitness through
+    the others and a point-to-line stage with scale (pairs within ``tolerance``); the final pose
+    with the highest fitness wins. init: a starting similarity (its scale kept), skips the
+    search. fitness and rmse_m are in the truth frame, as in :func:`align`.
+    """
+    map_xy = np.asarray(map_xy, dtype=np.float64).reshape(-1, 2)
+    truth_ds = voxel_downsample(truth_xy, voxel)
+    start = Similarity2D() if init is None else init
+    if len(map_xy) == 0 or len(truth_ds) < 2:  # the truth must have a size
+        return Alignment(start, 0.0, 0.0, tolerance, "none")
+    tree = cKDTree(truth_ds)
+    if not refine:
+        return _result(_map_at_scale(map_xy, start, voxel), tree, start, tolerance,
+                       "none" if init is None else "init")
+    resolution = similarity_resolution(truth_ds) if resolution is None else resolution
+    if init is None:
+        candidates = similarity_candidates(map_xy, truth_ds, scale_range=scale_range,
+                                           resolution=resolution, top_k=top_k)
+        starts, method = [c.transform for c in candidates], "similarity+icp"
+    else:
+        starts, method = [init], "init+icp"
+    first, *rest = similarity_schedule(resolution, tolerance, voxel)
+    rough, fine = SimilarityTarget(truth_ds, (first,)), SimilarityTarget(truth_ds, tuple(rest))
+    firsts = [_scaled_result(map_xy, tree, refine_similarity(map_xy, rough, s), tolerance, voxel)
+              for s in starts]
+    finals = []
+    for r in sorted(firsts, key=_rank)[:finalists]:
+        tf = refine_similarity(map_xy, fine, r.transform)
+        tf = refine_point_to_line(_map_at_scale(map_xy, tf, voxel), truth_ds, tf, tolerance,
+                                  with_scale=True)
+        finals.append(_scaled_result(map_xy, tree, tf, tolerance, voxel))
+    best = min(finals, key=_rank)
+    return Alignment(best.transform, best.fitness, best.rmse_m, tolerance, method)
+
+
+def _scaled_result(map_xy: np.ndarray, tree: cKDTree, tf: Similarity2D, tolerance: float,
+                   voxel: float) -> Alignment:
+    """Score ``tf`` on the map (map units) downsampled to ``voxel`` truth units at its scale."""
+    return _result(_map_at_scale(map_xy, tf, voxel), tree, tf, tolerance, "")

@@ -6,6 +6,12 @@ truth wall (cv2.matchTemplate, TM_CCORR). Dividing by the template's cell count 
 field value under the map's cells, in [0, 1]: a soft share of the map that lies on truth walls.
 The field saturates at 1 on a wall, so dense or cluttered truth regions cannot outscore the right
 place, and cells of a partial map that overhang the truth simply score 0.
+
+:func:`similarity_candidates` adds a sweep over the map's scale (the truth's field is computed
+once; only the map's points are scaled before rasterising). The mean field value would favour a
+map shrunk onto a dense knot of walls, so there every cell scores its field value minus the mean
+field over the truth's bounding box: the summed excess, in truth cells, is what a random
+placement earns nothing for, and it grows with the length of wall the map lays on truth walls.
 """
 
 from __future__ import annotations
@@ -15,6 +21,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
+from pcmapq.align.icp import voxel_downsample
 from pcmapq.align.transform import Similarity2D
 from pcmapq.grid import MetricGrid
 from pcmapq.raster.draw import hit_counts
@@ -22,7 +29,9 @@ from pcmapq.raster.draw import hit_counts
 
 @dataclass(frozen=True)
 class Candidate:
-    """A coarse pose: map frame -> truth frame, with its correlation score in [0, 1]."""
+    """A coarse pose: map frame -> truth frame, with its score: the mean field under the map in
+    [0, 1] (:func:`coarse_candidates`), or the summed field excess in truth cells
+    (:func:`similarity_candidates`)."""
 
     transform: Similarity2D
     score: float
@@ -56,9 +65,11 @@ def _peaks(response: np.ndarray, count: int, radius: int) -> tuple[np.ndarray, n
     return v[best], u[best]
 
 
-def _suppress(poses: np.ndarray, top_k: int, min_angle: float, min_dist: float) -> np.ndarray:
-    """Greedy non-maximum suppression over rows (score, yaw, x, y) sorted by score, descending:
-    a pose within ``min_angle`` radians and ``min_dist`` metres of a kept one is dropped."""
+def _suppress(poses: np.ndarray, top_k: int, min_angle: float, min_dist: float,
+              min_log_scale: float = np.inf) -> np.ndarray:
+    """Greedy non-maximum suppression over rows (score, yaw, x, y[, log scale]) sorted by score,
+    descending: a pose within ``min_angle`` radians, ``min_dist`` metres and (with a fifth column)
+    ``min_log_scale`` in log scale of a kept one is dropped."""
     kept: list[int] = []
     for i in range(len(poses)):
         if len(kept) == top_k:
@@ -67,7 +78,10 @@ def _suppress(poses: np.ndarray, top_k: int, min_angle: float, min_dist: float) 
             k = poses[kept]
             dyaw = np.abs(np.angle(np.exp(1j * (k[:, 1] - poses[i, 1]))))
             dxy = np.hypot(k[:, 2] - poses[i, 2], k[:, 3] - poses[i, 3])
-            if np.any((dyaw < min_angle) & (dxy < min_dist)):
+            near = (dyaw < min_angle) & (dxy < min_dist)
+            if poses.shape[1] > 4:
+                near &= np.abs(k[:, 4] - poses[i, 4]) < min_log_scale
+            if np.any(near):
                 continue
         kept.append(i)
     return poses[kept]
@@ -126,7 +140,91 @@ def coarse_candidates(map_xy: np.ndarray, truth_xy: np.ndarray, *,
     return [Candidate(_pose(yaw, xy, centre), float(score)) for score, yaw, *xy in best]
 
 
-def _pose(yaw: float, centre_truth: np.ndarray, centre_map: np.ndarray) -> Similarity2D:
-    """The rigid transform turning the map by ``yaw``, moving its centroid to ``centre_truth``."""
-    t = np.asarray(centre_truth) - _rotation(yaw) @ centre_map
-    return Similarity2D(float(t[0]), float(t[1]), float(yaw))
+def _pose(yaw: float, centre_truth: np.ndarray, centre_map: np.ndarray,
+          scale: float = 1.0) -> Similarity2D:
+    """The transform scaling the map by ``scale`` and turning it by ``yaw`` about its centroid,
+    then moving that centroid to ``centre_truth``."""
+    t = np.asarray(centre_truth) - scale * (_rotation(yaw) @ centre_map)
+    return Similarity2D(float(t[0]), float(t[1]), float(yaw), float(scale))
+
+
+def similarity_resolution(truth_xy: np.ndarray, cells: int = 20) -> float:
+    """Raster cell size, truth units, of the sweep over scale: the truth's radius about its
+    centroid over ``cells``. The map's size being unknown, the truth's sets it."""
+    return _radius(truth_xy - truth_xy.mean(axis=0)) / cells
+
+
+def _scales(map_radius: float, truth_radius: float, resolution: float,
+            scale_range: tuple[float, float], min_cells: float, max_size: float,
+            step: float) -> np.ndarray:
+    """Scales of the sweep: the scaled map's radius grows by ``step`` cells (of ``resolution``,
+    truth units) a step, from ``min_cells`` cells to ``max_size`` times the truth's radius,
+    within ``scale_range``. map_radius: map units; truth_radius: truth units."""
+    lo = max(scale_range[0] * map_radius, min(min_cells * resolution, truth_radius))
+    hi = max(lo, min(scale_range[1] * map_radius, max_size * truth_radius))
+    return np.arange(lo, hi + 0.5 * step * resolution, step * resolution) / map_radius
+
+
+def _templates(points: np.ndarray, yaws: np.ndarray, half: int) -> np.ndarray:
+    """Binary templates (yaws, 2 half + 1, 2 half + 1) float32 of points (N, 2, in cells, about
+    the centre cell) turned by each yaw (radians): as :func:`hit_counts` on
+    :func:`_template_grid`, for all yaws at once."""
+    c, s = np.cos(yaws)[:, None], np.sin(yaws)[:, None]
+    x, y = points[:, 0], points[:, 1]
+    u = np.floor(c * x - s * y + half + 0.5).astype(np.int64)
+    v = np.floor(half - (s * x + c * y) + 0.5).astype(np.int64)
+    size = 2 * half + 1
+    flat = (np.arange(len(yaws))[:, None] * size + v) * size + u
+    hits = np.bincount(flat.ravel(), minlength=len(yaws) * size * size)
+    return (hits > 0).astype(np.float32).reshape(len(yaws), size, size)
+
+
+def similarity_candidates(map_xy: np.ndarray, truth_xy: np.ndarray, *,
+                          scale_range: tuple[float, float] = (0.2, 5.0),
+                          resolution: float | None = None, step: float = 1.5, top_k: int = 6,
+                          per_angle: int = 3, max_size: float = 1.5,
+                          min_cells: float = 4.0) -> list[Candidate]:
+    """The ``top_k`` best distinct similarities (map frame -> truth frame) of a sweep over scale
+    and yaw, with no initial guess.
+
+    map_xy: (N, 2) in the map's own, unknown unit; truth_xy: (M, 2) truth units (metres).
+    scale_range: (lowest, highest) scale, truth units per map unit. resolution: raster cell and
+    field width sigma, truth units (default: :func:`similarity_resolution`).
+    The scaled map's radius runs from ``min_cells`` cells to ``max_size`` times the truth's
+    radius in steps of ``step`` cells; yaws step so that its farthest point moves by ``step``
+    cells (0.5 to 3 degrees). Scores: summed field excess (see the module), in truth cells.
+    Candidates come best first; one within 9 degrees, 4 cells and 15 % in scale of a better
+    one is dropped.
+    """
+    truth_radius = _radius(truth_xy - truth_xy.mean(axis=0))
+    resolution = similarity_resolution(truth_xy) if resolution is None else resolution
+    centre = map_xy.mean(axis=0)
+    centred = map_xy - centre
+    map_radius = max(_radius(centred), 1e-12)
+    scales = _scales(map_radius, truth_radius, resolution, scale_range, min_cells, max_size,
+                     step)
+    half_max = int(np.ceil(scales[-1] * map_radius / resolution)) + 1
+    fgrid = MetricGrid.covering(truth_xy, resolution, margin=(half_max + 1) * resolution)
+    field = likelihood_field(truth_xy, fgrid, resolution)
+    (u0, v0), (u1, v1) = np.round(fgrid.xy_to_pixels(
+        np.array([truth_xy.min(axis=0), truth_xy.max(axis=0)]))).astype(int)
+    baseline = float(field[v1:v0 + 1, u0:u1 + 1].mean())
+    rows = []
+    for scale in scales:
+        points = voxel_downsample(centred, 0.5 * resolution / scale) * (scale / resolution)
+        radius = scale * map_radius / resolution  # cells
+        half = int(np.ceil(radius)) + 1
+        offset = fgrid.pixels_to_xy(np.array([[half, half]]))[0]
+        yaws = np.radians(np.arange(0.0, 360.0, np.clip(np.degrees(step / radius), 0.5, 3.0)))
+        for yaw, template in zip(yaws, _templates(points, yaws, half), strict=True):
+            response = (cv2.matchTemplate(field, template, cv2.TM_CCORR)
+                        - baseline * template.sum())
+            v, u = _peaks(response, per_angle, radius=2)
+            xy = offset + np.column_stack([u, -v]) * resolution
+            rows.append(np.column_stack([response[v, u], np.full(len(v), yaw), xy,
+                                         np.full(len(v), np.log(scale))]))
+    poses = np.vstack(rows)
+    poses = poses[np.argsort(-poses[:, 0], kind="stable")]
+    best = _suppress(poses, top_k, np.radians(9.0), 4 * resolution, np.log(1.15))
+    return [Candidate(_pose(yaw, xy, centre, float(np.exp(log_s))), float(score))
+            for score, yaw, *xy, log_s in best]

@@ -1,0 +1,156 @@
+"""Alignment of maps of unknown scale: scale, rotation and translation with no initial guess."""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+import pytest
+
+from pcmapq import synth
+from pcmapq.align import align
+from pcmapq.align.icp import fit_similarity, refine_point_to_line, voxel_downsample
+from pcmapq.align.transform import Similarity2D
+
+from .conftest import shared
+
+PLAN = synth.building_plan(0)  # 24 m x 16 m
+WIDTH, HEIGHT = 24.0, 16.0
+
+
+@pytest.fixture(scope="module")
+def truth() -> np.ndarray:
+    return synth.wall_points(PLAN, spacing=0.05)
+
+
+@pytest.fixture(scope="module")
+def scan() -> np.ndarray:
+    """The same walls sampled again with 1.5 cm noise, in the plan frame."""
+    return synth.wall_points(PLAN, spacing=0.05, noise=0.015, seed=1)
+
+
+def similarity(scale: float, yaw_deg: float, tx: float, ty: float) -> Similarity2D:
+    return Similarity2D(tx, ty, float(np.radians(yaw_deg)), scale)
+
+
+def errors(expected: Similarity2D, got: Similarity2D) -> tuple[float, float, float]:
+    """(relative scale error, yaw error in degrees, translation error in truth units)."""
+    dyaw = abs((np.degrees(got.yaw - expected.yaw) + 180.0) % 360.0 - 180.0)
+    return (abs(got.scale / expected.scale - 1.0), float(dyaw),
+            float(np.hypot(got.tx - expected.tx, got.ty - expected.ty)))
+
+
+def inside(points: np.ndarray, box: tuple[float, float, float, float]) -> np.ndarray:
+    x0, y0, x1, y1 = box
+    keep = (points[:, 0] >= x0) & (points[:, 0] <= x1) & (points[:, 1] >= y0) & (points[:, 1] <= y1)
+    return points[keep]
+
+
+@pytest.mark.parametrize(("scale", "yaw", "tx", "ty"), [
+    (0.5, 120, 3.0, -4.0), (0.8, -75, -6.0, 2.0), (1.3, 30, 10.0, 5.0), (2.5, 200, -3.0, 8.0)])
+def test_full_map_of_unknown_scale(truth, scan, scale, yaw, tx, ty):
+    t_true = similarity(scale, yaw, tx, ty)
+    result = align(t_true.inverse().apply(scan), truth, scale=True)
+    ds, dyaw, dxy = errors(t_true, result.transform)
+    assert ds < 0.01 and dyaw < 0.5 and dxy < 0.1
+    assert result.fitness > 0.9 and result.rmse_m < 0.05 and result.method == "similarity+icp"
+
+
+@pytest.mark.parametrize(("box", "scale", "yaw", "tx", "ty"), [
+    ((-1.0, -1.0, 0.5 * WIDTH + 0.5, 17.0), 0.8, 120, 4.0, 4.0),          # left half
+    ((-1.0, -1.0, 0.75 * WIDTH, 0.75 * HEIGHT), 2.5, -75, -5.0, 3.0),      # 56 % corner
+    ((0.38 * WIDTH, 0.33 * HEIGHT, 25.0, 17.0), 1.3, 45, 1.0, 1.0),        # top-right 42 %
+])
+def test_partial_map_of_unknown_scale(truth, scan, box, scale, yaw, tx, ty):
+    t_true = similarity(scale, yaw, tx, ty)
+    result = align(t_true.inverse().apply(inside(scan, box)), truth, scale=True)
+    ds, dyaw, dxy = errors(t_true, result.transform)
+    assert ds < 0.01 and dyaw < 0.5 and dxy < 0.1
+    assert result.fitness > 0.9
+
+
+def test_plan_picture_in_pixels(truth):
+    """A plan drawn as an image and given in pixels (the map's 'unit' is its 4 cm cell)."""
+    t_true = similarity(0.04, -75, 12.0, -5.0)
+    segments = synth.transform_segments(PLAN, t_true.inverse())
+    grid = synth.plan_grid(segments, 1.0, margin=20.0)  # one pixel = one map unit
+    pixels = grid.cell_centres(synth.render(segments, grid, thickness=4.0) == synth.OCCUPIED)
+    result = align(pixels, truth, scale=True, scale_range=(0.01, 1.0))
+    ds, dyaw, dxy = errors(t_true, result.transform)
+    assert ds < 0.01 and dyaw < 0.5 and dxy < 0.1
+
+
+def test_rigid_map_keeps_scale_one(truth, scan):
+    t_true = similarity(1.0, 15, 5.0, -3.0)
+    result = align(t_true.inverse().apply(scan), truth, scale=True)
+    ds, dyaw, dxy = errors(t_true, result.transform)
+    assert ds < 0.002 and dyaw < 0.5 and dxy < 0.1
+
+
+def test_other_building_scores_low(truth, scan):
+    other = synth.wall_points(synth.building_plan(7, 18.0, 20.0), spacing=0.05, noise=0.015,
+                              seed=3)
+    t_true = similarity(1.7, 30, 3.0, 3.0)
+    wrong = align(t_true.inverse().apply(other), truth, scale=True)
+    right = align(t_true.inverse().apply(scan), truth, scale=True)
+    assert wrong.fitness < 0.6 < 0.9 < right.fitness
+
+
+def test_init_and_no_refine(truth, scan):
+    t_true = similarity(0.8, 172, 35.0, 40.0)
+    map_xy = t_true.inverse().apply(scan)
+    init = Similarity2D(0.3, -0.2, 0.0, 1.02).compose(t_true)
+    result = align(map_xy, truth, scale=True, init=init)
+    ds, dyaw, dxy = errors(t_true, result.transform)
+    assert result.method == "init+icp" and ds < 0.002 and dyaw < 0.2 and dxy < 0.05
+    kept = align(map_xy, truth, scale=True, init=t_true, refine=False)
+    assert kept.method == "init" and kept.transform == t_true and kept.fitness > 0.99
+
+
+def test_deterministic_and_empty(truth, scan):
+    map_xy = similarity(2.5, -75, 4.0, 4.0).inverse().apply(inside(scan, (-1, -1, 14, 17)))
+    assert align(map_xy, truth, scale=True) == align(map_xy, truth, scale=True)
+    empty = align(np.empty((0, 2)), truth, scale=True)
+    assert empty.fitness == 0.0 and empty.method == "none"
+
+
+def test_fit_similarity_is_exact():
+    t_true = similarity(0.37, 120, 3.0, -2.0)
+    points = np.random.default_rng(0).normal(size=(50, 2))
+    got = fit_similarity(points, t_true.apply(points))
+    assert errors(t_true, got) == pytest.approx((0.0, 0.0, 0.0), abs=1e-9)
+
+
+def test_point_to_line_refines_scale(truth):
+    """From 3 % off in scale, the point-to-line stage with scale lands on the truth."""
+    xy = voxel_downsample(truth, 0.05)
+    got = refine_point_to_line(xy, xy, Similarity2D(0.1, 0.0, 0.0, 1.03), with_scale=True)
+    assert errors(Similarity2D(), got) == pytest.approx((0.0, 0.0, 0.0), abs=1e-4)
+
+
+def occupied_pixels(mask: np.ndarray) -> np.ndarray:
+    """Centres (N, 2) of the true pixels, x = column, y = rows - 1 - row (origin lower-left, as
+    the Halmstad annotations)."""
+    v, u = np.nonzero(mask)
+    return np.column_stack([u, mask.shape[0] - 1 - v]).astype(np.float64)
+
+
+def test_halmstad_e5_09_against_layout():
+    """A robot map of building E5 against the building's layout, both in pixels: the annotated
+    map keypoints must land within 20 px (median) of their layout partners. The reference, a
+    least-squares similarity on the keypoints: scale 0.829, yaw 91.2 deg, median residual 4 px."""
+    root = ("halmstad", "maps", "E5")
+    notes = ("halmstad", "annotations")
+    robot = cv2.imread(str(shared(*root, "pseudo_occupancy", "E5_09.png")), cv2.IMREAD_GRAYSCALE)
+    layout = cv2.imread(str(shared(*root, "layout", "E5_layout.png")), cv2.IMREAD_UNCHANGED)
+    pairs = np.load(shared(*notes, "association_E5_09_E5_layout.npy"), allow_pickle=True)
+    pairs = np.array([p for p in pairs if p[0] is not None and p[1] is not None], dtype=int)
+    map_keys = np.load(shared(*notes, "keypoints_E5_09.npy")).astype(np.float64)[pairs[:, 0]]
+    layout_keys = np.load(shared(*notes, "keypoints_E5_layout.npy")).astype(np.float64)
+    layout_keys = layout_keys[pairs[:, 1]]
+    map_xy = occupied_pixels(robot == 0)
+    truth_xy = occupied_pixels(layout[..., :3].mean(axis=2) < 100)
+    # Lengths in layout pixels: 1 px voxels, 4 px inlier tolerance.
+    result = align(map_xy, truth_xy, scale=True, tolerance=4.0, voxel=1.0)
+    residual = np.linalg.norm(result.transform.apply(map_keys) - layout_keys, axis=1)
+    assert np.median(residual) < 20.0
+    assert abs(result.transform.scale - 0.829) < 0.02 and abs(result.transform.yaw_deg - 91) < 2
