@@ -18,6 +18,8 @@ class Settings:
         the YAML's); for a cloud truth, the cell size of its grid (default ``cloud_resolution``).
     cloud_resolution: cell size used for a point-cloud truth when none is given, metres.
     band_low, band_high: the wall band of a 3D cloud, metres above the floor.
+    scale: estimate the map's scale too (a similarity); for maps whose resolution is unknown
+        or wrong. A map image without resolution then starts from the truth's.
     init: initial guess of the map -> truth transform; skips the global step.
     align: False trusts the map's frame (``--no-align``): no global step, no ICP.
     fit_tolerance: a map point is an inlier of the alignment within this distance, metres.
@@ -41,6 +43,7 @@ class Settings:
     cloud_resolution: float = 0.05
     band_low: float = 0.3
     band_high: float = 2.0
+    scale: bool = False
     init: Similarity2D | None = None
     align: bool = True
     fit_tolerance: float = 0.2

@@ -99,7 +99,7 @@ def evaluate(map_path: str | Path, truth_path: str | Path, settings: Settings | 
 
     progress("aligning")
     alignment = align(map_xy, truth_xy, init=settings.init, refine=settings.align,
-                      tolerance=settings.fit_tolerance)
+                      tolerance=settings.fit_tolerance, scale=settings.scale)
 
     progress("rasterising")
     grid, truth_occ = truth_raster(truth, truth_xy, settings)

@@ -39,7 +39,8 @@ def warp_state(state: np.ndarray, src: MetricGrid, tf: Similarity2D, dst: Metric
     of it is, so one-cell walls survive any rotation.
     """
     # Area-average a much finer source down first: warpAffine alone would drop thin walls.
-    factor = dst.resolution * tf.scale / src.resolution
+    # A source cell is src.resolution * tf.scale long in the destination's frame.
+    factor = dst.resolution / (src.resolution * tf.scale)
     occ = (state == OCCUPIED).astype(np.float32)
     known = (state != UNKNOWN).astype(np.float32)
     if factor > 1.5:
