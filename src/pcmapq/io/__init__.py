@@ -9,6 +9,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from pcmapq.errors import InputError
+from pcmapq.io.carmen import is_carmen, load_carmen
 from pcmapq.io.clouds import CLOUD_SUFFIXES, PointMap, load_cloud
 from pcmapq.io.occupancy import IMAGE_SUFFIXES, YAML_SUFFIXES, OccupancyMap, load_occupancy
 
@@ -23,14 +24,16 @@ def load_map(path: str | Path, resolution: float | None = None) -> OccupancyMap 
 
     Occupancy images (.png, .pgm, .jpg, .bmp) and ROS map_server YAML (.yaml, .yml) give an
     :class:`OccupancyMap`; ``resolution`` (metres per cell) overrides the YAML's. Point clouds
-    (.ply, .pcd, .xyz, .txt, .npy, KITTI .bin) give a :class:`PointMap`; ``resolution`` is
-    ignored for them.
+    (.ply, .pcd, .xyz, .txt, .npy, KITTI .bin) and CARMEN laser logs (.log, .log.gz: the beam
+    endpoints at the logged poses) give a :class:`PointMap`; ``resolution`` is ignored for them.
     """
     path = Path(path)
     if not path.exists():
         raise InputError(f"{path}: not found")
     if not path.is_file():
         raise InputError(f"{path}: not a file")
+    if is_carmen(path):  # before the suffix test: the suffix of x.log.gz is .gz
+        return load_carmen(path)
     suffix = path.suffix.lower()
     if suffix in IMAGE_SUFFIXES or suffix in YAML_SUFFIXES:
         return load_occupancy(path, resolution)
