@@ -132,3 +132,24 @@ def test_moved_wall_shows_its_displacement(plan, truth_png, tmp_path):
         assert np.all(d[far] < 0.1), (name, np.sort(d[far])[-5:])
         near_count += near.sum()
     assert near_count >= 4
+
+
+def test_map_of_unknown_scale(plan, truth_png, tmp_path):
+    """A picture of the plan at another scale, with no resolution: --map-resolution auto starts
+    from the truth's 0.05 m per pixel and finds the true 0.1 m (scale 2 against that guess)."""
+    import cv2
+
+    tf = Similarity2D(-2.0, 5.0, np.radians(-70.0), 2.0)
+    segments = synth.transform_segments(plan, tf.inverse())
+    grid = synth.plan_grid(segments, 0.05)
+    path = tmp_path / "picture.png"  # no YAML beside it
+    cv2.imwrite(str(path), synth.render(segments, grid, thickness=0.075))
+    result = evaluate(path, truth_png, Settings(scale=True))
+    got = result.alignment.transform
+    # the picture's frame has its origin at the image's lower-left corner, in guessed metres
+    want = tf.compose(Similarity2D(grid.origin[0], grid.origin[1]))
+    assert abs(got.scale - 2.0) < 0.02, got
+    assert abs((got.yaw_deg - want.yaw_deg + 180) % 360 - 180) < 0.5
+    assert np.hypot(got.tx - want.tx, got.ty - want.ty) < 0.1
+    for name, det in result.detectors.items():
+        assert det.matching.quality >= 0.9, (name, det.matching.quality)

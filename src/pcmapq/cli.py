@@ -51,6 +51,22 @@ def _parse_init(text: str | None) -> Similarity2D | None:
     return Similarity2D(x, y, float(np.radians(yaw)))
 
 
+def _parse_resolution(text: str | None, scale: str) -> tuple[float | None, bool]:
+    """(--map-resolution as metres or None, whether to estimate the scale)."""
+    if scale not in ("fixed", "auto"):
+        raise typer.BadParameter(f"expected 'fixed' or 'auto', got {scale!r}", param_hint="--scale")
+    if text is None or text == "auto":
+        return None, scale == "auto" or text == "auto"
+    try:
+        value = float(text)
+    except ValueError:
+        value = -1.0
+    if not value > 0:
+        raise typer.BadParameter(f"expected metres per pixel or 'auto', got {text!r}",
+                                 param_hint="--map-resolution")
+    return value, scale == "auto"
+
+
 def _parse_taus(text: str) -> tuple[float, ...]:
     try:
         taus = tuple(float(v) for v in text.split(","))
@@ -76,9 +92,12 @@ def eval_command(
     map_path: Annotated[Path, typer.Argument(metavar="MAP", help="Map to score: image (.png/.pgm, "
                         "with its ROS YAML), YAML, or cloud (.ply/.pcd/.xyz/.npy/.bin).")],
     truth_path: Annotated[Path, typer.Argument(metavar="TRUTH", help="Ground truth, same kinds.")],
-    map_resolution: Annotated[float | None, typer.Option(
-        help="Metres per pixel of a map image without YAML (overrides its YAML).",
-        min=1e-6)] = None,
+    map_resolution: Annotated[str | None, typer.Option(
+        help="Metres per pixel of a map image without YAML (overrides its YAML); 'auto' "
+        "estimates the map's scale (same as --scale auto).")] = None,
+    scale: Annotated[str, typer.Option(
+        help="'fixed': the map's metres are metres; 'auto': estimate its scale too (a "
+        "similarity), for maps whose resolution is unknown.")] = "fixed",
     truth_resolution: Annotated[float | None, typer.Option(
         help="Metres per pixel of a truth image without YAML; cell size for a cloud truth "
         "(default 0.05).", min=1e-6)] = None,
@@ -115,7 +134,9 @@ def eval_command(
     ] = False,
 ) -> None:
     """Align MAP to TRUTH, then score it with Harris, Hough and SIFT features."""
-    settings = Settings(map_resolution=map_resolution, truth_resolution=truth_resolution,
+    resolution, auto = _parse_resolution(map_resolution, scale)
+    settings = Settings(map_resolution=resolution, truth_resolution=truth_resolution,
+                        scale=auto,
                         band_low=band_low, band_high=band_high, init=_parse_init(init),
                         align=not no_align, force=force, threshold=threshold, min_hits=min_hits,
                         detectors=_parse_detectors(detectors), full=full, taus=_parse_taus(tau))

@@ -93,8 +93,9 @@ def evaluate(map_path: str | Path, truth_path: str | Path, settings: Settings | 
     """Score the map at ``map_path`` against the truth at ``truth_path``."""
     settings = Settings() if settings is None else settings
     progress("loading")
-    source = load_map(map_path, settings.map_resolution)
     truth = load_map(truth_path, settings.truth_resolution)
+    guess = truth.grid.resolution if isinstance(truth, OccupancyMap) else settings.cloud_resolution
+    source = load_map(map_path, settings.map_resolution, guess if settings.scale else None)
     map_xy, truth_xy = plan_points(source, settings), plan_points(truth, settings)
 
     progress("aligning")

@@ -19,11 +19,13 @@ __all__ = ["OccupancyMap", "PointMap", "load_map"]
 _ADVERTISED = (".png", ".pgm", ".yaml", ".ply", ".pcd", ".xyz", ".txt", ".npy", ".bin")
 
 
-def load_map(path: str | Path, resolution: float | None = None) -> OccupancyMap | PointMap:
+def load_map(path: str | Path, resolution: float | None = None,
+             fallback_resolution: float | None = None) -> OccupancyMap | PointMap:
     """Load a map file by its extension.
 
     Occupancy images (.png, .pgm, .jpg, .bmp) and ROS map_server YAML (.yaml, .yml) give an
-    :class:`OccupancyMap`; ``resolution`` (metres per cell) overrides the YAML's. Point clouds
+    :class:`OccupancyMap`; ``resolution`` (metres per cell) overrides the YAML's, and
+    ``fallback_resolution`` serves an image with neither (its scale to be estimated). Point clouds
     (.ply, .pcd, .xyz, .txt, .npy, KITTI .bin) and CARMEN laser logs (.log, .log.gz: the beam
     endpoints at the logged poses) give a :class:`PointMap`; ``resolution`` is ignored for them.
     """
@@ -36,7 +38,7 @@ def load_map(path: str | Path, resolution: float | None = None) -> OccupancyMap 
         return load_carmen(path)
     suffix = path.suffix.lower()
     if suffix in IMAGE_SUFFIXES or suffix in YAML_SUFFIXES:
-        return load_occupancy(path, resolution)
+        return load_occupancy(path, resolution, fallback_resolution)
     if suffix in CLOUD_SUFFIXES:
         return load_cloud(path)
     raise InputError(f"{path}: unsupported format '{suffix}' (expected {', '.join(_ADVERTISED)})")

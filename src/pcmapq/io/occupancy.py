@@ -54,9 +54,11 @@ class MapMeta:
     mode: str = "trinary"
 
 
-def load_occupancy(path: Path, resolution: float | None = None) -> OccupancyMap:
+def load_occupancy(path: Path, resolution: float | None = None,
+                   fallback: float | None = None) -> OccupancyMap:
     """Load an occupancy image or a map_server YAML. ``resolution`` (metres per cell), if given,
-    overrides the YAML's; an image without a YAML beside it (same stem) needs it."""
+    overrides the YAML's; an image without a YAML beside it (same stem) needs it, or a
+    ``fallback`` resolution (a starting guess for a map whose scale will be estimated)."""
     if path.suffix.lower() in YAML_SUFFIXES:
         meta, image = read_yaml(path)
         if not image.is_file():
@@ -68,6 +70,8 @@ def load_occupancy(path: Path, resolution: float | None = None) -> OccupancyMap:
     if resolution is not None:
         meta = replace(meta, resolution=_resolution(path, resolution))
     grey, transparent = read_grey(image)
+    if meta.resolution is None and fallback is not None:
+        meta = replace(meta, resolution=_resolution(path, fallback))
     if meta.resolution is None:
         raise InputError(f"{path}: no resolution: give --map-resolution/--truth-resolution "
                          "or a YAML beside it")
