@@ -1,0 +1,39 @@
+"""The LiDAR front end: maps from scan sequences, with KISS-ICP or with given poses.
+
+- :func:`build_map_kiss`: KISS-ICP odometry over the scans, deskewed scans accumulated.
+- :func:`build_map_from_poses`: the scans placed with known poses (a reference map).
+- :mod:`pcmapq.mapping.poses`: KITTI / TUM pose files and calibrations.
+
+Frames: ``p_world = pose_k @ calib @ p_sensor``; every length in metres.
+"""
+
+from __future__ import annotations
+
+from pcmapq.mapping.kiss import build_map_kiss, kiss_config
+from pcmapq.mapping.poses import (
+    lidar_poses_from_camera,
+    read_calib,
+    read_kitti_poses,
+    read_tum_poses,
+    write_kitti_poses,
+    write_tum_poses,
+)
+from pcmapq.mapping.reference import build_map_from_poses
+from pcmapq.mapping.scans import ScanSequence, open_scans
+from pcmapq.mapping.voxelmap import VoxelMap, voxel_centroids
+
+__all__ = [
+    "ScanSequence",
+    "VoxelMap",
+    "build_map_from_poses",
+    "build_map_kiss",
+    "kiss_config",
+    "lidar_poses_from_camera",
+    "open_scans",
+    "read_calib",
+    "read_kitti_poses",
+    "read_tum_poses",
+    "voxel_centroids",
+    "write_kitti_poses",
+    "write_tum_poses",
+]
