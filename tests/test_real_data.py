@@ -63,9 +63,9 @@ def test_real_slam_map_turned_and_shifted_is_recovered(fr79, tmp_path):
         assert det.matching.quality >= 0.9, (name, det.matching.quality)
 
 
-def test_lidar_pair_aligns_in_2d_to_its_known_transform():
-    """registration/: two real LiDAR scans with their true transform; the wall bands of the two
-    clouds, aligned in 2D with no initial guess, give the true yaw and translation."""
+def test_lidar_pair_aligns_to_its_known_transform():
+    """registration/: two real LiDAR scans with their true transform. Both are 3D, so pcmapq
+    registers them in 3D (no initial guess) and reports the whole transform."""
     source, target = shared("registration", "source.ply"), shared("registration", "target.ply")
     truth = np.loadtxt(shared("registration", "T_target_source.txt"))
     want = Similarity2D.from_matrix(truth)
@@ -74,3 +74,5 @@ def test_lidar_pair_aligns_in_2d_to_its_known_transform():
     assert np.hypot(got.tx - want.tx, got.ty - want.ty) < 0.05, got
     assert abs(got.yaw_deg - want.yaw_deg) < 0.5, got
     assert result.alignment.fitness > 0.8
+    np.testing.assert_allclose(result.registration_3d.transform, truth, atol=0.02)
+    assert result.distances_3d.accuracy.mean < 0.2

@@ -11,11 +11,22 @@ from typing import Annotated
 import numpy as np
 import typer
 from rich.console import Console
+from rich.progress import Progress
 
 from pcmapq.align.transform import Similarity2D
 from pcmapq.config import DETECTOR_NAMES, Settings
 from pcmapq.errors import EvaluationError, InputError
-from pcmapq.io.writers import write_atomic
+from pcmapq.io import PointMap
+from pcmapq.io.writers import write_atomic, write_cloud
+from pcmapq.mapping import (
+    build_map_from_poses,
+    build_map_kiss,
+    lidar_poses_from_camera,
+    read_calib,
+    read_poses,
+    write_kitti_poses,
+    write_tum_poses,
+)
 from pcmapq.metrics.distances import DEFAULT_TAUS
 from pcmapq.pipeline import evaluate
 from pcmapq.report.table import print_table
@@ -28,6 +39,66 @@ app = typer.Typer(add_completion=False, no_args_is_help=True, pretty_exceptions_
 def main() -> None:
     """pcmapq: score a robot-made map against a ground-truth map (frame convention:
     p_truth = s * R(yaw) * p_map + t; metres and degrees)."""
+
+
+@app.command("map")
+def map_command(
+    source: Annotated[Path, typer.Argument(
+        help="Scan sequence: a folder of KITTI .bin / .ply / .pcd / .npy scans, a ROS bag or "
+        "an MCAP file.")],
+    out: Annotated[Path, typer.Option(help="The map, .ply or .pcd (voxel centroids).")],
+    poses_out: Annotated[Path | None, typer.Option(
+        help="Write the scan poses in KITTI format (12 numbers a line), as evo reads them.")
+    ] = None,
+    tum_out: Annotated[Path | None, typer.Option(
+        help="Write the scan poses in TUM format (t x y z qx qy qz qw; t = scan index).")
+    ] = None,
+    poses: Annotated[Path | None, typer.Option(
+        help="Build the map from these poses (KITTI or TUM file) instead of running KISS-ICP.")
+    ] = None,
+    calib: Annotated[Path | None, typer.Option(
+        help="With --poses: scanner -> pose-frame transform T (12 or 16 numbers, or a KITTI "
+        "calib.txt with Tr:); the map is then built in the first scanner's frame, "
+        "inv(T) P_k T.")] = None,
+    max_scans: Annotated[int | None, typer.Option(help="Use only the first N scans.", min=1)
+                         ] = None,
+    voxel: Annotated[float, typer.Option(help="Cell of the output map, metres.", min=1e-4)
+                     ] = 0.1,
+) -> None:
+    """Build a map from LiDAR scans with KISS-ICP (or with given poses) and save it."""
+    err = Console(stderr=True)
+    try:
+        with _bar(err) as tick:
+            if poses is None:
+                points, trajectory = build_map_kiss(source, max_scans=max_scans, voxel=voxel,
+                                                    progress=tick)
+            else:
+                trajectory = read_poses(poses)
+                if calib is not None:
+                    trajectory = lidar_poses_from_camera(trajectory, read_calib(calib))
+                if max_scans is not None:
+                    trajectory = trajectory[:max_scans]
+                points = build_map_from_poses(source, trajectory, voxel=voxel, progress=tick)
+        write_cloud(out, points)
+        if poses_out is not None:
+            write_kitti_poses(poses_out, trajectory)
+        if tum_out is not None:
+            write_tum_poses(tum_out, trajectory)
+    except (InputError, EvaluationError) as error:
+        err.print(f"pcmapq: error: {error}", markup=False, highlight=False, soft_wrap=True)
+        raise typer.Exit(error.exit_code) from None
+    err.print(f"{out}: {len(points)} points from {len(trajectory)} scans", highlight=False)
+
+
+@contextmanager
+def _bar(console: Console) -> Iterator[Callable[[int, int], None]]:
+    """A progress bar over scans on the terminal; nothing when not a terminal."""
+    if not console.is_terminal:
+        yield lambda done, total: None
+        return
+    with Progress(console=console, transient=True) as bar:
+        task = bar.add_task("scans", total=None)
+        yield lambda done, total: bar.update(task, completed=done, total=total)
 
 
 @contextmanager
@@ -89,9 +160,15 @@ def _parse_detectors(text: str) -> tuple[str, ...]:
 
 @app.command("eval")
 def eval_command(
-    map_path: Annotated[Path, typer.Argument(metavar="MAP", help="Map to score: image (.png/.pgm, "
-                        "with its ROS YAML), YAML, or cloud (.ply/.pcd/.xyz/.npy/.bin).")],
-    truth_path: Annotated[Path, typer.Argument(metavar="TRUTH", help="Ground truth, same kinds.")],
+    paths: Annotated[list[Path], typer.Argument(
+        metavar="MAP TRUTH", help="Map to score: image (.png/.pgm, with its ROS YAML), YAML, "
+        "cloud (.ply/.pcd/.xyz/.npy/.bin) or CARMEN log; then the ground truth, same kinds. "
+        "With --scans, TRUTH only.")],
+    scans: Annotated[Path | None, typer.Option(
+        help="Build the map from this scan sequence with KISS-ICP (see 'pcmapq map') and "
+        "score it.")] = None,
+    max_scans: Annotated[int | None, typer.Option(
+        help="With --scans: use only the first N scans.", min=1)] = None,
     map_resolution: Annotated[str | None, typer.Option(
         help="Metres per pixel of a map image without YAML (overrides its YAML); 'auto' "
         "estimates the map's scale (same as --scale auto).")] = None,
@@ -134,6 +211,10 @@ def eval_command(
     ] = False,
 ) -> None:
     """Align MAP to TRUTH, then score it with Harris, Hough and SIFT features."""
+    if len(paths) != (1 if scans else 2):
+        raise typer.BadParameter("give MAP and TRUTH, or --scans DIR and TRUTH",
+                                 param_hint="MAP TRUTH")
+    truth_path = paths[-1]
     resolution, auto = _parse_resolution(map_resolution, scale)
     settings = Settings(map_resolution=resolution, truth_resolution=truth_resolution,
                         scale=auto,
@@ -145,6 +226,12 @@ def eval_command(
     out = Console(quiet=quiet, width=None if err.is_terminal else 132)
     try:
         with _progress(err, enabled=not quiet) as progress:
+            if scans is None:
+                map_path: Path | PointMap = paths[0]
+            else:
+                progress("mapping the scans with KISS-ICP")
+                points, _ = build_map_kiss(scans, max_scans=max_scans)
+                map_path = PointMap(scans, points, True, kind="scans")
             result = evaluate(map_path, truth_path, settings, progress)
             progress("writing outputs")
             if json_path == "-":

@@ -34,6 +34,8 @@ class Settings:
         dropped) and 1 for a 2D cloud (a laser map puts one or two points per wall cell).
     detectors: which detectors to run.
     taus: distance thresholds of the F-score, metres.
+    voxel_3d: working voxel of the 3D registration when both sides are 3D clouds, metres
+        (0.3 indoors; 0.5-1 for outdoor maps).
     full: score against the whole truth; by default truth features outside the map's footprint
         (the area it observed) are not counted as missing.
     """
@@ -55,3 +57,4 @@ class Settings:
     detectors: tuple[str, ...] = DETECTOR_NAMES
     full: bool = False
     taus: tuple[float, ...] = DEFAULT_TAUS
+    voxel_3d: float = 0.3

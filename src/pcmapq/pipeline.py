@@ -3,11 +3,13 @@
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
 from pcmapq.align import align
+from pcmapq.align.rigid3d import Registration3D, align_3d, apply
 from pcmapq.align.transform import Similarity2D
 from pcmapq.config import Settings
 from pcmapq.errors import EvaluationError, InputError
@@ -15,7 +17,7 @@ from pcmapq.features import Features, detect
 from pcmapq.grid import MetricGrid
 from pcmapq.io import OccupancyMap, PointMap, load_map
 from pcmapq.match import match
-from pcmapq.metrics.distances import distances
+from pcmapq.metrics.distances import distances, distances_3d
 from pcmapq.raster.draw import OCCUPIED, UNKNOWN, points_to_grid, warp_state
 from pcmapq.raster.footprint import map_footprint, near
 from pcmapq.raster.slice import wall_band
@@ -88,19 +90,45 @@ def inside(features: Features, area: np.ndarray, grid: MetricGrid) -> np.ndarray
     return ok & area[np.clip(uv[:, 1], 0, rows - 1), np.clip(uv[:, 0], 0, cols - 1)]
 
 
-def evaluate(map_path: str | Path, truth_path: str | Path, settings: Settings | None = None,
-             progress: Progress = lambda step: None) -> Result:
-    """Score the map at ``map_path`` against the truth at ``truth_path``."""
+def align_clouds_3d(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap,
+                    settings: Settings) -> tuple[OccupancyMap | PointMap, Registration3D | None]:
+    """When both sides are 3D clouds (and no guess or --no-align says otherwise), register them
+    in 3D first; returns the map moved into the truth frame and the registration."""
+    both_3d = all(isinstance(s, PointMap) and s.is_3d for s in (source, truth))
+    if not (both_3d and settings.align and settings.init is None and not settings.scale):
+        return source, None
+    reg = align_3d(source.points, truth.points, voxel=settings.voxel_3d)
+    return replace(source, points=apply(reg.transform, source.points)), reg
+
+
+def evaluate(map_path: str | Path | PointMap, truth_path: str | Path,
+             settings: Settings | None = None, progress: Progress = lambda step: None) -> Result:
+    """Score the map at ``map_path`` (or a map already built, e.g. from scans) against the
+    truth at ``truth_path``."""
     settings = Settings() if settings is None else settings
     progress("loading")
     truth = load_map(truth_path, settings.truth_resolution)
-    guess = truth.grid.resolution if isinstance(truth, OccupancyMap) else settings.cloud_resolution
-    source = load_map(map_path, settings.map_resolution, guess if settings.scale else None)
-    map_xy, truth_xy = plan_points(source, settings), plan_points(truth, settings)
+    guess = settings.truth_resolution or settings.cloud_resolution
+    if isinstance(truth, OccupancyMap):
+        guess = truth.grid.resolution
+    source = map_path if isinstance(map_path, PointMap) else load_map(
+        map_path, settings.map_resolution, guess if settings.scale else None)
+    return score(source, truth, settings, progress)
 
+
+def score(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap, settings: Settings,
+          progress: Progress = lambda step: None) -> Result:
+    """Score a loaded map against a loaded truth: align, raster, detect, match."""
+    map_path, truth_path = source.path, truth.path
     progress("aligning")
-    alignment = align(map_xy, truth_xy, init=settings.init, refine=settings.align,
-                      tolerance=settings.fit_tolerance, scale=settings.scale)
+    source, registration = align_clouds_3d(source, truth, settings)
+    map_xy, truth_xy = plan_points(source, settings), plan_points(truth, settings)
+    if registration is None:
+        alignment = align(map_xy, truth_xy, init=settings.init, refine=settings.align,
+                          tolerance=settings.fit_tolerance, scale=settings.scale)
+    else:  # already aligned in 3D: score it in 2D as it is
+        alignment = align(map_xy, truth_xy, init=Similarity2D(), refine=False,
+                          tolerance=settings.fit_tolerance)
 
     progress("rasterising")
     grid, truth_occ = truth_raster(truth, truth_xy, settings)
@@ -122,8 +150,18 @@ def evaluate(map_path: str | Path, truth_path: str | Path, settings: Settings | 
             truth_f = truth_f.counted_where(inside(truth_f, footprint, grid))
         detectors[name] = DetectorResult(truth_f, map_f,
                                          match(name, truth_f, map_f, settings.threshold))
+    cloud_distances = None
+    if registration is not None:  # report the whole map -> truth transform, 3D and 2D
+        progress("distances in 3D")
+        moved = apply(alignment.transform.matrix_3d, source.points)
+        cloud_distances = distances_3d(moved, truth.points, settings.cloud_resolution,
+                                       settings.taus)
+        whole = alignment.transform.matrix_3d @ registration.transform
+        registration = registration._replace(transform=whole)
+        alignment = replace(alignment, transform=Similarity2D.from_matrix(whole), method="3d")
     return Result(map_path=Path(map_path), map_kind=source.kind, truth_path=Path(truth_path),
                   truth_kind=truth.kind, grid=grid, alignment=alignment, overlap=cover,
                   distances=distances(truth_occ, map_occ, footprint, grid, settings.taus),
+                  registration_3d=registration, distances_3d=cloud_distances,
                   threshold=settings.threshold, full=settings.full, detectors=detectors,
                   truth_occupied=truth_occ, map_occupied=map_occ)

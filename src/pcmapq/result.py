@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from pcmapq.align import Alignment
+from pcmapq.align.rigid3d import Registration3D
 from pcmapq.features import Features
 from pcmapq.grid import MetricGrid
 from pcmapq.match import Matching
@@ -79,6 +80,8 @@ class Result:
     alignment: Alignment
     overlap: Overlap
     distances: Distances
+    registration_3d: Registration3D | None
+    distances_3d: Distances | None
     threshold: float
     full: bool
     detectors: dict[str, DetectorResult]
@@ -105,6 +108,11 @@ class Result:
             "detectors": {},
             "matches": [], "missing": [], "extra": [],
         }
+        if self.registration_3d is not None:
+            reg = self.registration_3d
+            doc["alignment_3d"] = {"matrix": reg.transform.tolist(), "fitness": reg.fitness,
+                                   "rmse_m": reg.rmse}
+            doc["distances_3d"] = _distances_dict(self.distances_3d)
         for name, det in self.detectors.items():
             m = det.matching
             doc["detectors"][name] = {

@@ -7,6 +7,8 @@ import os
 import tempfile
 from pathlib import Path
 
+import numpy as np
+
 from pcmapq.errors import InputError
 
 
@@ -47,3 +49,21 @@ def _target_mode(path: Path) -> int:
         umask = os.umask(0)
         os.umask(umask)
         return 0o666 & ~umask
+
+
+def write_cloud(path: Path, points: np.ndarray) -> None:
+    """Write points (N, 3, metres) as .ply or .pcd (binary float32), whole or not at all."""
+    import open3d as o3d
+
+    if path.suffix.lower() not in (".ply", ".pcd"):
+        raise InputError(f"{path}: a map is written as .ply or .pcd")
+    cloud = o3d.t.geometry.PointCloud(o3d.core.Tensor(np.asarray(points, dtype=np.float32)))
+    tmp = path.with_name(f".{path.stem}.{os.getpid()}.tmp{path.suffix}")
+    try:
+        if not o3d.t.io.write_point_cloud(str(tmp), cloud):
+            raise InputError(f"{path}: cannot write")
+        os.replace(tmp, path)
+    except OSError as err:
+        raise InputError(f"{path}: cannot write: {err.strerror or err}") from None
+    finally:
+        tmp.unlink(missing_ok=True)

@@ -102,6 +102,16 @@ def write_tum_poses(path: str | Path, poses: np.ndarray, timestamps: np.ndarray 
     write_atomic(path, _format_rows(rows))
 
 
+def read_poses(path: str | Path) -> np.ndarray:
+    """Read a KITTI (12 columns) or TUM (8 columns) pose file, told apart by its first data
+    line: (K, 4, 4) poses, sensor -> world, metres."""
+    path = Path(path)
+    lines = [ln for ln in _read_text(path).splitlines() if ln.strip() and not ln.startswith("#")]
+    if lines and len(lines[0].split()) == 8:
+        return read_tum_poses(path)[1]
+    return read_kitti_poses(path)
+
+
 def read_calib(path: str | Path) -> np.ndarray:
     """Read a sensor calibration as a 4x4 transform (sensor -> frame of the poses, metres).
 

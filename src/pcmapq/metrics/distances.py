@@ -69,6 +69,11 @@ def distances(truth_occ: np.ndarray, map_occ: np.ndarray, footprint: np.ndarray,
     """
     acc = nearest_distance(truth_occ, grid)[map_occ]
     comp = nearest_distance(map_occ, grid)[truth_occ & footprint]
+    return _summary(acc, comp, taus)
+
+
+def _summary(acc: np.ndarray, comp: np.ndarray, taus: tuple[float, ...]) -> Distances:
+    """Metrics from the map->truth (``acc``) and truth->map (``comp``) distances, metres."""
     a, c = DistanceStats.of(acc), DistanceStats.of(comp)
     chamfer = None if a.mean is None or c.mean is None else 0.5 * (a.mean + c.mean)
     scores = []
@@ -77,3 +82,18 @@ def distances(truth_occ: np.ndarray, map_occ: np.ndarray, footprint: np.ndarray,
         r = float(np.mean(comp <= tau)) if len(comp) else 0.0
         scores.append(FScore(tau, p, r, 2 * p * r / (p + r) if p + r > 0 else 0.0))
     return Distances(a, c, chamfer, tuple(scores))
+
+
+def distances_3d(map_xyz: np.ndarray, truth_xyz: np.ndarray, voxel: float = 0.05,
+                 taus: tuple[float, ...] = DEFAULT_TAUS) -> Distances:
+    """The same metrics between two aligned 3D clouds (N, 3) and (M, 3), metres, in the truth
+    frame, as MapEval and Tanks-and-Temples compute them: nearest-neighbour distances (KD-tree)
+    between the clouds voxel-downsampled to ``voxel`` metres (centroids)."""
+    from scipy.spatial import cKDTree
+
+    from pcmapq.mapping.voxelmap import voxel_centroids
+
+    m, t = voxel_centroids(map_xyz, voxel), voxel_centroids(truth_xyz, voxel)
+    acc = cKDTree(t).query(m, workers=-1)[0] if len(t) else np.full(len(m), np.inf)
+    comp = cKDTree(m).query(t, workers=-1)[0] if len(m) else np.full(len(t), np.inf)
+    return _summary(acc, comp, taus)

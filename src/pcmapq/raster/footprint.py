@@ -44,10 +44,15 @@ def enclosed_area(occupied: np.ndarray, grid: MetricGrid, close: float = 1.5) ->
 
 
 def grow(area: np.ndarray, grid: MetricGrid, margin: float) -> np.ndarray:
-    """``area`` grown by ``margin`` metres (bool, same grid)."""
-    if margin <= 0:
+    """``area`` grown by ``margin`` metres (bool, same grid): the cells within
+    ``max(1, round(margin / resolution))`` cells of it. An exact Euclidean distance transform,
+    so the time does not depend on the margin (a dilation by a disc of r cells costs about r
+    times more: minutes for a 0.3 m margin on a 2 mm grid)."""
+    if margin <= 0 or not area.any():
         return area
-    return cv2.dilate(area.astype(np.uint8), _disc(margin, grid.resolution)).astype(bool)
+    radius = max(1, int(round(margin / grid.resolution)))
+    outside = (~area).astype(np.uint8)
+    return cv2.distanceTransform(outside, cv2.DIST_L2, cv2.DIST_MASK_PRECISE) <= radius
 
 
 def map_footprint(known: np.ndarray | None, occupied: np.ndarray, grid: MetricGrid,

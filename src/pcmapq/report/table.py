@@ -34,6 +34,11 @@ def print_table(result: Result, console: Console) -> None:
                       str(m.truth_features), str(m.map_features), str(m.matched),
                       *(_m(stats[k]) for k in ("mean", "median", "rmse", "max")))
     console.print(table)
+    if result.registration_3d is not None and result.distances_3d is not None:
+        reg, d3 = result.registration_3d, result.distances_3d
+        console.print(f"3D registration: fitness {reg.fitness:.3f}, rmse {reg.rmse:.3f} m; "
+                      f"3D accuracy mean {_m(d3.accuracy.mean)} m, completeness mean "
+                      f"{_m(d3.completeness.mean)} m, Chamfer {_m(d3.chamfer_m)} m")
     d = result.distances
     f = "  ".join(f"F@{s.tau_m:g} m {s.f:.3f}" for s in d.fscores)
     console.print(f"distances: accuracy mean {_m(d.accuracy.mean)} m, completeness mean "
