@@ -11,21 +11,7 @@ from pcmapq.align import align
 from pcmapq.align.icp import fit_similarity, refine_point_to_line, voxel_downsample
 from pcmapq.align.transform import Similarity2D
 
-from .conftest import shared
-
-PLAN = synth.building_plan(0)  # 24 m x 16 m
-WIDTH, HEIGHT = 24.0, 16.0
-
-
-@pytest.fixture(scope="module")
-def truth() -> np.ndarray:
-    return synth.wall_points(PLAN, spacing=0.05)
-
-
-@pytest.fixture(scope="module")
-def scan() -> np.ndarray:
-    """The same walls sampled again with 1.5 cm noise, in the plan frame."""
-    return synth.wall_points(PLAN, spacing=0.05, noise=0.015, seed=1)
+from .conftest import HEIGHT, PLAN, WIDTH, shared
 
 
 def similarity(scale: float, yaw_deg: float, tx: float, ty: float) -> Similarity2D:
