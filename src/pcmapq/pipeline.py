@@ -151,14 +151,12 @@ def score(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap, setti
         detectors[name] = DetectorResult(truth_f, map_f,
                                          match(name, truth_f, map_f, settings.threshold))
     cloud_distances = None
-    if registration is not None:  # report the whole map -> truth transform, 3D and 2D
+    if registration is not None:  # the map was moved in 3D: report that transform, in 2D too
         progress("distances in 3D")
-        moved = apply(alignment.transform.matrix_3d, source.points)
-        cloud_distances = distances_3d(moved, truth.points, settings.cloud_resolution,
+        cloud_distances = distances_3d(source.points, truth.points, settings.cloud_resolution,
                                        settings.taus)
-        whole = alignment.transform.matrix_3d @ registration.transform
-        registration = registration._replace(transform=whole)
-        alignment = replace(alignment, transform=Similarity2D.from_matrix(whole), method="3d")
+        alignment = replace(alignment, transform=Similarity2D.from_matrix(registration.transform),
+                            method="3d")
     return Result(map_path=Path(map_path), map_kind=source.kind, truth_path=Path(truth_path),
                   truth_kind=truth.kind, grid=grid, alignment=alignment, overlap=cover,
                   distances=distances(truth_occ, map_occ, footprint, grid, settings.taus),

@@ -25,15 +25,6 @@ class Similarity2D:
         c, s = np.cos(self.yaw) * self.scale, np.sin(self.yaw) * self.scale
         return np.array([[c, -s, self.tx], [s, c, self.ty], [0.0, 0.0, 1.0]])
 
-    @property
-    def matrix_3d(self) -> np.ndarray:
-        """4x4 homogeneous matrix acting on (x, y) as :attr:`matrix` and scaling z by ``scale``."""
-        m = np.eye(4) * self.scale
-        m[:2, :2] = self.matrix[:2, :2]
-        m[:2, 3] = [self.tx, self.ty]
-        m[3, 3] = 1.0
-        return m
-
     @classmethod
     def from_matrix(cls, m: np.ndarray) -> Similarity2D:
         """From a 3x3 (or the top-left 2x3 of a 4x4 planar) similarity matrix."""
