@@ -112,3 +112,25 @@ def test_map_of_another_place_exits_1_unless_forced(tmp_path):
     forced = run("eval", str(other), str(SAMPLE / "truth.png"), "--force", "--json", "-")
     assert forced.returncode == 0
     assert json.loads(forced.stdout)["alignment"]["agreement"] < 0.2
+
+
+def test_init_and_no_align(tmp_path):
+    """--no-align scores the map where it stands; --init starts ICP from a guess; a malformed
+    --init is a usage error (exit 2)."""
+    truth = str(SAMPLE / "truth.png")
+    still = run("eval", truth, truth, "--no-align", "--json", "-")
+    assert still.returncode == 0, still.stderr
+    a = json.loads(still.stdout)["alignment"]
+    assert (a["x_m"], a["y_m"], a["yaw_deg"], a["method"]) == (0.0, 0.0, 0.0, "none")
+    guided = run("eval", str(SAMPLE / "scan.ply"), truth, "--init", "6.2,7.9,36", "--json", "-")
+    assert guided.returncode == 0, guided.stderr
+    a = json.loads(guided.stdout)["alignment"]
+    assert a["method"] == "init+icp" and abs(a["yaw_deg"] - 37.0) < 0.5
+    assert run("eval", truth, truth, "--init", "1,2").returncode == 2
+
+
+def test_map_command_bad_input_exits_2(tmp_path):
+    proc = run("map", str(tmp_path / "none"), "--out", str(tmp_path / "m.ply"))
+    assert proc.returncode == 2 and "Traceback" not in proc.stderr
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1 and "none" in lines[0], proc.stderr

@@ -6,6 +6,7 @@ import base64
 import html
 
 from pcmapq import __version__
+from pcmapq.metrics.distances import DistanceStats
 from pcmapq.report.plot import distance_heatmap, png_bytes, vectorial_figure
 from pcmapq.result import Result
 
@@ -33,6 +34,13 @@ def _table(header: list[str], rows: list[list[str]]) -> str:
     body = "".join("<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in row) + "</tr>"
                    for row in rows)
     return f"<table><tr>{head}</tr>{body}</table>"
+
+
+def _stats_table(counted: str, rows: list[tuple[str, DistanceStats]]) -> str:
+    """A table of distance statistics, one row per (label, stats)."""
+    return _table(["", "mean [m]", "median [m]", "RMSE [m]", "95th pct [m]", counted],
+                  [[label, _f(s.mean), _f(s.median), _f(s.rmse), _f(s.p95), str(s.count)]
+                   for label, s in rows])
 
 
 def _f(value: float | None, digits: int = 3) -> str:
@@ -64,13 +72,17 @@ def report_html(result: Result) -> str:
                      "map features", "matched", "disp. mean [m]", "disp. median [m]",
                      "disp. RMSE [m]", "disp. max [m]"], rows)
     d = result.distances
-    dist = _table(["", "mean [m]", "median [m]", "RMSE [m]", "95th pct [m]", "cells"],
-                  [[label, _f(s.mean), _f(s.median), _f(s.rmse), _f(s.p95), str(s.count)]
-                   for label, s in (("accuracy (map to truth)", d.accuracy),
-                                    ("completeness (truth to map)", d.completeness))])
+    dist = _stats_table("cells", [("accuracy (map to truth)", d.accuracy),
+                                  ("completeness (truth to map)", d.completeness)])
     fscore = _table(["threshold [m]", "precision", "recall", "F-score"],
                     [[f"{f.tau_m:g}", _f(f.precision), _f(f.recall), _f(f.f)]
                      for f in d.fscores])
+    if result.registration_3d is not None and result.distances_3d is not None:
+        reg, d3 = result.registration_3d, result.distances_3d
+        dist += "<p class=\"note\">Both inputs are 3D clouds: registered in 3D (fitness " \
+                f"{_f(reg.fitness)}, RMSE {_f(reg.rmse)} m); distances between the clouds:</p>"
+        dist += _stats_table("points", [("3D accuracy (map to truth)", d3.accuracy),
+                                        ("3D completeness (truth to map)", d3.completeness)])
     vectors = _img(png_bytes(vectorial_figure(result)), "vectorial map per detector")
     heat = _img(png_bytes(distance_heatmap(result)), "map-to-truth distance heatmap")
     title = f"pcmapq: {html.escape(result.map_path.name)} against " \
