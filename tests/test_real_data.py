@@ -12,6 +12,7 @@ from pcmapq.align.transform import Similarity2D
 from pcmapq.config import Settings
 from pcmapq.grid import MetricGrid
 from pcmapq.pipeline import evaluate
+from pcmapq.report.html import report_html
 
 from .conftest import shared
 
@@ -76,3 +77,4 @@ def test_lidar_pair_aligns_to_its_known_transform():
     assert result.alignment.fitness > 0.8
     np.testing.assert_allclose(result.registration_3d.transform, truth, atol=0.02)
     assert result.distances_3d.accuracy.mean < 0.2
+    assert "3D accuracy (map to truth)" in report_html(result)
