@@ -203,6 +203,9 @@ def eval_command(
         help="Draw the vectorial map, one panel per detector, as PNG.")] = None,
     report: Annotated[Path | None, typer.Option(
         help="Write a self-contained HTML report (figures embedded).")] = None,
+    voxel_3d: Annotated[float, typer.Option(
+        "--voxel-3d", help="Working voxel of the 3D registration of two 3D clouds, metres "
+        "(0.5-1 for outdoor maps).", min=0.01)] = 0.3,
     tau: Annotated[str, typer.Option(
         help="Distance thresholds of the F-score, metres, comma-separated.")
     ] = ",".join(f"{t:g}" for t in DEFAULT_TAUS),
@@ -220,7 +223,8 @@ def eval_command(
                         scale=auto,
                         band_low=band_low, band_high=band_high, init=_parse_init(init),
                         align=not no_align, force=force, threshold=threshold, min_hits=min_hits,
-                        detectors=_parse_detectors(detectors), full=full, taus=_parse_taus(tau))
+                        detectors=_parse_detectors(detectors), full=full, taus=_parse_taus(tau),
+                        voxel_3d=voxel_3d)
     quiet = json_path == "-"
     err = Console(stderr=True)
     out = Console(quiet=quiet, width=None if err.is_terminal else 132)
