@@ -33,9 +33,10 @@ def enclosed_area(occupied: np.ndarray, grid: MetricGrid, close: float = 1.5) ->
         pad = np.pad(occupied, ((0, -rows % step), (0, -cols % step)))
         small = pad.reshape(pad.shape[0] // step, step, pad.shape[1] // step, step).any(axis=(1, 3))
     # pad so the closing does not stick to the border of the grid
-    r = _disc(close, grid.resolution * step).shape[0]
+    kernel = _disc(close, grid.resolution * step)
+    r = kernel.shape[0]
     padded = np.pad(small.astype(np.uint8), r)
-    closed = cv2.morphologyEx(padded, cv2.MORPH_CLOSE, _disc(close, grid.resolution * step))
+    closed = cv2.morphologyEx(padded, cv2.MORPH_CLOSE, kernel)
     filled = ndimage.binary_fill_holes(closed[r:-r, r:-r])
     if step > 1:
         filled = np.repeat(np.repeat(filled, step, axis=0), step, axis=1)
@@ -62,10 +63,3 @@ def map_footprint(known: np.ndarray | None, occupied: np.ndarray, grid: MetricGr
     area = known if known is not None else enclosed_area(occupied, grid)
     return grow(area | occupied, grid, margin)
 
-
-def near(occupied: np.ndarray, grid: MetricGrid, tolerance: float) -> np.ndarray:
-    """Cells within ``tolerance`` metres of an occupied cell (bool, same grid)."""
-    if not occupied.any():
-        return np.zeros_like(occupied)
-    dist = cv2.distanceTransform((~occupied).astype(np.uint8), cv2.DIST_L2, cv2.DIST_MASK_PRECISE)
-    return dist * grid.resolution <= tolerance
