@@ -17,9 +17,9 @@ from pcmapq.features import Features, detect
 from pcmapq.grid import MetricGrid
 from pcmapq.io import OccupancyMap, PointMap, load_map
 from pcmapq.match import match
-from pcmapq.metrics.distances import distances, distances_3d
+from pcmapq.metrics.distances import distances, distances_3d, nearest_distance
 from pcmapq.raster.draw import OCCUPIED, UNKNOWN, points_to_grid, warp_state
-from pcmapq.raster.footprint import map_footprint, near
+from pcmapq.raster.footprint import map_footprint
 from pcmapq.raster.slice import wall_band
 from pcmapq.result import DetectorResult, Overlap, Result
 
@@ -73,12 +73,13 @@ def map_raster(source: OccupancyMap | PointMap, map_xy: np.ndarray, transform: S
     return occupied, map_footprint(known, occupied, grid, settings.footprint_margin)
 
 
-def overlap(truth_occ: np.ndarray, map_occ: np.ndarray, footprint: np.ndarray, grid: MetricGrid,
-            fitness: float, tolerance: float) -> Overlap:
-    """How much of the truth the map covers, and how well the two agree there."""
+def overlap(truth_occ: np.ndarray, to_map: np.ndarray, footprint: np.ndarray, fitness: float,
+            tolerance: float) -> Overlap:
+    """How much of the truth the map covers, and how well the two agree there; ``to_map`` is
+    each cell's distance to the nearest map wall, metres."""
     seen = truth_occ & footprint
     coverage = float(seen.sum() / truth_occ.sum()) if truth_occ.any() else 0.0
-    recall = float(near(map_occ, grid, tolerance)[seen].mean()) if seen.any() else 0.0
+    recall = float((to_map[seen] <= tolerance).mean()) if seen.any() else 0.0
     return Overlap(footprint, coverage, recall, fitness * recall)
 
 
@@ -133,8 +134,8 @@ def score(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap, setti
     progress("rasterising")
     grid, truth_occ = truth_raster(truth, truth_xy, settings)
     map_occ, footprint = map_raster(source, map_xy, alignment.transform, grid, settings)
-    cover = overlap(truth_occ, map_occ, footprint, grid, alignment.fitness,
-                    settings.fit_tolerance)
+    to_map = nearest_distance(map_occ, grid)
+    cover = overlap(truth_occ, to_map, footprint, alignment.fitness, settings.fit_tolerance)
     if cover.agreement < settings.min_agreement and not settings.force:
         raise EvaluationError(
             f"{map_path}: does not match {truth_path}: agreement {cover.agreement:.2f} < "
@@ -159,7 +160,8 @@ def score(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap, setti
                             method="3d")
     return Result(map_path=Path(map_path), map_kind=source.kind, truth_path=Path(truth_path),
                   truth_kind=truth.kind, grid=grid, alignment=alignment, overlap=cover,
-                  distances=distances(truth_occ, map_occ, footprint, grid, settings.taus),
+                  distances=distances(truth_occ, map_occ, footprint, grid, settings.taus,
+                                      to_map),
                   registration_3d=registration, distances_3d=cloud_distances,
                   threshold=settings.threshold, full=settings.full, detectors=detectors,
                   truth_occupied=truth_occ, map_occupied=map_occ)
