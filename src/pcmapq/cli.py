@@ -67,7 +67,7 @@ def map_command(
 ) -> None:
     """Build a map from LiDAR scans with KISS-ICP (or with given poses) and save it."""
     err = Console(stderr=True)
-    try:
+    with _errors(err):
         with _bar(err) as tick:
             if poses is None:
                 points, trajectory = build_map_kiss(source, max_scans=max_scans, voxel=voxel,
@@ -84,10 +84,17 @@ def map_command(
             write_kitti_poses(poses_out, trajectory)
         if tum_out is not None:
             write_tum_poses(tum_out, trajectory)
-    except (InputError, EvaluationError) as error:
-        err.print(f"pcmapq: error: {error}", markup=False, highlight=False, soft_wrap=True)
-        raise typer.Exit(error.exit_code) from None
     err.print(f"{out}: {len(points)} points from {len(trajectory)} scans", highlight=False)
+
+
+@contextmanager
+def _errors(console: Console) -> Iterator[None]:
+    """Bad input or a failed evaluation: one line on stderr and the error's exit code."""
+    try:
+        yield
+    except (InputError, EvaluationError) as error:
+        console.print(f"pcmapq: error: {error}", markup=False, highlight=False, soft_wrap=True)
+        raise typer.Exit(error.exit_code) from None
 
 
 @contextmanager
@@ -228,30 +235,26 @@ def eval_command(
     quiet = json_path == "-"
     err = Console(stderr=True)
     out = Console(quiet=quiet, width=None if err.is_terminal else 132)
-    try:
-        with _progress(err, enabled=not quiet) as progress:
-            if scans is None:
-                map_path: Path | PointMap = paths[0]
-            else:
-                progress("mapping the scans with KISS-ICP")
-                points, _ = build_map_kiss(scans, max_scans=max_scans)
-                map_path = PointMap(scans, points, True, kind="scans")
-            result = evaluate(map_path, truth_path, settings, progress)
-            progress("writing outputs")
-            if json_path == "-":
-                sys.stdout.write(result.to_json())
-            elif json_path is not None:
-                write_atomic(Path(json_path), result.to_json())
-            if vectors is not None:
-                write_atomic(vectors, result.vectors_csv())
-            if plot is not None or report is not None:
-                from pcmapq.report.html import report_html
-                from pcmapq.report.plot import png_bytes, vectorial_figure
-            if plot is not None:
-                write_atomic(plot, png_bytes(vectorial_figure(result)))
-            if report is not None:
-                write_atomic(report, report_html(result))
-    except (InputError, EvaluationError) as error:
-        err.print(f"pcmapq: error: {error}", markup=False, highlight=False, soft_wrap=True)
-        raise typer.Exit(error.exit_code) from None
+    with _errors(err), _progress(err, enabled=not quiet) as progress:
+        if scans is None:
+            map_path: Path | PointMap = paths[0]
+        else:
+            progress("mapping the scans with KISS-ICP")
+            points, _ = build_map_kiss(scans, max_scans=max_scans)
+            map_path = PointMap(scans, points, True, kind="scans")
+        result = evaluate(map_path, truth_path, settings, progress)
+        progress("writing outputs")
+        if json_path == "-":
+            sys.stdout.write(result.to_json())
+        elif json_path is not None:
+            write_atomic(Path(json_path), result.to_json())
+        if vectors is not None:
+            write_atomic(vectors, result.vectors_csv())
+        if plot is not None or report is not None:
+            from pcmapq.report.html import report_html
+            from pcmapq.report.plot import png_bytes, vectorial_figure
+        if plot is not None:
+            write_atomic(plot, png_bytes(vectorial_figure(result)))
+        if report is not None:
+            write_atomic(report, report_html(result))
     print_table(result, out)
