@@ -161,6 +161,16 @@ def render(segments: np.ndarray, grid: MetricGrid, thickness: float = 0.15,
     return img
 
 
+def faces(occupied: np.ndarray) -> np.ndarray:
+    """The one-cell inner boundary of occupied cells (bool, same shape): walls drawn as their
+    two faces, the way a plan drawn as outlines (or a laser seeing both sides) draws them."""
+    import cv2
+
+    inner = cv2.erode(occupied.astype(np.uint8), np.ones((3, 3), np.uint8),
+                      borderType=cv2.BORDER_CONSTANT, borderValue=0)
+    return occupied & (inner == 0)
+
+
 def plan_grid(segments: np.ndarray, resolution: float, margin: float = 1.0) -> MetricGrid:
     """A grid covering the plan plus a margin, in the plan's frame."""
     return MetricGrid.covering(segments.reshape(-1, 2), resolution, margin)

@@ -13,9 +13,9 @@ from dataclasses import dataclass, replace
 
 import cv2
 import numpy as np
-from scipy import sparse
 from scipy.spatial import cKDTree
 
+from pcmapq.features.walls import wall_band
 from pcmapq.grid import MetricGrid
 
 #: Candidate pairs: truth indices, map indices, costs, displacements (M, 2) in metres.
@@ -97,37 +97,6 @@ def sorted_features(
     )
 
 
-def _overlap_matrix(n_out: int, out_size: float, n_in: int, in_size: float) -> sparse.csr_array:
-    """(n_out, n_in) weights of 1D area averaging: the fraction of output cell ``i`` (length
-    ``out_size``) covered by input cell ``j`` (length ``in_size``); both start at 0."""
-    edges = np.union1d(np.arange(n_out + 1) * out_size, np.arange(n_in + 1) * in_size)
-    edges = edges[edges <= min(n_out * out_size, n_in * in_size) + 1e-12]
-    mid = 0.5 * (edges[1:] + edges[:-1])
-    length = np.diff(edges)
-    i = np.minimum((mid / out_size).astype(np.int64), n_out - 1)
-    j = np.minimum((mid / in_size).astype(np.int64), n_in - 1)
-    return sparse.csr_array((length / out_size, (i, j)), shape=(n_out, n_in))
-
-
-def resample(image: np.ndarray, grid: MetricGrid,
-             resolution: float) -> tuple[np.ndarray, MetricGrid]:
-    """Resample ``image`` (rows, cols, on ``grid``) to cells of ``resolution`` metres by exact
-    area averaging over a grid with the same origin and yaw.
-
-    Returns the float32 image and its grid; the area beyond the input's extent reads 0.
-    """
-    image = np.asarray(image, dtype=np.float32)
-    if abs(grid.resolution - resolution) < 1e-9 * resolution:
-        return image, grid
-    work = grid.resampled(resolution)
-    ax = _overlap_matrix(work.shape[1], resolution, grid.shape[1], grid.resolution)
-    # rows count from the top, the origin is at the bottom: average the flipped rows
-    ay = _overlap_matrix(work.shape[0], resolution, grid.shape[0], grid.resolution)
-    out = ay @ image[::-1].astype(np.float64)
-    out = (ax @ out.T).T[::-1]
-    return np.ascontiguousarray(out, dtype=np.float32), work
-
-
 def disk(radius_px: float) -> np.ndarray:
     """A disk-shaped uint8 structuring element of ``radius_px`` pixels (at least 3x3)."""
     r = max(1, int(round(radius_px)))
@@ -146,26 +115,23 @@ def gaussian(image: np.ndarray, sigma_px: float) -> np.ndarray:
 def working_image(
     occupied: np.ndarray, grid: MetricGrid, resolution: float, closing: float
 ) -> tuple[np.ndarray, MetricGrid]:
-    """The occupied fraction of each working cell, after a grey-level closing.
+    """The image a detector works on: the walls' centre lines drawn as a band of fixed width
+    (see :mod:`pcmapq.features.walls`), so it does not depend on how the walls were drawn.
 
     Parameters
     ----------
     occupied : (rows, cols) bool raster on ``grid``, walls true.
     grid : the raster's grid.
     resolution : working cell size, metres.
-    closing : radius of the closing disk, metres. It fills gaps narrower than about twice this,
-        so a wall drawn as its two laser-seen faces looks like the filled wall of a plan.
+    closing : radius of the closing disk, metres. It joins the two faces of a wall drawn as
+        outlines (or seen from both sides by a laser), up to about twice this apart.
 
     Returns
     -------
     image : (rows, cols) float32 in [0, 1] on the working grid.
     work : the working grid (same origin and yaw as ``grid``).
     """
-    image, work = resample(occupied, grid, resolution)
-    if closing > 0:
-        kernel = disk(closing / resolution)
-        image = cv2.morphologyEx(image, cv2.MORPH_CLOSE, kernel, borderType=cv2.BORDER_REFLECT)
-    return image, work
+    return wall_band(occupied, grid, resolution, closing)
 
 
 def suppress(xy: np.ndarray, strength: np.ndarray, radius: float) -> np.ndarray:

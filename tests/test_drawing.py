@@ -1,0 +1,68 @@
+"""Drawing invariance: the same walls drawn 1, 2, 3 or 6 cells thick, or as their two faces,
+at 0.05 m and 0.025 m cells, score like the usual drawing, whichever side is the map."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from pcmapq import synth
+from pcmapq.features import detect
+from pcmapq.features.walls import prune, wall_band
+from pcmapq.grid import MetricGrid
+from pcmapq.match import match
+
+NAMES = ("harris", "hough", "sift")
+PLAN = synth.building_plan(0)
+#: The usual drawing: 0.15 m walls on 0.05 m cells.
+USUAL = synth.plan_grid(PLAN, 0.05)
+
+
+def drawn(resolution: float, cells: int | None) -> tuple[np.ndarray, MetricGrid]:
+    """The plan's walls ``cells`` cells thick, or (None) as the faces of 0.15 m walls."""
+    grid = synth.plan_grid(PLAN, resolution)
+    if cells is None:
+        return synth.faces(synth.render(PLAN, grid, 0.15) == synth.OCCUPIED), grid
+    return synth.render(PLAN, grid, thickness=cells * resolution) == synth.OCCUPIED, grid
+
+
+@pytest.fixture(scope="module")
+def usual():
+    occ = synth.render(PLAN, USUAL, 0.15) == synth.OCCUPIED
+    return {n: detect(n, occ, USUAL) for n in NAMES}
+
+
+@pytest.mark.parametrize("resolution", [0.05, 0.025])
+@pytest.mark.parametrize("cells", [1, 2, 3, 6, None], ids=["1", "2", "3", "6", "faces"])
+def test_same_walls_drawn_otherwise_score_alike(usual, resolution, cells):
+    occ, grid = drawn(resolution, cells)
+    for name in NAMES:
+        other = detect(name, occ, grid)
+        assert other.strong.sum() >= 10, name
+        for m in (match(name, usual[name], other), match(name, other, usual[name])):
+            assert m.quality >= 0.95 and m.precision >= 0.95, (name, m.quality, m.precision)
+
+
+@pytest.mark.parametrize("thickness", [0.025, 0.05, 0.15, 0.3])
+def test_wall_band_has_one_width(thickness):
+    """A straight wall of any thickness becomes a band 0.15 m wide on its centre line."""
+    grid = MetricGrid(0.025, (0.0, 0.0, 0.0), (120, 200))
+    occ = synth.render(np.array([[1.0, 1.5, 4.0, 1.5]]), grid, thickness) == synth.OCCUPIED
+    image, work = wall_band(occ, grid)
+    across = image[:, 40:60].sum(axis=0) * work.resolution  # metres of band per column
+    np.testing.assert_allclose(across, 0.15, atol=0.02)
+    rows = np.arange(image.shape[0])
+    centre = work.pixels_to_xy(np.column_stack([np.full(1, 50), [rows @ image[:, 50]
+                                                                 / image[:, 50].sum()]]))
+    assert abs(centre[0, 1] - 1.5) < 0.02
+
+
+def test_spurs_pruned_walls_kept():
+    """A free branch shorter than the limit goes; a long one and a loop stay."""
+    sk = np.zeros((40, 60), dtype=bool)
+    sk[20, 5:55] = True  # a wall
+    sk[21:25, 30] = True  # a 4-pixel spur off it
+    sk[5:20, 20] = True  # a 15-pixel branch
+    pruned = prune(sk, 8)
+    assert not pruned[22:25, 30].any()  # (21, 30) touches three wall pixels: a junction
+    assert pruned[20, 5:55].all() and pruned[5:20, 20].all()
