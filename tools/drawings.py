@@ -5,12 +5,14 @@ against the usual drawing in both directions (no alignment: same frame).
   thick and as double outlines (the two faces of a 0.15 m wall, one cell each) at 0.05 m and
   0.025 m cells, against the usual drawing (0.15 m walls at 0.05 m);
 - real: the Freiburg 079 SLAM map thickened by one and two cells and thinned to its skeleton,
-  and a Halmstad layout against its skeleton (../shared/data).
+  and a Halmstad layout against its skeleton (../shared/data);
+- counts: the strong features each detector finds on every real truth of ../shared/data.
 
-    python tools/drawings.py [--seeds 0,1,2] [--data ../shared/data]
+    python tools/drawings.py [--seeds 0,1,2] [--data ../shared/data] [--counts-only]
+        [--figure docs/img/wall_band.png]
 
 Prints markdown tables: per variant and detector the feature counts and quality / precision
-in both directions (variant as the map, then variant as the truth).
+in both directions (variant as the map, then variant as the truth); then the counts.
 """
 
 from __future__ import annotations
@@ -24,10 +26,12 @@ import numpy as np
 from skimage.morphology import skeletonize
 
 from pcmapq import synth
+from pcmapq.config import Settings
 from pcmapq.features import detect
 from pcmapq.grid import MetricGrid
-from pcmapq.io import load_map
+from pcmapq.io import OccupancyMap, load_map
 from pcmapq.match import match
+from pcmapq.pipeline import plan_points, truth_raster
 from pcmapq.raster.draw import OCCUPIED
 
 NAMES = ("harris", "hough", "sift")
@@ -102,11 +106,89 @@ def real(path: Path, resolution: float, title: str, variants: tuple[str, ...]) -
     return table(title, usual, rows)
 
 
+#: Every real truth: (name, path under the data folder, metres per pixel of an image).
+TRUTHS = (
+    ("Gazebo world (rendered)", "gazebo/Ground_Truth.png", 1.0 / 529.0),
+    ("Intel Research Lab plan", "floorplans/lab_intel.png", 0.05),
+    ("Freiburg 079 plan", "floorplans/Freiburg79_scan.png", 0.05),
+    *((f"Halmstad {b} layout", f"halmstad/maps/{b}/layout/{b}_layout.png", 0.05)
+      for b in ("E5", "F5", "HIH", "KPT4A")),
+    ("Intel CARMEN log (corrected poses)", "carmen/intel-corrected.log.gz", None),
+    ("FHW CARMEN log (corrected poses)", "carmen/fhw-corrected.log.gz", None),
+)
+
+
+def truth_counts(data: Path) -> str:
+    """A markdown table of the strong features of every real truth that is present."""
+    lines = ["### Strong features of the real truths", "",
+             "| truth | cells | " + " | ".join(NAMES) + " |", "|---" * (len(NAMES) + 2) + "|"]
+    for title, rel, resolution in TRUTHS:
+        path = data / rel
+        if not path.is_file():
+            continue
+        source = load_map(path, resolution)
+        if isinstance(source, OccupancyMap):
+            occ, grid = source.state == OCCUPIED, source.grid
+        else:
+            grid, occ = truth_raster(source, plan_points(source, Settings()), Settings())
+        counts = [int(detect(n, occ, grid).strong.sum()) for n in NAMES]
+        lines.append(f"| {title} | {grid.shape[1]} x {grid.shape[0]} at "
+                     f"{grid.resolution * 1000:.2f} mm | " + " | ".join(map(str, counts)) + " |")
+    return "\n".join(lines + [""])
+
+
+def figure(path: Path) -> None:
+    """Save a picture of a corner of the plan drawn three ways (top) and what the detectors
+    see of each (bottom), with the Harris corners."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from pcmapq.features.base import working_image
+
+    segments = synth.building_plan(0)
+    drawings = {"1 cell at 0.025 m": None, "6 cells (0.3 m) at 0.05 m": None,
+                "double outline at 0.025 m": None}
+    variants = plan_variants(segments)
+    keys = ("1 cell at 0.025 m", "6 cells at 0.05 m", "double outline at 0.025 m")
+    fig, axes = plt.subplots(2, 3, figsize=(10, 6.4), constrained_layout=True)
+    window = (11.0, 21.5, 8.0, 15.0)  # x0, x1, y0, y1 metres: rooms, a corridor, pillars
+    for col, (title, key) in enumerate(zip(drawings, keys, strict=True)):
+        occ, grid = variants[key]
+        image, work = working_image(occ, grid, 0.05, 0.1)
+        corners = detect("harris", occ, grid)
+        for row, (img, g) in enumerate(((occ.astype(float), grid), (image, work))):
+            ax = axes[row, col]
+            x0, y0 = g.origin[:2]
+            w, h = g.size_m
+            ax.imshow(img, cmap="Greys", vmin=0, vmax=1, extent=(x0, x0 + w, y0, y0 + h),
+                      interpolation="nearest")
+            if row == 1:
+                xy = corners.xy[corners.strong]
+                ax.plot(xy[:, 0], xy[:, 1], "o", mfc="none", mec="tab:red", ms=7)
+            ax.set_xlim(window[0], window[1])
+            ax.set_ylim(window[2], window[3])
+            ax.set_xticks([])
+            ax.set_yticks([])
+            ax.set_title(title if row == 0 else "what the detectors see", fontsize=10)
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seeds", default="0,1,2")
     parser.add_argument("--data", type=Path, default=DATA)
+    parser.add_argument("--counts-only", action="store_true")
+    parser.add_argument("--figure", type=Path, help="save the picture of docs/method.md here")
     args = parser.parse_args(argv)
+    if args.figure is not None:
+        figure(args.figure)
+        return 0
+    if args.counts_only:
+        print(truth_counts(args.data))
+        return 0
     for seed in (int(s) for s in args.seeds.split(",")):
         print(synthetic(seed))
     fr79 = args.data / "floorplans" / "freiburg_building79.png"
@@ -116,6 +198,7 @@ def main(argv: list[str] | None = None) -> int:
                    ("thickened by 1 cell", "thickened by 2 cells", "skeleton")))
     if layout.is_file():
         print(real(layout, 0.05, "Halmstad E5 layout (0.05 m assumed)", ("skeleton",)))
+    print(truth_counts(args.data))
     return 0
 
 
