@@ -1,9 +1,10 @@
 """What every detector shares: the Features type, the Detector record, and the working image.
 
-Detectors never look at the input raster directly. They see it resampled onto a *working grid*
-(same origin and yaw as the input grid, a fixed cell size in metres) by exact area averaging, so
-a plan drawn at 0.025 m and at 0.05 m gives the same working image up to rasterisation noise,
-and every length parameter (all in metres) means the same number of working pixels.
+Detectors never look at the input raster directly. They see the walls' centre lines drawn as a
+band of fixed width on a *working grid* (same origin and yaw as the input grid, a fixed cell
+size in metres; see :mod:`pcmapq.features.walls`), so a plan drawn with thin or thick walls, as
+outlines, at 0.025 m or at 0.05 m gives the same working image up to rasterisation noise, and
+every length parameter (all in metres) means the same number of working pixels.
 """
 
 from __future__ import annotations
