@@ -8,7 +8,7 @@ import pytest
 
 from pcmapq import synth
 from pcmapq.features import detect
-from pcmapq.features.walls import prune, wall_band
+from pcmapq.features.walls import prune, wall_image
 from pcmapq.grid import MetricGrid
 from pcmapq.match import match
 
@@ -44,11 +44,12 @@ def test_same_walls_drawn_otherwise_score_alike(usual, resolution, cells):
 
 
 @pytest.mark.parametrize("thickness", [0.025, 0.05, 0.15, 0.3])
-def test_wall_band_has_one_width(thickness):
+def test_wall_image_has_one_width(thickness):
     """A straight wall of any thickness becomes a band 0.15 m wide on its centre line."""
     grid = MetricGrid(0.025, (0.0, 0.0, 0.0), (120, 200))
     occ = synth.render(np.array([[1.0, 1.5, 4.0, 1.5]]), grid, thickness) == synth.OCCUPIED
-    image, work = wall_band(occ, grid)
+    walls = wall_image(occ, grid)
+    image, work = walls.image, walls.grid
     across = image[:, 40:60].sum(axis=0) * work.resolution  # metres of band per column
     np.testing.assert_allclose(across, 0.15, atol=0.02)
     rows = np.arange(image.shape[0])

@@ -27,7 +27,7 @@ from skimage.morphology import skeletonize
 
 from pcmapq import synth
 from pcmapq.config import Settings
-from pcmapq.features import detect
+from pcmapq.features import detect, walls_of
 from pcmapq.grid import MetricGrid
 from pcmapq.io import OccupancyMap, load_map
 from pcmapq.match import match
@@ -145,8 +145,6 @@ def figure(path: Path) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from pcmapq.features.base import working_image
-
     segments = synth.building_plan(0)
     drawings = {"1 cell at 0.025 m": None, "6 cells (0.3 m) at 0.05 m": None,
                 "double outline at 0.025 m": None}
@@ -156,7 +154,8 @@ def figure(path: Path) -> None:
     window = (11.0, 21.5, 8.0, 15.0)  # x0, x1, y0, y1 metres: rooms, a corridor, pillars
     for col, (title, key) in enumerate(zip(drawings, keys, strict=True)):
         occ, grid = variants[key]
-        image, work = working_image(occ, grid, 0.05, 0.1)
+        walls = walls_of(occ, grid)
+        image, work = walls.image, walls.grid
         corners = detect("harris", occ, grid)
         for row, (img, g) in enumerate(((occ.astype(float), grid), (image, work))):
             ax = axes[row, col]

@@ -13,7 +13,7 @@ from pcmapq.align.rigid3d import Registration3D, align_3d, apply
 from pcmapq.align.transform import Similarity2D
 from pcmapq.config import Settings
 from pcmapq.errors import EvaluationError, InputError
-from pcmapq.features import Features, detect
+from pcmapq.features import Features, detect_in, walls_of
 from pcmapq.grid import MetricGrid
 from pcmapq.io import OccupancyMap, PointMap, load_map
 from pcmapq.match import match
@@ -143,10 +143,12 @@ def score(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap, setti
             f"{cover.truth_recall:.0%} of the truth it covers lies near the map); "
             "a map of another place? --force scores it anyway")
 
+    progress("drawing the walls' centre lines")
+    truth_walls, map_walls = walls_of(truth_occ, grid), walls_of(map_occ, grid)
     detectors = {}
     for name in settings.detectors:
         progress(f"detecting {name}")
-        truth_f, map_f = detect(name, truth_occ, grid), detect(name, map_occ, grid)
+        truth_f, map_f = detect_in(name, truth_walls), detect_in(name, map_walls)
         if not settings.full:  # truth features the map never saw are not missing
             truth_f = truth_f.counted_where(inside(truth_f, footprint, grid))
         detectors[name] = DetectorResult(truth_f, map_f,

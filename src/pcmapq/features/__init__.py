@@ -13,9 +13,11 @@ import numpy as np
 
 from pcmapq.errors import InputError
 from pcmapq.features.base import Candidates, Detector, Features
+from pcmapq.features.walls import WallImage, wall_image
 from pcmapq.grid import MetricGrid
 
-__all__ = ["DETECTORS", "Candidates", "Detector", "Features", "detect"]
+__all__ = ["DETECTORS", "Candidates", "Detector", "Features", "WallImage", "detect", "detect_in",
+           "walls_of"]
 
 
 def _discover() -> dict[str, Detector]:
@@ -33,8 +35,28 @@ def _discover() -> dict[str, Detector]:
 DETECTORS: dict[str, Detector] = _discover()
 
 
+def walls_of(occupied: np.ndarray, grid: MetricGrid) -> WallImage:
+    """The walls of a binary map as every detector sees them (see :mod:`pcmapq.features.walls`).
+
+    occupied : (rows, cols) bool raster drawn on ``grid``, walls true.
+    """
+    occupied = np.asarray(occupied, dtype=bool)
+    if occupied.shape != tuple(grid.shape):
+        raise InputError(f"raster shape {occupied.shape} does not match grid shape {grid.shape}")
+    return wall_image(occupied, grid)
+
+
+def detect_in(name: str, walls: WallImage, **params) -> Features:
+    """Features of detector ``name`` (a key of :data:`DETECTORS`) in ``walls``, in the metric
+    frame of its grid; ``params`` are the detector's own (see its ``detect``), lengths in
+    metres."""
+    if name not in DETECTORS:
+        raise InputError(f"unknown feature detector {name!r}; known: {', '.join(DETECTORS)}")
+    return DETECTORS[name].detect(walls, **params)
+
+
 def detect(name: str, occupied: np.ndarray, grid: MetricGrid, **params) -> Features:
-    """Features of detector ``name`` on a binary map.
+    """Features of detector ``name`` on a binary map: :func:`detect_in` of :func:`walls_of`.
 
     Parameters
     ----------
@@ -43,9 +65,4 @@ def detect(name: str, occupied: np.ndarray, grid: MetricGrid, **params) -> Featu
     grid : the raster's grid; features are in its metric frame, metres.
     **params : the detector's own parameters (see its ``detect``), lengths in metres.
     """
-    if name not in DETECTORS:
-        raise InputError(f"unknown feature detector {name!r}; known: {', '.join(DETECTORS)}")
-    occupied = np.asarray(occupied, dtype=bool)
-    if occupied.shape != tuple(grid.shape):
-        raise InputError(f"raster shape {occupied.shape} does not match grid shape {grid.shape}")
-    return DETECTORS[name].detect(occupied, grid, **params)
+    return detect_in(name, walls_of(occupied, grid), **params)

@@ -1,4 +1,4 @@
-"""What every detector shares: the Features type, the Detector record, and the working image.
+"""What every detector shares: the Features type, the Detector record, and their helpers.
 
 Detectors never look at the input raster directly. They see the walls' centre lines drawn as a
 band of fixed width on a *working grid* (same origin and yaw as the input grid, a fixed cell
@@ -15,9 +15,6 @@ from dataclasses import dataclass, replace
 import cv2
 import numpy as np
 from scipy.spatial import cKDTree
-
-from pcmapq.features.walls import wall_band
-from pcmapq.grid import MetricGrid
 
 #: Candidate pairs: truth indices, map indices, costs, displacements (M, 2) in metres.
 Candidates = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
@@ -55,8 +52,8 @@ class Features:
 class Detector:
     """A feature detector: how to find features, and which pairs of features may match.
 
-    detect: ``detect(occupied, grid, **params) -> Features``; ``occupied`` is a (rows, cols)
-        bool raster on ``grid`` (walls true).
+    detect: ``detect(walls, **params) -> Features``; ``walls`` is a
+        :class:`~pcmapq.features.walls.WallImage`, the walls as every detector sees them.
     candidates: ``candidates(truth, map_, threshold) -> (i, j, cost, displacement)``: the pairs
         (truth ``i``, map ``j``) that may match under ``threshold`` metres, their costs in
         [0, 1] (0 a perfect pair, 1 the worst acceptable one) and displacements (M, 2) in
@@ -111,28 +108,6 @@ def gaussian(image: np.ndarray, sigma_px: float) -> np.ndarray:
         return image
     k = 2 * int(np.ceil(4 * sigma_px)) + 1
     return cv2.GaussianBlur(image, (k, k), sigma_px, borderType=cv2.BORDER_REFLECT)
-
-
-def working_image(
-    occupied: np.ndarray, grid: MetricGrid, resolution: float, closing: float
-) -> tuple[np.ndarray, MetricGrid]:
-    """The image a detector works on: the walls' centre lines drawn as a band of fixed width
-    (see :mod:`pcmapq.features.walls`), so it does not depend on how the walls were drawn.
-
-    Parameters
-    ----------
-    occupied : (rows, cols) bool raster on ``grid``, walls true.
-    grid : the raster's grid.
-    resolution : working cell size, metres.
-    closing : radius of the closing disk, metres. It joins the two faces of a wall drawn as
-        outlines (or seen from both sides by a laser), up to about twice this apart.
-
-    Returns
-    -------
-    image : (rows, cols) float32 in [0, 1] on the working grid.
-    work : the working grid (same origin and yaw as ``grid``).
-    """
-    return wall_band(occupied, grid, resolution, closing)
 
 
 def suppress(xy: np.ndarray, strength: np.ndarray, radius: float) -> np.ndarray:

@@ -23,9 +23,8 @@ from pcmapq.features.base import (
     point_candidates,
     sorted_features,
     suppress,
-    working_image,
 )
-from pcmapq.grid import MetricGrid
+from pcmapq.features.walls import WallImage
 
 
 def response(image: np.ndarray, resolution: float, sigma: float, integration: float,
@@ -74,17 +73,14 @@ def peaks(resp: np.ndarray, radius_px: float, floor: float) -> tuple[np.ndarray,
     return np.column_stack([u + np.clip(du, -0.5, 0.5), v + np.clip(dv, -0.5, 0.5)]), c
 
 
-def detect(occupied: np.ndarray, grid: MetricGrid, *, resolution: float = 0.05,
-           closing: float = 0.1, sigma: float = 0.1, integration: float = 0.2, k: float = 0.05,
+def detect(walls: WallImage, *, sigma: float = 0.1, integration: float = 0.2, k: float = 0.05,
            threshold: float = 4e-5, support: float = 0.5, radius: float = 0.3) -> Features:
     """Harris corners of a binary map.
 
     Parameters
     ----------
-    occupied : (rows, cols) bool raster on ``grid``, walls true.
-    grid : the raster's grid; features are returned in its metric frame.
-    resolution : working cell size, metres.
-    closing : closing radius, metres (see :func:`pcmapq.features.base.working_image`).
+    walls : the walls as detectors see them (:func:`pcmapq.features.walls.wall_image`);
+        features are returned in the metric frame of its grid.
     sigma : derivative scale, metres.
     integration : structure tensor integration scale, metres.
     k : Harris sensitivity.
@@ -97,7 +93,8 @@ def detect(occupied: np.ndarray, grid: MetricGrid, *, resolution: float = 0.05,
     -------
     Features with ``strength`` the response.
     """
-    image, work = working_image(occupied, grid, resolution, closing)
+    image, work = walls.image, walls.grid
+    resolution = work.resolution
     resp = response(image, resolution, sigma, integration, k)
     uv, value = peaks(resp, radius / resolution, support * threshold)
     xy = work.pixels_to_xy(uv)

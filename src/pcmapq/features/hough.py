@@ -50,8 +50,8 @@ from pcmapq.features.base import (
     gaussian,
     no_candidates,
     sorted_features,
-    working_image,
 )
+from pcmapq.features.walls import WallImage
 from pcmapq.grid import MetricGrid
 
 #: Largest direction difference of matching segments, degrees.
@@ -337,8 +337,7 @@ def inside_runs(seg: np.ndarray, inside: Callable[[np.ndarray], np.ndarray], ste
     return np.column_stack([seg[k, :2] + t[start, None] * d[k], seg[k, :2] + t[end, None] * d[k]])
 
 
-def detect(occupied: np.ndarray, grid: MetricGrid, *, resolution: float = 0.05,
-           closing: float = 0.1, sigma: float = 0.1, ridge: float = 0.05, min_length: float = 0.5,
+def detect(walls: WallImage, *, sigma: float = 0.1, ridge: float = 0.05, min_length: float = 0.5,
            max_gap: float = 0.2, support: float = 0.5, angle_step: float = 0.5,
            merge_angle: float = 15.0, merge_offset: float = 0.15,
            max_bridge: float = 1.5) -> Features:
@@ -346,10 +345,9 @@ def detect(occupied: np.ndarray, grid: MetricGrid, *, resolution: float = 0.05,
 
     Parameters
     ----------
-    occupied : (rows, cols) bool raster on ``grid``, walls true.
-    grid : the raster's grid; segments are returned in its metric frame.
-    resolution : working cell size, metres; also the Hough rho step.
-    closing : closing radius, metres (see :func:`pcmapq.features.base.working_image`).
+    walls : the walls as detectors see them (:func:`pcmapq.features.walls.wall_image`);
+        segments are returned in the metric frame of its grid, whose cell is also the Hough
+        rho step.
     sigma : smoothing scale of the ridge (centre line) detection, metres.
     ridge : least scale-normalised ridge strength; a one-cell (0.05 m) line scores about 0.2.
     min_length : length of a strong segment, metres.
@@ -366,7 +364,8 @@ def detect(occupied: np.ndarray, grid: MetricGrid, *, resolution: float = 0.05,
     -------
     Features with ``segments`` (N, 4), ``xy`` the midpoints and ``strength`` the lengths.
     """
-    image, work = working_image(occupied, grid, resolution, closing)
+    image, work = walls.image, walls.grid
+    resolution = work.resolution
     mask, direction = ridges(image, sigma / resolution, ridge)
     smooth = gaussian(image, sigma / resolution)
     shortest = support * min_length

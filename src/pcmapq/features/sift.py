@@ -45,9 +45,8 @@ from pcmapq.features.base import (
     point_candidates,
     sorted_features,
     suppress,
-    working_image,
 )
-from pcmapq.grid import MetricGrid
+from pcmapq.features.walls import WallImage
 
 #: Keypoints closer than this are one keypoint, metres.
 _DUPLICATE = 0.1
@@ -74,8 +73,7 @@ def entropy(image: np.ndarray, window_px: float) -> np.ndarray:
     return np.where((p <= 1e-7) | (p >= 1 - 1e-7), 0.0, h).astype(np.float32)
 
 
-def detect(occupied: np.ndarray, grid: MetricGrid, *, resolution: float = 0.05,
-           closing: float = 0.1, window: float = 0.15, threshold: float = 0.025,
+def detect(walls: WallImage, *, window: float = 0.15, threshold: float = 0.025,
            support: float = 0.5, radius: float = 0.3, octave_layers: int = 3,
            edge: float = 10.0, sigma: float = 1.6, max_size: float = 1.0,
            support_edge: float = 2.0) -> Features:
@@ -83,10 +81,8 @@ def detect(occupied: np.ndarray, grid: MetricGrid, *, resolution: float = 0.05,
 
     Parameters
     ----------
-    occupied : (rows, cols) bool raster on ``grid``, walls true.
-    grid : the raster's grid; features are returned in its metric frame.
-    resolution : working cell size, metres.
-    closing : closing radius, metres (see :func:`pcmapq.features.base.working_image`).
+    walls : the walls as detectors see them (:func:`pcmapq.features.walls.wall_image`);
+        features are returned in the metric frame of its grid.
     window : sigma of the entropy window, metres.
     threshold : detection threshold on the response (DoG contrast, image in [0, 1]).
     support : support threshold, as a fraction of ``threshold``.
@@ -104,7 +100,8 @@ def detect(occupied: np.ndarray, grid: MetricGrid, *, resolution: float = 0.05,
     -------
     Features with ``strength`` the response and ``descriptors`` (N, 128) float32.
     """
-    image, work = working_image(occupied, grid, resolution, closing)
+    image, work = walls.image, walls.grid
+    resolution = work.resolution
     ent = entropy(image, window / resolution)
     # octaves whose smallest keypoint (layer 1, refined half a layer down) is under max_size
     first = 2.0 * sigma * 2.0 ** (0.5 / octave_layers) * resolution

@@ -26,9 +26,11 @@ What the detectors see then depends on where the walls are, not on how many cell
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import cv2
 import numpy as np
-from scipy import ndimage, sparse
+from scipy import sparse
 from skimage.morphology import skeletonize
 
 from pcmapq.grid import MetricGrid
@@ -118,9 +120,23 @@ def centreline(occupied: np.ndarray, grid: MetricGrid, resolution: float, closin
     size = np.maximum(stats[:, cv2.CC_STAT_WIDTH], stats[:, cv2.CC_STAT_HEIGHT]) * resolution
     is_small = size <= small
     is_small[0] = False
-    objects = ndimage.binary_fill_holes(is_small[label])
+    objects = fill_holes(is_small[label], small / resolution)
     line = prune(skeletonize(wall.astype(bool) & ~objects), spur / resolution)
     return line, cores(objects, width / resolution), fine
+
+
+def fill_holes(mask: np.ndarray, largest_px: float) -> np.ndarray:
+    """``mask`` (bool) with its holes filled: the 4-connected pieces of its complement that do
+    not touch the border, at most ``largest_px`` pixels wide and high."""
+    n, label, stats, _ = cv2.connectedComponentsWithStats((~mask).astype(np.uint8),
+                                                          connectivity=4)
+    x, y = stats[:, cv2.CC_STAT_LEFT], stats[:, cv2.CC_STAT_TOP]
+    w, h = stats[:, cv2.CC_STAT_WIDTH], stats[:, cv2.CC_STAT_HEIGHT]
+    rows, cols = mask.shape
+    inside = (x > 0) & (y > 0) & (x + w < cols) & (y + h < rows)
+    hole = inside & (np.maximum(w, h) <= largest_px)
+    hole[0] = False  # label 0: the mask itself
+    return mask | hole[label]
 
 
 def cores(objects: np.ndarray, width_px: float) -> np.ndarray:
@@ -132,13 +148,26 @@ def cores(objects: np.ndarray, width_px: float) -> np.ndarray:
     _, label = cv2.connectedComponents(objects.astype(np.uint8), connectivity=8)
     depth = cv2.distanceTransform(np.pad(objects.astype(np.uint8), 1), cv2.DIST_L2,
                                   cv2.DIST_MASK_PRECISE)[1:-1, 1:-1]
-    deepest = np.asarray(ndimage.maximum(depth, label, index=np.arange(label.max() + 1)))
+    deepest = np.zeros(label.max() + 1, dtype=np.float32)
+    np.maximum.at(deepest, label[objects], depth[objects])
     return objects & (depth >= deepest[label] - 0.5 * width_px)
 
 
-def wall_band(occupied: np.ndarray, grid: MetricGrid, resolution: float = 0.05,
-              closing: float = 0.1, width: float = 0.15, spur: float = 0.25,
-              small: float = 1.0) -> tuple[np.ndarray, MetricGrid]:
+@dataclass(frozen=True)
+class WallImage:
+    """The walls as the detectors see them.
+
+    image: (rows, cols) float32 in [0, 1], the wall band's share of each working cell.
+    grid: the working grid (same origin and yaw as the input raster's grid).
+    """
+
+    image: np.ndarray
+    grid: MetricGrid
+
+
+def wall_image(occupied: np.ndarray, grid: MetricGrid, resolution: float = 0.05,
+               closing: float = 0.1, width: float = 0.15, spur: float = 0.25,
+               small: float = 1.0) -> WallImage:
     """The walls as the detectors see them: their centre lines drawn ``width`` metres wide.
 
     Parameters
@@ -156,8 +185,7 @@ def wall_band(occupied: np.ndarray, grid: MetricGrid, resolution: float = 0.05,
 
     Returns
     -------
-    image : (rows, cols) float32 in [0, 1], the band's share of each working cell.
-    work : the working grid (same origin and yaw as ``grid``).
+    The :class:`WallImage` on a grid of ``resolution`` metres.
     """
     fine_res = 0.5 * resolution
     line, core, fine = centreline(occupied, grid, fine_res, closing, spur, small, width)
@@ -165,4 +193,4 @@ def wall_band(occupied: np.ndarray, grid: MetricGrid, resolution: float = 0.05,
     if line.any():
         dist = cv2.distanceTransform((~line).astype(np.uint8), cv2.DIST_L2, cv2.DIST_MASK_PRECISE)
         band = np.maximum(band, np.clip(0.5 + (0.5 * width / fine_res - dist), 0.0, 1.0))
-    return resample(band, fine, resolution)
+    return WallImage(*resample(band, fine, resolution))
