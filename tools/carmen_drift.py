@@ -49,6 +49,7 @@ class Rung:
     fitness: float
     quality: dict[str, float]
     precision: dict[str, float]
+    f1: dict[str, float]
     accuracy_mean_m: float | None
     completeness_mean_m: float | None
     chamfer_m: float | None
@@ -129,6 +130,7 @@ def ladder(log: Path, levels: tuple[float, ...] = DEFAULT_LEVELS, seed: int = 0,
                 fitness=result.alignment.fitness,
                 quality={k: d.matching.quality for k, d in result.detectors.items()},
                 precision={k: d.matching.precision for k, d in result.detectors.items()},
+                f1={k: d.matching.f1 for k, d in result.detectors.items()},
                 accuracy_mean_m=dist.accuracy.mean, completeness_mean_m=dist.completeness.mean,
                 chamfer_m=dist.chamfer_m, f_at_01=f01, seconds=seconds))
     return rungs
@@ -143,12 +145,13 @@ def markdown(rungs: list[Rung]) -> str:
     names = list(rungs[0].quality) if rungs else []
     head = (["drift %", "max pose err m", "max yaw err deg", "fitness"]
             + [f"q {n}" for n in names] + [f"prec {n}" for n in names]
+            + [f"f1 {n}" for n in names]
             + ["acc mean m", "comp mean m", "Chamfer m", "F@0.1", "s"])
     lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for r in rungs:
         cells = ([f"{100 * r.level:g}", _num(r.pose_error_m, 2), _num(r.yaw_error_deg, 1),
                   _num(r.fitness)] + [_num(r.quality[n]) for n in names]
-                 + [_num(r.precision[n]) for n in names]
+                 + [_num(r.precision[n]) for n in names] + [_num(r.f1[n]) for n in names]
                  + [_num(r.accuracy_mean_m), _num(r.completeness_mean_m), _num(r.chamfer_m),
                     _num(r.f_at_01), f"{r.seconds:.1f}"])
         lines.append("| " + " | ".join(cells) + " |")
