@@ -12,7 +12,7 @@ and scored with ``pcmapq.pipeline.evaluate(map, reference)`` (``Settings(force=T
     python tools/carmen_drift.py LOG [LOG ...] [--levels 0,0.0005,0.001,0.002,0.005,0.01,0.02,0.04]
         [--seed 0] [--max-range 30] [--scans K]
 
-Prints one markdown table per log.
+Prints one markdown table per log, and the steps where a detector's f1 does not fall.
 """
 
 from __future__ import annotations
@@ -49,7 +49,7 @@ class Rung:
     fitness: float
     quality: dict[str, float]
     precision: dict[str, float]
-    f1: dict[str, float]
+    f1: dict[str, float | None]
     accuracy_mean_m: float | None
     completeness_mean_m: float | None
     chamfer_m: float | None
@@ -158,6 +158,28 @@ def markdown(rungs: list[Rung]) -> str:
     return "\n".join(lines)
 
 
+def not_falling(rungs: list[Rung]) -> list[tuple[str, float, float, float, float]]:
+    """The steps of the ladder where a detector's f1 does not fall: (detector, level before,
+    level after, f1 before, f1 after), in ladder order. An undefined f1 (None) is skipped."""
+    out = []
+    for name in rungs[0].f1 if rungs else []:
+        for a, b in zip(rungs, rungs[1:], strict=False):
+            fa, fb = a.f1[name], b.f1[name]
+            if fa is not None and fb is not None and not fb < fa:
+                out.append((name, a.level, b.level, fa, fb))
+    return out
+
+
+def falls_text(rungs: list[Rung]) -> str:
+    """One line: does every detector's f1 fall at every step of the ladder?"""
+    steps = not_falling(rungs)
+    if not steps:
+        return "f1 falls at every step for every detector."
+    return "f1 does not fall: " + "; ".join(
+        f"{n} from {100 * a:g} to {100 * b:g} % ({fa:.3f}, {fb:.3f})" for n, a, b, fa, fb in steps
+    ) + "."
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("logs", nargs="+", type=Path)
@@ -172,8 +194,8 @@ def main(argv: list[str] | None = None) -> int:
     levels = tuple(float(v) for v in args.levels.split(","))
     for log in args.logs:
         print(f"\n### {log.name} (seed {args.seed}, max range {args.max_range:g} m)\n")
-        print(markdown(ladder(log, levels, args.seed, args.max_range, scans=args.scans)),
-              flush=True)
+        rungs = ladder(log, levels, args.seed, args.max_range, scans=args.scans)
+        print(markdown(rungs) + "\n\n" + falls_text(rungs), flush=True)
     return 0
 
 
