@@ -167,6 +167,24 @@ def _drift_tool():
     return module
 
 
+def test_not_falling_lists_the_steps_where_f1_does_not_fall() -> None:
+    tool = _drift_tool()
+
+    def rung(level: float, harris: float, sift: float | None):
+        return tool.Rung(level=level, pose_error_m=0.0, yaw_error_deg=0.0, fitness=1.0,
+                         quality={}, precision={}, f1={"harris": harris, "sift": sift},
+                         accuracy_mean_m=None, completeness_mean_m=None, chamfer_m=None,
+                         f_at_01=None, seconds=0.0)
+
+    rungs = [rung(0.0, 1.0, 1.0), rung(0.01, 0.5, None), rung(0.02, 0.5, 0.4),
+             rung(0.04, 0.6, 0.3)]
+    assert tool.not_falling(rungs) == [("harris", 0.01, 0.02, 0.5, 0.5),
+                                       ("harris", 0.02, 0.04, 0.5, 0.6)]
+    assert tool.falls_text(rungs) == ("f1 does not fall: harris from 1 to 2 % (0.500, 0.500); "
+                                      "harris from 2 to 4 % (0.500, 0.600).")
+    assert tool.falls_text(rungs[:2]) == "f1 falls at every step for every detector."
+
+
 def test_drift_ranks_maps() -> None:
     """Orebro's first 80 scans, readings up to 10 m (about 3 s): the map along a drifted
     trajectory (4 % gain errors) scores worse than the corrected one on every detector's
@@ -179,3 +197,20 @@ def test_drift_ranks_maps() -> None:
         assert large.precision[name] < none.precision[name], name
     assert large.f_at_01 < none.f_at_01
     assert large.accuracy_mean_m > none.accuracy_mean_m
+
+
+def test_drift_ladder_every_f1_falls_and_sift_quality_with_it():
+    """Orebro's first 180 scans, readings up to 10 m, at 1, 2 and 4 % drift (pose errors about
+    2.6, 5.2 and 10.4 m; about 10 s): every detector's f1 falls at every step, and SIFT's
+    quality falls below 0.6 at 4 % (it saturated near 0.8 when any keypoint within the
+    threshold matched, however unlike its descriptor)."""
+    log = shared("carmen", "orebro-corrected.log.gz")
+    tool = _drift_tool()
+    rungs = tool.ladder(log, levels=(0.01, 0.02, 0.04), max_range=10.0,
+                        settings=Settings(force=True), scans=180)
+    assert tool.not_falling(rungs) == []
+    for name in rungs[0].f1:
+        values = [r.f1[name] for r in rungs]
+        assert all(b < a for a, b in zip(values, values[1:], strict=False)), (name, values)
+    assert rungs[-1].quality["sift"] < 0.6
+    assert rungs[-1].pose_error_m > 10.0

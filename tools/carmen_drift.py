@@ -12,7 +12,7 @@ and scored with ``pcmapq.pipeline.evaluate(map, reference)`` (``Settings(force=T
     python tools/carmen_drift.py LOG [LOG ...] [--levels 0,0.0005,0.001,0.002,0.005,0.01,0.02,0.04]
         [--seed 0] [--max-range 30] [--scans K]
 
-Prints one markdown table per log.
+Prints one markdown table per log, and the steps where a detector's f1 does not fall.
 """
 
 from __future__ import annotations
@@ -49,6 +49,7 @@ class Rung:
     fitness: float
     quality: dict[str, float]
     precision: dict[str, float]
+    f1: dict[str, float | None]
     accuracy_mean_m: float | None
     completeness_mean_m: float | None
     chamfer_m: float | None
@@ -129,6 +130,7 @@ def ladder(log: Path, levels: tuple[float, ...] = DEFAULT_LEVELS, seed: int = 0,
                 fitness=result.alignment.fitness,
                 quality={k: d.matching.quality for k, d in result.detectors.items()},
                 precision={k: d.matching.precision for k, d in result.detectors.items()},
+                f1={k: d.matching.f1 for k, d in result.detectors.items()},
                 accuracy_mean_m=dist.accuracy.mean, completeness_mean_m=dist.completeness.mean,
                 chamfer_m=dist.chamfer_m, f_at_01=f01, seconds=seconds))
     return rungs
@@ -143,16 +145,39 @@ def markdown(rungs: list[Rung]) -> str:
     names = list(rungs[0].quality) if rungs else []
     head = (["drift %", "max pose err m", "max yaw err deg", "fitness"]
             + [f"q {n}" for n in names] + [f"prec {n}" for n in names]
+            + [f"f1 {n}" for n in names]
             + ["acc mean m", "comp mean m", "Chamfer m", "F@0.1", "s"])
     lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for r in rungs:
         cells = ([f"{100 * r.level:g}", _num(r.pose_error_m, 2), _num(r.yaw_error_deg, 1),
                   _num(r.fitness)] + [_num(r.quality[n]) for n in names]
-                 + [_num(r.precision[n]) for n in names]
+                 + [_num(r.precision[n]) for n in names] + [_num(r.f1[n]) for n in names]
                  + [_num(r.accuracy_mean_m), _num(r.completeness_mean_m), _num(r.chamfer_m),
                     _num(r.f_at_01), f"{r.seconds:.1f}"])
         lines.append("| " + " | ".join(cells) + " |")
     return "\n".join(lines)
+
+
+def not_falling(rungs: list[Rung]) -> list[tuple[str, float, float, float, float]]:
+    """The steps of the ladder where a detector's f1 does not fall: (detector, level before,
+    level after, f1 before, f1 after), in ladder order. An undefined f1 (None) is skipped."""
+    out = []
+    for name in rungs[0].f1 if rungs else []:
+        for a, b in zip(rungs, rungs[1:], strict=False):
+            fa, fb = a.f1[name], b.f1[name]
+            if fa is not None and fb is not None and not fb < fa:
+                out.append((name, a.level, b.level, fa, fb))
+    return out
+
+
+def falls_text(rungs: list[Rung]) -> str:
+    """One line: does every detector's f1 fall at every step of the ladder?"""
+    steps = not_falling(rungs)
+    if not steps:
+        return "f1 falls at every step for every detector."
+    return "f1 does not fall: " + "; ".join(
+        f"{n} from {100 * a:g} to {100 * b:g} % ({fa:.3f}, {fb:.3f})" for n, a, b, fa, fb in steps
+    ) + "."
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -169,8 +194,8 @@ def main(argv: list[str] | None = None) -> int:
     levels = tuple(float(v) for v in args.levels.split(","))
     for log in args.logs:
         print(f"\n### {log.name} (seed {args.seed}, max range {args.max_range:g} m)\n")
-        print(markdown(ladder(log, levels, args.seed, args.max_range, scans=args.scans)),
-              flush=True)
+        rungs = ladder(log, levels, args.seed, args.max_range, scans=args.scans)
+        print(markdown(rungs) + "\n\n" + falls_text(rungs), flush=True)
     return 0
 
 
