@@ -88,6 +88,11 @@ class Result:
     truth_occupied: np.ndarray
     map_occupied: np.ndarray
 
+    def note(self, name: str) -> str | None:
+        """Why detector ``name``'s quality, precision or f1 is undefined (None if defined)."""
+        scope = "" if self.full else "inside the footprint"
+        return self.detectors[name].matching.note(scope)
+
     def to_dict(self) -> dict:
         """The JSON document (see README): plain types, floats rounded to DECIMALS."""
         tf = self.alignment.transform
@@ -117,6 +122,7 @@ class Result:
             m = det.matching
             doc["detectors"][name] = {
                 "quality": m.quality, "precision": m.precision, "f1": m.f1,
+                "note": self.note(name),
                 "truth_features": m.truth_features, "map_features": m.map_features,
                 "matched": m.matched, "threshold_m": self.threshold,
                 "displacement_m": det.displacement_stats(),
