@@ -87,6 +87,7 @@ class Result:
     detectors: dict[str, DetectorResult]
     truth_occupied: np.ndarray
     map_occupied: np.ndarray
+    footprint_rule: str = "known"
 
     def note(self, name: str) -> str | None:
         """Why detector ``name``'s quality, precision or f1 is undefined (None if defined)."""
@@ -108,6 +109,7 @@ class Result:
                           "truth_recall": self.overlap.truth_recall,
                           "agreement": self.overlap.agreement},
             "coverage": self.overlap.coverage,
+            "footprint": self.footprint_rule,
             "scored_against": "whole truth" if self.full else "footprint",
             "distances": _distances_dict(self.distances),
             "detectors": {},

@@ -24,6 +24,11 @@ img { max-width: 100%; border: 1px solid #eee; }
 """
 
 
+#: How each footprint rule reads in the report.
+FOOTPRINT_WORDS = {"known": "known cells", "walls": "enclosed by its walls",
+                   "all": "its whole rectangle"}
+
+
 def _img(png: bytes, alt: str) -> str:
     return f'<img alt="{html.escape(alt)}" src="data:image/png;base64,' \
            f'{base64.b64encode(png).decode("ascii")}">'
@@ -64,8 +69,10 @@ def report_html(result: Result) -> str:
         ["x [m]", "y [m]", "yaw [deg]", "scale", "fitness", "inlier RMSE [m]", "method"],
         [[_f(tf.tx), _f(tf.ty), _f(tf.yaw_deg, 2), _f(tf.scale, 4),
           f"{_f(a.fitness)} (within {a.tolerance_m:g} m)", _f(a.rmse_m), a.method]])
-    cover = _table(["coverage", "truth recall in footprint", "agreement", "scored against"],
-                   [[_f(o.coverage), _f(o.truth_recall), _f(o.agreement),
+    cover = _table(["coverage", "footprint", "truth recall in footprint", "agreement",
+                    "scored against"],
+                   [[_f(o.coverage), FOOTPRINT_WORDS.get(result.footprint_rule, ""),
+                     _f(o.truth_recall), _f(o.agreement),
                      "whole truth" if result.full else "the map's footprint"]])
     rows = []
     for name, det in result.detectors.items():
