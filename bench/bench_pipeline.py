@@ -65,7 +65,7 @@ def main() -> None:
           + " | peak RSS MB | quality harris/hough/sift |")
     print("|---" * (len(steps) + 4) + "|")
     for r in rows:
-        q = "/".join(f"{v:.2f}" for v in r["quality"].values())
+        q = "/".join("n/a" if v is None else f"{v:.2f}" for v in r["quality"].values())
         t = " | ".join(f"{r['times'].get(s, 0.0):.2f}" for s in steps)
         print(f"| {r['case']} | {r['grid'][0]} x {r['grid'][1]} | {t} | {r['rss_mb']:.0f} | {q} |")
 

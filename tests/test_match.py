@@ -70,7 +70,7 @@ def test_quality_precision_f1_arithmetic():
 def test_hysteresis():
     # a weak map feature confirms a strong truth feature
     m = match("harris", points([[0, 0]]), points([[0.1, 0]], strong=[False]))
-    assert m.quality == 1.0 and m.map_features == 0 and m.precision == 0.0
+    assert m.quality == 1.0 and m.map_features == 0 and m.precision is None
     # two weak features never match each other
     m = match("harris", points([[0, 0]], [False]), points([[0.1, 0]], [False]))
     assert len(m.truth_idx) == 0 and m.truth_features == 0
@@ -82,12 +82,24 @@ def test_hysteresis():
 
 
 def test_empty_inputs():
+    """A ratio with nothing to count is undefined (None), not 0; so is f1 then."""
     empty = points(np.zeros((0, 2)))
-    for truth, map_ in ((empty, empty), (empty, points([[0, 0]])), (points([[0, 0]]), empty)):
+    expected = [(None, None, "no strong truth feature; no strong map feature"),
+                (None, 0.0, "no strong truth feature"),
+                (0.0, None, "no strong map feature")]
+    pairs = ((empty, empty), (empty, points([[0, 0]])), (points([[0, 0]]), empty))
+    for (truth, map_), (quality, precision, note) in zip(pairs, expected, strict=True):
         m = match("harris", truth, map_)
         assert m.matched == 0 and m.displacement.shape == (0, 2)
-        # a ratio with nothing to count is 0; f1 is 0 when quality and precision are both 0
-        assert (m.quality, m.precision, m.f1) == (0.0, 0.0, 0.0)
+        assert (m.quality, m.precision, m.f1) == (quality, precision, None)
+        assert m.note() == note
+    # both defined and both 0: f1 is 0, no note
+    m = match("harris", points([[0, 0]]), points([[5, 0]]))
+    assert (m.quality, m.precision, m.f1, m.note()) == (0.0, 0.0, 0.0, None)
+    # only weak truth features: undefined, and the note says where
+    m = match("harris", points([[0, 0]], [False]), points([[0.1, 0]]))
+    assert m.quality is None and m.precision == 1.0 and m.f1 is None
+    assert m.note("inside the footprint") == "no strong truth feature inside the footprint"
 
 
 def test_assign_components():

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import json
+
 import cv2
 import numpy as np
 import pytest
@@ -9,6 +11,7 @@ import pytest
 from pcmapq import synth
 from pcmapq.align.transform import Similarity2D
 from pcmapq.config import Settings
+from pcmapq.errors import InputError
 from pcmapq.pipeline import evaluate
 
 from .conftest import in_map_frame, write_cloud_map
@@ -18,6 +21,13 @@ CUTS = [((-1, -1, 12.5, 17), Similarity2D(4.0, -6.0, np.radians(63.0))),      # 
         ((9.5, 6.0, 25, 17), Similarity2D(-8.0, 3.0, np.radians(-128.0))),    # north-east third
         ((-1, -1, 25, 7.2), Similarity2D(15.0, 12.0, np.radians(201.0))),     # south rooms
         ((7.0, -1, 25, 11.0), Similarity2D(-3.0, -2.0, np.radians(17.0)))]    # a 45 % corner
+
+#: Binary partial maps (black walls on white, no unknown value): 25-57 % of the plan, any pose.
+#: No cut runs along a wall (the map would keep a sliver of it that the true share counts).
+BINARY_CUTS = [((-1, -1, 7.8, 11.5), Similarity2D(-6.0, 5.0, np.radians(151.0))),  # 25 %
+               ((15, -1, 25, 17), Similarity2D(3.0, -9.0, np.radians(288.0))),      # 32 %
+               ((-1, 8.5, 25, 17), Similarity2D(7.0, 2.0, np.radians(138.0))),      # 46 %
+               ((-1, -1, 16.5, 14), Similarity2D(-2.0, -4.0, np.radians(230.0)))]  # 57 %
 
 
 def true_share(plan: np.ndarray, box) -> float:
@@ -45,11 +55,22 @@ def write_partial_image(plan, box, tf: Similarity2D, path):
     return path
 
 
+def write_binary_partial(plan, box, tf: Similarity2D, path):
+    """The plan's walls inside ``box`` (truth frame) seen in the map frame, black on white."""
+    img, grid = synth.binary_partial(plan, box, tf)
+    cv2.imwrite(str(path), img)
+    ox, oy, _ = grid.origin
+    path.with_suffix(".yaml").write_text(f"image: {path.name}\nresolution: 0.05\n"
+                                         f"origin: [{ox}, {oy}, 0.0]\n")
+    return path
+
+
 @pytest.mark.parametrize(("box", "tf"), CUTS)
 def test_partial_image_map(plan, truth_png, tmp_path, box, tf):
     share = true_share(plan, box)
     assert 0.3 <= share <= 0.62
     result = evaluate(write_partial_image(plan, box, tf, tmp_path / "part.png"), truth_png)
+    assert result.footprint_rule == "known"  # its unknown cells say what it did not observe
     got = result.alignment.transform
     assert np.hypot(got.tx - tf.tx, got.ty - tf.ty) < 0.1
     assert abs(result.overlap.coverage - share) < 0.1, (result.overlap.coverage, share)
@@ -85,3 +106,74 @@ def test_full_flag_scores_against_the_whole_truth(plan, truth_png, tmp_path):
         q_part = part.detectors[name].matching.quality
         q_whole = whole.detectors[name].matching.quality
         assert q_whole < 0.75 * q_part, (name, q_whole, q_part)
+
+
+@pytest.mark.parametrize(("box", "tf"), BINARY_CUTS)
+def test_binary_partial_image_map(plan, truth_png, tmp_path, box, tf):
+    """A binary image has no unknown cells: its footprint is the area its walls enclose."""
+    share = true_share(plan, box)
+    assert 0.24 <= share <= 0.6
+    result = evaluate(write_binary_partial(plan, box, tf, tmp_path / "part.png"), truth_png)
+    assert result.footprint_rule == "walls"
+    got = result.alignment.transform
+    assert np.hypot(got.tx - tf.tx, got.ty - tf.ty) < 0.1
+    assert abs(result.overlap.coverage - share) < 0.1, (result.overlap.coverage, share)
+    for name, det in result.detectors.items():
+        assert det.matching.quality >= 0.85, (name, det.matching.quality)
+
+
+def test_known_footprint_of_a_binary_map_counts_its_whole_rectangle(plan, truth_png, tmp_path):
+    """--footprint known on a binary image: every cell is known, so the truth's walls anywhere
+    in its rectangle count as missing (the behaviour before the walls rule)."""
+    box, tf = BINARY_CUTS[2]
+    share = true_share(plan, box)
+    path = write_binary_partial(plan, box, tf, tmp_path / "part.png")
+    walls = evaluate(path, truth_png)
+    known = evaluate(path, truth_png, Settings(footprint="known"))
+    everything = evaluate(path, truth_png, Settings(footprint="all"))
+    assert known.footprint_rule == "known" and everything.footprint_rule == "all"
+    assert known.overlap.coverage > share + 0.1, (known.overlap.coverage, share)
+    assert everything.overlap.coverage >= known.overlap.coverage - 0.01
+    for name in walls.detectors:
+        assert known.detectors[name].matching.quality < walls.detectors[name].matching.quality
+    assert json.loads(known.to_json())["footprint"] == "known"
+
+
+def test_all_footprint_of_an_image_with_unknown_cells(plan, truth_png, tmp_path):
+    """--footprint all: the image's whole rectangle, unknown cells included."""
+    box, tf = CUTS[1]
+    path = write_partial_image(plan, box, tf, tmp_path / "part.png")
+    known = evaluate(path, truth_png, Settings(detectors=("harris",)))
+    whole = evaluate(path, truth_png, Settings(detectors=("harris",), footprint="all"))
+    assert known.footprint_rule == "known"
+    assert whole.overlap.coverage > known.overlap.coverage + 0.3
+
+
+def test_cloud_has_no_known_cells(plan, truth_png, tmp_path):
+    pts = synth.wall_points(plan, 0.05)
+    path = write_cloud_map(pts, tmp_path / "cloud.npy")
+    with pytest.raises(InputError, match="cloud.npy: a point cloud has no known cells"):
+        evaluate(path, truth_png, Settings(footprint="known", detectors=("harris",)))
+    result = evaluate(path, truth_png, Settings(footprint="all", detectors=("harris",)))
+    assert result.footprint_rule == "all" and result.overlap.coverage >= 0.99
+
+
+def test_cli_footprint_option(plan, truth_png, tmp_path):
+    from typer.testing import CliRunner
+
+    from pcmapq.cli import app
+
+    box, tf = BINARY_CUTS[0]
+    path = str(write_binary_partial(plan, box, tf, tmp_path / "part.png"))
+    runner = CliRunner()
+    res = runner.invoke(app, ["eval", path, str(truth_png), "--detectors", "harris",
+                              "--json", str(tmp_path / "r.json")])
+    assert res.exit_code == 0, res.output
+    assert "(footprint: walls)" in res.output
+    assert json.loads((tmp_path / "r.json").read_text())["footprint"] == "walls"
+    res = runner.invoke(app, ["eval", path, str(truth_png), "--footprint", "everything"])
+    assert res.exit_code == 2 and "--footprint" in res.output
+    cloud = str(write_cloud_map(synth.wall_points(plan, 0.1), tmp_path / "cloud.npy"))
+    res = runner.invoke(app, ["eval", cloud, str(truth_png), "--footprint", "known"])
+    assert res.exit_code == 2 and "Traceback" not in res.output
+    assert "cloud.npy: a point cloud has no known cells" in res.output

@@ -3,11 +3,13 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from pcmapq import synth
 from pcmapq.align.transform import Similarity2D
 from pcmapq.grid import MetricGrid
 from pcmapq.raster.draw import FREE, OCCUPIED, UNKNOWN, hit_counts, points_to_grid, warp_state
+from pcmapq.raster.footprint import footprint_rule
 
 
 def state_of(img: np.ndarray) -> np.ndarray:
@@ -54,3 +56,42 @@ def test_warp_with_rotation_and_scale(plan):
     # turned walls come out a little thicker (a cell is occupied from a third of it)
     assert iou(warped == OCCUPIED, truth) > 0.7
     assert (warped == UNKNOWN).sum() < 0.35 * warped.size  # the plan's box is known
+
+
+def _rule(state: np.ndarray, requested: str = "auto") -> str:
+    return footprint_rule(requested, state == UNKNOWN, 0.05)
+
+
+def test_footprint_rule_tells_binary_images_from_occupancy_maps():
+    """auto: known cells when the image has unknown regions (>= 1 % of it in patches at least
+    0.5 m wide), the walls' enclosed area when it has none."""
+    binary = np.full((200, 200), FREE, np.int8)  # 10 m x 10 m, 0.05 m cells
+    binary[50, 20:180] = OCCUPIED
+    assert _rule(binary) == "walls"
+    framed = binary.copy()  # a grey frame 4 cells (0.2 m) wide: not a region
+    framed[:4], framed[-4:], framed[:, :4], framed[:, -4:] = UNKNOWN, UNKNOWN, UNKNOWN, UNKNOWN
+    assert (framed == UNKNOWN).mean() > 0.07 and _rule(framed) == "walls"
+    blurred = binary.copy()  # anti-aliased wall edges and stray grey pixels
+    blurred[[49, 51], 20:180] = UNKNOWN
+    blurred[::7, ::11] = UNKNOWN
+    assert _rule(blurred) == "walls"
+    strip = binary.copy()  # an unknown strip 0.4 m wide across the map: narrower than 0.5 m
+    strip[100:108] = UNKNOWN
+    assert _rule(strip) == "walls"
+    explored = binary.copy()  # an unexplored 1 m x 2.5 m room: 2.5 % of the image
+    explored[120:140, 20:70] = UNKNOWN
+    assert _rule(explored) == "known"
+    tiny = binary.copy()  # a 0.6 m x 0.6 m grey patch (a legend?): 0.4 %, below 1 %
+    tiny[150:162, 150:162] = UNKNOWN
+    assert _rule(tiny) == "walls"
+    for rule in ("known", "walls", "all"):  # explicit choices are kept
+        assert _rule(binary, rule) == rule and _rule(explored, rule) == rule
+
+
+def test_footprint_rule_of_a_cloud():
+    assert footprint_rule("auto", None, 0.0) == "walls"
+    assert footprint_rule("all", None, 0.0) == "all"
+    with pytest.raises(ValueError, match="no known cells"):
+        footprint_rule("known", None, 0.0)
+    with pytest.raises(ValueError, match="unknown footprint rule"):
+        footprint_rule("everything", None, 0.0)

@@ -95,3 +95,34 @@ def test_lidar_pair_aligns_to_its_known_transform():
     np.testing.assert_allclose(result.registration_3d.transform, truth, atol=0.02)
     assert result.distances_3d.accuracy.mean < 0.2
     assert "3D accuracy (map to truth)" in report_html(result)
+
+
+def test_real_binary_partial_map_footprint_from_its_walls(fr79, tmp_path):
+    """A binary map (walls black, the rest white, no unknown value) of a middle part of the
+    Freiburg 079 SLAM map, turned by 200 degrees: its footprint is the area its walls enclose,
+    so the coverage is the part's share of the walls and the rest of its rectangle does not
+    count as missing (with its known cells: coverage 0.67, qualities 0.56-0.59)."""
+    from pcmapq.io import load_map
+    from pcmapq.raster.draw import OCCUPIED
+
+    occupied = load_map(fr79).state == OCCUPIED
+    rows, cols = occupied.shape
+    c0, c1 = 150, 450  # columns of the part, 7.5 m to 22.5 m
+    share = occupied[:, c0:c1].sum() / occupied.sum()
+    part = np.full(occupied.shape, 255, np.uint8)
+    part[:, c0:c1][occupied[:, c0:c1]] = 0
+    src = MetricGrid(FR79_RES, (0.0, 0.0, 0.0), (rows, cols))
+    tf = Similarity2D(2.0, 2.0, np.radians(200.0))  # src (truth) -> dst (map)
+    x0, x1, top = c0 * FR79_RES, c1 * FR79_RES, rows * FR79_RES
+    dst = MetricGrid.covering(tf.apply([[x0, 0], [x1, 0], [x0, top], [x1, top]]), FR79_RES)
+    m = src.xy_to_pixel_matrix() @ tf.inverse().matrix @ dst.pixel_to_xy_matrix()
+    turned = cv2.warpAffine(part, m[:2], dst.shape[::-1], flags=cv2.INTER_NEAREST |
+                            cv2.WARP_INVERSE_MAP, borderValue=255)
+    result = evaluate(_write_ros_map(turned, tmp_path / "part.png", FR79_RES, dst.origin[:2]),
+                      fr79)
+    assert result.footprint_rule == "walls"
+    got, want = result.alignment.transform, tf.inverse()
+    assert np.hypot(got.tx - want.tx, got.ty - want.ty) < 0.1, got
+    assert abs(result.overlap.coverage - share) < 0.1, (result.overlap.coverage, share)
+    for name, det in result.detectors.items():
+        assert det.matching.quality >= 0.85, (name, det.matching.quality)

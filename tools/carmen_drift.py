@@ -47,8 +47,8 @@ class Rung:
     pose_error_m: float
     yaw_error_deg: float
     fitness: float
-    quality: dict[str, float]
-    precision: dict[str, float]
+    quality: dict[str, float | None]
+    precision: dict[str, float | None]
     f1: dict[str, float | None]
     accuracy_mean_m: float | None
     completeness_mean_m: float | None
@@ -140,6 +140,11 @@ def _num(value: float | None, digits: int = 3) -> str:
     return "-" if value is None else f"{value:.{digits}f}"
 
 
+def _score(value: float | None) -> str:
+    """A quality or precision ('n/a' when undefined: nothing to count)."""
+    return "n/a" if value is None else f"{value:.3f}"
+
+
 def markdown(rungs: list[Rung]) -> str:
     """The ladder as a markdown table."""
     names = list(rungs[0].quality) if rungs else []
@@ -150,8 +155,8 @@ def markdown(rungs: list[Rung]) -> str:
     lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for r in rungs:
         cells = ([f"{100 * r.level:g}", _num(r.pose_error_m, 2), _num(r.yaw_error_deg, 1),
-                  _num(r.fitness)] + [_num(r.quality[n]) for n in names]
-                 + [_num(r.precision[n]) for n in names] + [_num(r.f1[n]) for n in names]
+                  _num(r.fitness)] + [_score(r.quality[n]) for n in names]
+                 + [_score(r.precision[n]) for n in names] + [_score(r.f1[n]) for n in names]
                  + [_num(r.accuracy_mean_m), _num(r.completeness_mean_m), _num(r.chamfer_m),
                     _num(r.f_at_01), f"{r.seconds:.1f}"])
         lines.append("| " + " | ".join(cells) + " |")

@@ -151,10 +151,20 @@ def num(value: float | None, digits: int = 3) -> str:
     return "-" if value is None else f"{value:.{digits}f}"
 
 
+def score(value: float | None) -> str:
+    """A quality, precision or f1 with two decimals ('n/a' when undefined: nothing to count)."""
+    return "n/a" if value is None else f"{value:.2f}"
+
+
+def q_p(result: Result, name: str) -> str:
+    """'q / p' of one detector of a result."""
+    m = result.detectors[name].matching
+    return f"{score(m.quality)} / {score(m.precision)}"
+
+
 def qualities(result: Result) -> str:
     """'harris q / p, hough q / p, sift q / p' of a result."""
-    return ", ".join(f"{name} {d.matching.quality:.2f} / {d.matching.precision:.2f}"
-                     for name, d in result.detectors.items())
+    return ", ".join(f"{name} {q_p(result, name)}" for name in result.detectors)
 
 
 def yaw_error(yaw_deg: float, expected_deg: float) -> float:
@@ -292,15 +302,13 @@ def halmstad_pipeline(data: Path) -> str:
             r, tf = run.result, run.result.alignment.transform
             map_keys, layout_keys = bench.keypoint_pairs(data, name, building)
             ref = bench.fit_similarity(map_keys, layout_keys)
-            det = r.detectors
             f02 = next((f.f for f in r.distances.fscores if abs(f.tau_m - 0.2) < 1e-9), None)
             cells = [name, share, f"{tf.scale:.3f} ({ref.scale:.3f})",
                      f"{tf.yaw_deg:.1f} ({ref.yaw_deg:.1f})",
                      f"{keypoint_residual(r, map_path, map_keys, layout_keys):.1f}",
                      num(r.alignment.fitness, 2), num(r.overlap.coverage, 2),
                      num(r.overlap.agreement, 2)]
-            cells += [f"{det[k].matching.quality:.2f} / {det[k].matching.precision:.2f}"
-                      for k in ("harris", "hough", "sift")]
+            cells += [q_p(r, k) for k in ("harris", "hough", "sift")]
             cells += [num(r.distances.accuracy.mean), num(r.distances.completeness.mean),
                       num(f02, 2), f"{run.seconds:.1f}"]
             lines.append("| " + " | ".join(cells) + " |")
@@ -389,13 +397,11 @@ def floorplans_section(data: Path = DATA, img: Path | None = IMG) -> str:
         r, tf = run.result, run.result.alignment.transform
         ok = (yaw_error(tf.yaw_deg, case.yaw_deg) < 5.0
               and abs(tf.scale / case.survey_scale - 1.0) < 0.05)
-        det = r.detectors
         cells = [case.name, f"{tf.scale:.3f} ({case.survey_scale:.3f})",
                  f"{tf.yaw_deg:.1f} ({case.yaw_deg:.0f})", "yes" if ok else "**no**",
                  num(r.alignment.fitness, 2), num(r.overlap.coverage, 2),
                  num(r.overlap.agreement, 2)]
-        cells += [f"{det[k].matching.quality:.2f} / {det[k].matching.precision:.2f}"
-                  for k in ("harris", "hough", "sift")]
+        cells += [q_p(r, k) for k in ("harris", "hough", "sift")]
         cells += [num(r.distances.accuracy.mean), num(r.distances.completeness.mean),
                   f"{run.seconds:.1f}"]
         lines.append("| " + " | ".join(cells) + " |")

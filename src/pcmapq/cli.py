@@ -29,6 +29,7 @@ from pcmapq.mapping import (
 )
 from pcmapq.metrics.distances import DEFAULT_TAUS
 from pcmapq.pipeline import evaluate
+from pcmapq.raster.footprint import FOOTPRINT_RULES
 from pcmapq.report.table import print_table
 
 app = typer.Typer(add_completion=False, no_args_is_help=True, pretty_exceptions_enable=False,
@@ -165,6 +166,13 @@ def _parse_detectors(text: str) -> tuple[str, ...]:
     return names
 
 
+def _parse_footprint(text: str) -> str:
+    if text not in FOOTPRINT_RULES:
+        raise typer.BadParameter(f"expected one of {', '.join(FOOTPRINT_RULES)}, got {text!r}",
+                                 param_hint="--footprint")
+    return text
+
+
 @app.command("eval")
 def eval_command(
     paths: Annotated[list[Path], typer.Argument(
@@ -216,6 +224,10 @@ def eval_command(
     tau: Annotated[str, typer.Option(
         help="Distance thresholds of the F-score, metres, comma-separated.")
     ] = ",".join(f"{t:g}" for t in DEFAULT_TAUS),
+    footprint: Annotated[str, typer.Option(
+        help="The area the map observed: 'known' cells of an image, the area its 'walls' "
+        "enclose, 'all' of its rectangle; 'auto': known cells for an image with unknown "
+        "regions, walls for a binary image or a cloud.")] = Settings.footprint,
     full: Annotated[bool, typer.Option(
         "--full", help="Score against the whole truth, not only the part the map covers.")
     ] = False,
@@ -231,7 +243,7 @@ def eval_command(
                         band_low=band_low, band_high=band_high, init=_parse_init(init),
                         align=not no_align, force=force, threshold=threshold, min_hits=min_hits,
                         detectors=_parse_detectors(detectors), full=full, taus=_parse_taus(tau),
-                        voxel_3d=voxel_3d)
+                        voxel_3d=voxel_3d, footprint=_parse_footprint(footprint))
     quiet = json_path == "-"
     err = Console(stderr=True)
     out = Console(quiet=quiet, width=None if err.is_terminal else 132)

@@ -27,6 +27,10 @@ class Settings:
         truth (fitness) times the share of the truth it covers that lies near the map is below
         this.
     force: evaluate even when the agreement is below ``min_agreement``.
+    footprint: how the map's footprint (the area it observed) is found, one of
+        ``pcmapq.raster.footprint.FOOTPRINT_RULES``: ``known`` cells of an image, the area its
+        ``walls`` enclose, ``all`` of its rectangle, or ``auto``: known cells for an image with
+        unknown regions, walls for a binary image or a cloud.
     footprint_margin: the map's footprint is grown by this much, metres.
     threshold: largest distance between matched features, metres.
     min_hits: a cloud cell is occupied when it holds at least this many points; by default 2
@@ -51,6 +55,7 @@ class Settings:
     fit_tolerance: float = 0.2
     min_agreement: float = 0.2
     force: bool = False
+    footprint: str = "auto"
     footprint_margin: float = 0.3
     threshold: float = 0.5
     min_hits: int | None = None

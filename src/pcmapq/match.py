@@ -13,8 +13,9 @@ strong-strong pair beats a strong-weak one.
 
 quality = matched strong truth / strong truth features (the paper's q = RMF / GTF);
 precision = matched strong map / strong map features; f1 = their harmonic mean. A ratio with
-nothing to count (no strong feature on that side) is 0, and f1 is 0 when quality and precision
-are both 0.
+nothing to count (no strong feature on that side) is undefined, None, not 0: a round room has no
+corner, and its perfect map must not score 0 for missing none. f1 is None when either is None,
+0 when both are 0.
 """
 
 from __future__ import annotations
@@ -38,9 +39,11 @@ class Matching:
     displacement: (M, 2) metres, from the truth feature to its map feature (the paper's
         "vectorial map"), in the truth/map metric frame.
     cost: (M,) the detector's normalised cost of each pair, [0, 1].
-    quality: matched strong truth / strong truth features (the paper's q), in [0, 1].
-    precision: matched strong map / strong map features, in [0, 1].
-    f1: harmonic mean of quality and precision; 0 when both are 0.
+    quality: matched strong truth / strong truth features (the paper's q), in [0, 1]; None
+        when there is no strong truth feature.
+    precision: matched strong map / strong map features, in [0, 1]; None when there is no
+        strong map feature.
+    f1: harmonic mean of quality and precision; 0 when both are 0, None when either is None.
     truth_features, map_features: numbers of strong truth and strong map features.
     matched: number of strong truth features matched (quality's numerator).
     matched_map: number of strong map features matched (precision's numerator).
@@ -52,15 +55,23 @@ class Matching:
     map_idx: np.ndarray
     displacement: np.ndarray
     cost: np.ndarray
-    quality: float
-    precision: float
-    f1: float
+    quality: float | None
+    precision: float | None
+    f1: float | None
     truth_features: int
     map_features: int
     matched: int
     matched_map: int
     missing: np.ndarray
     extra: np.ndarray
+
+    def note(self, truth_scope: str = "") -> str | None:
+        """Why a score is undefined, one line (None when all three are defined);
+        ``truth_scope`` qualifies the truth's features, e.g. "inside the footprint"."""
+        scope = f" {truth_scope}" if truth_scope else ""
+        reasons = ([f"no strong truth feature{scope}"] if self.quality is None else []) + \
+                  (["no strong map feature"] if self.precision is None else [])
+        return "; ".join(reasons) or None
 
 
 def assign(i: np.ndarray, j: np.ndarray, cost: np.ndarray, weight: np.ndarray) -> np.ndarray:
@@ -114,8 +125,16 @@ def _assign_component(i: np.ndarray, j: np.ndarray, cost: np.ndarray,
     return sel[sel >= 0]
 
 
-def _ratio(num: int, den: int) -> float:
-    return float(num) / den if den > 0 else 0.0
+def _ratio(num: int, den: int) -> float | None:
+    """num / den; None (undefined, not 0) when there is nothing to count."""
+    return float(num) / den if den > 0 else None
+
+
+def harmonic_mean(quality: float | None, precision: float | None) -> float | None:
+    """f1 of a quality and a precision: None when either is None, 0 when both are 0."""
+    if quality is None or precision is None:
+        return None
+    return 2 * quality * precision / (quality + precision) if quality + precision > 0 else 0.0
 
 
 def match(name: str, truth: Features, map_: Features, threshold: float = 0.5) -> Matching:
@@ -146,7 +165,6 @@ def match(name: str, truth: Features, map_: Features, threshold: float = 0.5) ->
     matched_map = int(map_.strong[mj].sum())
     quality = _ratio(matched, len(t_strong))
     precision = _ratio(matched_map, len(m_strong))
-    f1 = 2 * quality * precision / (quality + precision) if quality + precision > 0 else 0.0
     return Matching(
         truth_idx=ti,
         map_idx=mj,
@@ -154,7 +172,7 @@ def match(name: str, truth: Features, map_: Features, threshold: float = 0.5) ->
         cost=np.asarray(cost, dtype=np.float64)[chosen][order],
         quality=quality,
         precision=precision,
-        f1=f1,
+        f1=harmonic_mean(quality, precision),
         truth_features=len(t_strong),
         map_features=len(m_strong),
         matched=matched,

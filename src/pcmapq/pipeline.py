@@ -19,7 +19,7 @@ from pcmapq.io import OccupancyMap, PointMap, load_map
 from pcmapq.match import match
 from pcmapq.metrics.distances import distances, distances_3d, nearest_distance
 from pcmapq.raster.draw import OCCUPIED, UNKNOWN, points_to_grid, warp_state
-from pcmapq.raster.footprint import map_footprint
+from pcmapq.raster.footprint import footprint_rule, map_footprint
 from pcmapq.raster.slice import wall_band
 from pcmapq.result import DetectorResult, Overlap, Result
 
@@ -60,17 +60,40 @@ def truth_raster(truth: OccupancyMap | PointMap, truth_xy: np.ndarray,
     return grid, points_to_grid(truth_xy, grid, min_hits(truth, settings))
 
 
+def map_footprint_rule(source: OccupancyMap | PointMap, settings: Settings) -> str:
+    """The footprint rule this map follows: ``settings.footprint`` with ``auto`` resolved (see
+    :func:`pcmapq.raster.footprint.footprint_rule`); a rule the map cannot follow is bad input."""
+    image = isinstance(source, OccupancyMap)
+    try:
+        return footprint_rule(settings.footprint, source.state == UNKNOWN if image else None,
+                              source.grid.resolution if image else 0.0)
+    except ValueError as err:
+        raise InputError(f"{source.path}: {err}") from None
+
+
 def map_raster(source: OccupancyMap | PointMap, map_xy: np.ndarray, transform: Similarity2D,
-               grid: MetricGrid, settings: Settings) -> tuple[np.ndarray, np.ndarray]:
+               grid: MetricGrid, settings: Settings,
+               rule: str | None = None) -> tuple[np.ndarray, np.ndarray]:
     """The aligned map drawn into the truth's grid: its occupied cells and its footprint (the
-    area it observed, see :mod:`pcmapq.raster.footprint`), both bool."""
-    if isinstance(source, OccupancyMap):
+    area it observed under ``rule``, by default :func:`map_footprint_rule`'s, see
+    :mod:`pcmapq.raster.footprint`), both bool."""
+    image = isinstance(source, OccupancyMap)
+    rule = map_footprint_rule(source, settings) if rule is None else rule
+    if image:
         state = warp_state(source.state, source.grid, transform, grid)
         occupied, known = state == OCCUPIED, state != UNKNOWN
+        rows, cols = source.grid.shape
+        corners = source.grid.pixels_to_xy(
+            np.array([[-0.5, -0.5], [cols - 0.5, -0.5], [cols - 0.5, rows - 0.5],
+                      [-0.5, rows - 0.5]]))
     else:
         occupied = points_to_grid(transform.apply(map_xy), grid, min_hits(source, settings))
         known = None
-    return occupied, map_footprint(known, occupied, grid, settings.footprint_margin)
+        (x0, y0), (x1, y1) = map_xy.min(axis=0), map_xy.max(axis=0)
+        corners = np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]])
+    footprint = map_footprint(rule, occupied, grid, settings.footprint_margin, known=known,
+                              rectangle=transform.apply(corners))
+    return occupied, footprint
 
 
 def overlap(truth_occ: np.ndarray, to_map: np.ndarray, footprint: np.ndarray, fitness: float,
@@ -121,6 +144,7 @@ def score(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap, setti
           progress: Progress = lambda step: None) -> Result:
     """Score a loaded map against a loaded truth: align, raster, detect, match."""
     map_path, truth_path = source.path, truth.path
+    rule = map_footprint_rule(source, settings)
     progress("aligning")
     source, registration = align_clouds_3d(source, truth, settings)
     map_xy, truth_xy = plan_points(source, settings), plan_points(truth, settings)
@@ -133,7 +157,7 @@ def score(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap, setti
 
     progress("rasterising")
     grid, truth_occ = truth_raster(truth, truth_xy, settings)
-    map_occ, footprint = map_raster(source, map_xy, alignment.transform, grid, settings)
+    map_occ, footprint = map_raster(source, map_xy, alignment.transform, grid, settings, rule)
     to_map = nearest_distance(map_occ, grid)
     cover = overlap(truth_occ, to_map, footprint, alignment.fitness, settings.fit_tolerance)
     if cover.agreement < settings.min_agreement and not settings.force:
@@ -166,4 +190,5 @@ def score(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap, setti
                                       to_map),
                   registration_3d=registration, distances_3d=cloud_distances,
                   threshold=settings.threshold, full=settings.full, detectors=detectors,
+                  footprint_rule=rule,
                   truth_occupied=truth_occ, map_occupied=map_occ)

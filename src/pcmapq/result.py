@@ -87,6 +87,12 @@ class Result:
     detectors: dict[str, DetectorResult]
     truth_occupied: np.ndarray
     map_occupied: np.ndarray
+    footprint_rule: str = "known"
+
+    def note(self, name: str) -> str | None:
+        """Why detector ``name``'s quality, precision or f1 is undefined (None if defined)."""
+        scope = "" if self.full else "inside the footprint"
+        return self.detectors[name].matching.note(scope)
 
     def to_dict(self) -> dict:
         """The JSON document (see README): plain types, floats rounded to DECIMALS."""
@@ -103,6 +109,7 @@ class Result:
                           "truth_recall": self.overlap.truth_recall,
                           "agreement": self.overlap.agreement},
             "coverage": self.overlap.coverage,
+            "footprint": self.footprint_rule,
             "scored_against": "whole truth" if self.full else "footprint",
             "distances": _distances_dict(self.distances),
             "detectors": {},
@@ -117,6 +124,7 @@ class Result:
             m = det.matching
             doc["detectors"][name] = {
                 "quality": m.quality, "precision": m.precision, "f1": m.f1,
+                "note": self.note(name),
                 "truth_features": m.truth_features, "map_features": m.map_features,
                 "matched": m.matched, "threshold_m": self.threshold,
                 "displacement_m": det.displacement_stats(),

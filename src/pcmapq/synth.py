@@ -176,6 +176,24 @@ def plan_grid(segments: np.ndarray, resolution: float, margin: float = 1.0) -> M
     return MetricGrid.covering(segments.reshape(-1, 2), resolution, margin)
 
 
+def binary_partial(segments: np.ndarray, box: tuple[float, float, float, float],
+                   tf: Similarity2D, resolution: float = 0.05,
+                   margin: float = 1.0) -> tuple[np.ndarray, MetricGrid]:
+    """A binary map of part of the plan, as the paper's inputs are (black walls on white, no
+    unknown value): the walls inside ``box`` (x0, y0, x1, y1, plan frame, metres), seen in a
+    map frame where ``p_plan = tf(p_map)``. The image covers the box's bounding rectangle in
+    the map frame plus ``margin`` metres. Returns the uint8 image (0 or 255) and its grid."""
+    import cv2
+
+    x0, y0, x1, y1 = box
+    corners = tf.inverse().apply(np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]]))
+    grid = MetricGrid.covering(corners, resolution, margin)
+    walls = render(transform_segments(segments, tf.inverse()), grid) == OCCUPIED
+    inside = np.zeros(grid.shape, np.uint8)
+    cv2.fillConvexPoly(inside, np.round(grid.xy_to_pixels(corners)).astype(np.int32), 1)
+    return np.where(walls & (inside > 0), 0, 255).astype(np.uint8), grid
+
+
 def wall_points(segments: np.ndarray, spacing: float = 0.02, thickness: float = 0.15,
                 noise: float = 0.0, seed: int = 0) -> np.ndarray:
     """Points on both faces of every wall, ``spacing`` metres apart, with Gaussian noise of std

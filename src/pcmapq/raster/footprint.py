@@ -1,12 +1,20 @@
 """The footprint of a map: the part of the truth's grid that the map observed.
 
-Rule (documented in docs/method.md):
-- an occupancy image observed its known cells, free or occupied, drawn into the truth's grid;
-- a point cloud observed the area its walls enclose: its occupied cells, closed with a disc of
-  radius ``close`` metres (bridging doors and gaps between walls) and with holes filled; a room
-  whose walls were seen is observed, open ground beyond the outermost walls is not.
-Either way the footprint is then grown by ``margin`` metres, so truth features on the border of
-what the map saw (a wall the map ends on) count as inside.
+Rules (``--footprint``, documented in docs/method.md):
+- ``known``: an occupancy image observed its known cells, free or occupied, drawn into the
+  truth's grid;
+- ``walls``: the map observed the area its walls enclose: its occupied cells, closed with a disc
+  of radius ``close`` metres (bridging doors and gaps between walls) and with holes filled; a
+  room whose walls were seen is observed, open ground beyond the outermost walls is not. A
+  point cloud's rule, and a binary image's (black walls on white: no unknown value, so no
+  evidence of what was not observed);
+- ``all``: the map's whole rectangle (an image's extent, a cloud's bounding box, in its frame);
+- ``auto`` (default): ``known`` for an image with unknown regions, ``walls`` otherwise. An
+  unknown region is what remains of the unknown cells after an opening by a disc of
+  ``UNKNOWN_WIDTH`` metres (so anti-aliased wall edges, a thin grey border, stray pixels do not
+  count); an image has them when they make up at least ``UNKNOWN_SHARE`` of it.
+Whatever the rule, the footprint is then grown by ``margin`` metres, so truth features on the
+border of what the map saw (a wall the map ends on) count as inside.
 """
 
 from __future__ import annotations
@@ -16,6 +24,15 @@ import numpy as np
 from scipy import ndimage
 
 from pcmapq.grid import MetricGrid
+
+#: The footprint rules, ``auto`` first (the default).
+FOOTPRINT_RULES = ("auto", "known", "walls", "all")
+#: Unknown cells count as an unknown region when they are part of a patch at least this wide,
+#: metres: an opening by a disc of this diameter.
+UNKNOWN_WIDTH = 0.5
+#: An image whose unknown regions make up at least this share of it has ``known`` cells that
+#: say what it observed (``auto``); below it, it is treated as binary (``walls``).
+UNKNOWN_SHARE = 0.01
 
 
 def _disc(radius_m: float, resolution: float) -> np.ndarray:
@@ -56,10 +73,63 @@ def grow(area: np.ndarray, grid: MetricGrid, margin: float) -> np.ndarray:
     return cv2.distanceTransform(outside, cv2.DIST_L2, cv2.DIST_MASK_PRECISE) <= radius
 
 
-def map_footprint(known: np.ndarray | None, occupied: np.ndarray, grid: MetricGrid,
-                  margin: float = 0.3) -> np.ndarray:
-    """The map's footprint on the truth's grid (bool): its known cells when it has them (an
-    occupancy image), else the area its occupied cells enclose; grown by ``margin`` metres."""
-    area = known if known is not None else enclosed_area(occupied, grid)
+def unknown_regions(unknown: np.ndarray, resolution: float,
+                    width: float = UNKNOWN_WIDTH) -> np.ndarray:
+    """The unknown cells (bool) that belong to a patch at least ``width`` metres wide: an
+    opening by a disc of that diameter (two exact distance transforms). Beyond the image is
+    known, so a thin unknown border is not a region. ``resolution``: metres per cell."""
+    r = width / 2.0 / resolution  # cells
+    pad = int(np.ceil(r)) + 1
+    padded = np.pad(unknown, pad).astype(np.uint8)
+    core = cv2.distanceTransform(padded, cv2.DIST_L2, cv2.DIST_MASK_PRECISE) > r
+    opened = cv2.distanceTransform((~core).astype(np.uint8), cv2.DIST_L2,
+                                   cv2.DIST_MASK_PRECISE) <= r
+    return (opened & padded.astype(bool))[pad:-pad, pad:-pad]
+
+
+def footprint_rule(requested: str, unknown: np.ndarray | None, resolution: float) -> str:
+    """The rule a map's footprint follows: ``requested`` (one of FOOTPRINT_RULES), with
+    ``auto`` resolved. ``unknown``: the image's unknown cells (None for a point cloud);
+    ``resolution``: the image's metres per cell. Raises ValueError for ``known`` on a cloud."""
+    if requested not in FOOTPRINT_RULES:
+        raise ValueError(f"unknown footprint rule {requested!r}; choose from "
+                         f"{', '.join(FOOTPRINT_RULES)}")
+    if unknown is None:
+        if requested == "known":
+            raise ValueError("a point cloud has no known cells: footprint 'walls' or 'all'")
+        return "walls" if requested == "auto" else requested
+    if requested != "auto":
+        return requested
+    if not unknown.any():
+        return "walls"
+    share = float(unknown_regions(unknown, resolution).mean())
+    return "known" if share >= UNKNOWN_SHARE else "walls"
+
+
+def polygon_area(corners: np.ndarray, grid: MetricGrid) -> np.ndarray:
+    """The cells of ``grid`` (bool) the convex polygon ``corners`` ((K, 2) metres, in the grid's
+    frame) covers (OpenCV's fill: cells its edges touch included)."""
+    shift = 8  # fixed-point bits: cell centres are at integer pixel coordinates
+    uv = np.round(grid.xy_to_pixels(corners) * (1 << shift)).astype(np.int32)
+    area = np.zeros(grid.shape, np.uint8)
+    cv2.fillConvexPoly(area, uv, 1, lineType=cv2.LINE_8, shift=shift)
+    return area.astype(bool)
+
+
+def map_footprint(rule: str, occupied: np.ndarray, grid: MetricGrid, margin: float = 0.3,
+                  known: np.ndarray | None = None,
+                  rectangle: np.ndarray | None = None) -> np.ndarray:
+    """The map's footprint on the truth's grid (bool) under ``rule`` (resolved: ``known``,
+    ``walls`` or ``all``, see :func:`footprint_rule`): its known cells, the area its occupied
+    cells enclose, or its rectangle (``rectangle``: (4, 2) corners, truth frame, metres);
+    grown by ``margin`` metres."""
+    if rule == "known" and known is not None:
+        area = known
+    elif rule == "all" and rectangle is not None:
+        area = polygon_area(rectangle, grid)
+    elif rule == "walls":
+        area = enclosed_area(occupied, grid)
+    else:
+        raise ValueError(f"footprint rule {rule!r} needs what this map lacks")
     return grow(area | occupied, grid, margin)
 

@@ -24,6 +24,11 @@ img { max-width: 100%; border: 1px solid #eee; }
 """
 
 
+#: How each footprint rule reads in the report.
+FOOTPRINT_WORDS = {"known": "known cells", "walls": "enclosed by its walls",
+                   "all": "its whole rectangle"}
+
+
 def _img(png: bytes, alt: str) -> str:
     return f'<img alt="{html.escape(alt)}" src="data:image/png;base64,' \
            f'{base64.b64encode(png).decode("ascii")}">'
@@ -47,6 +52,11 @@ def _f(value: float | None, digits: int = 3) -> str:
     return "-" if value is None else f"{value:.{digits}f}"
 
 
+def _q(value: float | None) -> str:
+    """A score with three decimals; 'n/a' when undefined (nothing to count)."""
+    return "n/a" if value is None else f"{value:.3f}"
+
+
 def report_html(result: Result) -> str:
     """The whole report as one HTML document (figures as embedded PNGs, no network needed)."""
     a, tf, o = result.alignment, result.alignment.transform, result.overlap
@@ -59,18 +69,24 @@ def report_html(result: Result) -> str:
         ["x [m]", "y [m]", "yaw [deg]", "scale", "fitness", "inlier RMSE [m]", "method"],
         [[_f(tf.tx), _f(tf.ty), _f(tf.yaw_deg, 2), _f(tf.scale, 4),
           f"{_f(a.fitness)} (within {a.tolerance_m:g} m)", _f(a.rmse_m), a.method]])
-    cover = _table(["coverage", "truth recall in footprint", "agreement", "scored against"],
-                   [[_f(o.coverage), _f(o.truth_recall), _f(o.agreement),
+    cover = _table(["coverage", "footprint", "truth recall in footprint", "agreement",
+                    "scored against"],
+                   [[_f(o.coverage), FOOTPRINT_WORDS.get(result.footprint_rule, ""),
+                     _f(o.truth_recall), _f(o.agreement),
                      "whole truth" if result.full else "the map's footprint"]])
     rows = []
     for name, det in result.detectors.items():
         m, s = det.matching, det.displacement_stats()
-        rows.append([name, _f(m.quality), _f(m.precision), _f(m.f1), str(m.truth_features),
+        rows.append([name, _q(m.quality), _q(m.precision), _q(m.f1), str(m.truth_features),
                      str(m.map_features), str(m.matched), _f(s["mean"]), _f(s["median"]),
                      _f(s["rmse"]), _f(s["max"])])
     scores = _table(["detector", "quality q", "precision", "f1", "truth features",
                      "map features", "matched", "disp. mean [m]", "disp. median [m]",
                      "disp. RMSE [m]", "disp. max [m]"], rows)
+    notes = [f"{name}: n/a: {note}" for name in result.detectors
+             if (note := result.note(name)) is not None]
+    if notes:
+        scores += "".join(f'<p class="note">{html.escape(n)}</p>' for n in notes)
     d = result.distances
     dist = _stats_table("cells", [("accuracy (map to truth)", d.accuracy),
                                   ("completeness (truth to map)", d.completeness)])
@@ -102,8 +118,9 @@ alignment. A low fitness on a map of the right place measures its distortion.</p
 footprint). Truth features outside the footprint are not counted as missing.</p>
 <h2>Feature matching within {result.threshold:g} m</h2>{scores}
 <p class="note">quality q = matched truth features / truth features (the paper's measure, a
-recall); precision = matched map features / map features; f1 = their harmonic mean.
-Displacements are from each truth feature to its map feature.</p>
+recall); precision = matched map features / map features; f1 = their harmonic mean;
+n/a: nothing to count (undefined, not 0). Displacements are from each truth feature to its
+map feature.</p>
 <h2>Distances</h2>{dist}
 <p class="note">Chamfer distance {_f(d.chamfer_m)} m (mean of the two means). Definitions in
 docs/metrics.md.</p>{fscore}

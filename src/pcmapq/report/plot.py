@@ -55,6 +55,11 @@ def arrow_gain(result: Result) -> float:
     return max(1.0, _nice(0.04 * result.grid.size_m[0] / d.max()))
 
 
+def _score(value: float | None) -> str:
+    """A score with two decimals; 'n/a' when undefined (nothing to count)."""
+    return "n/a" if value is None else f"{value:.2f}"
+
+
 def _panel(ax, result: Result, name: str, det: DetectorResult, gain: float) -> None:
     ax.imshow(overlay(result), extent=extent(result), origin="upper", interpolation="nearest")
     if not result.full:
@@ -79,8 +84,9 @@ def _panel(ax, result: Result, name: str, det: DetectorResult, gain: float) -> N
     bar = _nice(width / 5)
     ax.add_artist(AnchoredSizeBar(ax.transData, bar, f"{bar:g} m", "lower right", pad=0.4,
                                   frameon=True, size_vertical=width / 300))
-    ax.set_title(f"{name}: quality {m.quality:.2f}, precision {m.precision:.2f}, "
-                 f"f1 {m.f1:.2f}", fontsize=10)
+    ax.set_title(f"{name}: quality {_score(m.quality)}, precision {_score(m.precision)}, "
+                 f"f1 {_score(m.f1)}"
+                 + (f"\n{note}" if (note := result.note(name)) else ""), fontsize=10)
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
     ax.set_aspect("equal")

@@ -12,6 +12,11 @@ def _m(value: float | None) -> str:
     return "-" if value is None else f"{value:.3f}"
 
 
+def _q(value: float | None) -> str:
+    """A score with three decimals; 'n/a' when undefined (nothing to count)."""
+    return "n/a" if value is None else f"{value:.3f}"
+
+
 def print_table(result: Result, console: Console) -> None:
     """Print the alignment and the per-detector qualities (metres, degrees)."""
     a = result.alignment
@@ -20,7 +25,7 @@ def print_table(result: Result, console: Console) -> None:
         f"[bold]{result.map_path}[/] -> [bold]{result.truth_path}[/]  "
         f"x {tf.tx:.3f} m  y {tf.ty:.3f} m  yaw {tf.yaw_deg:.2f} deg  scale {tf.scale:.4f}  "
         f"fitness {a.fitness:.3f} (within {a.tolerance_m} m)  rmse {a.rmse_m:.3f} m  "
-        f"coverage {result.overlap.coverage:.3f}"
+        f"coverage {result.overlap.coverage:.3f} (footprint: {result.footprint_rule})"
         + ("  (scored against the whole truth)" if result.full else ""))
     table = Table(title=f"feature matching within {result.threshold} m")
     for col in ("detector", "quality", "precision", "f1", "truth", "map", "matched"):
@@ -30,10 +35,13 @@ def print_table(result: Result, console: Console) -> None:
     for name, det in result.detectors.items():
         m = det.matching
         stats = det.displacement_stats()
-        table.add_row(name, f"{m.quality:.3f}", f"{m.precision:.3f}", f"{m.f1:.3f}",
+        table.add_row(name, _q(m.quality), _q(m.precision), _q(m.f1),
                       str(m.truth_features), str(m.map_features), str(m.matched),
                       *(_m(stats[k]) for k in ("mean", "median", "rmse", "max")))
     console.print(table)
+    for name in result.detectors:
+        if (note := result.note(name)) is not None:
+            console.print(f"{name}: n/a: {note}", highlight=False)
     if result.registration_3d is not None and result.distances_3d is not None:
         reg, d3 = result.registration_3d, result.distances_3d
         console.print(f"3D registration: fitness {reg.fitness:.3f}, rmse {reg.rmse:.3f} m; "
