@@ -475,17 +475,14 @@ def carmen_notes() -> list[str]:
         "",
         "Every figure gets worse (or, at the smallest drifts, stays level) as the drift "
         "grows, to 1, 2 and 4 % (Intel pose errors 10-36 m, FHW 2-9 m), and every detector's "
-        "f1 falls at every step, but for one step when this was written: Intel's Harris f1 "
-        "from 0.5 to 1 % (0.395, 0.397), where its quality even rises (0.520, 0.585). That "
-        "step is noise, not a flaw: at 0.5 % Intel's "
-        "poses are already off by 5 m and 24 degrees, and its Harris f1 is 0.15 above chance "
-        "(the same map's corners shifted 2 m in 12 directions match with f1 0.25 at both "
-        "levels); a 1 % map has more corners (495 vs 417), so more of them land within "
-        "0.5 m of a truth corner by chance. With seeds 1 and 2, Harris and Hough f1 fall "
-        "strictly at 0.5, 1 and 2 % (seed 1 Harris 0.428, 0.365, 0.269; seed 2 0.476, 0.357, "
-        "0.270). At 2 and 4 % Intel's Harris f1 (0.220, 0.191) is at its chance level (0.230, "
-        "0.191): a recall under a 0.5 m threshold has a floor set by how many features the map "
-        "has.",
+        "f1 falls at every step (the line under each table is computed from it). Before the "
+        "detectors saw wall centre lines (docs/method.md), one step did not: Intel's Harris f1 "
+        "from 0.5 to 1 % (0.395, 0.397). That step was noise, not a flaw: at 0.5 % Intel's "
+        "poses are already off by 5 m and 24 degrees; its Harris f1 was 0.15 above chance "
+        "(the same map's corners shifted 2 m in 12 directions matched with f1 0.25 at both "
+        "levels) and a 1 % map has more corners, so more of them land within 0.5 m of a truth "
+        "corner by chance. At 2 and 4 % a recall under a 0.5 m threshold has a floor set by how "
+        "many features the map has (Intel's Harris f1 then sat at its chance level).",
         "",
         "SIFT before its descriptor gate (any keypoint within 0.5 m matched, however unlike, "
         "and descriptors turned to SIFT's dominant orientation): its quality saturated near "
@@ -493,7 +490,7 @@ def carmen_notes() -> list[str]:
         "threshold of most truth keypoints, and has 2.5-3 times the keypoints). Since a pair "
         "must also look alike (descriptor distance at most 512, the descriptors' length: "
         "cosine >= 0.5; upright descriptors; docs/method.md), SIFT falls like the others, "
-        "below 0.6 at 4 % (tables above). Before, at seed 0:",
+        "below 0.6 at 4 % (tables above). Before the gate and the centre lines, at seed 0:",
         "",
         sift_before_table(),
     ]
