@@ -5,6 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from pcmapq.align.transform import Similarity2D
+from pcmapq.io.occupancy import Thresholds
 from pcmapq.metrics.distances import DEFAULT_TAUS
 
 DETECTOR_NAMES = ("harris", "hough", "sift")
@@ -16,6 +17,8 @@ class Settings:
 
     map_resolution, truth_resolution: metres per pixel of an image that has no YAML (overrides
         the YAML's); for a cloud truth, the cell size of its grid (default ``cloud_resolution``).
+    map_thresholds, truth_thresholds: map_server's occupied_thresh, free_thresh and negate for
+        an image map / truth, overriding its YAML (``--map-occupied-thresh`` ...).
     cloud_resolution: cell size used for a point-cloud truth when none is given, metres.
     band_low, band_high: the wall band of a 3D cloud, metres above the floor.
     scale: estimate the map's scale too (a similarity); for maps whose resolution is unknown
@@ -42,6 +45,8 @@ class Settings:
 
     map_resolution: float | None = None
     truth_resolution: float | None = None
+    map_thresholds: Thresholds | None = None
+    truth_thresholds: Thresholds | None = None
     cloud_resolution: float = 0.05
     band_low: float = 0.3
     band_high: float = 2.0

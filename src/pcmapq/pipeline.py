@@ -108,12 +108,14 @@ def evaluate(map_path: str | Path | PointMap, truth_path: str | Path,
     truth at ``truth_path``."""
     settings = Settings() if settings is None else settings
     progress("loading")
-    truth = load_map(truth_path, settings.truth_resolution)
+    truth = load_map(truth_path, settings.truth_resolution,
+                     thresholds=settings.truth_thresholds)
     guess = settings.truth_resolution or settings.cloud_resolution
     if isinstance(truth, OccupancyMap):
         guess = truth.grid.resolution
     source = map_path if isinstance(map_path, PointMap) else load_map(
-        map_path, settings.map_resolution, guess if settings.scale else None)
+        map_path, settings.map_resolution, guess if settings.scale else None,
+        settings.map_thresholds)
     return score(source, truth, settings, progress)
 
 
