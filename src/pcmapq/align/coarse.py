@@ -43,11 +43,42 @@ class Search:
 
     poses: (K, 4) rows (score, yaw rad, x, y) of the per-yaw peaks (rigid search), or (K, 5)
     with a fifth column, the log of the scale (similarity search); sorted by score, descending.
-    x, y: where the map's centroid lands, truth units.
+    x, y: where the map's centroid lands, truth units. centre: the map's centroid, map frame;
+    radius: the map's largest distance from it, map units.
     """
 
     candidates: list[Candidate]
     poses: np.ndarray
+    centre: np.ndarray
+    radius: float
+
+
+#: Poses within these of the final one are "near" it (see :func:`distinctiveness`): yaw,
+#: degrees; position, share of the (scaled) map's radius; scale, ratio.
+NEAR_DEG, NEAR_RADIUS, NEAR_SCALE = 15.0, 0.2, 1.15
+
+
+def distinctiveness(search: Search, tf: Similarity2D) -> float:
+    """How distinct the pose ``tf`` (map -> truth, usually the refined winner) is in the
+    search's scores, in [0, 1]: 1 - (best score of the poses far from ``tf``) / (best score of
+    the poses near it). Near: within NEAR_DEG degrees, NEAR_RADIUS map radii of centroid
+    position and (similarity search) a scale ratio of NEAR_SCALE. 0 when the search scored no
+    pose near ``tf`` higher than one elsewhere (refinement left the search's peak, or another
+    pose scores as well); 1 when nothing elsewhere scores above zero."""
+    poses = search.poses
+    if len(poses) == 0:
+        return 0.0
+    centre = tf.apply(search.centre.reshape(1, 2))[0]
+    dyaw = np.abs(np.angle(np.exp(1j * (poses[:, 1] - tf.yaw))))
+    dxy = np.hypot(poses[:, 2] - centre[0], poses[:, 3] - centre[1])
+    near = (dyaw < np.radians(NEAR_DEG)) & (dxy < NEAR_RADIUS * tf.scale * search.radius)
+    if poses.shape[1] > 4:
+        near &= np.abs(poses[:, 4] - np.log(tf.scale)) < np.log(NEAR_SCALE)
+    peak = float(poses[near, 0].max()) if near.any() else 0.0
+    elsewhere = float(poses[~near, 0].max()) if (~near).any() else 0.0
+    if peak <= 0.0:
+        return 0.0
+    return float(np.clip(1.0 - max(elsewhere, 0.0) / peak, 0.0, 1.0))
 
 
 def likelihood_field(truth_xy: np.ndarray, grid: MetricGrid, sigma: float) -> np.ndarray:
@@ -156,7 +187,7 @@ def coarse_search(map_xy: np.ndarray, truth_xy: np.ndarray, *,
     poses = poses[np.argsort(-poses[:, 0], kind="stable")]
     best = _suppress(poses, top_k, np.radians(3 * angle_step_deg), 4 * resolution)
     return Search([Candidate(_pose(yaw, xy, centre), float(score)) for score, yaw, *xy in best],
-                  poses)
+                  poses, centre, radius)
 
 
 def _pose(yaw: float, centre_truth: np.ndarray, centre_map: np.ndarray,
@@ -252,4 +283,4 @@ def similarity_search(map_xy: np.ndarray, truth_xy: np.ndarray, *,
     poses = poses[np.argsort(-poses[:, 0], kind="stable")]
     best = _suppress(poses, top_k, np.radians(9.0), 4 * resolution, np.log(1.15))
     return Search([Candidate(_pose(yaw, xy, centre, float(np.exp(log_s))), float(score))
-                   for score, yaw, *xy, log_s in best], poses)
+                   for score, yaw, *xy, log_s in best], poses, centre, map_radius)
