@@ -26,10 +26,9 @@ class Settings:
     init: initial guess of the map -> truth transform; skips the global step.
     align: False trusts the map's frame (``--no-align``): no global step, no ICP.
     fit_tolerance: a map point is an inlier of the alignment within this distance, metres.
-    min_agreement: the map is taken to show another place when the share of its points near the
-        truth (fitness) times the share of the truth it covers that lies near the map is below
-        this.
-    force: evaluate even when the agreement is below ``min_agreement``.
+    min_confidence: the map is taken to show another place when its ``confidence`` (see
+        :func:`pcmapq.pipeline.confidence`) is below this.
+    force: evaluate even when the confidence is below ``min_confidence``.
     footprint_margin: the map's footprint is grown by this much, metres.
     threshold: largest distance between matched features, metres.
     min_hits: a cloud cell is occupied when it holds at least this many points; by default 2
@@ -54,7 +53,7 @@ class Settings:
     init: Similarity2D | None = None
     align: bool = True
     fit_tolerance: float = 0.2
-    min_agreement: float = 0.2
+    min_confidence: float = 0.5
     force: bool = False
     footprint_margin: float = 0.3
     threshold: float = 0.5
