@@ -73,16 +73,16 @@ def test_halmstad_layout_walls_read_occupied_by_ros_thresholds():
 
 def test_halmstad_full_pipeline_puts_keypoints_within_20_px():
     """E5_09 vs the E5 layout through evaluate(): the annotated keypoints land within 20 px
-    (median) of their partners and the map agrees with the layout."""
+    (median) of their partners, with no force: the map is taken to show the layout's place."""
     tool = validate_tool()
     root = shared("halmstad")
     map_path = shared("halmstad", "maps", "E5", "pseudo_occupancy", "E5_09.png")
     layout = shared("halmstad", "maps", "E5", "layout", "E5_layout.png")
-    settings = tool.Settings(scale=True, truth_resolution=0.05, force=True)
+    settings = tool.Settings(scale=True, truth_resolution=0.05)
     result = tool.timed_evaluate(map_path, layout, settings).result
     bench = tool.load_tool(tool.ROOT / "bench" / "bench_scale.py")
     map_keys, layout_keys = bench.keypoint_pairs(root, "E5_09", "E5")
     residual = tool.keypoint_residual(result, map_path, map_keys, layout_keys)
     assert residual < 20.0
     assert np.isfinite(result.distances.accuracy.mean)
-    assert result.overlap.agreement > 0.2
+    assert result.overlap.confidence >= 0.5

@@ -27,14 +27,14 @@ import sys
 import tempfile
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from types import ModuleType
 
 import numpy as np
 
 from pcmapq.config import Settings
-from pcmapq.io import OccupancyMap, load_map
+from pcmapq.io import OccupancyMap, Thresholds, load_map
 from pcmapq.io.occupancy import MapMeta, classify, read_grey
 from pcmapq.pipeline import evaluate
 from pcmapq.raster.draw import OCCUPIED
@@ -65,21 +65,22 @@ CARMEN_LOGS = ("intel-corrected.log.gz", "fhw-corrected.log.gz")
 @dataclass(frozen=True)
 class FloorPlan:
     """A SLAM map vs a plan. survey_scale: plan pixels per map pixel of a survey fit;
-    yaw_deg: expected rotation; yaml: map_server thresholds for the map, if ROS's do not fit."""
+    yaw_deg: expected rotation; thresholds: map_server thresholds for the map, if ROS's do not
+    fit (``--map-occupied-thresh`` ... on the command line)."""
 
     name: str
     map_file: str
     plan_file: str
     survey_scale: float
     yaw_deg: float
-    yaml: dict[str, float] = field(default_factory=dict)
+    thresholds: Thresholds | None = None
 
 
 #: The Intel map's walls are grey 127 (p = 0.502, unknown under ROS's occupied_thresh 0.65) and
 #: its unexplored area grey 230 (p = 0.098, free under ROS's free_thresh 0.196).
 FLOORPLANS = (
     FloorPlan("Intel Research Lab", "intel_map.png", "lab_intel.png", 1.168, 180.0,
-              {"occupied_thresh": 0.4, "free_thresh": 0.05}),
+              Thresholds(occupied=0.4, free=0.05)),
     FloorPlan("Freiburg 079", "freiburg_building79.png", "Freiburg79_scan.png", 0.863, 0.0),
 )
 
@@ -201,8 +202,8 @@ def gazebo_section(data: Path = DATA) -> str:
         f"Alignment: scale {tf.scale:.4f} (a map pixel is {tf.scale * truth_px:.3f} mm; the "
         "images' size ratios are 2.0023 across, 1.9578 down), yaw "
         f"{tf.yaw_deg:.3f} deg, fitness {r.alignment.fitness:.3f}, inlier RMSE "
-        f"{cm(r.alignment.rmse_m)} cm; coverage {r.overlap.coverage:.2f}, agreement "
-        f"{r.overlap.agreement:.2f}.",
+        f"{cm(r.alignment.rmse_m)} cm; coverage {r.overlap.coverage:.2f}, confidence "
+        f"{r.overlap.confidence:.2f}.",
         "",
         "| map -> truth distance [cm] | mean | median | RMSE | p95 | std | max | samples |",
         "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |",
@@ -286,11 +287,11 @@ def halmstad_pipeline(data: Path) -> str:
     bench = load_tool(ROOT / "bench" / "bench_scale.py")
     lines = [
         "| map | occupied: grey < 50 / < 100 | scale (ref) | yaw deg (ref) | "
-        "keypoint residual px | fitness | coverage | agreement | Harris q / p | Hough q / p | "
+        "keypoint residual px | fitness | coverage | confidence | Harris q / p | Hough q / p | "
         "SIFT q / p | acc mean m | comp mean m | F@0.2 | s |",
         "|" + " --- |" * 15,
     ]
-    settings = Settings(scale=True, truth_resolution=PLAN_RESOLUTION, force=True)
+    settings = Settings(scale=True, truth_resolution=PLAN_RESOLUTION)
     with tempfile.TemporaryDirectory(prefix="pcmapq_validate_") as tmp:
         for name in HALMSTAD_MAPS:
             building = name.rsplit("_", 1)[0]
@@ -307,7 +308,7 @@ def halmstad_pipeline(data: Path) -> str:
                      f"{tf.yaw_deg:.1f} ({ref.yaw_deg:.1f})",
                      f"{keypoint_residual(r, map_path, map_keys, layout_keys):.1f}",
                      num(r.alignment.fitness, 2), num(r.overlap.coverage, 2),
-                     num(r.overlap.agreement, 2)]
+                     num(r.overlap.confidence, 2)]
             cells += [q_p(r, k) for k in ("harris", "hough", "sift")]
             cells += [num(r.distances.accuracy.mean), num(r.distances.completeness.mean),
                       num(f02, 2), f"{run.seconds:.1f}"]
@@ -328,7 +329,7 @@ def halmstad_section(data: Path = DATA) -> str:
         "",
         halmstad_bench(folder),
         "",
-        f"Full pipeline, `Settings(scale=True, truth_resolution={PLAN_RESOLUTION}, force=True)`, "
+        f"Full pipeline, `Settings(scale=True, truth_resolution={PLAN_RESOLUTION})` (no `force`), "
         "map image vs layout image, one map per building. The layout's walls are read as "
         "occupied by ROS's default thresholds, so no YAML is needed: column 2 is the share of "
         "its pixels darker than 50 (wall cores) and than 100 (the bench's wall mask) that the "
@@ -349,12 +350,9 @@ def floorplan_run(case: FloorPlan, data: Path = DATA) -> Run:
     """One SLAM map vs its plan: plan at PLAN_RESOLUTION, the map's scale estimated (it starts
     at the plan's resolution, so the scale is plan pixels per map pixel)."""
     folder = data / "floorplans"
-    settings = Settings(scale=True, truth_resolution=PLAN_RESOLUTION, force=True)
-    with tempfile.TemporaryDirectory(prefix="pcmapq_validate_") as tmp:
-        map_path = folder / case.map_file
-        if case.yaml:
-            map_path = with_yaml(map_path, Path(tmp), PLAN_RESOLUTION, **case.yaml)
-        return timed_evaluate(map_path, folder / case.plan_file, settings)
+    settings = Settings(scale=True, truth_resolution=PLAN_RESOLUTION,
+                        map_thresholds=case.thresholds)
+    return timed_evaluate(folder / case.map_file, folder / case.plan_file, settings)
 
 
 def save_figure(result: Result, path: Path, dpi: int = 80) -> int:
@@ -381,14 +379,14 @@ def floorplans_section(data: Path = DATA, img: Path | None = IMG) -> str:
         "with a grey fill, RGBA) and `freiburg_building79.png` vs `Freiburg79_scan.png`. No "
         f"resolution is given: the plan is taken at {PLAN_RESOLUTION} m per pixel and the map's "
         "scale is estimated from the same start, so the scale is plan pixels per map pixel. "
-        "`Settings(scale=True, truth_resolution=0.05, force=True)`. The Intel map's walls are "
+        "`Settings(scale=True, truth_resolution=0.05)`, no `force`. The Intel map's walls are "
         "grey 127 (p = 0.50: unknown under ROS's occupied_thresh 0.65) and its unexplored area "
-        "grey 230 (p = 0.10: free under ROS's free_thresh 0.196), so it is read through a "
-        "YAML with `occupied_thresh: 0.4`, `free_thresh: 0.05` beside a temporary copy. The "
-        "Freiburg images read correctly with ROS's defaults.",
+        "grey 230 (p = 0.10: free under ROS's free_thresh 0.196), so it is read with "
+        "`--map-occupied-thresh 0.4 --map-free-thresh 0.05` (`Settings.map_thresholds`), no "
+        "YAML. The Freiburg images read correctly with ROS's defaults.",
         "",
         "| pair | scale (survey) | yaw deg (expected) | recovered | fitness | coverage | "
-        "agreement | Harris q / p | Hough q / p | SIFT q / p | acc mean m | comp mean m | s |",
+        "confidence | Harris q / p | Hough q / p | SIFT q / p | acc mean m | comp mean m | s |",
         "|" + " --- |" * 13,
     ]
     figures = []
@@ -400,7 +398,7 @@ def floorplans_section(data: Path = DATA, img: Path | None = IMG) -> str:
         cells = [case.name, f"{tf.scale:.3f} ({case.survey_scale:.3f})",
                  f"{tf.yaw_deg:.1f} ({case.yaw_deg:.0f})", "yes" if ok else "**no**",
                  num(r.alignment.fitness, 2), num(r.overlap.coverage, 2),
-                 num(r.overlap.agreement, 2)]
+                 num(r.overlap.confidence, 2)]
         cells += [q_p(r, k) for k in ("harris", "hough", "sift")]
         cells += [num(r.distances.accuracy.mean), num(r.distances.completeness.mean),
                   f"{run.seconds:.1f}"]
@@ -410,9 +408,9 @@ def floorplans_section(data: Path = DATA, img: Path | None = IMG) -> str:
             figures.append(f"![{case.name}: vectorial map](img/{figure_name(case)}) "
                            f"({size // 1000} kB)")
     lines += ["", "'recovered': yaw within 5 degrees of the expected one and scale within 5 % "
-              "of the survey's. Agreement below 0.2 would stop a run without `force`: the "
-              "plans hold only the walls, the SLAM maps also furniture and clutter, so most "
-              "map cells lie off the plan (precision and accuracy say the same)."]
+              "of the survey's. The plans hold only the walls, the SLAM maps also furniture and "
+              "clutter, so most map cells lie off the plan (fitness, precision and accuracy "
+              "say so); the confidence (`tools/same_place.py`) is not misled by them."]
     if figures:
         lines += ["", *figures]
     return "\n".join(lines)

@@ -16,7 +16,7 @@ from rich.progress import Progress
 from pcmapq.align.transform import Similarity2D
 from pcmapq.config import DETECTOR_NAMES, Settings
 from pcmapq.errors import EvaluationError, InputError
-from pcmapq.io import PointMap
+from pcmapq.io import PointMap, Thresholds
 from pcmapq.io.writers import write_atomic, write_cloud
 from pcmapq.mapping import (
     build_map_from_poses,
@@ -146,6 +146,14 @@ def _parse_resolution(text: str | None, scale: str) -> tuple[float | None, bool]
     return value, scale == "auto"
 
 
+def _thresholds(occupied: float | None, free: float | None,
+                negate: bool | None) -> Thresholds | None:
+    """map_server overrides from the command line (None when none is given)."""
+    if occupied is None and free is None and negate is None:
+        return None
+    return Thresholds(occupied, free, negate)
+
+
 def _parse_taus(text: str) -> tuple[float, ...]:
     try:
         taus = tuple(float(v) for v in text.split(","))
@@ -193,6 +201,24 @@ def eval_command(
     truth_resolution: Annotated[float | None, typer.Option(
         help="Metres per pixel of a truth image without YAML; cell size for a cloud truth "
         "(default 0.05).", min=1e-6)] = None,
+    map_occupied_thresh: Annotated[float | None, typer.Option(
+        help="Map image: occupied if p > this (map_server's occupied_thresh; overrides the "
+        "YAML's, default 0.65).", min=0.0, max=1.0, show_default=False)] = None,
+    map_free_thresh: Annotated[float | None, typer.Option(
+        help="Map image: free if p < this (map_server's free_thresh; overrides the YAML's, "
+        "default 0.196).", min=0.0, max=1.0, show_default=False)] = None,
+    map_negate: Annotated[bool | None, typer.Option(
+        "--map-negate/--map-no-negate", help="Map image: p = v / 255 instead of (255 - v) / 255 "
+        "(map_server's negate; overrides the YAML's).", show_default=False)] = None,
+    truth_occupied_thresh: Annotated[float | None, typer.Option(
+        help="Truth image: as --map-occupied-thresh.", min=0.0, max=1.0,
+        show_default=False)] = None,
+    truth_free_thresh: Annotated[float | None, typer.Option(
+        help="Truth image: as --map-free-thresh.", min=0.0, max=1.0, show_default=False)
+    ] = None,
+    truth_negate: Annotated[bool | None, typer.Option(
+        "--truth-negate/--truth-no-negate", help="Truth image: as --map-negate.",
+        show_default=False)] = None,
     init: Annotated[str | None, typer.Option(
         help="Initial guess x,y,yaw (m, m, deg), map -> truth; skips the global search.")] = None,
     no_align: Annotated[bool, typer.Option(
@@ -239,6 +265,10 @@ def eval_command(
     truth_path = paths[-1]
     resolution, auto = _parse_resolution(map_resolution, scale)
     settings = Settings(map_resolution=resolution, truth_resolution=truth_resolution,
+                        map_thresholds=_thresholds(map_occupied_thresh, map_free_thresh,
+                                                   map_negate),
+                        truth_thresholds=_thresholds(truth_occupied_thresh, truth_free_thresh,
+                                                     truth_negate),
                         scale=auto,
                         band_low=band_low, band_high=band_high, init=_parse_init(init),
                         align=not no_align, force=force, threshold=threshold, min_hits=min_hits,

@@ -5,6 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from pcmapq.align.transform import Similarity2D
+from pcmapq.io.occupancy import Thresholds
 from pcmapq.metrics.distances import DEFAULT_TAUS
 
 DETECTOR_NAMES = ("harris", "hough", "sift")
@@ -16,6 +17,8 @@ class Settings:
 
     map_resolution, truth_resolution: metres per pixel of an image that has no YAML (overrides
         the YAML's); for a cloud truth, the cell size of its grid (default ``cloud_resolution``).
+    map_thresholds, truth_thresholds: map_server's occupied_thresh, free_thresh and negate for
+        an image map / truth, overriding its YAML (``--map-occupied-thresh`` ...).
     cloud_resolution: cell size used for a point-cloud truth when none is given, metres.
     band_low, band_high: the wall band of a 3D cloud, metres above the floor.
     scale: estimate the map's scale too (a similarity); for maps whose resolution is unknown
@@ -23,10 +26,9 @@ class Settings:
     init: initial guess of the map -> truth transform; skips the global step.
     align: False trusts the map's frame (``--no-align``): no global step, no ICP.
     fit_tolerance: a map point is an inlier of the alignment within this distance, metres.
-    min_agreement: the map is taken to show another place when the share of its points near the
-        truth (fitness) times the share of the truth it covers that lies near the map is below
-        this.
-    force: evaluate even when the agreement is below ``min_agreement``.
+    min_confidence: the map is taken to show another place when its ``confidence`` (see
+        :func:`pcmapq.pipeline.confidence`) is below this.
+    force: evaluate even when the confidence is below ``min_confidence``.
     footprint: how the map's footprint (the area it observed) is found, one of
         ``pcmapq.raster.footprint.FOOTPRINT_RULES``: ``known`` cells of an image, the area its
         ``walls`` enclose, ``all`` of its rectangle, or ``auto``: known cells for an image with
@@ -46,6 +48,8 @@ class Settings:
 
     map_resolution: float | None = None
     truth_resolution: float | None = None
+    map_thresholds: Thresholds | None = None
+    truth_thresholds: Thresholds | None = None
     cloud_resolution: float = 0.05
     band_low: float = 0.3
     band_high: float = 2.0
@@ -53,7 +57,7 @@ class Settings:
     init: Similarity2D | None = None
     align: bool = True
     fit_tolerance: float = 0.2
-    min_agreement: float = 0.2
+    min_confidence: float = 0.5
     force: bool = False
     footprint: str = "auto"
     footprint_margin: float = 0.3

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from pcmapq.align import align
+from pcmapq.align import Alignment, align
 from pcmapq.align.rigid3d import Registration3D, align_3d, apply
 from pcmapq.align.transform import Similarity2D
 from pcmapq.config import Settings
@@ -96,14 +96,66 @@ def map_raster(source: OccupancyMap | PointMap, map_xy: np.ndarray, transform: S
     return occupied, footprint
 
 
-def overlap(truth_occ: np.ndarray, to_map: np.ndarray, footprint: np.ndarray, fitness: float,
-            tolerance: float) -> Overlap:
-    """How much of the truth the map covers, and how well the two agree there; ``to_map`` is
-    each cell's distance to the nearest map wall, metres."""
+#: Confidence terms (see :func:`confidence`): the distinctiveness worth full confidence, and
+#: the truth recalls worth none and full confidence.
+FULL_DISTINCT = 0.2
+RECALL_NONE, RECALL_FULL = 0.4, 0.8
+#: A map whose radius exceeds the truth's by this factor cannot be a part of it (a scale).
+OVERSIZE = 1.5
+
+
+def confidence(distinct: float | None, recall: float) -> float:
+    """That the map shows the truth's place, [0, 1]: the smaller of distinct / FULL_DISTINCT
+    and (recall - RECALL_NONE) / (RECALL_FULL - RECALL_NONE), clipped. ``distinct``: the global
+    search's distinctiveness of the final pose (None without a search: ``--init``,
+    ``--no-align``, a 3D registration; then the recall term alone); ``recall``: share of the
+    covered truth walls near the map. 0.5 is distinctiveness 0.1 and recall 0.6."""
+    terms = [(recall - RECALL_NONE) / (RECALL_FULL - RECALL_NONE)]
+    if distinct is not None:
+        terms.append(distinct / FULL_DISTINCT)
+    return float(np.clip(min(terms), 0.0, 1.0))
+
+
+def overlap(truth_occ: np.ndarray, to_map: np.ndarray, footprint: np.ndarray,
+            alignment: Alignment) -> Overlap:
+    """How much of the truth the map covers, how well the two agree there, and the confidence
+    that they show one place; ``to_map`` is each cell's distance to the nearest map wall,
+    metres."""
     seen = truth_occ & footprint
     coverage = float(seen.sum() / truth_occ.sum()) if truth_occ.any() else 0.0
+    tolerance = alignment.tolerance_m
     recall = float((to_map[seen] <= tolerance).mean()) if seen.any() else 0.0
-    return Overlap(footprint, coverage, recall, fitness * recall)
+    return Overlap(footprint, coverage, recall, alignment.fitness * recall,
+                   confidence(alignment.distinctiveness, recall))
+
+
+def _radius(xy: np.ndarray) -> float:
+    """Largest distance of points (N, 2) from their centroid, in their unit."""
+    return float(np.sqrt(((xy - xy.mean(axis=0)) ** 2).sum(axis=1).max()))
+
+
+def refusal(map_path: Path, truth_path: Path, alignment: Alignment, cover: Overlap,
+            settings: Settings, map_xy: np.ndarray, truth_xy: np.ndarray) -> str:
+    """One line: why the map seems not to show the truth's place, and the likely cause with the
+    option that addresses it."""
+    distinct = alignment.distinctiveness
+    why = (f"{cover.truth_recall:.0%} of the truth it covers lies near the map" +
+           ("" if distinct is None else
+            f", the best pose scores {distinct:.0%} above the best one elsewhere"))
+    size = _radius(map_xy) / max(_radius(truth_xy), 1e-12)
+    if settings.init is not None or not settings.align:
+        cause = ("the given frame: a wrong --init guess or --no-align; drop them for a "
+                 "global search")
+    elif not settings.scale and size > OVERSIZE:
+        cause = (f"a scale that differs: the map spans {size:.1f} times the truth; try "
+                 "--scale auto")
+    elif not settings.scale:
+        cause = "a map of another place, or of another scale (--scale auto)"
+    else:
+        cause = f"a map of another place (best scale found {alignment.transform.scale:.3g})"
+    return (f"{map_path}: does not seem to show the place of {truth_path}: confidence "
+            f"{cover.confidence:.2f} < {settings.min_confidence} ({why}); likely cause: "
+            f"{cause}; --force scores it anyway")
 
 
 def inside(features: Features, area: np.ndarray, grid: MetricGrid) -> np.ndarray:
@@ -131,12 +183,14 @@ def evaluate(map_path: str | Path | PointMap, truth_path: str | Path,
     truth at ``truth_path``."""
     settings = Settings() if settings is None else settings
     progress("loading")
-    truth = load_map(truth_path, settings.truth_resolution)
+    truth = load_map(truth_path, settings.truth_resolution,
+                     thresholds=settings.truth_thresholds)
     guess = settings.truth_resolution or settings.cloud_resolution
     if isinstance(truth, OccupancyMap):
         guess = truth.grid.resolution
     source = map_path if isinstance(map_path, PointMap) else load_map(
-        map_path, settings.map_resolution, guess if settings.scale else None)
+        map_path, settings.map_resolution, guess if settings.scale else None,
+        settings.map_thresholds)
     return score(source, truth, settings, progress)
 
 
@@ -159,13 +213,10 @@ def score(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap, setti
     grid, truth_occ = truth_raster(truth, truth_xy, settings)
     map_occ, footprint = map_raster(source, map_xy, alignment.transform, grid, settings, rule)
     to_map = nearest_distance(map_occ, grid)
-    cover = overlap(truth_occ, to_map, footprint, alignment.fitness, settings.fit_tolerance)
-    if cover.agreement < settings.min_agreement and not settings.force:
-        raise EvaluationError(
-            f"{map_path}: does not match {truth_path}: agreement {cover.agreement:.2f} < "
-            f"{settings.min_agreement} ({alignment.fitness:.0%} of the map lies near the truth, "
-            f"{cover.truth_recall:.0%} of the truth it covers lies near the map); "
-            "a map of another place? --force scores it anyway")
+    cover = overlap(truth_occ, to_map, footprint, alignment)
+    if cover.confidence < settings.min_confidence and not settings.force:
+        raise EvaluationError(refusal(map_path, truth_path, alignment, cover, settings, map_xy,
+                                      truth_xy))
 
     progress("drawing the walls' centre lines")
     truth_walls, map_walls = walls_of(truth_occ, grid), walls_of(map_occ, grid)

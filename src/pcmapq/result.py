@@ -59,13 +59,16 @@ class Overlap:
     footprint: (rows, cols) bool on the truth's grid, the area the map observed.
     coverage: share of the truth's occupied cells inside the footprint, [0, 1].
     truth_recall: share of those within the fit tolerance of a map occupied cell, [0, 1].
-    agreement: alignment fitness times truth_recall: low for a map of another place.
+    agreement: alignment fitness times truth_recall.
+    confidence: that the map shows the truth's place, [0, 1] (see pipeline.confidence); below
+        0.5 a map of another place.
     """
 
     footprint: np.ndarray
     coverage: float
     truth_recall: float
     agreement: float
+    confidence: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -107,7 +110,9 @@ class Result:
                           "tolerance_m": self.alignment.tolerance_m,
                           "method": self.alignment.method,
                           "truth_recall": self.overlap.truth_recall,
-                          "agreement": self.overlap.agreement},
+                          "agreement": self.overlap.agreement,
+                          "distinctiveness": self.alignment.distinctiveness,
+                          "confidence": self.overlap.confidence},
             "coverage": self.overlap.coverage,
             "footprint": self.footprint_rule,
             "scored_against": "whole truth" if self.full else "footprint",

@@ -7,16 +7,17 @@ map of unknown unit (a scanned plan, a map exported as a picture).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy.spatial import cKDTree
 
 from pcmapq.align.coarse import (
     auto_resolution,
-    coarse_candidates,
-    similarity_candidates,
+    coarse_search,
+    distinctiveness,
     similarity_resolution,
+    similarity_search,
 )
 from pcmapq.align.icp import (
     DEFAULT_SCHEDULE,
@@ -39,7 +40,9 @@ class Alignment:
     transform: map frame -> truth frame. fitness: share of (voxel-downsampled) map points within
     ``tolerance_m`` of a truth point after alignment, [0, 1]. rmse_m: RMSE of those inlier
     distances, metres. method: "coarse+icp", "similarity+icp" (global search over scale too),
-    "init+icp", "init" or "none".
+    "init+icp", "init" or "none". distinctiveness: how far the final pose's score in the global
+    search stands above the best score elsewhere, [0, 1] (see
+    :func:`~pcmapq.align.coarse.distinctiveness`); None when there was no global search.
     """
 
     transform: Similarity2D
@@ -47,6 +50,7 @@ class Alignment:
     rmse_m: float
     tolerance_m: float
     method: str
+    distinctiveness: float | None = None
 
 
 def _score_tree(map_xy: np.ndarray, tree: cKDTree, tf: Similarity2D,
@@ -110,7 +114,8 @@ def align(map_xy: np.ndarray, truth_xy: np.ndarray, *, init: Similarity2D | None
         tf = refine_point_to_line(map_ds, truth_ds, tf, DEFAULT_SCHEDULE[-1][0])
         return _result(map_ds, tree, tf, tolerance, "init+icp")
     resolution = auto_resolution(map_ds) if resolution is None else resolution
-    starts = coarse_candidates(map_ds, truth_ds, resolution=resolution, top_k=top_k)
+    search = coarse_search(map_ds, truth_ds, resolution=resolution, top_k=top_k)
+    starts = search.candidates
     (first_dist, first_voxel), *fine_stages = DEFAULT_SCHEDULE
     rough = IcpTarget(truth_ds, ((max(first_dist, 2 * resolution), first_voxel),))
     fine = IcpTarget(truth_ds, tuple(fine_stages))
@@ -120,7 +125,8 @@ def align(map_xy: np.ndarray, truth_xy: np.ndarray, *, init: Similarity2D | None
                       "coarse+icp") for r in sorted(firsts, key=_rank)[:finalists]]
     best = min(finals, key=_rank).transform
     best = refine_point_to_line(map_ds, truth_ds, best, DEFAULT_SCHEDULE[-1][0])
-    return _result(map_ds, tree, best, tolerance, "coarse+icp")
+    return replace(_result(map_ds, tree, best, tolerance, "coarse+icp"),
+                   distinctiveness=distinctiveness(search, best))
 
 
 def _rank(a: Alignment) -> tuple[float, float]:
@@ -179,10 +185,11 @@ def align_similarity(map_xy: np.ndarray, truth_xy: np.ndarray, *,
         return _result(_map_at_scale(map_xy, start, voxel), tree, start, tolerance,
                        "none" if init is None else "init")
     resolution = similarity_resolution(truth_ds) if resolution is None else resolution
+    search = None
     if init is None:
-        candidates = similarity_candidates(map_xy, truth_ds, scale_range=scale_range,
-                                           resolution=resolution, top_k=top_k)
-        starts, method = [c.transform for c in candidates], "similarity+icp"
+        search = similarity_search(map_xy, truth_ds, scale_range=scale_range,
+                                   resolution=resolution, top_k=top_k)
+        starts, method = [c.transform for c in search.candidates], "similarity+icp"
     else:
         starts, method = [init], "init+icp"
     first, *rest = similarity_schedule(resolution, tolerance, voxel)
@@ -196,7 +203,8 @@ def align_similarity(map_xy: np.ndarray, truth_xy: np.ndarray, *,
                                   with_scale=True)
         finals.append(_scaled_result(map_xy, tree, tf, tolerance, voxel))
     best = min(finals, key=_rank)
-    return Alignment(best.transform, best.fitness, best.rmse_m, tolerance, method)
+    distinct = None if search is None else distinctiveness(search, best.transform)
+    return Alignment(best.transform, best.fitness, best.rmse_m, tolerance, method, distinct)
 
 
 def _scaled_result(map_xy: np.ndarray, tree: cKDTree, tf: Similarity2D, tolerance: float,

@@ -37,6 +37,50 @@ class Candidate:
     score: float
 
 
+@dataclass(frozen=True)
+class Search:
+    """A global search: its candidates, best first, and every peak it scored.
+
+    poses: (K, 4) rows (score, yaw rad, x, y) of the per-yaw peaks (rigid search), or (K, 5)
+    with a fifth column, the log of the scale (similarity search); sorted by score, descending.
+    x, y: where the map's centroid lands, truth units. centre: the map's centroid, map frame;
+    radius: the map's largest distance from it, map units.
+    """
+
+    candidates: list[Candidate]
+    poses: np.ndarray
+    centre: np.ndarray
+    radius: float
+
+
+#: Poses within these of the final one are "near" it (see :func:`distinctiveness`): yaw,
+#: degrees; position, share of the (scaled) map's radius; scale, ratio.
+NEAR_DEG, NEAR_RADIUS, NEAR_SCALE = 15.0, 0.2, 1.15
+
+
+def distinctiveness(search: Search, tf: Similarity2D) -> float:
+    """How distinct the pose ``tf`` (map -> truth, usually the refined winner) is in the
+    search's scores, in [0, 1]: 1 - (best score of the poses far from ``tf``) / (best score of
+    the poses near it). Near: within NEAR_DEG degrees, NEAR_RADIUS map radii of centroid
+    position and (similarity search) a scale ratio of NEAR_SCALE. 0 when the search scored no
+    pose near ``tf`` higher than one elsewhere (refinement left the search's peak, or another
+    pose scores as well); 1 when nothing elsewhere scores above zero."""
+    poses = search.poses
+    if len(poses) == 0:
+        return 0.0
+    centre = tf.apply(search.centre.reshape(1, 2))[0]
+    dyaw = np.abs(np.angle(np.exp(1j * (poses[:, 1] - tf.yaw))))
+    dxy = np.hypot(poses[:, 2] - centre[0], poses[:, 3] - centre[1])
+    near = (dyaw < np.radians(NEAR_DEG)) & (dxy < NEAR_RADIUS * tf.scale * search.radius)
+    if poses.shape[1] > 4:
+        near &= np.abs(poses[:, 4] - np.log(tf.scale)) < np.log(NEAR_SCALE)
+    peak = float(poses[near, 0].max()) if near.any() else 0.0
+    elsewhere = float(poses[~near, 0].max()) if (~near).any() else 0.0
+    if peak <= 0.0:
+        return 0.0
+    return float(np.clip(1.0 - max(elsewhere, 0.0) / peak, 0.0, 1.0))
+
+
 def likelihood_field(truth_xy: np.ndarray, grid: MetricGrid, sigma: float) -> np.ndarray:
     """``exp(-d^2 / 2 sigma^2)`` on ``grid``, d = metres to the nearest cell holding a truth point
     (N, 2, metres). (rows, cols) float32 in [0, 1]."""
@@ -98,10 +142,15 @@ def auto_resolution(map_xy: np.ndarray) -> float:
     return max(0.25, _radius(map_xy - map_xy.mean(axis=0)) / 40.0)
 
 
-def coarse_candidates(map_xy: np.ndarray, truth_xy: np.ndarray, *,
-                      resolution: float | None = None, sigma: float | None = None,
-                      angle_step_deg: float | None = None, overhang: float = 2.0,
-                      top_k: int = 6, per_angle: int = 3) -> list[Candidate]:
+def coarse_candidates(map_xy: np.ndarray, truth_xy: np.ndarray, **options) -> list[Candidate]:
+    """The candidates of :func:`coarse_search` (same arguments), best first."""
+    return coarse_search(map_xy, truth_xy, **options).candidates
+
+
+def coarse_search(map_xy: np.ndarray, truth_xy: np.ndarray, *,
+                  resolution: float | None = None, sigma: float | None = None,
+                  angle_step_deg: float | None = None, overhang: float = 2.0,
+                  top_k: int = 6, per_angle: int = 3) -> Search:
     """The ``top_k`` best distinct poses (map frame -> truth frame) of a yaw sweep over 360 degrees.
 
     map_xy, truth_xy: (N, 2) metres, each in its own frame.
@@ -137,7 +186,8 @@ def coarse_candidates(map_xy: np.ndarray, truth_xy: np.ndarray, *,
     poses = np.vstack(rows)
     poses = poses[np.argsort(-poses[:, 0], kind="stable")]
     best = _suppress(poses, top_k, np.radians(3 * angle_step_deg), 4 * resolution)
-    return [Candidate(_pose(yaw, xy, centre), float(score)) for score, yaw, *xy in best]
+    return Search([Candidate(_pose(yaw, xy, centre), float(score)) for score, yaw, *xy in best],
+                  poses, centre, radius)
 
 
 def _pose(yaw: float, centre_truth: np.ndarray, centre_map: np.ndarray,
@@ -179,11 +229,17 @@ def _templates(points: np.ndarray, yaws: np.ndarray, half: int) -> np.ndarray:
     return (hits > 0).astype(np.float32).reshape(len(yaws), size, size)
 
 
-def similarity_candidates(map_xy: np.ndarray, truth_xy: np.ndarray, *,
-                          scale_range: tuple[float, float] = (0.2, 5.0),
-                          resolution: float | None = None, step: float = 1.5, top_k: int = 6,
-                          per_angle: int = 3, max_size: float = 1.5,
-                          min_cells: float = 4.0) -> list[Candidate]:
+def similarity_candidates(map_xy: np.ndarray, truth_xy: np.ndarray,
+                          **options) -> list[Candidate]:
+    """The candidates of :func:`similarity_search` (same arguments), best first."""
+    return similarity_search(map_xy, truth_xy, **options).candidates
+
+
+def similarity_search(map_xy: np.ndarray, truth_xy: np.ndarray, *,
+                      scale_range: tuple[float, float] = (0.2, 5.0),
+                      resolution: float | None = None, step: float = 1.5, top_k: int = 6,
+                      per_angle: int = 3, max_size: float = 1.5,
+                      min_cells: float = 4.0) -> Search:
     """The ``top_k`` best distinct similarities (map frame -> truth frame) of a sweep over scale
     and yaw, with no initial guess.
 
@@ -226,5 +282,5 @@ def similarity_candidates(map_xy: np.ndarray, truth_xy: np.ndarray, *,
     poses = np.vstack(rows)
     poses = poses[np.argsort(-poses[:, 0], kind="stable")]
     best = _suppress(poses, top_k, np.radians(9.0), 4 * resolution, np.log(1.15))
-    return [Candidate(_pose(yaw, xy, centre, float(np.exp(log_s))), float(score))
-            for score, yaw, *xy, log_s in best]
+    return Search([Candidate(_pose(yaw, xy, centre, float(np.exp(log_s))), float(score))
+                   for score, yaw, *xy, log_s in best], poses, centre, map_radius)

@@ -11,16 +11,23 @@ from pathlib import Path
 from pcmapq.errors import InputError
 from pcmapq.io.carmen import is_carmen, load_carmen
 from pcmapq.io.clouds import CLOUD_SUFFIXES, PointMap, load_cloud
-from pcmapq.io.occupancy import IMAGE_SUFFIXES, YAML_SUFFIXES, OccupancyMap, load_occupancy
+from pcmapq.io.occupancy import (
+    IMAGE_SUFFIXES,
+    YAML_SUFFIXES,
+    OccupancyMap,
+    Thresholds,
+    load_occupancy,
+)
 
-__all__ = ["OccupancyMap", "PointMap", "load_map"]
+__all__ = ["OccupancyMap", "PointMap", "Thresholds", "load_map"]
 
 #: The formats named in the error for an unknown extension (others are accepted quietly).
 _ADVERTISED = (".png", ".pgm", ".yaml", ".ply", ".pcd", ".xyz", ".txt", ".npy", ".bin")
 
 
 def load_map(path: str | Path, resolution: float | None = None,
-             fallback_resolution: float | None = None) -> OccupancyMap | PointMap:
+             fallback_resolution: float | None = None,
+             thresholds: Thresholds | None = None) -> OccupancyMap | PointMap:
     """Load a map file by its extension.
 
     Occupancy images (.png, .pgm, .jpg, .bmp) and ROS map_server YAML (.yaml, .yml) give an
@@ -28,6 +35,8 @@ def load_map(path: str | Path, resolution: float | None = None,
     ``fallback_resolution`` serves an image with neither (its scale to be estimated). Point clouds
     (.ply, .pcd, .xyz, .txt, .npy, KITTI .bin) and CARMEN laser logs (.log, .log.gz: the beam
     endpoints at the logged poses) give a :class:`PointMap`; ``resolution`` is ignored for them.
+    ``thresholds`` (map_server's occupied_thresh, free_thresh, negate) override an image's YAML;
+    clouds ignore them.
     """
     path = Path(path)
     if not path.exists():
@@ -38,7 +47,7 @@ def load_map(path: str | Path, resolution: float | None = None,
         return load_carmen(path)
     suffix = path.suffix.lower()
     if suffix in IMAGE_SUFFIXES or suffix in YAML_SUFFIXES:
-        return load_occupancy(path, resolution, fallback_resolution)
+        return load_occupancy(path, resolution, fallback_resolution, thresholds)
     if suffix in CLOUD_SUFFIXES:
         return load_cloud(path)
     raise InputError(f"{path}: unsupported format '{suffix}' (expected {', '.join(_ADVERTISED)})")

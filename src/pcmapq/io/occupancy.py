@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, replace
 from pathlib import Path
+from typing import TypeVar
 
 import cv2
 import numpy as np
@@ -25,6 +26,7 @@ from pcmapq.raster.draw import FREE, OCCUPIED, UNKNOWN
 IMAGE_SUFFIXES = (".png", ".pgm", ".jpg", ".jpeg", ".bmp")
 YAML_SUFFIXES = (".yaml", ".yml")
 MODES = ("trinary", "scale", "raw")
+_T = TypeVar("_T")
 
 
 @dataclass(frozen=True)
@@ -54,11 +56,36 @@ class MapMeta:
     mode: str = "trinary"
 
 
+@dataclass(frozen=True)
+class Thresholds:
+    """map_server reading options given on the command line; each one that is not None
+    overrides the YAML's value (or map_server's default when there is no YAML).
+    occupied, free: probabilities in [0, 1]; negate: read dark as free."""
+
+    occupied: float | None = None
+    free: float | None = None
+    negate: bool | None = None
+
+    def apply(self, meta: MapMeta) -> MapMeta:
+        """``meta`` with these overrides."""
+        return replace(meta,
+                       occupied_thresh=_pick(self.occupied, meta.occupied_thresh),
+                       free_thresh=_pick(self.free, meta.free_thresh),
+                       negate=_pick(self.negate, meta.negate))
+
+
+def _pick(value: _T | None, default: _T) -> _T:
+    """``value`` unless it is None."""
+    return default if value is None else value
+
+
 def load_occupancy(path: Path, resolution: float | None = None,
-                   fallback: float | None = None) -> OccupancyMap:
+                   fallback: float | None = None,
+                   thresholds: Thresholds | None = None) -> OccupancyMap:
     """Load an occupancy image or a map_server YAML. ``resolution`` (metres per cell), if given,
     overrides the YAML's; an image without a YAML beside it (same stem) needs it, or a
-    ``fallback`` resolution (a starting guess for a map whose scale will be estimated)."""
+    ``fallback`` resolution (a starting guess for a map whose scale will be estimated).
+    ``thresholds`` override the YAML's occupied_thresh, free_thresh and negate."""
     if path.suffix.lower() in YAML_SUFFIXES:
         meta, image = read_yaml(path)
         if not image.is_file():
@@ -69,6 +96,8 @@ def load_occupancy(path: Path, resolution: float | None = None,
         meta = read_yaml(beside[0])[0] if beside else MapMeta(resolution=None)
     if resolution is not None:
         meta = replace(meta, resolution=_resolution(path, resolution))
+    if thresholds is not None:
+        meta = thresholds.apply(meta)
     grey, transparent = read_grey(image)
     if meta.resolution is None and fallback is not None:
         meta = replace(meta, resolution=_resolution(path, fallback))
