@@ -69,10 +69,10 @@ def report_html(result: Result) -> str:
         ["x [m]", "y [m]", "yaw [deg]", "scale", "fitness", "inlier RMSE [m]", "method"],
         [[_f(tf.tx), _f(tf.ty), _f(tf.yaw_deg, 2), _f(tf.scale, 4),
           f"{_f(a.fitness)} (within {a.tolerance_m:g} m)", _f(a.rmse_m), a.method]])
-    cover = _table(["coverage", "footprint", "truth recall in footprint", "agreement",
+    cover = _table(["coverage", "footprint", "truth recall in footprint", "confidence",
                     "scored against"],
                    [[_f(o.coverage), FOOTPRINT_WORDS.get(result.footprint_rule, ""),
-                     _f(o.truth_recall), _f(o.agreement),
+                     _f(o.truth_recall), _f(o.confidence),
                      "whole truth" if result.full else "the map's footprint"]])
     rows = []
     for name, det in result.detectors.items():

@@ -25,7 +25,8 @@ def print_table(result: Result, console: Console) -> None:
         f"[bold]{result.map_path}[/] -> [bold]{result.truth_path}[/]  "
         f"x {tf.tx:.3f} m  y {tf.ty:.3f} m  yaw {tf.yaw_deg:.2f} deg  scale {tf.scale:.4f}  "
         f"fitness {a.fitness:.3f} (within {a.tolerance_m} m)  rmse {a.rmse_m:.3f} m  "
-        f"coverage {result.overlap.coverage:.3f} (footprint: {result.footprint_rule})"
+        f"coverage {result.overlap.coverage:.3f} (footprint: {result.footprint_rule})  "
+        f"confidence {result.overlap.confidence:.2f}"
         + ("  (scored against the whole truth)" if result.full else ""))
     table = Table(title=f"feature matching within {result.threshold} m")
     for col in ("detector", "quality", "precision", "f1", "truth", "map", "matched"):
