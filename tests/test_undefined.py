@@ -96,7 +96,7 @@ def test_map_without_strong_features(tmp_path):
     truth = write_image_map(polygon(np.array([[-4, -4], [4, -4], [4, 4], [-4, 4]], float)),
                             tmp_path / "square.png")
     mapped = write_image_map(rounded_square(), tmp_path / "rounded.png")
-    result = evaluate(mapped, truth, Settings(detectors=("harris", "hough")))
+    result = evaluate(mapped, truth, Settings(detectors=("harris", "hough"), force=True))
     harris = result.detectors["harris"].matching
     assert (harris.truth_features, harris.map_features) == (4, 0)
     assert harris.quality == 0.0 and harris.precision is None and harris.f1 is None

@@ -96,24 +96,31 @@ def map_raster(source: OccupancyMap | PointMap, map_xy: np.ndarray, transform: S
     return occupied, footprint
 
 
-#: Confidence terms (see :func:`confidence`): the distinctiveness worth full confidence, and
-#: the truth recalls worth none and full confidence.
+#: Confidence terms (see :func:`confidence`): the distinctiveness worth full confidence, the
+#: truth recalls and the agreements worth none and full confidence.
 FULL_DISTINCT = 0.2
 RECALL_NONE, RECALL_FULL = 0.4, 0.8
+AGREE_NONE, AGREE_FULL = 0.7, 0.9
 #: A map whose radius exceeds the truth's by this factor cannot be a part of it (a scale).
 OVERSIZE = 1.5
 
 
-def confidence(distinct: float | None, recall: float) -> float:
+def confidence(distinct: float | None, recall: float, agreement: float = 0.0) -> float:
     """That the map shows the truth's place, [0, 1]: the smaller of distinct / FULL_DISTINCT
     and (recall - RECALL_NONE) / (RECALL_FULL - RECALL_NONE), clipped. ``distinct``: the global
     search's distinctiveness of the final pose (None without a search: ``--init``,
     ``--no-align``, a 3D registration; then the recall term alone); ``recall``: share of the
-    covered truth walls near the map. 0.5 is distinctiveness 0.1 and recall 0.6."""
+    covered truth walls near the map. 0.5 is distinctiveness 0.1 and recall 0.6.
+
+    A map that lies on the truth both ways is the truth's place even when the place is
+    symmetric (a round room, a square hall: the pose is ambiguous, the scores are not), so
+    ``agreement`` (fitness x recall) gives confidence on its own:
+    (agreement - AGREE_NONE) / (AGREE_FULL - AGREE_NONE), 0.5 at 0.8; the larger one counts."""
     terms = [(recall - RECALL_NONE) / (RECALL_FULL - RECALL_NONE)]
     if distinct is not None:
         terms.append(distinct / FULL_DISTINCT)
-    return float(np.clip(min(terms), 0.0, 1.0))
+    agreed = (agreement - AGREE_NONE) / (AGREE_FULL - AGREE_NONE)
+    return float(np.clip(max(min(terms), agreed), 0.0, 1.0))
 
 
 def overlap(truth_occ: np.ndarray, to_map: np.ndarray, footprint: np.ndarray,
@@ -125,8 +132,9 @@ def overlap(truth_occ: np.ndarray, to_map: np.ndarray, footprint: np.ndarray,
     coverage = float(seen.sum() / truth_occ.sum()) if truth_occ.any() else 0.0
     tolerance = alignment.tolerance_m
     recall = float((to_map[seen] <= tolerance).mean()) if seen.any() else 0.0
-    return Overlap(footprint, coverage, recall, alignment.fitness * recall,
-                   confidence(alignment.distinctiveness, recall))
+    agreement = alignment.fitness * recall
+    return Overlap(footprint, coverage, recall, agreement,
+                   confidence(alignment.distinctiveness, recall, agreement))
 
 
 def _radius(xy: np.ndarray) -> float:
