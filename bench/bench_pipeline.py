@@ -60,8 +60,9 @@ def main() -> None:
             proc = subprocess.run([sys.executable, "-c", CHILD, str(ROOT), case, tmp],
                                   capture_output=True, text=True, check=True)
         rows.append(json.loads(proc.stdout.strip().splitlines()[-1]))
-    steps = ["loading", "aligning", "rasterising", "detecting", "total"]
-    print("| case | grid (rows x cols) | " + " | ".join(f"{s} s" for s in steps)
+    steps = ["loading", "aligning", "rasterising", "drawing", "detecting", "total"]
+    names = {"drawing": "wall centre lines"}  # the step "drawing the walls' centre lines"
+    print("| case | grid (rows x cols) | " + " | ".join(f"{names.get(s, s)} s" for s in steps)
           + " | peak RSS MB | quality harris/hough/sift |")
     print("|---" * (len(steps) + 4) + "|")
     for r in rows:
