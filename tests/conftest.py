@@ -4,12 +4,12 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import cv2
 import numpy as np
 import pytest
 
 from pcmapq import synth
 from pcmapq.align.transform import Similarity2D
+from pcmapq.io.writers import write_ros_map
 
 SHARED_DATA = Path(__file__).resolve().parents[2] / "shared" / "data"
 
@@ -17,12 +17,7 @@ SHARED_DATA = Path(__file__).resolve().parents[2] / "shared" / "data"
 def write_image_map(segments: np.ndarray, path: Path, resolution: float = 0.05) -> Path:
     """Render wall segments (metres) as a ROS map: ``path`` (.png) plus a YAML beside it."""
     grid = synth.plan_grid(segments, resolution)
-    cv2.imwrite(str(path), synth.render(segments, grid))
-    ox, oy, _ = grid.origin
-    path.with_suffix(".yaml").write_text(
-        f"image: {path.name}\nresolution: {resolution}\norigin: [{ox}, {oy}, 0.0]\n"
-        "negate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n")
-    return path
+    return write_ros_map(path, synth.render(segments, grid), resolution, grid.origin[:2])
 
 
 def write_cloud_map(points: np.ndarray, path: Path) -> Path:

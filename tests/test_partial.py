@@ -12,6 +12,7 @@ from pcmapq import synth
 from pcmapq.align.transform import Similarity2D
 from pcmapq.config import Settings
 from pcmapq.errors import InputError
+from pcmapq.io.writers import write_ros_map
 from pcmapq.pipeline import evaluate
 
 from .conftest import in_map_frame, write_cloud_map
@@ -48,21 +49,13 @@ def write_partial_image(plan, box, tf: Similarity2D, path):
     mask = np.zeros(grid.shape, np.uint8)
     cv2.fillConvexPoly(mask, np.round(grid.xy_to_pixels(corners)).astype(np.int32), 1)
     img[mask == 0] = synth.UNKNOWN
-    cv2.imwrite(str(path), img)
-    ox, oy, _ = grid.origin
-    path.with_suffix(".yaml").write_text(f"image: {path.name}\nresolution: 0.05\n"
-                                         f"origin: [{ox}, {oy}, 0.0]\n")
-    return path
+    return write_ros_map(path, img, 0.05, grid.origin[:2])
 
 
 def write_binary_partial(plan, box, tf: Similarity2D, path):
     """The plan's walls inside ``box`` (truth frame) seen in the map frame, black on white."""
     img, grid = synth.binary_partial(plan, box, tf)
-    cv2.imwrite(str(path), img)
-    ox, oy, _ = grid.origin
-    path.with_suffix(".yaml").write_text(f"image: {path.name}\nresolution: 0.05\n"
-                                         f"origin: [{ox}, {oy}, 0.0]\n")
-    return path
+    return write_ros_map(path, img, 0.05, grid.origin[:2])
 
 
 @pytest.mark.parametrize(("box", "tf"), CUTS)

@@ -14,6 +14,7 @@ from pcmapq.config import Settings
 from pcmapq.features import DETECTORS, detect
 from pcmapq.grid import MetricGrid
 from pcmapq.io import load_map
+from pcmapq.io.writers import write_ros_map
 from pcmapq.match import match
 from pcmapq.pipeline import evaluate
 from pcmapq.raster.draw import OCCUPIED
@@ -27,11 +28,7 @@ FR79_RES = 0.05
 
 def _write_ros_map(image: np.ndarray, path: Path, resolution: float,
                    origin: tuple[float, float]) -> Path:
-    cv2.imwrite(str(path), image)
-    path.with_suffix(".yaml").write_text(
-        f"image: {path.name}\nresolution: {resolution}\norigin: [{origin[0]}, {origin[1]}, 0]\n"
-        "negate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n")
-    return path
+    return write_ros_map(path, image, resolution, origin)
 
 
 @pytest.fixture(scope="module")

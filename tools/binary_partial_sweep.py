@@ -12,12 +12,12 @@ import sys
 import tempfile
 from pathlib import Path
 
-import cv2
 import numpy as np
 
 from pcmapq import synth
 from pcmapq.align.transform import Similarity2D
 from pcmapq.config import Settings
+from pcmapq.io.writers import write_ros_map
 from pcmapq.pipeline import evaluate
 
 #: Parts of the 24 m x 16 m plan (x0, y0, x1, y1, metres), 25-60 % of its walls; no cut runs
@@ -39,11 +39,7 @@ def true_share(plan: np.ndarray, box: tuple[float, float, float, float]) -> floa
 def write_binary(plan: np.ndarray, box, tf: Similarity2D, path: Path) -> Path:
     """The binary partial map as a PNG with its ROS YAML."""
     img, grid = synth.binary_partial(plan, box, tf)
-    cv2.imwrite(str(path), img)
-    ox, oy, _ = grid.origin
-    path.with_suffix(".yaml").write_text(f"image: {path.name}\nresolution: 0.05\n"
-                                         f"origin: [{ox}, {oy}, 0.0]\n")
-    return path
+    return write_ros_map(path, img, 0.05, grid.origin[:2])
 
 
 def poses(count: int, seed: int) -> list[Similarity2D]:
@@ -67,10 +63,8 @@ def main(argv: list[str] | None = None) -> int:
     print("|---|---|---|" + "---|" * len(rules))
     with tempfile.TemporaryDirectory(prefix="pcmapq_sweep_") as tmp:
         truth = Path(tmp) / "truth.png"
-        cv2.imwrite(str(truth), synth.render(plan, synth.plan_grid(plan, 0.05)))
-        ox, oy, _ = synth.plan_grid(plan, 0.05).origin
-        truth.with_suffix(".yaml").write_text(f"image: truth.png\nresolution: 0.05\n"
-                                              f"origin: [{ox}, {oy}, 0.0]\n")
+        grid = synth.plan_grid(plan, 0.05)
+        write_ros_map(truth, synth.render(plan, grid), 0.05, grid.origin[:2])
         for k, box in enumerate(BOXES):
             share = true_share(plan, box)
             for i, tf in enumerate(poses(args.poses, args.seed + k)):

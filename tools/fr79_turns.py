@@ -19,6 +19,7 @@ import numpy as np
 
 from pcmapq.align.transform import Similarity2D
 from pcmapq.grid import MetricGrid
+from pcmapq.io.writers import write_ros_map
 from pcmapq.pipeline import evaluate
 
 DATA = Path(__file__).resolve().parents[2] / "shared" / "data"
@@ -26,15 +27,6 @@ DATA = Path(__file__).resolve().parents[2] / "shared" / "data"
 RESOLUTION = 0.05
 #: Unknown grey of the turned map's border (map_server reads 153 as unknown).
 UNKNOWN_GREY = 153
-
-
-def write_ros_map(image: np.ndarray, path: Path, origin: tuple[float, float]) -> Path:
-    """The image and its map_server YAML (ROS default thresholds) at ``path``."""
-    cv2.imwrite(str(path), image)
-    path.with_suffix(".yaml").write_text(
-        f"image: {path.name}\nresolution: {RESOLUTION}\norigin: [{origin[0]}, {origin[1]}, 0]\n"
-        "negate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n")
-    return path
 
 
 def turned(image: np.ndarray, tf: Similarity2D, folder: Path) -> Path:
@@ -46,7 +38,8 @@ def turned(image: np.ndarray, tf: Similarity2D, folder: Path) -> Path:
     m = src.xy_to_pixel_matrix() @ tf.inverse().matrix @ dst.pixel_to_xy_matrix()
     out = cv2.warpAffine(image, m[:2], dst.shape[::-1], borderValue=UNKNOWN_GREY,
                          flags=cv2.INTER_NEAREST | cv2.WARP_INVERSE_MAP)
-    return write_ros_map(out, folder / f"turned_{tf.yaw_deg:.0f}.png", dst.origin[:2])
+    return write_ros_map(folder / f"turned_{tf.yaw_deg:.0f}.png", out, RESOLUTION,
+                         dst.origin[:2])
 
 
 def score(value: float | None) -> str:
@@ -66,7 +59,7 @@ def main(argv: list[str] | None = None) -> int:
     image = cv2.imread(str(source), cv2.IMREAD_GRAYSCALE)
     print("| turn | recovered yaw | Harris | Hough | SIFT |\n| --- | --- | --- | --- | --- |")
     with tempfile.TemporaryDirectory() as tmp:
-        truth = write_ros_map(image, Path(tmp) / "fr79.png", (0.0, 0.0))
+        truth = write_ros_map(Path(tmp) / "fr79.png", image, RESOLUTION)
         for deg in (float(t) for t in args.turns.split(",")):
             tf = Similarity2D(-3.0, 21.0, np.radians(deg))
             result = evaluate(turned(image, tf, Path(tmp)), truth)

@@ -7,6 +7,7 @@ import os
 import tempfile
 from pathlib import Path
 
+import cv2
 import numpy as np
 
 from pcmapq.errors import InputError
@@ -33,6 +34,24 @@ def write_atomic(path: Path, data: str | bytes) -> None:
             with contextlib.suppress(OSError):
                 os.unlink(tmp)
         raise InputError(f"{path}: cannot write: {one_line(exc)}") from None
+
+
+def write_ros_map(path: Path, image: np.ndarray, resolution: float,
+                  origin: tuple[float, float] = (0.0, 0.0)) -> Path:
+    """Save an occupancy image (uint8 grey values, ROS's 0 occupied, 254 free, 205 unknown) at
+    ``path`` (.png or .pgm) with its map_server YAML beside it (same stem): ``resolution``
+    metres per pixel, ``origin`` (x, y) metres of the image's lower-left corner, yaw 0, ROS's
+    default thresholds. Both are written whole (:func:`write_atomic`). Returns ``path``."""
+    path = Path(path)
+    ok, encoded = cv2.imencode(path.suffix or ".png", np.asarray(image, dtype=np.uint8))
+    if not ok:
+        raise InputError(f"{path}: cannot be written as an image")
+    write_atomic(path, encoded.tobytes())
+    write_atomic(path.with_suffix(".yaml"),
+                 f"image: {path.name}\nresolution: {resolution}\n"
+                 f"origin: [{origin[0]}, {origin[1]}, 0.0]\n"
+                 "negate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n")
+    return path
 
 
 def one_line(exc: BaseException) -> str:
