@@ -14,7 +14,7 @@ import numpy as np
 
 from pcmapq import synth
 from pcmapq.align import align
-from pcmapq.align.transform import Similarity2D
+from pcmapq.transform import Similarity2D
 
 W, H = 24.0, 16.0
 

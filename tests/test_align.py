@@ -9,7 +9,7 @@ from pcmapq import synth
 from pcmapq.align import Alignment, align, score
 from pcmapq.align.coarse import coarse_candidates
 from pcmapq.align.icp import voxel_downsample
-from pcmapq.align.transform import Similarity2D
+from pcmapq.transform import Similarity2D
 
 from .conftest import HEIGHT, PLAN, WIDTH
 

@@ -14,12 +14,12 @@ import pytest
 
 from pcmapq import synth
 from pcmapq.align.coarse import Search, distinctiveness
-from pcmapq.align.transform import Similarity2D
 from pcmapq.config import Settings
 from pcmapq.errors import EvaluationError
 from pcmapq.io import Thresholds, load_map
 from pcmapq.pipeline import confidence, evaluate
 from pcmapq.raster.draw import FREE, OCCUPIED, UNKNOWN
+from pcmapq.transform import Similarity2D
 
 from .conftest import in_map_frame, shared, write_image_map
 

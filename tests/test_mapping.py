@@ -22,7 +22,7 @@ from pcmapq.mapping import (
     write_kitti_poses,
     write_tum_poses,
 )
-from pcmapq.mapping.voxelmap import voxel_keys
+from pcmapq.voxels import voxel_keys
 
 from .conftest import shared
 

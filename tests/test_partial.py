@@ -9,11 +9,11 @@ import numpy as np
 import pytest
 
 from pcmapq import synth
-from pcmapq.align.transform import Similarity2D
 from pcmapq.config import Settings
 from pcmapq.errors import InputError
 from pcmapq.io.writers import write_ros_map
 from pcmapq.pipeline import evaluate
+from pcmapq.transform import Similarity2D
 
 from .conftest import in_map_frame, write_cloud_map
 

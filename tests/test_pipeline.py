@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 
 from pcmapq import synth
-from pcmapq.align.transform import Similarity2D
 from pcmapq.config import Settings
 from pcmapq.pipeline import evaluate
+from pcmapq.transform import Similarity2D
 
 from .conftest import in_map_frame, write_cloud_map, write_image_map
 

@@ -9,7 +9,6 @@ import numpy as np
 import pytest
 from skimage.morphology import skeletonize
 
-from pcmapq.align.transform import Similarity2D
 from pcmapq.config import Settings
 from pcmapq.features import DETECTORS, detect
 from pcmapq.grid import MetricGrid
@@ -19,6 +18,7 @@ from pcmapq.match import match
 from pcmapq.pipeline import evaluate
 from pcmapq.raster.draw import OCCUPIED
 from pcmapq.report.html import report_html
+from pcmapq.transform import Similarity2D
 
 from .conftest import shared
 

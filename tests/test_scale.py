@@ -9,7 +9,7 @@ import pytest
 from pcmapq import synth
 from pcmapq.align import align
 from pcmapq.align.icp import fit_similarity, refine_point_to_line, voxel_downsample
-from pcmapq.align.transform import Similarity2D
+from pcmapq.transform import Similarity2D
 
 from .conftest import HEIGHT, PLAN, WIDTH, shared
 

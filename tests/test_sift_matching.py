@@ -7,12 +7,12 @@ import numpy as np
 import pytest
 
 from pcmapq import synth
-from pcmapq.align.transform import Similarity2D
 from pcmapq.features import Features, detect
 from pcmapq.features.sift import DESCRIPTOR_GATE, DESCRIPTOR_NORM
 from pcmapq.grid import MetricGrid
 from pcmapq.match import match
 from pcmapq.raster import draw
+from pcmapq.transform import Similarity2D
 
 
 def unit(*weights: float) -> np.ndarray:

@@ -15,10 +15,10 @@ from pathlib import Path
 import numpy as np
 
 from pcmapq import synth
-from pcmapq.align.transform import Similarity2D
 from pcmapq.config import Settings
 from pcmapq.io.writers import write_ros_map
 from pcmapq.pipeline import evaluate
+from pcmapq.transform import Similarity2D
 
 #: Parts of the 24 m x 16 m plan (x0, y0, x1, y1, metres), 25-60 % of its walls; no cut runs
 #: along a wall (the map would keep a sliver of it that the share counts).

@@ -17,10 +17,10 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from pcmapq.align.transform import Similarity2D
 from pcmapq.grid import MetricGrid
 from pcmapq.io.writers import write_ros_map
 from pcmapq.pipeline import evaluate
+from pcmapq.transform import Similarity2D
 
 DATA = Path(__file__).resolve().parents[2] / "shared" / "data"
 #: Assumed resolution of the SLAM map, metres per pixel.

@@ -13,7 +13,6 @@ import typer
 from rich.console import Console
 from rich.progress import Progress
 
-from pcmapq.align.transform import Similarity2D
 from pcmapq.config import DETECTOR_NAMES, Settings
 from pcmapq.errors import EvaluationError, InputError
 from pcmapq.io import PointMap, Thresholds
@@ -31,6 +30,7 @@ from pcmapq.metrics.distances import DEFAULT_TAUS
 from pcmapq.pipeline import evaluate
 from pcmapq.raster.footprint import FOOTPRINT_RULES
 from pcmapq.report.table import print_table
+from pcmapq.transform import Similarity2D
 
 app = typer.Typer(add_completion=False, no_args_is_help=True, pretty_exceptions_enable=False,
                   help="Map quality against a ground-truth map, in metres.")

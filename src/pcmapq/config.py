@@ -4,9 +4,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from pcmapq.align.transform import Similarity2D
 from pcmapq.io.occupancy import Thresholds
 from pcmapq.metrics.distances import DEFAULT_TAUS
+from pcmapq.transform import Similarity2D
 
 DETECTOR_NAMES = ("harris", "hough", "sift")
 

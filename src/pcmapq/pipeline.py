@@ -10,7 +10,6 @@ import numpy as np
 
 from pcmapq.align import Alignment, align
 from pcmapq.align.rigid3d import Registration3D, align_3d, apply
-from pcmapq.align.transform import Similarity2D
 from pcmapq.config import Settings
 from pcmapq.errors import EvaluationError, InputError
 from pcmapq.features import Features, detect_in, walls_of
@@ -22,6 +21,7 @@ from pcmapq.raster.draw import OCCUPIED, UNKNOWN, points_to_grid, warp_state
 from pcmapq.raster.footprint import footprint_rule, map_footprint
 from pcmapq.raster.slice import wall_band
 from pcmapq.result import DetectorResult, Overlap, Result
+from pcmapq.transform import Similarity2D
 
 Progress = Callable[[str], None]
 

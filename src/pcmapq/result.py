@@ -6,15 +6,18 @@ import io
 import json
 from dataclasses import asdict, dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from pcmapq.align import Alignment
-from pcmapq.align.rigid3d import Registration3D
 from pcmapq.features import Features
 from pcmapq.grid import MetricGrid
 from pcmapq.match import Matching
 from pcmapq.metrics.distances import Distances
+
+if TYPE_CHECKING:  # the alignment modules load Open3D; a Result only holds their outputs
+    from pcmapq.align import Alignment
+    from pcmapq.align.rigid3d import Registration3D
 
 #: Decimals kept in saved numbers: micrometres, so reruns give byte-identical files.
 DECIMALS = 6

@@ -28,7 +28,7 @@ from pcmapq.align.icp import (
     voxel_downsample,
 )
 from pcmapq.align.icp import refine as icp_refine
-from pcmapq.align.transform import Similarity2D
+from pcmapq.transform import Similarity2D
 
 __all__ = ["Alignment", "Similarity2D", "align", "align_similarity", "score"]
 

@@ -22,9 +22,9 @@ import cv2
 import numpy as np
 
 from pcmapq.align.icp import voxel_downsample
-from pcmapq.align.transform import Similarity2D
 from pcmapq.grid import MetricGrid
 from pcmapq.raster.draw import hit_counts
+from pcmapq.transform import Similarity2D
 
 
 @dataclass(frozen=True)

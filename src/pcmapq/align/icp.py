@@ -7,11 +7,15 @@ exactly, so it finishes every refinement."""
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
-import open3d as o3d
 from scipy.spatial import cKDTree
 
-from pcmapq.align.transform import Similarity2D
+from pcmapq.transform import Similarity2D
+
+if TYPE_CHECKING:
+    import open3d as o3d
 
 #: ICP stages: (max correspondence distance, voxel size), metres. Both shrink stage by stage.
 DEFAULT_SCHEDULE: tuple[tuple[float, float], ...] = ((1.0, 0.2), (0.5, 0.1), (0.2, 0.05))
@@ -35,6 +39,7 @@ def voxel_downsample(xy: np.ndarray, voxel: float) -> np.ndarray:
 
 def _cloud(xy: np.ndarray) -> o3d.geometry.PointCloud:
     """Points (N, 2, metres) as an Open3D cloud at z = 0."""
+    import open3d as o3d  # heavy: loaded when ICP runs
     xyz = np.column_stack([xy, np.zeros(len(xy))])
     return o3d.geometry.PointCloud(o3d.utility.Vector3dVector(xyz))
 
@@ -71,6 +76,8 @@ def refine(map_xy: np.ndarray, target: IcpTarget, init: Similarity2D,
     Runs the target's schedule of shrinking correspondence distances and voxel sizes, projecting
     to SE(2) after every stage. Returns the map -> truth transform (scale 1).
     """
+    import open3d as o3d  # heavy: loaded when ICP runs
+
     tf = Similarity2D(init.tx, init.ty, init.yaw)
     criteria = o3d.pipelines.registration.ICPConvergenceCriteria(
         relative_fitness=1e-6, relative_rmse=1e-6, max_iteration=max_iterations)

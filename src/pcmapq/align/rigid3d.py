@@ -31,7 +31,7 @@ from scipy.spatial import cKDTree
 from scipy.spatial.transform import Rotation
 
 from pcmapq.errors import EvaluationError, InputError
-from pcmapq.mapping.voxelmap import voxel_centroids, voxel_keys
+from pcmapq.voxels import voxel_centroids, voxel_keys
 
 __all__ = ["Registration3D", "align_3d"]
 

@@ -12,7 +12,6 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-import open3d as o3d
 
 from pcmapq.errors import InputError
 from pcmapq.io.writers import one_line
@@ -72,6 +71,8 @@ def with_z(path: Path, table: np.ndarray) -> np.ndarray:
 
 def read_open3d(path: Path) -> np.ndarray:
     """PLY or PCD via Open3D. Open3D reports unreadable files by returning no points."""
+    import open3d as o3d  # heavy: loaded when a PLY or PCD is read
+
     with path.open("rb") as f:
         head = f.read(3)
     if path.suffix.lower() == ".ply" and head != b"ply":

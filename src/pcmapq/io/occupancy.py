@@ -18,10 +18,10 @@ import cv2
 import numpy as np
 import yaml
 
+from pcmapq.cells import FREE, OCCUPIED, UNKNOWN
 from pcmapq.errors import InputError
 from pcmapq.grid import MetricGrid
 from pcmapq.io.writers import one_line
-from pcmapq.raster.draw import FREE, OCCUPIED, UNKNOWN
 
 IMAGE_SUFFIXES = (".png", ".pgm", ".jpg", ".jpeg", ".bmp")
 YAML_SUFFIXES = (".yaml", ".yml")

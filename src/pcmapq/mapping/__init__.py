@@ -21,7 +21,7 @@ from pcmapq.mapping.poses import (
 )
 from pcmapq.mapping.reference import build_map_from_poses
 from pcmapq.mapping.scans import ScanSequence, open_scans
-from pcmapq.mapping.voxelmap import VoxelMap, voxel_centroids
+from pcmapq.voxels import VoxelMap, voxel_centroids
 
 __all__ = [
     "ScanSequence",

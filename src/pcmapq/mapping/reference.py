@@ -18,7 +18,7 @@ import numpy as np
 
 from pcmapq.errors import InputError
 from pcmapq.mapping.scans import open_scans
-from pcmapq.mapping.voxelmap import VoxelMap
+from pcmapq.voxels import VoxelMap
 
 __all__ = ["build_map_from_poses"]
 

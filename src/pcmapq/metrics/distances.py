@@ -94,7 +94,7 @@ def distances_3d(map_xyz: np.ndarray, truth_xyz: np.ndarray, voxel: float = 0.05
     between the clouds voxel-downsampled to ``voxel`` metres (centroids)."""
     from scipy.spatial import cKDTree
 
-    from pcmapq.mapping.voxelmap import voxel_centroids
+    from pcmapq.voxels import voxel_centroids
 
     m, t = voxel_centroids(map_xyz, voxel), voxel_centroids(truth_xyz, voxel)
     acc = cKDTree(t).query(m, workers=-1)[0] if len(t) else np.full(len(m), np.inf)

@@ -7,13 +7,12 @@ from typing import TYPE_CHECKING
 import cv2
 import numpy as np
 
+from pcmapq.cells import FREE, OCCUPIED, UNKNOWN
 from pcmapq.grid import MetricGrid
 
 if TYPE_CHECKING:
-    from pcmapq.align.transform import Similarity2D
+    from pcmapq.transform import Similarity2D
 
-#: Cell states of an occupancy raster.
-UNKNOWN, FREE, OCCUPIED = -1, 0, 1
 
 
 def hit_counts(xy: np.ndarray, grid: MetricGrid) -> np.ndarray:
