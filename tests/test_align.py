@@ -72,8 +72,10 @@ def test_bent_map_still_aligns(truth):
     result = align(map_xy, truth)
     # The bend turns the far end by 7 degrees: most of the map fits, not all of it.
     assert 0.5 < result.fitness < 0.9
+    # no rigid pose fits a bent map: the best one stays within the bend's own range (7.2 degrees
+    # from end to end; the far end moves about 1 m), here 0.79 m and 7.3 degrees
     dxy, dyaw = pose_error(t_true, result.transform)
-    assert dyaw < 8.0
+    assert dxy < 1.5 and dyaw < 8.0
 
 
 def test_other_building_scores_low(truth, scan):

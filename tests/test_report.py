@@ -27,23 +27,49 @@ def moved_result(plan, truth_png, tmp_path_factory):
     return evaluate(path, truth_png, Settings(threshold=1.0))
 
 
-def decode(png: bytes) -> np.ndarray:
-    return cv2.imdecode(np.frombuffer(png, np.uint8), cv2.IMREAD_COLOR)
+@pytest.fixture(scope="module")
+def perfect_result(truth_png):
+    """The truth scored against itself: nothing moved."""
+    return evaluate(truth_png, truth_png)
 
 
-def test_vectorial_figure_draws_the_displacements(moved_result):
-    img = decode(png_bytes(vectorial_figure(moved_result)))
-    assert img.shape[1] > 2 * img.shape[0]  # three panels side by side
-    assert img.std() > 20  # not blank
-    # the arrows are black: drawn where the L wall moved, so some pixels are pure black
-    assert np.count_nonzero(img.max(axis=2) < 30) > 50
+#: Where the moved L wall's vertical arm stands in the map (truth frame, metres): x0, x1, y0, y1.
+MOVED_ARM = (19.6, 20.2, 2.0, 3.5)
 
 
-def test_heatmap_colours_the_moved_wall(moved_result):
-    img = decode(png_bytes(distance_heatmap(moved_result)))
-    # viridis' yellow end (0.5 m, clipped) appears: the moved wall is 0.5 m from the truth
-    b, g, r = img[..., 0].astype(int), img[..., 1].astype(int), img[..., 2].astype(int)
-    assert np.count_nonzero((r > 200) & (g > 200) & (b < 80)) > 20
+def region(fig, ax, box: tuple[float, float, float, float], dpi: int = 130):
+    """The pixels of ``png_bytes(fig, dpi)`` that show the data box (x0, x1, y0, y1) of ``ax``:
+    (rows, cols, 3) BGR."""
+    img = cv2.imdecode(np.frombuffer(png_bytes(fig, dpi), np.uint8), cv2.IMREAD_COLOR)
+    x0, x1, y0, y1 = box
+    corners = ax.transData.transform([[x0, y0], [x1, y1]]) * (dpi / fig.dpi)
+    (u0, v0), (u1, v1) = np.round(corners).astype(int)
+    rows = img.shape[0]
+    return img[rows - max(v0, v1): rows - min(v0, v1), min(u0, u1): max(u0, u1)]
+
+
+def test_vectorial_figure_draws_the_displacements(moved_result, perfect_result):
+    """Black arrows where the wall moved, none there when nothing moved (Hough panel: the
+    arm's displacement is drawn at its midpoint)."""
+    def black(result) -> int:
+        fig = vectorial_figure(result)
+        ax = fig.axes[list(result.detectors).index("hough")]
+        return int(np.count_nonzero(region(fig, ax, MOVED_ARM).max(axis=2) < 60))
+
+    assert black(moved_result) > 20
+    assert black(perfect_result) == 0
+
+
+def test_heatmap_colours_the_moved_wall(moved_result, perfect_result):
+    """viridis' yellow end (0.5 m, clipped) on the moved arm, none there when nothing moved."""
+    def yellow(result) -> int:
+        fig = distance_heatmap(result)
+        img = region(fig, fig.axes[0], MOVED_ARM).astype(int)
+        b, g, r = img[..., 0], img[..., 1], img[..., 2]
+        return int(np.count_nonzero((r > 200) & (g > 200) & (b < 80)))
+
+    assert yellow(moved_result) > 10
+    assert yellow(perfect_result) == 0
 
 
 def test_report_is_self_contained(moved_result):
