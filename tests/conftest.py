@@ -64,3 +64,27 @@ def shared(*parts: str) -> Path:
     if not path.exists():
         pytest.skip(f"{path} is absent (real data lives in ../shared/data)")
     return path
+
+
+#: A test is ``realdata`` when it reads ../shared/data (through :func:`shared` or one of these
+#: fixtures), ``e2e`` when it runs the whole pipeline, the command line or a subprocess (or uses
+#: a fixture that does), ``unit`` otherwise: ``pytest -m unit`` runs the fast ones alone.
+REALDATA_FIXTURES = {"fr79", "kitti_maps", "registration_pair"}
+E2E_FIXTURES = {"moved_result", "perfect_result", "sample_json", "round_png"}
+E2E_CALLS = ("evaluate(", "score(", ".invoke(", "subprocess", "run(", "build_map", "_ladder(",
+             "carmen_drift", "validate_tool", "main(")
+
+
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    """Mark every test ``realdata``, ``e2e`` or ``unit`` (see REALDATA_FIXTURES above)."""
+    import inspect
+
+    for item in items:
+        source = inspect.getsource(item.function)
+        fixtures = set(getattr(item, "fixturenames", ()))
+        if "shared(" in source or fixtures & REALDATA_FIXTURES:
+            item.add_marker(pytest.mark.realdata)
+        elif any(call in source for call in E2E_CALLS) or fixtures & E2E_FIXTURES:
+            item.add_marker(pytest.mark.e2e)
+        else:
+            item.add_marker(pytest.mark.unit)
