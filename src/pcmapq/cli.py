@@ -26,11 +26,13 @@ from pcmapq.mapping import (
     write_kitti_poses,
     write_tum_poses,
 )
-from pcmapq.metrics.distances import DEFAULT_TAUS
 from pcmapq.pipeline import evaluate
 from pcmapq.raster.footprint import FOOTPRINT_RULES
 from pcmapq.report.table import print_table
 from pcmapq.transform import Similarity2D
+
+#: The documented defaults, read from the one place that defines them.
+DEFAULTS = Settings()
 
 app = typer.Typer(add_completion=False, no_args_is_help=True, pretty_exceptions_enable=False,
                   help="Map quality against a ground-truth map, in metres.")
@@ -226,16 +228,19 @@ def eval_command(
     force: Annotated[bool, typer.Option(
         help="Evaluate even when the map does not seem to show the truth's place.")] = False,
     threshold: Annotated[float, typer.Option(
-        help="Largest distance between matched features, metres.", min=1e-6)] = 0.5,
+        help="Largest distance between matched features, metres.", min=1e-6)
+    ] = DEFAULTS.threshold,
     band_low: Annotated[float, typer.Option(
-        help="Wall band of a 3D cloud: lower bound, metres above the floor.")] = 0.3,
+        help="Wall band of a 3D cloud: lower bound, metres above the floor.")
+    ] = DEFAULTS.band_low,
     band_high: Annotated[float, typer.Option(
-        help="Wall band of a 3D cloud: upper bound, metres above the floor.")] = 2.0,
+        help="Wall band of a 3D cloud: upper bound, metres above the floor.")
+    ] = DEFAULTS.band_high,
     min_hits: Annotated[int | None, typer.Option(
         help="Points needed to mark a cloud's cell occupied [default: 2 for a 3D cloud, 1 for "
         "a 2D one].", min=1, show_default=False)] = None,
     detectors: Annotated[str, typer.Option(
-        help="Comma-separated detectors to run.")] = ",".join(DETECTOR_NAMES),
+        help="Comma-separated detectors to run.")] = ",".join(DEFAULTS.detectors),
     json_path: Annotated[str | None, typer.Option(
         "--json", help="Write the result as JSON to this path ('-' for stdout only).")] = None,
     vectors: Annotated[Path | None, typer.Option(
@@ -246,10 +251,10 @@ def eval_command(
         help="Write a self-contained HTML report (figures embedded).")] = None,
     voxel_3d: Annotated[float, typer.Option(
         "--voxel-3d", help="Working voxel of the 3D registration of two 3D clouds, metres "
-        "(0.5-1 for outdoor maps).", min=0.01)] = 0.3,
+        "(0.5-1 for outdoor maps).", min=0.01)] = DEFAULTS.voxel_3d,
     tau: Annotated[str, typer.Option(
         help="Distance thresholds of the F-score, metres, comma-separated.")
-    ] = ",".join(f"{t:g}" for t in DEFAULT_TAUS),
+    ] = ",".join(f"{t:g}" for t in DEFAULTS.taus),
     footprint: Annotated[str, typer.Option(
         help="The area the map observed: 'known' cells of an image, the area its 'walls' "
         "enclose, 'all' of its rectangle; 'auto': known cells for an image with unknown "

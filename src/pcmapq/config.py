@@ -4,11 +4,13 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from pcmapq.features import DETECTORS
 from pcmapq.io.occupancy import Thresholds
 from pcmapq.metrics.distances import DEFAULT_TAUS
 from pcmapq.transform import Similarity2D
 
-DETECTOR_NAMES = ("harris", "hough", "sift")
+#: Every registered detector (a module of :mod:`pcmapq.features` that defines ``DETECTOR``).
+DETECTOR_NAMES = tuple(DETECTORS)
 
 
 @dataclass(frozen=True)
