@@ -3,12 +3,16 @@
 from __future__ import annotations
 
 import json
+import shlex
 import subprocess
 import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
+
+import pcmapq
+from pcmapq.config import Settings
 
 ROOT = Path(__file__).resolve().parents[1]
 SAMPLE = ROOT / "data" / "sample"
@@ -63,11 +67,26 @@ def test_vectors_csv_has_one_row_per_match(sample_json):
     assert len(lines) - 1 == len(doc["matches"])
 
 
-def test_json_is_byte_identical_between_runs(sample_json, tmp_path):
-    _, first, _ = sample_json
-    proc = run("eval", str(SAMPLE / "scan.ply"), str(SAMPLE / "truth.png"), "--json", "-")
-    assert proc.returncode == 0, proc.stderr
-    assert proc.stdout == first.read_text()  # also: nothing but the JSON on stdout
+def test_json_is_byte_identical_between_runs(sample_json):
+    first, _, _ = sample_json
+    args = ("eval", str(SAMPLE / "scan.ply"), str(SAMPLE / "truth.png"), "--json", "-")
+    runs = [run(*args) for _ in range(2)]
+    assert all(p.returncode == 0 for p in runs), runs[0].stderr
+    assert runs[0].stdout == runs[1].stdout  # also: nothing but the JSON on stdout
+    again = json.loads(runs[0].stdout)
+    # the same result as the first run's, which wrote its outputs elsewhere: only its command
+    # line differs
+    assert again["pcmapq"]["command"] == shlex.join(["pcmapq", *args])
+    assert {k: v for k, v in again.items() if k != "pcmapq"} == {
+        k: v for k, v in first.items() if k != "pcmapq"}
+
+
+def test_json_says_how_it_was_made(sample_json):
+    doc, _, _ = sample_json
+    assert doc["pcmapq"]["version"] == pcmapq.__version__
+    assert doc["pcmapq"]["command"].startswith("pcmapq eval ")
+    assert "--json" in doc["pcmapq"]["command"] and "--threshold" not in doc["pcmapq"]["command"]
+    assert doc["settings"] == json.loads(json.dumps(Settings().to_dict()))
 
 
 @pytest.mark.parametrize("case", ["missing", "garbage_png", "yaml_without_resolution",

@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+import shlex
 import sys
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
+from dataclasses import replace
 from pathlib import Path
 from typing import Annotated
 
@@ -121,6 +123,25 @@ def _progress(console: Console, enabled: bool) -> Iterator[Callable[[str], None]
         yield lambda step: status.update(f"{step}...")
 
 
+def _command_line(ctx: typer.Context) -> str:
+    """The command as given, rebuilt from its parsed parameters (defaults left out), so a saved
+    result says how it was made: ``pcmapq eval MAP TRUTH --option value ...``."""
+    words = ["pcmapq", ctx.info_name or "eval"]
+    for param in ctx.command.params:
+        value = ctx.params.get(param.name)
+        source = ctx.get_parameter_source(param.name)
+        if source is None or source.name == "DEFAULT" or value is None:
+            continue
+        if param.param_type_name == "argument":
+            words += [str(v) for v in (value if isinstance(value, (list, tuple)) else [value])]
+        elif isinstance(value, bool) and param.is_flag:
+            if value or param.secondary_opts:
+                words.append(param.opts[0] if value else param.secondary_opts[0])
+        else:
+            words += [param.opts[0], str(value)]
+    return shlex.join(words)
+
+
 def _parse_init(text: str | None) -> Similarity2D | None:
     if text is None:
         return None
@@ -185,6 +206,7 @@ def _parse_footprint(text: str) -> str:
 
 @app.command("eval")
 def eval_command(
+    ctx: typer.Context,
     paths: Annotated[list[Path], typer.Argument(
         metavar="MAP TRUTH", help="Map to score: image (.png/.pgm, with its ROS YAML), YAML, "
         "cloud (.ply/.pcd/.xyz/.npy/.bin) or CARMEN log; then the ground truth, same kinds. "
@@ -289,7 +311,8 @@ def eval_command(
             progress("mapping the scans with KISS-ICP")
             points, _ = build_map_kiss(scans, max_scans=max_scans)
             map_path = PointMap(scans, points, True, kind="scans")
-        result = evaluate(map_path, truth_path, settings, progress)
+        result = replace(evaluate(map_path, truth_path, settings, progress),
+                         command=_command_line(ctx))
         progress("writing outputs")
         if json_path == "-":
             sys.stdout.write(result.to_json())

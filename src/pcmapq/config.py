@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass, fields
 
 from pcmapq.features import DETECTORS
 from pcmapq.io.occupancy import Thresholds
@@ -69,3 +69,18 @@ class Settings:
     full: bool = False
     taus: tuple[float, ...] = DEFAULT_TAUS
     voxel_3d: float = 0.3
+
+    def to_dict(self) -> dict:
+        """Every option as plain JSON types, in metres and degrees: ``init`` as
+        ``{"x_m", "y_m", "yaw_deg"}``, tuples as lists, thresholds as dicts."""
+        out = {}
+        for f in fields(self):
+            value = getattr(self, f.name)
+            if isinstance(value, Similarity2D):
+                value = {"x_m": value.tx, "y_m": value.ty, "yaw_deg": value.yaw_deg}
+            elif isinstance(value, Thresholds):
+                value = asdict(value)
+            elif isinstance(value, tuple):
+                value = list(value)
+            out[f.name] = value
+        return out

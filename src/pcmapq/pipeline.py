@@ -249,5 +249,5 @@ def score(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap, setti
                                       to_map),
                   registration_3d=registration, distances_3d=cloud_distances,
                   threshold=settings.threshold, full=settings.full, detectors=detectors,
-                  footprint_rule=rule,
+                  footprint_rule=rule, settings=settings.to_dict(),
                   truth_occupied=truth_occ, map_occupied=map_occ)

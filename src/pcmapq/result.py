@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from pcmapq import __version__
 from pcmapq.features import Features
 from pcmapq.grid import MetricGrid
 from pcmapq.match import Matching
@@ -76,7 +77,11 @@ class Overlap:
 
 @dataclass(frozen=True)
 class Result:
-    """A finished evaluation; all coordinates in the truth frame, metres."""
+    """A finished evaluation; all coordinates in the truth frame, metres.
+
+    settings: the options it ran with (``Settings.to_dict()``, metres and degrees); command: the
+    command line that made it (``pcmapq eval ...``, defaults left out), None from the library.
+    """
 
     map_path: Path
     map_kind: str
@@ -94,6 +99,8 @@ class Result:
     truth_occupied: np.ndarray
     map_occupied: np.ndarray
     footprint_rule: str = "known"
+    settings: dict | None = None
+    command: str | None = None
 
     def note(self, name: str) -> str | None:
         """Why detector ``name``'s quality, precision or f1 is undefined (None if defined)."""
@@ -104,6 +111,8 @@ class Result:
         """The JSON document (see README): plain types, floats rounded to DECIMALS."""
         tf = self.alignment.transform
         doc = {
+            "pcmapq": {"version": __version__, "command": self.command},
+            "settings": self.settings,
             "map": {"path": str(self.map_path), "kind": self.map_kind},
             "truth": {"path": str(self.truth_path), "kind": self.truth_kind,
                       "resolution_m": self.grid.resolution},
