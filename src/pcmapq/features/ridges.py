@@ -1,0 +1,110 @@
+"""Wall centre lines of an image and their straight pieces (for the Hough detector).
+
+A pixel is on a ridge when the maximum of the smoothed image across the ridge (given by the
+Hessian, Steger's detector) lies inside it; ridge pixels are split by their local direction
+into 30 degree bins and every connected run of one bin is a straight piece, fitted by its
+principal axis. Lengths are in pixels here; :mod:`pcmapq.features.hough` converts.
+"""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+
+from pcmapq.features.base import gaussian
+
+
+def ridges(image: np.ndarray, sigma_px: float, floor: float) -> tuple[np.ndarray, np.ndarray]:
+    """One-pixel centre lines of the bright ridges of ``image`` (Steger's detector), and their
+    local direction.
+
+    A pixel is on a ridge when the maximum of the smoothed image across the ridge (along the
+    Hessian's most negative eigenvector, to second order) lies inside the pixel: the line is
+    one pixel wide wherever the wall's centre falls between pixels. Blob-like points (curved as
+    much along as across, i.e. wall ends) are left out, so the lines stop short of wall ends
+    and T junctions instead of fanning out.
+
+    Parameters
+    ----------
+    image : (rows, cols) float32 in [0, 1].
+    sigma_px : smoothing scale, pixels.
+    floor : least ridge strength ``-sigma^2 * lambda`` (scale-normalised second derivative
+        across the ridge), dimensionless.
+
+    Returns
+    -------
+    mask : (rows, cols) bool mask of ridge pixels.
+    direction : (rows, cols) float32 direction along the ridge, radians in [0, pi) measured
+        from the pixel u axis towards v (meaningful on the mask only).
+    """
+    s = gaussian(image, sigma_px)
+
+    def diff(du: int, dv: int, scale: float) -> np.ndarray:
+        return cv2.Sobel(s, cv2.CV_32F, du, dv, ksize=3, borderType=cv2.BORDER_REFLECT) / scale
+
+    gu, gv = diff(1, 0, 8.0), diff(0, 1, 8.0)
+    a, c, b = diff(2, 0, 4.0), diff(0, 2, 4.0), diff(1, 1, 4.0)
+    root = np.sqrt(0.25 * (a - c) ** 2 + b * b)
+    lam, along = 0.5 * (a + c) - root, 0.5 * (a + c) + root  # across and along the ridge
+    theta = 0.5 * np.arctan2(2 * b, a - c) + 0.5 * np.pi  # eigenvector of lam: across
+    nu, nv = np.cos(theta), np.sin(theta)
+    t = -(gu * nu + gv * nv) / np.minimum(lam, -1e-12)  # distance to the maximum, pixels
+    inside = (np.abs(t * nu) <= 0.5) & (np.abs(t * nv) <= 0.5)
+    line_like = np.abs(along) <= 0.5 * np.abs(lam)  # not a blob (a wall end)
+    mask = inside & line_like & (-lam * sigma_px**2 >= floor)
+    return mask, np.mod(theta + 0.5 * np.pi, np.pi).astype(np.float32)
+
+
+#: Direction bins of one partition of the ridge pixels (30 degrees each).
+_BINS = 6
+
+
+def _label(mask: np.ndarray, direction: np.ndarray, offset: float) -> tuple[np.ndarray, int]:
+    """Connected pieces (8-connected) of ridge pixels whose directions fall in the same bin of
+    ``_BINS`` bins over [0, pi), the bins shifted by ``offset`` of a bin: (rows, cols) int32
+    labels (0 off the pieces) and the number of pieces."""
+    bins = np.floor(np.mod(direction * (_BINS / np.pi) + offset, _BINS)).astype(np.int32)
+    labels = np.zeros(mask.shape, dtype=np.int32)
+    count = 0
+    for k in range(_BINS):
+        n, lab = cv2.connectedComponents((mask & (bins == k)).astype(np.uint8), connectivity=8)
+        on = lab > 0
+        labels[on] = lab[on] + count
+        count += n - 1
+    return labels, count
+
+
+def pieces(mask: np.ndarray, direction: np.ndarray) -> np.ndarray:
+    """Straight pieces of the ridge lines, in pixels (u, v): (N, 4) ``u0, v0, u1, v1``.
+
+    The ridge pixels are split by their local direction into 30 degree bins; each connected run
+    of pixels of one bin is a piece, fitted by the principal axis of its pixels and spanning
+    them (to the outer edges of its end pixels). Two partitions, the second shifted by half a
+    bin, are used together, so a wall whose direction lies on a bin border is still whole in one
+    of them; the duplicates are merged later. A piece follows the ridge pixels themselves: it
+    neither jumps between parallel walls nor cuts across a curve, and a wall wavy by a pixel
+    stays one piece as long as its direction stays within the bin.
+    """
+    out = []
+    for offset in (0.0, 0.5):
+        labels, n = _label(mask, direction, offset)
+        v, u = np.nonzero(labels)
+        lab = labels[v, u]
+        count = np.bincount(lab, minlength=n + 1).astype(np.float64)
+        count[0] = 1.0
+        cu = np.bincount(lab, u, n + 1) / count
+        cv = np.bincount(lab, v, n + 1) / count
+        du, dv = u - cu[lab], v - cv[lab]
+        suu = np.bincount(lab, du * du, n + 1)
+        svv = np.bincount(lab, dv * dv, n + 1)
+        suv = np.bincount(lab, du * dv, n + 1)
+        angle = 0.5 * np.arctan2(2 * suv, suu - svv)  # principal axis of each piece
+        eu, ev = np.cos(angle), np.sin(angle)
+        t = du * eu[lab] + dv * ev[lab]
+        lo, hi = np.full(n + 1, np.inf), np.full(n + 1, -np.inf)
+        np.minimum.at(lo, lab, t)
+        np.maximum.at(hi, lab, t)
+        lo, hi = lo[1:] - 0.5, hi[1:] + 0.5  # pixel centres to pixel edges
+        cu, cv, eu, ev = cu[1:], cv[1:], eu[1:], ev[1:]
+        out.append(np.column_stack([cu + lo * eu, cv + lo * ev, cu + hi * eu, cv + hi * ev]))
+    return np.concatenate(out).reshape(-1, 4)

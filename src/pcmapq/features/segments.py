@@ -1,0 +1,195 @@
+"""Geometry of wall segments (N, 4) ``x0, y0, x1, y1`` in metres: directions, merging
+collinear fragments into maximal walls, and where segments run inside a wall (for the Hough
+detector)."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from pcmapq.grid import MetricGrid
+
+
+def directions(seg: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Unit directions (N, 2) and lengths (N,) of segments (N, 4)."""
+    d = seg[:, 2:] - seg[:, :2]
+    length = np.hypot(d[:, 0], d[:, 1])
+    return d / np.maximum(length, 1e-12)[:, None], length
+
+
+#: Regroup-and-refit rounds of one merged segment.
+_REFITS = 4
+#: Smoothed occupied fraction above which a cell is inside a wall, for bridging.
+SOLID = 0.3
+#: Points tested along a gap to bridge.
+_BRIDGE_SAMPLES = 16
+#: Smoothed occupied fraction a Hough segment keeps all along; it is cut where it drops below.
+INSIDE = 0.5
+
+
+def _line(ends: np.ndarray, weight: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Weighted total-least-squares line through segment endpoints ``ends`` (K, 2, 2), each
+    segment weighted by ``weight`` (K,): a point on it (2,) and its unit direction (2,)."""
+    pts = ends.reshape(-1, 2)
+    w = np.repeat(weight, 2)
+    centre = w @ pts / w.sum()
+    r = pts - centre
+    cov = (r * w[:, None]).T @ r
+    angle = 0.5 * np.arctan2(2 * cov[0, 1], cov[0, 0] - cov[1, 1])  # principal axis
+    return centre, np.array([np.cos(angle), np.sin(angle)])
+
+
+def _grow(t: np.ndarray, fits: np.ndarray, group: np.ndarray, max_gap: float,
+          bridged: Callable[[np.ndarray, np.ndarray], np.ndarray]) -> np.ndarray:
+    """The group extended by every fitting segment near its extent along the line, repeatedly,
+    as the extent grows.
+
+    ``t`` (N, 2) are the endpoint positions along the line, metres. A segment is near when the
+    gap between it and the group is at most ``max_gap``, or when ``bridged(start, end)`` says
+    the wall is solid over the gap (positions along the line, metres, one pair per segment).
+    """
+    a, b = t.min(axis=1), t.max(axis=1)
+    while True:
+        lo, hi = t[group].min(), t[group].max()
+        above = a > hi
+        start, end = np.where(above, hi, b), np.where(above, a, lo)
+        gap = np.where(above | (b < lo), end - start, 0.0)
+        near = fits & ~group & (gap <= max_gap)
+        far = np.flatnonzero(fits & ~group & ~near)
+        if len(far):
+            near[far] = bridged(start[far], end[far])
+        if not near.any():
+            return group
+        group = group | near
+
+
+def merge(seg: np.ndarray, max_angle: float, max_offset: float, max_gap: float,
+          solid: Callable[[np.ndarray], np.ndarray] | None = None,
+          max_bridge: float = 0.0) -> np.ndarray:
+    """Merge collinear fragments into maximal segments.
+
+    Longest first, each remaining segment seeds a group that absorbs every fragment within
+    ``max_angle`` of the group's line direction, ``max_offset`` of the line and ``max_gap`` of
+    its extent along it (or up to ``max_bridge`` away when the wall is solid all along the gap);
+    the line is then refitted to the group (weighted total least squares of the endpoints) and
+    the group regathered, a few rounds. Fragments are compared with the group's line, not with
+    each other, so a chain of slightly turning fragments cannot drift. Only fragments within
+    twice ``max_angle`` and twice ``max_offset`` of the seed's line are considered (the group's
+    line stays near its seed's; this keeps large maps fast). The merged segments are merged
+    again until nothing changes.
+
+    Parameters
+    ----------
+    seg : (N, 4) segments, metres.
+    max_angle : largest direction difference, degrees.
+    max_offset : largest distance of a fragment's endpoints from the group's line, metres.
+    max_gap : largest gap along the line between the group's extent and a fragment, metres.
+    solid : ``solid(xy)``: whether the points (..., 2), metres, are inside a wall (bool, same
+        leading shape); None: never.
+    max_bridge : largest gap bridged where ``solid`` holds all along it, metres.
+
+    Returns
+    -------
+    (M, 4) merged segments: each group's fitted line, spanning all of its endpoints. Metres,
+    M <= N.
+    """
+    d, length = directions(seg)
+    ends = np.stack([seg[:, :2], seg[:, 2:]], axis=1)  # (N, 2, 2)
+    cos_max = np.cos(np.radians(max_angle))
+    cos_near = np.cos(np.radians(min(2 * max_angle, 90.0)))
+    steps = np.linspace(0.0, 1.0, _BRIDGE_SAMPLES)
+    left = np.ones(len(seg), dtype=bool)
+    out = []
+    for seed in np.lexsort((seg[:, 1], seg[:, 0], -length)):  # longest first
+        if not left[seed]:
+            continue
+        # the group's line stays near its seed's: only fragments within twice the angle and
+        # offset of the seed's line can join (this keeps the loop cheap on large maps)
+        u = d[seed]
+        off = np.abs((ends - ends[seed, 0]) @ np.array([-u[1], u[0]])).max(axis=1)
+        near = np.flatnonzero(left & (np.abs(d @ u) >= cos_near) & (off <= 2 * max_offset))
+        e, dn, ln = ends[near], d[near], length[near]
+        group = near == seed
+        for _ in range(_REFITS):
+            centre, u = _line(e[group], ln[group])
+
+            def bridged(start: np.ndarray, end: np.ndarray, centre=centre, u=u) -> np.ndarray:
+                if solid is None:
+                    return np.zeros(len(start), dtype=bool)
+                pos = start[:, None] + (end - start)[:, None] * steps  # (K, S) along the line
+                return (end - start <= max_bridge) & solid(centre + pos[..., None] * u).all(1)
+
+            t = (e - centre) @ u  # (K, 2) along the line
+            off = np.abs((e - centre) @ np.array([-u[1], u[0]])).max(axis=1)
+            fits = (np.abs(dn @ u) >= cos_max) & (off <= max_offset)
+            grown = _grow(t, fits, group, max_gap, bridged)
+            if np.array_equal(grown, group):
+                break
+            group = grown
+        left[near[group]] = False
+        centre, u = _line(e[group], ln[group])
+        t = (e[group] - centre) @ u
+        out.append(np.concatenate([centre + t.min() * u, centre + t.max() * u]))
+    merged = np.asarray(out).reshape(-1, 4)
+    # merged segments are better fitted than the fragments: merge them again until stable
+    if len(merged) == len(seg):
+        return merged
+    return merge(merged, max_angle, max_offset, max_gap, solid, max_bridge)
+
+
+def wall_test(image: np.ndarray, work: MetricGrid,
+              level: float) -> Callable[[np.ndarray], np.ndarray]:
+    """``solid(xy)``: whether points (..., 2), metres, fall on cells of ``image`` (on grid
+    ``work``) of at least ``level``; points outside the image are not solid."""
+
+    def solid(xy: np.ndarray) -> np.ndarray:
+        uv = np.floor(work.xy_to_pixels(xy.reshape(-1, 2)) + 0.5).astype(np.int64)
+        rows, cols = image.shape
+        inside = (uv[:, 0] >= 0) & (uv[:, 0] < cols) & (uv[:, 1] >= 0) & (uv[:, 1] < rows)
+        out = np.zeros(len(uv), dtype=bool)
+        out[inside] = image[uv[inside, 1], uv[inside, 0]] >= level
+        return out.reshape(xy.shape[:-1])
+
+    return solid
+
+
+def _points(seg: np.ndarray, step: float) -> np.ndarray:
+    """Points (M, 2) every ``step`` along segments (N, 4), both ends included."""
+    d, length = directions(seg)
+    n = np.floor(length / step).astype(np.int64) + 2
+    which = np.repeat(np.arange(len(seg)), n)
+    t = np.minimum((np.arange(n.sum()) - (np.cumsum(n) - n)[which]) * step, length[which])
+    return seg[which, :2] + t[:, None] * d[which]
+
+
+def away(xy: np.ndarray, seg: np.ndarray, distance: float, step: float) -> np.ndarray:
+    """(N,) bool: which points ``xy`` (N, 2) are farther than ``distance`` from every segment
+    (M, 4) (tested at points every ``step`` along them). Metres."""
+    if len(seg) == 0 or len(xy) == 0:
+        return np.ones(len(xy), dtype=bool)
+    dist, _ = cKDTree(_points(seg, step)).query(xy, distance_upper_bound=distance)
+    return ~np.isfinite(dist)
+
+
+def inside_runs(seg: np.ndarray, inside: Callable[[np.ndarray], np.ndarray], step: float,
+                shortest: float) -> np.ndarray:
+    """The parts of segments (N, 4, metres) along which ``inside(xy)`` holds at every point
+    tested (every ``step`` metres), at least ``shortest`` metres long: (M, 4) metres."""
+    d, length = directions(seg)
+    n = np.floor(length / step).astype(np.int64) + 1  # points per segment
+    which = np.repeat(np.arange(len(seg)), n)
+    first = np.cumsum(n) - n
+    t = (np.arange(n.sum()) - first[which]) * step  # along each segment, metres
+    ok = inside(seg[which, :2] + t[:, None] * d[which])
+    new = np.ones(len(ok), dtype=bool)
+    new[first] = True
+    new[1:] &= ~ok[:-1] | (which[1:] != which[:-1])  # run starts: no inside point before it
+    last = np.ones(len(ok), dtype=bool)
+    last[:-1] = ~ok[1:] | (which[1:] != which[:-1])  # run ends: no inside point after it
+    start, end = np.flatnonzero(ok & new), np.flatnonzero(ok & last)  # paired, in order
+    keep = t[end] - t[start] >= shortest
+    start, end = start[keep], end[keep]
+    k = which[start]
+    return np.column_stack([seg[k, :2] + t[start, None] * d[k], seg[k, :2] + t[end, None] * d[k]])
