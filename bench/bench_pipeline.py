@@ -13,6 +13,8 @@ import sys
 import tempfile
 from pathlib import Path
 
+from pcmapq.report.text import score
+
 ROOT = Path(__file__).resolve().parents[1]
 
 CHILD = r"""
@@ -66,7 +68,7 @@ def main() -> None:
           + " | peak RSS MB | quality harris/hough/sift |")
     print("|---" * (len(steps) + 4) + "|")
     for r in rows:
-        q = "/".join("n/a" if v is None else f"{v:.2f}" for v in r["quality"].values())
+        q = "/".join(score(v, 2) for v in r["quality"].values())
         t = " | ".join(f"{r['times'].get(s, 0.0):.2f}" for s in steps)
         print(f"| {r['case']} | {r['grid'][0]} x {r['grid'][1]} | {t} | {r['rss_mb']:.0f} | {q} |")
 

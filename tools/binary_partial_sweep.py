@@ -18,6 +18,7 @@ from pcmapq import synth
 from pcmapq.config import Settings
 from pcmapq.io.writers import write_ros_map
 from pcmapq.pipeline import evaluate
+from pcmapq.report.text import score
 from pcmapq.transform import Similarity2D
 
 #: Parts of the 24 m x 16 m plan (x0, y0, x1, y1, metres), 25-60 % of its walls; no cut runs
@@ -76,7 +77,7 @@ def main(argv: list[str] | None = None) -> int:
                     qs = [v for v in q if v is not None]
                     rows[rule].append((r.overlap.coverage - share, min(qs), max(qs)))
                     cells.append(f"{r.overlap.coverage:.2f} ({r.footprint_rule}) / "
-                                 + ", ".join("n/a" if v is None else f"{v:.2f}" for v in q))
+                                 + ", ".join(score(v, 2) for v in q))
                 print("| " + " | ".join(cells) + " |", flush=True)
     print()
     for rule, got in rows.items():

@@ -29,6 +29,7 @@ import numpy as np
 from pcmapq.config import Settings
 from pcmapq.io.carmen import DEFAULT_MAX_RANGE, endpoints, read_flaser
 from pcmapq.pipeline import evaluate
+from pcmapq.report.text import number, score
 
 #: Drift levels: relative gain errors of the rotation and translation increments.
 DEFAULT_LEVELS = (0.0, 0.0005, 0.001, 0.002, 0.005, 0.01, 0.02, 0.04)
@@ -136,15 +137,6 @@ def ladder(log: Path, levels: tuple[float, ...] = DEFAULT_LEVELS, seed: int = 0,
     return rungs
 
 
-def _num(value: float | None, digits: int = 3) -> str:
-    return "-" if value is None else f"{value:.{digits}f}"
-
-
-def _score(value: float | None) -> str:
-    """A quality or precision ('n/a' when undefined: nothing to count)."""
-    return "n/a" if value is None else f"{value:.3f}"
-
-
 def markdown(rungs: list[Rung]) -> str:
     """The ladder as a markdown table."""
     names = list(rungs[0].quality) if rungs else []
@@ -154,11 +146,11 @@ def markdown(rungs: list[Rung]) -> str:
             + ["acc mean m", "comp mean m", "Chamfer m", "F@0.1", "s"])
     lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for r in rungs:
-        cells = ([f"{100 * r.level:g}", _num(r.pose_error_m, 2), _num(r.yaw_error_deg, 1),
-                  _num(r.fitness)] + [_score(r.quality[n]) for n in names]
-                 + [_score(r.precision[n]) for n in names] + [_score(r.f1[n]) for n in names]
-                 + [_num(r.accuracy_mean_m), _num(r.completeness_mean_m), _num(r.chamfer_m),
-                    _num(r.f_at_01), f"{r.seconds:.1f}"])
+        cells = ([f"{100 * r.level:g}", number(r.pose_error_m, 2), number(r.yaw_error_deg, 1),
+                  number(r.fitness)] + [score(r.quality[n]) for n in names]
+                 + [score(r.precision[n]) for n in names] + [score(r.f1[n]) for n in names]
+                 + [number(r.accuracy_mean_m), number(r.completeness_mean_m), number(r.chamfer_m),
+                    number(r.f_at_01), f"{r.seconds:.1f}"])
         lines.append("| " + " | ".join(cells) + " |")
     return "\n".join(lines)
 

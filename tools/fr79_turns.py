@@ -20,6 +20,7 @@ import numpy as np
 from pcmapq.grid import MetricGrid
 from pcmapq.io.writers import write_ros_map
 from pcmapq.pipeline import evaluate
+from pcmapq.report.text import score
 from pcmapq.transform import Similarity2D
 
 DATA = Path(__file__).resolve().parents[2] / "shared" / "data"
@@ -42,11 +43,6 @@ def turned(image: np.ndarray, tf: Similarity2D, folder: Path) -> Path:
                          dst.origin[:2])
 
 
-def score(value: float | None) -> str:
-    """A quality or precision, 'n/a' when there was nothing to count."""
-    return "n/a" if value is None else f"{value:.2f}"
-
-
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--data", type=Path, default=DATA)
@@ -67,7 +63,7 @@ def main(argv: list[str] | None = None) -> int:
             for det in result.detectors.values():
                 m = det.matching
                 cells.append(f"{m.truth_features} / {m.map_features}, "
-                             f"{score(m.quality)} / {score(m.precision)}")
+                             f"{score(m.quality, 2)} / {score(m.precision, 2)}")
             print("| " + " | ".join(cells) + " |")
     return 0
 

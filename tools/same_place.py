@@ -29,6 +29,7 @@ from pcmapq.config import Settings
 from pcmapq.io import PointMap, Thresholds
 from pcmapq.io.carmen import DEFAULT_MAX_RANGE, endpoints, read_flaser
 from pcmapq.pipeline import evaluate
+from pcmapq.report.text import number
 from pcmapq.result import Result
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -163,10 +164,6 @@ def measure(pair: Pair) -> Row:
                time.perf_counter() - start)
 
 
-def _f(value: float | None) -> str:
-    return "-" if value is None else f"{value:.2f}"
-
-
 def _verdict(ok: bool, same: bool) -> str:
     """'accepted' / 'refused', in bold when wrong."""
     word = "accepted" if ok else "refused"
@@ -180,8 +177,8 @@ def markdown(rows: list[Row]) -> str:
              "|" + " --- |" * 11]
     for r in rows:
         lines.append("| " + " | ".join([
-            r.pair.name, "same" if r.pair.same else "other", r.mode, _f(r.fitness),
-            _f(r.recall), _f(r.agreement), _f(r.distinct), _f(r.confidence),
+            r.pair.name, "same" if r.pair.same else "other", r.mode, number(r.fitness, 2),
+            *(number(v, 2) for v in (r.recall, r.agreement, r.distinct, r.confidence)),
             _verdict(r.old_ok, r.pair.same), _verdict(r.new_ok, r.pair.same),
             f"{r.seconds:.1f}"]) + " |")
     lines += ["", summary(rows)]
@@ -209,8 +206,8 @@ def matrix(data: Path) -> str:
             rows.append(measure(pair))
     wrong = [r for r in rows if r.new_ok != r.pair.same]
     lines = [f"Every Halmstad map against every layout: {summary(rows)}"]
-    lines += [f"- {r.pair.name}: distinctiveness {_f(r.distinct)}, recall {_f(r.recall)}, "
-              f"confidence {_f(r.confidence)}" for r in wrong]
+    lines += [f"- {r.pair.name}: distinctiveness {number(r.distinct, 2)}, "
+              f"recall {number(r.recall, 2)}, confidence {number(r.confidence, 2)}" for r in wrong]
     return "\n".join(lines)
 
 

@@ -38,6 +38,7 @@ from pcmapq.io import OccupancyMap, Thresholds, load_map
 from pcmapq.io.occupancy import MapMeta, classify, read_grey
 from pcmapq.pipeline import evaluate
 from pcmapq.raster.draw import OCCUPIED
+from pcmapq.report.text import number, score
 from pcmapq.result import Result
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -147,20 +148,10 @@ def cm(value: float | None) -> str:
     return "-" if value is None else f"{100 * value:.2f}"
 
 
-def num(value: float | None, digits: int = 3) -> str:
-    """A number with ``digits`` decimals ('-' for None)."""
-    return "-" if value is None else f"{value:.{digits}f}"
-
-
-def score(value: float | None) -> str:
-    """A quality, precision or f1 with two decimals ('n/a' when undefined: nothing to count)."""
-    return "n/a" if value is None else f"{value:.2f}"
-
-
 def q_p(result: Result, name: str) -> str:
     """'q / p' of one detector of a result."""
     m = result.detectors[name].matching
-    return f"{score(m.quality)} / {score(m.precision)}"
+    return f"{score(m.quality, 2)} / {score(m.precision, 2)}"
 
 
 def qualities(result: Result) -> str:
@@ -307,11 +298,11 @@ def halmstad_pipeline(data: Path) -> str:
             cells = [name, share, f"{tf.scale:.3f} ({ref.scale:.3f})",
                      f"{tf.yaw_deg:.1f} ({ref.yaw_deg:.1f})",
                      f"{keypoint_residual(r, map_path, map_keys, layout_keys):.1f}",
-                     num(r.alignment.fitness, 2), num(r.overlap.coverage, 2),
-                     num(r.overlap.confidence, 2)]
+                     number(r.alignment.fitness, 2), number(r.overlap.coverage, 2),
+                     number(r.overlap.confidence, 2)]
             cells += [q_p(r, k) for k in ("harris", "hough", "sift")]
-            cells += [num(r.distances.accuracy.mean), num(r.distances.completeness.mean),
-                      num(f02, 2), f"{run.seconds:.1f}"]
+            cells += [number(r.distances.accuracy.mean), number(r.distances.completeness.mean),
+                      number(f02, 2), f"{run.seconds:.1f}"]
             lines.append("| " + " | ".join(cells) + " |")
     return "\n".join(lines)
 
@@ -397,10 +388,10 @@ def floorplans_section(data: Path = DATA, img: Path | None = IMG) -> str:
               and abs(tf.scale / case.survey_scale - 1.0) < 0.05)
         cells = [case.name, f"{tf.scale:.3f} ({case.survey_scale:.3f})",
                  f"{tf.yaw_deg:.1f} ({case.yaw_deg:.0f})", "yes" if ok else "**no**",
-                 num(r.alignment.fitness, 2), num(r.overlap.coverage, 2),
-                 num(r.overlap.confidence, 2)]
+                 number(r.alignment.fitness, 2), number(r.overlap.coverage, 2),
+                 number(r.overlap.confidence, 2)]
         cells += [q_p(r, k) for k in ("harris", "hough", "sift")]
-        cells += [num(r.distances.accuracy.mean), num(r.distances.completeness.mean),
+        cells += [number(r.distances.accuracy.mean), number(r.distances.completeness.mean),
                   f"{run.seconds:.1f}"]
         lines.append("| " + " | ".join(cells) + " |")
         if img is not None:

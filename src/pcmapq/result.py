@@ -107,6 +107,11 @@ class Result:
         scope = "" if self.full else "inside the footprint"
         return self.detectors[name].matching.note(scope)
 
+    def notes(self) -> list[str]:
+        """One line per detector with an undefined score: ``name: n/a: why``."""
+        return [f"{name}: n/a: {note}" for name in self.detectors
+                if (note := self.note(name)) is not None]
+
     def to_dict(self) -> dict:
         """The JSON document (see README): plain types, floats rounded to DECIMALS."""
         tf = self.alignment.transform

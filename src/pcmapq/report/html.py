@@ -8,6 +8,7 @@ import html
 from pcmapq import __version__
 from pcmapq.metrics.distances import DistanceStats
 from pcmapq.report.plot import distance_heatmap, png_bytes, vectorial_figure
+from pcmapq.report.text import number, score
 from pcmapq.result import Result
 
 STYLE = """
@@ -44,17 +45,8 @@ def _table(header: list[str], rows: list[list[str]]) -> str:
 def _stats_table(counted: str, rows: list[tuple[str, DistanceStats]]) -> str:
     """A table of distance statistics, one row per (label, stats)."""
     return _table(["", "mean [m]", "median [m]", "RMSE [m]", "95th pct [m]", counted],
-                  [[label, _f(s.mean), _f(s.median), _f(s.rmse), _f(s.p95), str(s.count)]
+                  [[label, *(number(v) for v in (s.mean, s.median, s.rmse, s.p95)), str(s.count)]
                    for label, s in rows])
-
-
-def _f(value: float | None, digits: int = 3) -> str:
-    return "-" if value is None else f"{value:.{digits}f}"
-
-
-def _q(value: float | None) -> str:
-    """A score with three decimals; 'n/a' when undefined (nothing to count)."""
-    return "n/a" if value is None else f"{value:.3f}"
 
 
 def report_html(result: Result) -> str:
@@ -67,36 +59,35 @@ def report_html(result: Result) -> str:
          f"{result.grid.size_m[0]:.1f} x {result.grid.size_m[1]:.1f} m"]])
     alignment = _table(
         ["x [m]", "y [m]", "yaw [deg]", "scale", "fitness", "inlier RMSE [m]", "method"],
-        [[_f(tf.tx), _f(tf.ty), _f(tf.yaw_deg, 2), _f(tf.scale, 4),
-          f"{_f(a.fitness)} (within {a.tolerance_m:g} m)", _f(a.rmse_m), a.method]])
+        [[number(tf.tx), number(tf.ty), number(tf.yaw_deg, 2), number(tf.scale, 4),
+          f"{number(a.fitness)} (within {a.tolerance_m:g} m)", number(a.rmse_m), a.method]])
     cover = _table(["coverage", "footprint", "truth recall in footprint", "confidence",
                     "scored against"],
-                   [[_f(o.coverage), FOOTPRINT_WORDS.get(result.footprint_rule, ""),
-                     _f(o.truth_recall), _f(o.confidence),
+                   [[number(o.coverage), FOOTPRINT_WORDS.get(result.footprint_rule, ""),
+                     number(o.truth_recall), number(o.confidence),
                      "whole truth" if result.full else "the map's footprint"]])
     rows = []
     for name, det in result.detectors.items():
         m, s = det.matching, det.displacement_stats()
-        rows.append([name, _q(m.quality), _q(m.precision), _q(m.f1), str(m.truth_features),
-                     str(m.map_features), str(m.matched), _f(s["mean"]), _f(s["median"]),
-                     _f(s["rmse"]), _f(s["max"])])
+        rows.append([name, score(m.quality), score(m.precision), score(m.f1),
+                     str(m.truth_features),
+                     str(m.map_features), str(m.matched), number(s["mean"]), number(s["median"]),
+                     number(s["rmse"]), number(s["max"])])
     scores = _table(["detector", "quality q", "precision", "f1", "truth features",
                      "map features", "matched", "disp. mean [m]", "disp. median [m]",
                      "disp. RMSE [m]", "disp. max [m]"], rows)
-    notes = [f"{name}: n/a: {note}" for name in result.detectors
-             if (note := result.note(name)) is not None]
-    if notes:
-        scores += "".join(f'<p class="note">{html.escape(n)}</p>' for n in notes)
+    scores += "".join(f'<p class="note">{html.escape(n)}</p>' for n in result.notes())
     d = result.distances
     dist = _stats_table("cells", [("accuracy (map to truth)", d.accuracy),
                                   ("completeness (truth to map)", d.completeness)])
     fscore = _table(["threshold [m]", "precision", "recall", "F-score"],
-                    [[f"{f.tau_m:g}", _f(f.precision), _f(f.recall), _f(f.f)]
+                    [[f"{f.tau_m:g}", number(f.precision), number(f.recall), number(f.f)]
                      for f in d.fscores])
     if result.registration_3d is not None and result.distances_3d is not None:
         reg, d3 = result.registration_3d, result.distances_3d
         dist += "<p class=\"note\">Both inputs are 3D clouds: registered in 3D (fitness " \
-                f"{_f(reg.fitness)}, RMSE {_f(reg.rmse)} m); distances between the clouds:</p>"
+                f"{number(reg.fitness)}, RMSE {number(reg.rmse)} m); distances between the " \
+                "clouds:</p>"
         dist += _stats_table("points", [("3D accuracy (map to truth)", d3.accuracy),
                                         ("3D completeness (truth to map)", d3.completeness)])
     vectors = _img(png_bytes(vectorial_figure(result)), "vectorial map per detector")
@@ -122,7 +113,7 @@ recall); precision = matched map features / map features; f1 = their harmonic me
 n/a: nothing to count (undefined, not 0). Displacements are from each truth feature to its
 map feature.</p>
 <h2>Distances</h2>{dist}
-<p class="note">Chamfer distance {_f(d.chamfer_m)} m (mean of the two means). Definitions in
+<p class="note">Chamfer distance {number(d.chamfer_m)} m (mean of the two means). Definitions in
 docs/metrics.md.</p>{fscore}
 <h2>Vectorial map</h2>{vectors}
 <h2>Distance heatmap</h2>{heat}

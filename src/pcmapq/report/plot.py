@@ -18,6 +18,7 @@ from matplotlib.lines import Line2D  # noqa: E402
 from mpl_toolkits.axes_grid1.anchored_artists import AnchoredSizeBar  # noqa: E402
 from scipy import ndimage  # noqa: E402
 
+from pcmapq.report.text import score
 from pcmapq.result import DetectorResult, Result  # noqa: E402
 
 TRUTH_GREY, MAP_BLUE = (0.62, 0.62, 0.62), (0.25, 0.55, 0.95)
@@ -55,11 +56,6 @@ def arrow_gain(result: Result) -> float:
     return max(1.0, _nice(0.04 * result.grid.size_m[0] / d.max()))
 
 
-def _score(value: float | None) -> str:
-    """A score with two decimals; 'n/a' when undefined (nothing to count)."""
-    return "n/a" if value is None else f"{value:.2f}"
-
-
 def _panel(ax, result: Result, name: str, det: DetectorResult, gain: float) -> None:
     ax.imshow(overlay(result), extent=extent(result), origin="upper", interpolation="nearest")
     if not result.full:
@@ -84,8 +80,8 @@ def _panel(ax, result: Result, name: str, det: DetectorResult, gain: float) -> N
     bar = _nice(width / 5)
     ax.add_artist(AnchoredSizeBar(ax.transData, bar, f"{bar:g} m", "lower right", pad=0.4,
                                   frameon=True, size_vertical=width / 300))
-    ax.set_title(f"{name}: quality {_score(m.quality)}, precision {_score(m.precision)}, "
-                 f"f1 {_score(m.f1)}"
+    ax.set_title(f"{name}: quality {score(m.quality, 2)}, precision {score(m.precision, 2)}, "
+                 f"f1 {score(m.f1, 2)}"
                  + (f"\n{note}" if (note := result.note(name)) else ""), fontsize=10)
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")

@@ -5,16 +5,8 @@ from __future__ import annotations
 from rich.console import Console
 from rich.table import Table
 
+from pcmapq.report.text import number, score
 from pcmapq.result import Result
-
-
-def _m(value: float | None) -> str:
-    return "-" if value is None else f"{value:.3f}"
-
-
-def _q(value: float | None) -> str:
-    """A score with three decimals; 'n/a' when undefined (nothing to count)."""
-    return "n/a" if value is None else f"{value:.3f}"
 
 
 def print_table(result: Result, console: Console) -> None:
@@ -36,19 +28,18 @@ def print_table(result: Result, console: Console) -> None:
     for name, det in result.detectors.items():
         m = det.matching
         stats = det.displacement_stats()
-        table.add_row(name, _q(m.quality), _q(m.precision), _q(m.f1),
+        table.add_row(name, score(m.quality), score(m.precision), score(m.f1),
                       str(m.truth_features), str(m.map_features), str(m.matched),
-                      *(_m(stats[k]) for k in ("mean", "median", "rmse", "max")))
+                      *(number(stats[k]) for k in ("mean", "median", "rmse", "max")))
     console.print(table)
-    for name in result.detectors:
-        if (note := result.note(name)) is not None:
-            console.print(f"{name}: n/a: {note}", highlight=False)
+    for line in result.notes():
+        console.print(line, highlight=False)
     if result.registration_3d is not None and result.distances_3d is not None:
         reg, d3 = result.registration_3d, result.distances_3d
         console.print(f"3D registration: fitness {reg.fitness:.3f}, rmse {reg.rmse:.3f} m; "
-                      f"3D accuracy mean {_m(d3.accuracy.mean)} m, completeness mean "
-                      f"{_m(d3.completeness.mean)} m, Chamfer {_m(d3.chamfer_m)} m")
+                      f"3D accuracy mean {number(d3.accuracy.mean)} m, completeness mean "
+                      f"{number(d3.completeness.mean)} m, Chamfer {number(d3.chamfer_m)} m")
     d = result.distances
     f = "  ".join(f"F@{s.tau_m:g} m {s.f:.3f}" for s in d.fscores)
-    console.print(f"distances: accuracy mean {_m(d.accuracy.mean)} m, completeness mean "
-                  f"{_m(d.completeness.mean)} m, Chamfer {_m(d.chamfer_m)} m  {f}")
+    console.print(f"distances: accuracy mean {number(d.accuracy.mean)} m, completeness mean "
+                  f"{number(d.completeness.mean)} m, Chamfer {number(d.chamfer_m)} m  {f}")
