@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import shlex
 import sys
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
@@ -10,14 +9,14 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Annotated
 
-import numpy as np
 import typer
 from rich.console import Console
 from rich.progress import Progress
 
-from pcmapq.config import DETECTOR_NAMES, Settings
+from pcmapq import options
+from pcmapq.config import Settings
 from pcmapq.errors import EvaluationError, InputError
-from pcmapq.io import PointMap, Thresholds
+from pcmapq.io import PointMap
 from pcmapq.io.writers import write_atomic, write_cloud
 from pcmapq.mapping import (
     build_map_from_poses,
@@ -29,9 +28,7 @@ from pcmapq.mapping import (
     write_tum_poses,
 )
 from pcmapq.pipeline import evaluate
-from pcmapq.raster.footprint import FOOTPRINT_RULES
 from pcmapq.report.table import print_table
-from pcmapq.transform import Similarity2D
 
 #: The documented defaults, read from the one place that defines them.
 DEFAULTS = Settings()
@@ -123,87 +120,6 @@ def _progress(console: Console, enabled: bool) -> Iterator[Callable[[str], None]
         yield lambda step: status.update(f"{step}...")
 
 
-def _command_line(ctx: typer.Context) -> str:
-    """The command as given, rebuilt from its parsed parameters (defaults left out), so a saved
-    result says how it was made: ``pcmapq eval MAP TRUTH --option value ...``."""
-    words = ["pcmapq", ctx.info_name or "eval"]
-    for param in ctx.command.params:
-        value = ctx.params.get(param.name)
-        source = ctx.get_parameter_source(param.name)
-        if source is None or source.name == "DEFAULT" or value is None:
-            continue
-        if param.param_type_name == "argument":
-            words += [str(v) for v in (value if isinstance(value, (list, tuple)) else [value])]
-        elif isinstance(value, bool) and param.is_flag:
-            if value or param.secondary_opts:
-                words.append(param.opts[0] if value else param.secondary_opts[0])
-        else:
-            words += [param.opts[0], str(value)]
-    return shlex.join(words)
-
-
-def _parse_init(text: str | None) -> Similarity2D | None:
-    if text is None:
-        return None
-    try:
-        x, y, yaw = (float(v) for v in text.split(","))
-    except ValueError:
-        raise typer.BadParameter(f"expected x,y,yaw (metres, metres, degrees), got {text!r}",
-                                 param_hint="--init") from None
-    return Similarity2D(x, y, float(np.radians(yaw)))
-
-
-def _parse_resolution(text: str | None, scale: str) -> tuple[float | None, bool]:
-    """(--map-resolution as metres or None, whether to estimate the scale)."""
-    if scale not in ("fixed", "auto"):
-        raise typer.BadParameter(f"expected 'fixed' or 'auto', got {scale!r}", param_hint="--scale")
-    if text is None or text == "auto":
-        return None, scale == "auto" or text == "auto"
-    try:
-        value = float(text)
-    except ValueError:
-        value = -1.0
-    if not value > 0:
-        raise typer.BadParameter(f"expected metres per pixel or 'auto', got {text!r}",
-                                 param_hint="--map-resolution")
-    return value, scale == "auto"
-
-
-def _thresholds(occupied: float | None, free: float | None,
-                negate: bool | None) -> Thresholds | None:
-    """map_server overrides from the command line (None when none is given)."""
-    if occupied is None and free is None and negate is None:
-        return None
-    return Thresholds(occupied, free, negate)
-
-
-def _parse_taus(text: str) -> tuple[float, ...]:
-    try:
-        taus = tuple(float(v) for v in text.split(","))
-    except ValueError:
-        taus = ()
-    if not taus or min(taus) <= 0:
-        raise typer.BadParameter(f"expected positive distances in metres, got {text!r}",
-                                 param_hint="--tau")
-    return taus
-
-
-def _parse_detectors(text: str) -> tuple[str, ...]:
-    names = tuple(n.strip() for n in text.split(",") if n.strip())
-    unknown = [n for n in names if n not in DETECTOR_NAMES]
-    if unknown or not names:
-        raise typer.BadParameter(f"unknown detector(s) {unknown}; choose from "
-                                 f"{','.join(DETECTOR_NAMES)}", param_hint="--detectors")
-    return names
-
-
-def _parse_footprint(text: str) -> str:
-    if text not in FOOTPRINT_RULES:
-        raise typer.BadParameter(f"expected one of {', '.join(FOOTPRINT_RULES)}, got {text!r}",
-                                 param_hint="--footprint")
-    return text
-
-
 @app.command("eval")
 def eval_command(
     ctx: typer.Context,
@@ -280,7 +196,7 @@ def eval_command(
     footprint: Annotated[str, typer.Option(
         help="The area the map observed: 'known' cells of an image, the area its 'walls' "
         "enclose, 'all' of its rectangle; 'auto': known cells for an image with unknown "
-        "regions, walls for a binary image or a cloud.")] = Settings.footprint,
+        "regions, walls for a binary image or a cloud.")] = DEFAULTS.footprint,
     full: Annotated[bool, typer.Option(
         "--full", help="Score against the whole truth, not only the part the map covers.")
     ] = False,
@@ -290,17 +206,16 @@ def eval_command(
         raise typer.BadParameter("give MAP and TRUTH, or --scans DIR and TRUTH",
                                  param_hint="MAP TRUTH")
     truth_path = paths[-1]
-    resolution, auto = _parse_resolution(map_resolution, scale)
-    settings = Settings(map_resolution=resolution, truth_resolution=truth_resolution,
-                        map_thresholds=_thresholds(map_occupied_thresh, map_free_thresh,
-                                                   map_negate),
-                        truth_thresholds=_thresholds(truth_occupied_thresh, truth_free_thresh,
-                                                     truth_negate),
-                        scale=auto,
-                        band_low=band_low, band_high=band_high, init=_parse_init(init),
-                        align=not no_align, force=force, threshold=threshold, min_hits=min_hits,
-                        detectors=_parse_detectors(detectors), full=full, taus=_parse_taus(tau),
-                        voxel_3d=voxel_3d, footprint=_parse_footprint(footprint))
+    resolution, auto = options.parse_resolution(map_resolution, scale)
+    settings = Settings(
+        map_resolution=resolution, truth_resolution=truth_resolution, scale=auto,
+        map_thresholds=options.thresholds(map_occupied_thresh, map_free_thresh, map_negate),
+        truth_thresholds=options.thresholds(truth_occupied_thresh, truth_free_thresh,
+                                            truth_negate),
+        band_low=band_low, band_high=band_high, init=options.parse_init(init),
+        align=not no_align, force=force, threshold=threshold, min_hits=min_hits,
+        detectors=options.parse_detectors(detectors), full=full, taus=options.parse_taus(tau),
+        voxel_3d=voxel_3d, footprint=options.parse_footprint(footprint))
     quiet = json_path == "-"
     err = Console(stderr=True)
     out = Console(quiet=quiet, width=None if err.is_terminal else 132)
@@ -312,7 +227,7 @@ def eval_command(
             points, _ = build_map_kiss(scans, max_scans=max_scans)
             map_path = PointMap(scans, points, True, kind="scans")
         result = replace(evaluate(map_path, truth_path, settings, progress),
-                         command=_command_line(ctx))
+                         command=options.command_line(ctx))
         progress("writing outputs")
         if json_path == "-":
             sys.stdout.write(result.to_json())
