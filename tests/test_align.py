@@ -7,7 +7,7 @@ import pytest
 
 from pcmapq import synth
 from pcmapq.align import Alignment, align, score
-from pcmapq.align.coarse import coarse_candidates
+from pcmapq.align.coarse import coarse_search
 from pcmapq.align.icp import voxel_downsample
 from pcmapq.transform import Similarity2D
 
@@ -116,7 +116,8 @@ def test_deterministic(truth, scan):
 
 def test_coarse_candidates_rank_right_pose_first(truth, scan):
     t_true, map_xy = to_map_frame(scan, 90, -20.0, 12.0)
-    best = coarse_candidates(voxel_downsample(map_xy, 0.05), voxel_downsample(truth, 0.05))[0]
+    best = coarse_search(voxel_downsample(map_xy, 0.05),
+                         voxel_downsample(truth, 0.05)).candidates[0]
     dxy, dyaw = pose_error(t_true, best.transform)
     assert dxy < 0.6 and dyaw < 2.0 and 0.0 < best.score <= 1.0
 

@@ -168,7 +168,7 @@ def align_similarity(map_xy: np.ndarray, truth_xy: np.ndarray, *,
     truth frame. Every length parameter is in truth units: ``tolerance`` and ``voxel`` as in
     :func:`align`; the map is downsampled to ``voxel`` truth units at the current scale.
     resolution: cell of the global search (default: the truth's radius / 20, see
-    :func:`~pcmapq.align.coarse.similarity_candidates`), which also sets the ICP schedule
+    :func:`~pcmapq.align.coarse.similarity_search`), which also sets the ICP schedule
     (:func:`similarity_schedule`). The ``top_k`` candidates of the search over scale, yaw and
     position are refined by a first scaled ICP stage, the best ``finalists`` by fitness through
     the others and a point-to-line stage with scale (pairs within ``tolerance``); the final pose

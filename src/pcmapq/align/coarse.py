@@ -7,7 +7,7 @@ field value under the map's cells, in [0, 1]: a soft share of the map that lies 
 The field saturates at 1 on a wall, so dense or cluttered truth regions cannot outscore the right
 place, and cells of a partial map that overhang the truth simply score 0.
 
-:func:`similarity_candidates` adds a sweep over the map's scale (the truth's field is computed
+:func:`similarity_search` adds a sweep over the map's scale (the truth's field is computed
 once; only the map's points are scaled before rasterising). The mean field value would favour a
 map shrunk onto a dense knot of walls, so there every cell scores its field value minus the mean
 field over the truth's bounding box: the summed excess, in truth cells, is what a random
@@ -30,8 +30,8 @@ from pcmapq.transform import Similarity2D
 @dataclass(frozen=True)
 class Candidate:
     """A coarse pose: map frame -> truth frame, with its score: the mean field under the map in
-    [0, 1] (:func:`coarse_candidates`), or the summed field excess in truth cells
-    (:func:`similarity_candidates`)."""
+    [0, 1] (:func:`coarse_search`), or the summed field excess in truth cells
+    (:func:`similarity_search`)."""
 
     transform: Similarity2D
     score: float
@@ -142,11 +142,6 @@ def auto_resolution(map_xy: np.ndarray) -> float:
     return max(0.25, _radius(map_xy - map_xy.mean(axis=0)) / 40.0)
 
 
-def coarse_candidates(map_xy: np.ndarray, truth_xy: np.ndarray, **options) -> list[Candidate]:
-    """The candidates of :func:`coarse_search` (same arguments), best first."""
-    return coarse_search(map_xy, truth_xy, **options).candidates
-
-
 def coarse_search(map_xy: np.ndarray, truth_xy: np.ndarray, *,
                   resolution: float | None = None, sigma: float | None = None,
                   angle_step_deg: float | None = None, overhang: float = 2.0,
@@ -227,12 +222,6 @@ def _templates(points: np.ndarray, yaws: np.ndarray, half: int) -> np.ndarray:
     flat = (np.arange(len(yaws))[:, None] * size + v) * size + u
     hits = np.bincount(flat.ravel(), minlength=len(yaws) * size * size)
     return (hits > 0).astype(np.float32).reshape(len(yaws), size, size)
-
-
-def similarity_candidates(map_xy: np.ndarray, truth_xy: np.ndarray,
-                          **options) -> list[Candidate]:
-    """The candidates of :func:`similarity_search` (same arguments), best first."""
-    return similarity_search(map_xy, truth_xy, **options).candidates
 
 
 def similarity_search(map_xy: np.ndarray, truth_xy: np.ndarray, *,
