@@ -28,21 +28,22 @@ def write_reference() -> None:
     REFERENCE.write_text(json.dumps(sample_document(), indent=1) + "\n")
 
 
-def differences(got, want, where: str = "") -> list[str]:
-    """Where two JSON values differ: keys, lengths, strings, or numbers by more than 1e-6."""
+def differences(got, want, where: str = "", tol: float = 1e-6) -> list[str]:
+    """Where two JSON values differ: keys of the reference that are gone, lengths, strings, or
+    numbers by more than ``tol``. Keys the reference does not have are new fields, not changes."""
     if isinstance(want, dict) and isinstance(got, dict):
-        if set(got) != set(want):
-            return [f"{where}: keys {sorted(set(got) ^ set(want))}"]
-        return [d for k in want for d in differences(got[k], want[k], f"{where}.{k}")]
+        if set(want) - set(got):
+            return [f"{where}: keys {sorted(set(want) - set(got))} gone"]
+        return [d for k in want for d in differences(got[k], want[k], f"{where}.{k}", tol)]
     if isinstance(want, list) and isinstance(got, list):
         if len(got) != len(want):
             return [f"{where}: {len(got)} items, reference {len(want)}"]
         return [d for i, (g, w) in enumerate(zip(got, want, strict=True))
-                for d in differences(g, w, f"{where}[{i}]")]
+                for d in differences(g, w, f"{where}[{i}]", tol)]
     numbers = (int, float)
     if (isinstance(got, numbers) and isinstance(want, numbers)
             and not isinstance(got, bool) and not isinstance(want, bool)):
-        return [] if abs(got - want) <= 1e-6 else [f"{where}: {got} != {want}"]
+        return [] if abs(got - want) <= tol else [f"{where}: {got} != {want}"]
     return [] if got == want else [f"{where}: {got!r} != {want!r}"]
 
 
@@ -58,3 +59,9 @@ def test_the_comparison_sees_a_change():
     assert differences(moved, doc) == [f".alignment.x_m: {moved['alignment']['x_m']} != "
                                        f"{doc['alignment']['x_m']}"]
     assert differences(doc, doc) == []
+    gone = json.loads(json.dumps(doc))
+    del gone["alignment"]["fitness"]
+    assert differences(gone, doc) == [".alignment: keys ['fitness'] gone"]
+    gone["alignment"]["new_field"] = 1.0  # a field the reference lacks is no change
+    gone["alignment"]["fitness"] = doc["alignment"]["fitness"]
+    assert differences(gone, doc) == []

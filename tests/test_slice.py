@@ -59,17 +59,20 @@ def test_floor_height(tilted: np.ndarray) -> None:
 
 
 def test_wall_band_is_walls_only(tilted: np.ndarray, cloud: np.ndarray, walls: cKDTree) -> None:
-    band = wall_band(tilted, 0.3, 2.0)
+    band, levelling = wall_band(tilted, 0.3, 2.0)
     assert band.shape[1] == 2
     dist, _ = walls.query(band)
     # floor or ceiling points (38k each) would be ~14% of the band, mostly far from walls
     assert np.mean(dist < 0.05) > 0.99
     expected = np.count_nonzero((cloud[:, 2] >= 0.3) & (cloud[:, 2] <= 2.0))
     assert len(band) == pytest.approx(expected, rel=0.01)
+    # the levelling it reports is the tilt it removed, and the floor it measured from
+    assert levelling.tilt_deg == pytest.approx(TILT_DEG, abs=0.1)
+    assert levelling.floor_z_m == pytest.approx(FLOOR_Z, abs=0.02)
 
 
 def test_wall_band_is_deterministic(tilted: np.ndarray) -> None:
-    np.testing.assert_array_equal(wall_band(tilted), wall_band(tilted))
+    np.testing.assert_array_equal(wall_band(tilted)[0], wall_band(tilted)[0])
 
 
 def test_floor_below_a_stronger_ceiling_and_below_noise(cloud: np.ndarray) -> None:
@@ -79,7 +82,7 @@ def test_floor_below_a_stronger_ceiling_and_below_noise(cloud: np.ndarray) -> No
     sparse_below = np.column_stack([rng.uniform(0, 20, (300, 2)), rng.uniform(-3, -0.2, 300)])
     pts = np.vstack([thinned, sparse_below]) + [0.0, 0.0, -0.5]
     assert floor_height(pts) == pytest.approx(-0.5, abs=0.02)
-    band = wall_band(pts)
+    band, _ = wall_band(pts)
     assert len(band) == pytest.approx(np.count_nonzero((cloud[:, 2] >= 0.3)
                                                        & (cloud[:, 2] <= 2.0)), rel=0.01)
 

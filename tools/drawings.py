@@ -130,7 +130,7 @@ def truth_counts(data: Path) -> str:
         if isinstance(source, OccupancyMap):
             occ, grid = source.state == OCCUPIED, source.grid
         else:
-            grid, occ = truth_raster(source, plan_points(source, Settings()), Settings())
+            grid, occ = truth_raster(source, plan_points(source, Settings())[0], Settings())
         counts = [int(detect(n, occ, grid).strong.sum()) for n in NAMES]
         lines.append(f"| {title} | {grid.shape[1]} x {grid.shape[0]} at "
                      f"{grid.resolution * 1000:.2f} mm | " + " | ".join(map(str, counts)) + " |")

@@ -13,6 +13,7 @@ from pcmapq.align.rigid3d import Registration3D, align_3d, apply
 from pcmapq.config import Settings
 from pcmapq.errors import EvaluationError, InputError
 from pcmapq.features import Features, detect_in, walls_of
+from pcmapq.frames import Frames, Levelling
 from pcmapq.grid import MetricGrid
 from pcmapq.io import OccupancyMap, PointMap, load_map
 from pcmapq.match import match
@@ -26,21 +27,24 @@ from pcmapq.transform import Similarity2D
 Progress = Callable[[str], None]
 
 
-def plan_points(source: OccupancyMap | PointMap, settings: Settings) -> np.ndarray:
-    """The 2D structure of an input, (N, 2) metres in its own frame: occupied cell centres of an
-    image, the wall band of a 3D cloud, or a 2D cloud as it is."""
+def plan_points(source: OccupancyMap | PointMap,
+                settings: Settings) -> tuple[np.ndarray, Levelling | None]:
+    """The 2D structure of an input, (N, 2) metres in its own plan frame: occupied cell centres
+    of an image, the wall band of a 3D cloud (with the levelling that made its plan), or a 2D
+    cloud as it is."""
+    levelling = None
     if isinstance(source, OccupancyMap):
         xy = source.grid.cell_centres(source.state == OCCUPIED)
     elif source.is_3d:
         try:
-            xy = wall_band(source.points, settings.band_low, settings.band_high)
+            xy, levelling = wall_band(source.points, settings.band_low, settings.band_high)
         except ValueError as err:
             raise InputError(f"{source.path}: {err}") from None
     else:
         xy = source.points[:, :2]
     if len(xy) == 0:
         raise InputError(f"{source.path}: no occupied cells or wall points")
-    return xy
+    return xy, levelling
 
 
 def min_hits(cloud: PointMap, settings: Settings) -> int:
@@ -209,13 +213,16 @@ def score(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap, setti
     rule = map_footprint_rule(source, settings)
     progress("aligning")
     source, registration = align_clouds_3d(source, truth, settings)
-    map_xy, truth_xy = plan_points(source, settings), plan_points(truth, settings)
+    (map_xy, map_level), (truth_xy, truth_level) = (plan_points(source, settings),
+                                                    plan_points(truth, settings))
     if registration is None:
         alignment = align(map_xy, truth_xy, init=settings.init, refine=settings.align,
                           tolerance=settings.fit_tolerance, scale=settings.scale)
-    else:  # already aligned in 3D: score it in 2D as it is
-        alignment = align(map_xy, truth_xy, init=Similarity2D(), refine=False,
-                          tolerance=settings.fit_tolerance)
+    else:  # already aligned in 3D: score its plan in 2D as it is
+        alignment = replace(align(map_xy, truth_xy, init=Similarity2D(), refine=False,
+                                  tolerance=settings.fit_tolerance), method="3d")
+    frames = Frames(alignment.transform, map_level, truth_level,
+                    None if registration is None else registration.transform)
 
     progress("rasterising")
     grid, truth_occ = truth_raster(truth, truth_xy, settings)
@@ -237,17 +244,15 @@ def score(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap, setti
         detectors[name] = DetectorResult(truth_f, map_f,
                                          match(name, truth_f, map_f, settings.threshold))
     cloud_distances = None
-    if registration is not None:  # the map was moved in 3D: report that transform, in 2D too
+    if registration is not None:
         progress("distances in 3D")
         cloud_distances = distances_3d(source.points, truth.points, settings.cloud_resolution,
                                        settings.taus)
-        alignment = replace(alignment, transform=Similarity2D.from_matrix(registration.transform),
-                            method="3d")
     return Result(map_path=Path(map_path), map_kind=source.kind, truth_path=Path(truth_path),
                   truth_kind=truth.kind, grid=grid, alignment=alignment, overlap=cover,
                   distances=distances(truth_occ, map_occ, footprint, grid, settings.taus,
                                       to_map),
                   registration_3d=registration, distances_3d=cloud_distances,
                   threshold=settings.threshold, full=settings.full, detectors=detectors,
-                  footprint_rule=rule, settings=settings.to_dict(),
+                  footprint_rule=rule, frames=frames, settings=settings.to_dict(),
                   truth_occupied=truth_occ, map_occupied=map_occ)

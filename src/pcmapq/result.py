@@ -12,9 +12,11 @@ import numpy as np
 
 from pcmapq import __version__
 from pcmapq.features import Features
+from pcmapq.frames import Frames
 from pcmapq.grid import MetricGrid
 from pcmapq.match import Matching
-from pcmapq.metrics.distances import Distances
+from pcmapq.metrics.distances import Distances, FScore
+from pcmapq.stats import Stats
 
 if TYPE_CHECKING:  # the alignment modules load Open3D; a Result only holds their outputs
     from pcmapq.align import Alignment
@@ -47,20 +49,17 @@ class DetectorResult:
         """Length of each displacement, (M,) metres."""
         return np.linalg.norm(self.matching.displacement, axis=1)
 
-    def displacement_stats(self) -> dict[str, float | None]:
-        """mean, median, rmse and max of the displacement lengths, metres (None if no match)."""
-        d = self.distances
-        if len(d) == 0:
-            return {"mean": None, "median": None, "rmse": None, "max": None}
-        return {"mean": float(d.mean()), "median": float(np.median(d)),
-                "rmse": float(np.sqrt(np.mean(d**2))), "max": float(d.max())}
+    def displacement_stats(self) -> Stats:
+        """Statistics of the displacement lengths, metres (undefined with no match)."""
+        return Stats.of(self.distances)
 
 
 @dataclass(frozen=True)
 class Overlap:
     """What part of the truth the map covers and how well they agree there.
 
-    footprint: (rows, cols) bool on the truth's grid, the area the map observed.
+    footprint: (rows, cols) bool on the truth's grid, the area the map observed (None in a
+        result read back from JSON).
     coverage: share of the truth's occupied cells inside the footprint, [0, 1].
     truth_recall: share of those within the fit tolerance of a map occupied cell, [0, 1].
     agreement: alignment fitness times truth_recall.
@@ -68,7 +67,7 @@ class Overlap:
         0.5 a map of another place.
     """
 
-    footprint: np.ndarray
+    footprint: np.ndarray | None
     coverage: float
     truth_recall: float
     agreement: float
@@ -79,8 +78,12 @@ class Overlap:
 class Result:
     """A finished evaluation; all coordinates in the truth frame, metres.
 
-    settings: the options it ran with (``Settings.to_dict()``, metres and degrees); command: the
-    command line that made it (``pcmapq eval ...``, defaults left out), None from the library.
+    frames: the chain from each input to the truth's plan (levelling, 3D registration, the 2D
+    alignment; :mod:`pcmapq.frames`). settings: the options it ran with (``Settings.to_dict()``,
+    metres and degrees); command: the command line that made it (``pcmapq eval ...``, defaults
+    left out), None from the library. truth_occupied, map_occupied (and the overlap's
+    footprint): the rasters on ``grid``; None in a result read back by :meth:`from_json`, which
+    holds everything the JSON holds and no more.
     """
 
     map_path: Path
@@ -96,8 +99,9 @@ class Result:
     threshold: float
     full: bool
     detectors: dict[str, DetectorResult]
-    truth_occupied: np.ndarray
-    map_occupied: np.ndarray
+    truth_occupied: np.ndarray | None
+    map_occupied: np.ndarray | None
+    frames: Frames
     footprint_rule: str = "known"
     settings: dict | None = None
     command: str | None = None
@@ -114,13 +118,16 @@ class Result:
 
     def to_dict(self) -> dict:
         """The JSON document (see README): plain types, floats rounded to DECIMALS."""
-        tf = self.alignment.transform
+        tf = self.frames.map_to_truth()
+        x0, y0, yaw0 = self.grid.origin
         doc = {
             "pcmapq": {"version": __version__, "command": self.command},
             "settings": self.settings,
             "map": {"path": str(self.map_path), "kind": self.map_kind},
             "truth": {"path": str(self.truth_path), "kind": self.truth_kind,
-                      "resolution_m": self.grid.resolution},
+                      "resolution_m": self.grid.resolution,
+                      "origin": {"x_m": x0, "y_m": y0, "yaw_deg": float(np.degrees(yaw0))},
+                      "shape": list(self.grid.shape)},
             "alignment": {"x_m": tf.tx, "y_m": tf.ty, "yaw_deg": tf.yaw_deg, "scale": tf.scale,
                           "matrix": tf.matrix.tolist(), "fitness": self.alignment.fitness,
                           "rmse_m": self.alignment.rmse_m,
@@ -130,6 +137,7 @@ class Result:
                           "agreement": self.overlap.agreement,
                           "distinctiveness": self.alignment.distinctiveness,
                           "confidence": self.overlap.confidence},
+            "frames": self.frames.to_dict(),
             "coverage": self.overlap.coverage,
             "footprint": self.footprint_rule,
             "scored_against": "whole truth" if self.full else "footprint",
@@ -148,13 +156,17 @@ class Result:
                 "quality": m.quality, "precision": m.precision, "f1": m.f1,
                 "note": self.note(name),
                 "truth_features": m.truth_features, "map_features": m.map_features,
-                "matched": m.matched, "threshold_m": self.threshold,
-                "displacement_m": det.displacement_stats(),
+                "matched": m.matched, "matched_map": m.matched_map,
+                "threshold_m": self.threshold,
+                "displacement_m": det.displacement_stats().to_dict(),
             }
             doc["matches"] += [
-                {"detector": name, "truth_xy_m": t, "map_xy_m": p, "displacement_m": d}
-                for t, p, d in zip(det.truth_xy.tolist(), det.map_xy.tolist(),
-                                   det.distances.tolist(), strict=True)]
+                {"detector": name, "truth_xy_m": t, "map_xy_m": p, "displacement_m": d,
+                 "counted": {"truth": ts, "map": ms}}
+                for t, p, d, ts, ms in zip(
+                    det.truth_xy.tolist(), det.map_xy.tolist(), det.distances.tolist(),
+                    det.truth.strong[m.truth_idx].tolist(), det.map.strong[m.map_idx].tolist(),
+                    strict=True)]
             doc["missing"] += [{"detector": name, "truth_xy_m": t}
                                for t in det.truth.xy[m.missing].tolist()]
             doc["extra"] += [{"detector": name, "map_xy_m": p}
@@ -163,6 +175,13 @@ class Result:
 
     def to_json(self) -> str:
         return json.dumps(self.to_dict(), indent=2) + "\n"
+
+    @classmethod
+    def from_json(cls, text: str) -> Result:
+        """The Result that :meth:`to_json` wrote: ``from_json(r.to_json()).to_json() ==
+        r.to_json()``. What the JSON does not hold is absent: the rasters are None, feature
+        strengths and pair costs NaN, descriptors and segments None."""
+        return _from_dict(json.loads(text))
 
     def vectors_csv(self) -> str:
         """One row per matched feature: truth and map position and displacement, metres."""
@@ -176,8 +195,74 @@ class Result:
 
 
 def _distances_dict(d: Distances) -> dict:
-    return {"accuracy_m": asdict(d.accuracy), "completeness_m": asdict(d.completeness),
+    return {"accuracy_m": d.accuracy.to_dict(), "completeness_m": d.completeness.to_dict(),
             "chamfer_m": d.chamfer_m, "f_score": [asdict(f) for f in d.fscores]}
+
+
+def _distances_of(doc: dict) -> Distances:
+    return Distances(Stats.from_dict(doc["accuracy_m"]), Stats.from_dict(doc["completeness_m"]),
+                     doc["chamfer_m"], tuple(FScore(**f) for f in doc["f_score"]))
+
+
+def _xy(rows: list[dict], key: str) -> np.ndarray:
+    """The ``key`` points of JSON rows as (N, 2) metres."""
+    return np.array([r[key] for r in rows], dtype=np.float64).reshape(-1, 2)
+
+
+def _detector_of(doc: dict, matches: list[dict], missing: list[dict],
+                 extra: list[dict]) -> DetectorResult:
+    """One detector read back: the truth's features are the matched ones then the missing
+    ones, the map's the matched ones then the extra ones."""
+    n, k, e = len(matches), len(missing), len(extra)
+    t_strong = np.array([m["counted"]["truth"] for m in matches] + [True] * k, dtype=bool)
+    m_strong = np.array([m["counted"]["map"] for m in matches] + [True] * e, dtype=bool)
+    truth_xy = np.vstack([_xy(matches, "truth_xy_m"), _xy(missing, "truth_xy_m")])
+    map_xy = np.vstack([_xy(matches, "map_xy_m"), _xy(extra, "map_xy_m")])
+    pairs = np.arange(n)
+    matching = Matching(
+        truth_idx=pairs, map_idx=pairs, displacement=map_xy[:n] - truth_xy[:n],
+        cost=np.full(n, np.nan), quality=doc["quality"], precision=doc["precision"],
+        f1=doc["f1"], truth_features=doc["truth_features"], map_features=doc["map_features"],
+        matched=doc["matched"], matched_map=doc["matched_map"],
+        missing=np.arange(n, n + k), extra=np.arange(n, n + e))
+    return DetectorResult(Features(truth_xy, np.full(n + k, np.nan), t_strong),
+                          Features(map_xy, np.full(n + e, np.nan), m_strong), matching)
+
+
+def _from_dict(doc: dict) -> Result:
+    """:meth:`Result.from_json` of a parsed document."""
+    from pcmapq.align import Alignment  # runtime imports: reading a 3D result loads Open3D
+    from pcmapq.align.rigid3d import Registration3D
+
+    a, t = doc["alignment"], doc["truth"]
+    frames = Frames.from_dict(doc["frames"])
+    origin = t["origin"]
+    grid = MetricGrid(t["resolution_m"], (origin["x_m"], origin["y_m"],
+                                          float(np.radians(origin["yaw_deg"]))),
+                      tuple(t["shape"]))
+    reg = doc.get("alignment_3d")
+    detectors = {}
+    for name, d in doc["detectors"].items():
+        rows = {key: [r for r in doc[key] if r["detector"] == name]
+                for key in ("matches", "missing", "extra")}
+        detectors[name] = _detector_of(d, rows["matches"], rows["missing"], rows["extra"])
+    return Result(
+        map_path=Path(doc["map"]["path"]), map_kind=doc["map"]["kind"],
+        truth_path=Path(t["path"]), truth_kind=t["kind"], grid=grid,
+        alignment=Alignment(frames.planar, a["fitness"], a["rmse_m"], a["tolerance_m"],
+                            a["method"], a["distinctiveness"]),
+        overlap=Overlap(None, doc["coverage"], a["truth_recall"], a["agreement"],
+                        a["confidence"]),
+        distances=_distances_of(doc["distances"]),
+        registration_3d=None if reg is None else Registration3D(
+            np.asarray(reg["matrix"], dtype=np.float64), reg["fitness"], reg["rmse_m"]),
+        distances_3d=_distances_of(doc["distances_3d"]) if "distances_3d" in doc else None,
+        threshold=next((d["threshold_m"] for d in doc["detectors"].values()),
+                       (doc["settings"] or {}).get("threshold", 0.5)),
+        full=doc["scored_against"] == "whole truth", detectors=detectors,
+        truth_occupied=None, map_occupied=None, frames=frames,
+        footprint_rule=doc["footprint"], settings=doc["settings"],
+        command=doc["pcmapq"]["command"])
 
 
 def _rounded(value):

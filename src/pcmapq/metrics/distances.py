@@ -10,28 +10,10 @@ import numpy as np
 from scipy import ndimage
 
 from pcmapq.grid import MetricGrid
+from pcmapq.stats import Stats
 
 #: Default distance thresholds of the F-score, metres.
 DEFAULT_TAUS = (0.05, 0.1, 0.2, 0.5)
-
-
-@dataclass(frozen=True)
-class DistanceStats:
-    """Statistics of a set of distances, metres (None when the set is empty or holds an
-    infinite distance: nothing on the other side to measure to)."""
-
-    mean: float | None
-    median: float | None
-    rmse: float | None
-    p95: float | None
-    count: int
-
-    @classmethod
-    def of(cls, d: np.ndarray) -> DistanceStats:
-        if len(d) == 0 or not np.isfinite(d).all():
-            return cls(None, None, None, None, int(len(d)))
-        return cls(float(d.mean()), float(np.median(d)), float(np.sqrt(np.mean(d**2))),
-                   float(np.percentile(d, 95)), int(len(d)))
 
 
 @dataclass(frozen=True)
@@ -47,8 +29,8 @@ class FScore:
 
 @dataclass(frozen=True)
 class Distances:
-    accuracy: DistanceStats      # map -> truth
-    completeness: DistanceStats  # truth (inside the footprint) -> map
+    accuracy: Stats      # map -> truth
+    completeness: Stats  # truth (inside the footprint) -> map
     chamfer_m: float | None      # mean of the two means
     fscores: tuple[FScore, ...]
 
@@ -77,7 +59,7 @@ def distances(truth_occ: np.ndarray, map_occ: np.ndarray, footprint: np.ndarray,
 
 def _summary(acc: np.ndarray, comp: np.ndarray, taus: tuple[float, ...]) -> Distances:
     """Metrics from the map->truth (``acc``) and truth->map (``comp``) distances, metres."""
-    a, c = DistanceStats.of(acc), DistanceStats.of(comp)
+    a, c = Stats.of(acc), Stats.of(comp)
     chamfer = None if a.mean is None or c.mean is None else 0.5 * (a.mean + c.mean)
     scores = []
     for tau in taus:

@@ -9,6 +9,8 @@ from __future__ import annotations
 import numpy as np
 import open3d as o3d
 
+from pcmapq.frames import Levelling
+
 #: Height histogram bin for finding the floor, metres.
 FLOOR_BIN = 0.05
 #: A histogram peak is "strong" when it holds at least this share of the largest bin's count.
@@ -24,25 +26,28 @@ PLANE_POINTS = 20_000
 PLANE_TRIES = 3
 
 
-def wall_band(points: np.ndarray, low: float = 0.3, high: float = 2.0) -> np.ndarray:
+def wall_band(points: np.ndarray, low: float = 0.3,
+              high: float = 2.0) -> tuple[np.ndarray, Levelling]:
     """The points between ``low`` and ``high`` metres above the floor, projected onto the floor.
 
     points: (N, 3) metres, z roughly up. The cloud is first levelled with :func:`level_rotation`
     (a rotation about the horizontal axis only, so x, y and yaw are kept as far as the tilt
     allows), then the floor is found with :func:`floor_height`. Returns (M, 2) x, y in metres of
-    the levelled cloud. Raises ValueError if there are no points or the band is empty.
+    the levelled cloud and the :class:`~pcmapq.frames.Levelling` that made it. Raises ValueError
+    if there are no points or the band is empty.
     """
     if not low < high:
         raise ValueError(f"wall band: low ({low} m) must be below high ({high} m)")
     pts = _finite_points(points)
-    levelled = pts @ level_rotation(pts).T
+    rotation = level_rotation(pts)
+    levelled = pts @ rotation.T
     floor = floor_height(levelled)
     z = levelled[:, 2] - floor
     band = levelled[(z >= low) & (z <= high), :2]
     if len(band) == 0:
         raise ValueError(f"no points between {low} and {high} m above the floor "
                          f"(floor found at z = {floor:.2f} m)")
-    return band
+    return band, Levelling(rotation, floor)
 
 
 def level_rotation(points: np.ndarray) -> np.ndarray:

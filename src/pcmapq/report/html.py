@@ -6,10 +6,10 @@ import base64
 import html
 
 from pcmapq import __version__
-from pcmapq.metrics.distances import DistanceStats
 from pcmapq.report.plot import distance_heatmap, png_bytes, vectorial_figure
 from pcmapq.report.text import number, score
 from pcmapq.result import Result
+from pcmapq.stats import Stats
 
 STYLE = """
 body { font-family: -apple-system, 'Segoe UI', Helvetica, Arial, sans-serif; margin: 2em auto;
@@ -42,11 +42,20 @@ def _table(header: list[str], rows: list[list[str]]) -> str:
     return f"<table><tr>{head}</tr>{body}</table>"
 
 
-def _stats_table(counted: str, rows: list[tuple[str, DistanceStats]]) -> str:
+#: The statistics a table shows, with their headers.
+STATS_COLUMNS = (("mean", "mean [m]"), ("median", "median [m]"), ("rmse", "RMSE [m]"),
+                 ("std", "std [m]"), ("min", "min [m]"), ("max", "max [m]"),
+                 ("p95", "95th pct [m]"))
+
+
+def _stats_cells(s: Stats) -> list[str]:
+    return [number(getattr(s, key)) for key, _ in STATS_COLUMNS]
+
+
+def _stats_table(counted: str, rows: list[tuple[str, Stats]]) -> str:
     """A table of distance statistics, one row per (label, stats)."""
-    return _table(["", "mean [m]", "median [m]", "RMSE [m]", "95th pct [m]", counted],
-                  [[label, *(number(v) for v in (s.mean, s.median, s.rmse, s.p95)), str(s.count)]
-                   for label, s in rows])
+    return _table(["", *(h for _, h in STATS_COLUMNS), counted],
+                  [[label, *_stats_cells(s), str(s.count)] for label, s in rows])
 
 
 def report_html(result: Result) -> str:
@@ -68,14 +77,13 @@ def report_html(result: Result) -> str:
                      "whole truth" if result.full else "the map's footprint"]])
     rows = []
     for name, det in result.detectors.items():
-        m, s = det.matching, det.displacement_stats()
+        m = det.matching
         rows.append([name, score(m.quality), score(m.precision), score(m.f1),
-                     str(m.truth_features),
-                     str(m.map_features), str(m.matched), number(s["mean"]), number(s["median"]),
-                     number(s["rmse"]), number(s["max"])])
+                     str(m.truth_features), str(m.map_features), str(m.matched),
+                     str(m.matched_map), *_stats_cells(det.displacement_stats())])
     scores = _table(["detector", "quality q", "precision", "f1", "truth features",
-                     "map features", "matched", "disp. mean [m]", "disp. median [m]",
-                     "disp. RMSE [m]", "disp. max [m]"], rows)
+                     "map features", "truth matched", "map matched",
+                     *(f"disp. {h}" for _, h in STATS_COLUMNS)], rows)
     scores += "".join(f'<p class="note">{html.escape(n)}</p>' for n in result.notes())
     d = result.distances
     dist = _stats_table("cells", [("accuracy (map to truth)", d.accuracy),

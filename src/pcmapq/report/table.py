@@ -30,7 +30,7 @@ def print_table(result: Result, console: Console) -> None:
         stats = det.displacement_stats()
         table.add_row(name, score(m.quality), score(m.precision), score(m.f1),
                       str(m.truth_features), str(m.map_features), str(m.matched),
-                      *(number(stats[k]) for k in ("mean", "median", "rmse", "max")))
+                      *(number(getattr(stats, k)) for k in ("mean", "median", "rmse", "max")))
     console.print(table)
     for line in result.notes():
         console.print(line, highlight=False)
