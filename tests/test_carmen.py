@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pcmapq.config import Settings
+from pcmapq.config import AlignmentConfig, Settings
 from pcmapq.errors import InputError
 from pcmapq.io import PointMap, load_map
 from pcmapq.io.carmen import beam_angles, endpoints, load_carmen, read_flaser
@@ -184,8 +184,9 @@ def test_drift_ranks_maps() -> None:
     trajectory (4 % gain errors) scores worse than the corrected one on every detector's
     quality and precision and on the distance figures."""
     log = shared("carmen", "orebro-corrected.log.gz")
+    forced = Settings(alignment=AlignmentConfig(force=True))
     none, large = _drift_tool().ladder(log, levels=(0.0, 0.04), max_range=10.0,
-                                       settings=Settings(force=True), scans=80)
+                                       settings=forced, scans=80)
     for name in none.quality:
         assert large.quality[name] < none.quality[name], name
         assert large.precision[name] < none.precision[name], name
@@ -201,7 +202,7 @@ def test_drift_ladder_every_f1_falls_and_sift_quality_with_it():
     log = shared("carmen", "orebro-corrected.log.gz")
     tool = _drift_tool()
     rungs = tool.ladder(log, levels=(0.01, 0.02, 0.04), max_range=10.0,
-                        settings=Settings(force=True), scans=180)
+                        settings=Settings(alignment=AlignmentConfig(force=True)), scans=180)
     assert tool.not_falling(rungs) == []
     for name in rungs[0].f1:
         values = [r.f1[name] for r in rungs]

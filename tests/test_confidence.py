@@ -14,7 +14,7 @@ import pytest
 
 from pcmapq import synth
 from pcmapq.align.coarse import Search, distinctiveness
-from pcmapq.config import Settings
+from pcmapq.config import AlignmentConfig, MatchingConfig, Settings, SourceConfig
 from pcmapq.errors import EvaluationError
 from pcmapq.io import Thresholds, load_map
 from pcmapq.pipeline import confidence, evaluate
@@ -24,7 +24,7 @@ from pcmapq.transform import Similarity2D
 from .conftest import in_map_frame, shared, write_image_map
 
 SAMPLE = Path(__file__).resolve().parents[1] / "data" / "sample"
-FAST = Settings(detectors=())
+FAST = Settings(matching=MatchingConfig(detectors=()))
 
 
 def run(*args: str) -> subprocess.CompletedProcess:
@@ -78,7 +78,8 @@ def test_building_against_itself_turned_is_confident(plan, truth_png, tmp_path, 
     distinctiveness 0.3 rigid, 0.6 with the scale free; recall 1.0)."""
     tf = Similarity2D(3.0, -2.0, np.radians(123.0))
     path = write_image_map(in_map_frame(plan, tf), tmp_path / "turned.png")
-    result = evaluate(path, truth_png, Settings(detectors=(), scale=scale))
+    result = evaluate(path, truth_png, Settings(matching=MatchingConfig(detectors=()),
+                                                alignment=AlignmentConfig(scale=scale)))
     assert result.overlap.confidence == 1.0
     assert result.alignment.distinctiveness > 0.2
 
@@ -90,11 +91,13 @@ def test_other_places_are_refused(truth_png, tmp_path, scale):
     for name, segments in (("rooms", round_rooms()),
                            ("other", synth.building_plan(7, 18.0, 20.0))):
         path = write_image_map(segments, tmp_path / f"{name}.png")
-        settings = Settings(detectors=(), scale=scale, force=True)
+        settings = Settings(matching=MatchingConfig(detectors=()),
+                            alignment=AlignmentConfig(scale=scale, force=True))
         result = evaluate(path, truth_png, settings)
         assert result.overlap.confidence < 0.5, (name, result.overlap)
         with pytest.raises(EvaluationError, match="likely cause"):
-            evaluate(path, truth_png, Settings(detectors=(), scale=scale))
+            evaluate(path, truth_png, Settings(matching=MatchingConfig(detectors=()),
+                                               alignment=AlignmentConfig(scale=scale)))
 
 
 def test_cli_exit_codes_and_refusal_messages(tmp_path):
@@ -190,7 +193,9 @@ def test_intel_map_against_freiburgs_plan_is_refused():
     assert proc.returncode == 1 and "another place" in proc.stderr, proc.stderr
 
 
-PLAN = Settings(scale=True, truth_resolution=0.05, detectors=())
+PLAN = Settings(alignment=AlignmentConfig(scale=True),
+                truth=SourceConfig(resolution=0.05),
+                matching=MatchingConfig(detectors=()))
 
 
 @pytest.mark.parametrize(("image", "plan", "same"), [
@@ -214,5 +219,6 @@ def test_carmen_buildings_are_refused():
     intel = shared("carmen", "intel-corrected.log.gz")
     fhw = shared("carmen", "fhw-corrected.log.gz")
     for a, b in ((intel, fhw), (fhw, intel)):
-        result = evaluate(a, b, Settings(detectors=(), force=True))
+        result = evaluate(a, b, Settings(matching=MatchingConfig(detectors=()),
+                                         alignment=AlignmentConfig(force=True)))
         assert result.overlap.confidence < 0.5, (a.name, b.name, result.overlap.confidence)

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from pcmapq import synth
-from pcmapq.config import Settings
+from pcmapq.config import AlignmentConfig, FootprintConfig, MatchingConfig, Settings
 from pcmapq.errors import InputError
 from pcmapq.io.writers import write_ros_map
 from pcmapq.pipeline import evaluate
@@ -94,7 +94,7 @@ def test_full_flag_scores_against_the_whole_truth(plan, truth_png, tmp_path):
     box, tf = CUTS[0]
     path = write_partial_image(plan, box, tf, tmp_path / "part.png")
     part = evaluate(path, truth_png)
-    whole = evaluate(path, truth_png, Settings(full=True))
+    whole = evaluate(path, truth_png, Settings(footprint=FootprintConfig(full=True)))
     for name in part.detectors:
         q_part = part.detectors[name].matching.quality
         q_whole = whole.detectors[name].matching.quality
@@ -124,8 +124,10 @@ def test_known_footprint_of_a_binary_map_counts_its_whole_rectangle(plan, truth_
     walls = evaluate(path, truth_png)
     # the truth's walls across the rectangle lie far from the map, so the confidence that the
     # map shows this place is low with these footprints: force them
-    known = evaluate(path, truth_png, Settings(footprint="known", force=True))
-    everything = evaluate(path, truth_png, Settings(footprint="all", force=True))
+    known = evaluate(path, truth_png, Settings(footprint=FootprintConfig(rule="known"),
+                                               alignment=AlignmentConfig(force=True)))
+    everything = evaluate(path, truth_png, Settings(footprint=FootprintConfig(rule="all"),
+                                                    alignment=AlignmentConfig(force=True)))
     assert known.footprint_rule == "known" and everything.footprint_rule == "all"
     assert known.overlap.coverage > share + 0.1, (known.overlap.coverage, share)
     assert everything.overlap.coverage >= known.overlap.coverage - 0.01
@@ -138,9 +140,11 @@ def test_all_footprint_of_an_image_with_unknown_cells(plan, truth_png, tmp_path)
     """--footprint all: the image's whole rectangle, unknown cells included."""
     box, tf = CUTS[1]
     path = write_partial_image(plan, box, tf, tmp_path / "part.png")
-    known = evaluate(path, truth_png, Settings(detectors=("harris",)))
-    whole = evaluate(path, truth_png, Settings(detectors=("harris",), footprint="all",
-                                               force=True))  # low recall across the rectangle
+    known = evaluate(path, truth_png, Settings(matching=MatchingConfig(detectors=("harris",))))
+    whole = evaluate(path, truth_png, Settings(matching=MatchingConfig(detectors=("harris",)),
+                                               footprint=FootprintConfig(rule="all"),
+                                               # low recall across the rectangle
+                                               alignment=AlignmentConfig(force=True)))
     assert known.footprint_rule == "known"
     assert whole.overlap.coverage > known.overlap.coverage + 0.3
 
@@ -149,8 +153,10 @@ def test_cloud_has_no_known_cells(plan, truth_png, tmp_path):
     pts = synth.wall_points(plan, 0.05)
     path = write_cloud_map(pts, tmp_path / "cloud.npy")
     with pytest.raises(InputError, match="cloud.npy: a point cloud has no known cells"):
-        evaluate(path, truth_png, Settings(footprint="known", detectors=("harris",)))
-    result = evaluate(path, truth_png, Settings(footprint="all", detectors=("harris",)))
+        evaluate(path, truth_png, Settings(footprint=FootprintConfig(rule="known"),
+                                           matching=MatchingConfig(detectors=("harris",))))
+    result = evaluate(path, truth_png, Settings(footprint=FootprintConfig(rule="all"),
+                                                matching=MatchingConfig(detectors=("harris",))))
     assert result.footprint_rule == "all" and result.overlap.coverage >= 0.99
 
 

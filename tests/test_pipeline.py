@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from pcmapq import synth
-from pcmapq.config import Settings
+from pcmapq.config import AlignmentConfig, MatchingConfig, Settings
 from pcmapq.pipeline import evaluate
 from pcmapq.transform import Similarity2D
 
@@ -61,7 +61,7 @@ def _ladder(plan, truth_png, tmp_path, maps) -> list[dict[str, tuple[float, floa
             path = write_image_map(segments_or_points, tmp_path / f"step{i}.png")
         else:
             path = write_cloud_map(segments_or_points, tmp_path / f"step{i}.npy")
-        result = evaluate(path, truth_png, Settings(force=True))
+        result = evaluate(path, truth_png, Settings(alignment=AlignmentConfig(force=True)))
         rows.append({n: (d.matching.quality, d.matching.precision, d.matching.f1)
                      for n, d in result.detectors.items()})
     return rows
@@ -118,7 +118,8 @@ def test_moved_wall_shows_its_displacement(plan, truth_png, tmp_path):
     wall = plan[[20, 21]]
     moved = synth.move_wall(synth.move_wall(plan, 20, (0.5, 0.0)), 21, (0.5, 0.0))
     path = write_image_map(moved, tmp_path / "moved.png")
-    result = evaluate(path, truth_png, Settings(threshold=1.0, force=True))
+    result = evaluate(path, truth_png, Settings(matching=MatchingConfig(threshold=1.0),
+                                                alignment=AlignmentConfig(force=True)))
     near_count = 0
     for name, det in result.detectors.items():
         gap = _distance_to_segments(det.truth_xy, wall)
@@ -144,7 +145,7 @@ def test_map_of_unknown_scale(plan, truth_png, tmp_path):
     grid = synth.plan_grid(segments, 0.05)
     path = tmp_path / "picture.png"  # no YAML beside it
     cv2.imwrite(str(path), synth.render(segments, grid, thickness=0.075))
-    result = evaluate(path, truth_png, Settings(scale=True))
+    result = evaluate(path, truth_png, Settings(alignment=AlignmentConfig(scale=True)))
     got = result.alignment.transform
     # the picture's frame has its origin at the image's lower-left corner, in guessed metres
     want = tf.compose(Similarity2D(grid.origin[0], grid.origin[1]))

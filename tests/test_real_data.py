@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from skimage.morphology import skeletonize
 
-from pcmapq.config import Settings
+from pcmapq.config import AlignmentConfig, Settings
 from pcmapq.features import DETECTORS, detect
 from pcmapq.grid import MetricGrid
 from pcmapq.io import load_map
@@ -84,7 +84,7 @@ def test_lidar_pair_aligns_to_its_known_transform():
     source, target = shared("registration", "source.ply"), shared("registration", "target.ply")
     truth = np.loadtxt(shared("registration", "T_target_source.txt"))
     want = Similarity2D.from_matrix(truth)
-    result = evaluate(source, target, Settings(force=True))
+    result = evaluate(source, target, Settings(alignment=AlignmentConfig(force=True)))
     got = result.alignment.transform
     assert np.hypot(got.tx - want.tx, got.ty - want.ty) < 0.05, got
     assert abs(got.yaw_deg - want.yaw_deg) < 0.5, got

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from pcmapq import synth
-from pcmapq.config import Settings
+from pcmapq.config import MatchingConfig, Settings
 from pcmapq.pipeline import evaluate
 from pcmapq.report.html import report_html
 from pcmapq.report.plot import distance_heatmap, png_bytes, vectorial_figure
@@ -24,7 +24,7 @@ def moved_result(plan, truth_png, tmp_path_factory):
     """A map whose L-shaped wall stands 0.5 m east of the truth's."""
     moved = synth.move_wall(synth.move_wall(plan, 20, (0.5, 0.0)), 21, (0.5, 0.0))
     path = write_image_map(moved, tmp_path_factory.mktemp("moved") / "moved.png")
-    return evaluate(path, truth_png, Settings(threshold=1.0))
+    return evaluate(path, truth_png, Settings(matching=MatchingConfig(threshold=1.0)))
 
 
 @pytest.fixture(scope="module")

@@ -11,7 +11,7 @@ from rich.console import Console
 from typer.testing import CliRunner
 
 from pcmapq.cli import app
-from pcmapq.config import Settings
+from pcmapq.config import AlignmentConfig, FootprintConfig, MatchingConfig, Settings
 from pcmapq.pipeline import evaluate
 from pcmapq.report.html import report_html
 from pcmapq.report.plot import vectorial_figure
@@ -86,7 +86,8 @@ def test_round_room_json_table_report_plot(round_result):
 
 
 def test_with_full_the_note_does_not_mention_the_footprint(round_png):
-    result = evaluate(round_png, round_png, Settings(full=True, detectors=("harris",)))
+    result = evaluate(round_png, round_png, Settings(footprint=FootprintConfig(full=True),
+                                                     matching=MatchingConfig(detectors=("harris",))))
     assert result.note("harris") == "no strong truth feature; no strong map feature"
 
 
@@ -96,7 +97,9 @@ def test_map_without_strong_features(tmp_path):
     truth = write_image_map(polygon(np.array([[-4, -4], [4, -4], [4, 4], [-4, 4]], float)),
                             tmp_path / "square.png")
     mapped = write_image_map(rounded_square(), tmp_path / "rounded.png")
-    result = evaluate(mapped, truth, Settings(detectors=("harris", "hough"), force=True))
+    settings = Settings(matching=MatchingConfig(detectors=("harris", "hough")),
+                        alignment=AlignmentConfig(force=True))
+    result = evaluate(mapped, truth, settings)
     harris = result.detectors["harris"].matching
     assert (harris.truth_features, harris.map_features) == (4, 0)
     assert harris.quality == 0.0 and harris.precision is None and harris.f1 is None

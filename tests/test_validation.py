@@ -78,7 +78,8 @@ def test_halmstad_full_pipeline_puts_keypoints_within_20_px():
     root = shared("halmstad")
     map_path = shared("halmstad", "maps", "E5", "pseudo_occupancy", "E5_09.png")
     layout = shared("halmstad", "maps", "E5", "layout", "E5_layout.png")
-    settings = tool.Settings(scale=True, truth_resolution=0.05)
+    settings = tool.Settings(alignment=tool.AlignmentConfig(scale=True),
+                             truth=tool.SourceConfig(resolution=0.05))
     result = tool.timed_evaluate(map_path, layout, settings).result
     bench = tool.load_tool(tool.ROOT / "bench" / "bench_scale.py")
     map_keys, layout_keys = bench.keypoint_pairs(root, "E5_09", "E5")

@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from pcmapq import synth
-from pcmapq.config import Settings
+from pcmapq.config import AlignmentConfig, FootprintConfig, Settings
 from pcmapq.io.writers import write_ros_map
 from pcmapq.pipeline import evaluate
 from pcmapq.report.text import score
@@ -72,7 +72,8 @@ def main(argv: list[str] | None = None) -> int:
                 path = write_binary(plan, box, tf, Path(tmp) / f"part{k}_{i}.png")
                 cells = [str(box), f"{share:.2f}", f"{np.degrees(tf.yaw) % 360:.0f}"]
                 for rule in rules:
-                    r = evaluate(path, truth, Settings(footprint=rule, force=True))
+                    r = evaluate(path, truth, Settings(footprint=FootprintConfig(rule=rule),
+                                                       alignment=AlignmentConfig(force=True)))
                     q = [d.matching.quality for d in r.detectors.values()]
                     qs = [v for v in q if v is not None]
                     rows[rule].append((r.overlap.coverage - share, min(qs), max(qs)))

@@ -26,7 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
-from pcmapq.config import Settings
+from pcmapq.config import AlignmentConfig, Settings
 from pcmapq.io.carmen import DEFAULT_MAX_RANGE, endpoints, read_flaser
 from pcmapq.pipeline import evaluate
 from pcmapq.report.text import number, score
@@ -107,7 +107,7 @@ def ladder(log: Path, levels: tuple[float, ...] = DEFAULT_LEVELS, seed: int = 0,
            scans: int | None = None) -> list[Rung]:
     """Score the maps of ``log`` at each drift level against its corrected map, both made of
     its first ``scans`` scans (all by default) and their readings up to ``max_range`` metres."""
-    settings = Settings(force=True) if settings is None else settings
+    settings = Settings(alignment=AlignmentConfig(force=True)) if settings is None else settings
     poses, ranges, angles = (part[:scans] for part in read_flaser(log))
     rungs = []
     with tempfile.TemporaryDirectory(prefix="carmen_drift_") as tmp:

@@ -25,7 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
-from pcmapq.config import Settings
+from pcmapq.config import AlignmentConfig, MatchingConfig, Settings, SourceConfig
 from pcmapq.io import PointMap, Thresholds
 from pcmapq.io.carmen import DEFAULT_MAX_RANGE, endpoints, read_flaser
 from pcmapq.pipeline import evaluate
@@ -40,9 +40,11 @@ OLD_MIN_AGREEMENT = 0.2
 NEW_MIN_CONFIDENCE = Settings().min_confidence
 
 #: Scale estimated, plan taken at 0.05 m per pixel (as tools/validate.py).
-PLAN = Settings(scale=True, truth_resolution=0.05, force=True, detectors=())
+PLAN = Settings(alignment=AlignmentConfig(scale=True, force=True),
+                truth=SourceConfig(resolution=0.05),
+                matching=MatchingConfig(detectors=()))
 #: Both sides metric.
-RIGID = Settings(force=True, detectors=())
+RIGID = Settings(alignment=AlignmentConfig(force=True), matching=MatchingConfig(detectors=()))
 #: The Intel SLAM map's walls are grey 127, its unexplored area grey 230.
 INTEL_MAP = Thresholds(occupied=0.4, free=0.05)
 

@@ -33,7 +33,7 @@ from types import ModuleType
 
 import numpy as np
 
-from pcmapq.config import Settings
+from pcmapq.config import AlignmentConfig, Settings, SourceConfig
 from pcmapq.io import OccupancyMap, Thresholds, load_map
 from pcmapq.io.occupancy import MapMeta, classify, read_grey
 from pcmapq.pipeline import evaluate
@@ -169,7 +169,8 @@ def yaw_error(yaw_deg: float, expected_deg: float) -> float:
 def gazebo_run(data: Path = DATA) -> Run:
     """The Gazebo SLAM map scored against its truth, scale estimated."""
     folder = data / "gazebo"
-    settings = Settings(truth_resolution=GAZEBO_RESOLUTION, scale=True)
+    settings = Settings(truth=SourceConfig(resolution=GAZEBO_RESOLUTION),
+                        alignment=AlignmentConfig(scale=True))
     return timed_evaluate(folder / "SLAM_Gen_Map.png", folder / "Ground_Truth.png", settings)
 
 
@@ -282,7 +283,8 @@ def halmstad_pipeline(data: Path) -> str:
         "SIFT q / p | acc mean m | comp mean m | F@0.2 | s |",
         "|" + " --- |" * 15,
     ]
-    settings = Settings(scale=True, truth_resolution=PLAN_RESOLUTION)
+    settings = Settings(alignment=AlignmentConfig(scale=True),
+                        truth=SourceConfig(resolution=PLAN_RESOLUTION))
     with tempfile.TemporaryDirectory(prefix="pcmapq_validate_") as tmp:
         for name in HALMSTAD_MAPS:
             building = name.rsplit("_", 1)[0]
@@ -341,8 +343,9 @@ def floorplan_run(case: FloorPlan, data: Path = DATA) -> Run:
     """One SLAM map vs its plan: plan at PLAN_RESOLUTION, the map's scale estimated (it starts
     at the plan's resolution, so the scale is plan pixels per map pixel)."""
     folder = data / "floorplans"
-    settings = Settings(scale=True, truth_resolution=PLAN_RESOLUTION,
-                        map_thresholds=case.thresholds)
+    settings = Settings(alignment=AlignmentConfig(scale=True),
+                        truth=SourceConfig(resolution=PLAN_RESOLUTION),
+                        map=SourceConfig(thresholds=case.thresholds))
     return timed_evaluate(folder / case.map_file, folder / case.plan_file, settings)
 
 

@@ -14,7 +14,7 @@ from rich.console import Console
 from rich.progress import Progress
 
 from pcmapq import options
-from pcmapq.config import Settings
+from pcmapq.config import DistancesConfig, MatchingConfig, Settings, SourceConfig
 from pcmapq.errors import EvaluationError, InputError
 from pcmapq.io import PointMap
 from pcmapq.io.writers import write_atomic, write_cloud
@@ -167,18 +167,18 @@ def eval_command(
         help="Evaluate even when the map does not seem to show the truth's place.")] = False,
     threshold: Annotated[float, typer.Option(
         help="Largest distance between matched features, metres.", min=1e-6)
-    ] = DEFAULTS.threshold,
+    ] = DEFAULTS.matching.threshold,
     band_low: Annotated[float, typer.Option(
         help="Wall band of a 3D cloud: lower bound, metres above the floor.")
-    ] = DEFAULTS.band_low,
+    ] = DEFAULTS.raster.band_low,
     band_high: Annotated[float, typer.Option(
         help="Wall band of a 3D cloud: upper bound, metres above the floor.")
-    ] = DEFAULTS.band_high,
+    ] = DEFAULTS.raster.band_high,
     min_hits: Annotated[int | None, typer.Option(
         help="Points needed to mark a cloud's cell occupied [default: 2 for a 3D cloud, 1 for "
         "a 2D one].", min=1, show_default=False)] = None,
     detectors: Annotated[str, typer.Option(
-        help="Comma-separated detectors to run.")] = ",".join(DEFAULTS.detectors),
+        help="Comma-separated detectors to run.")] = ",".join(DEFAULTS.matching.detectors),
     json_path: Annotated[str | None, typer.Option(
         "--json", help="Write the result as JSON to this path ('-' for stdout only).")] = None,
     vectors: Annotated[Path | None, typer.Option(
@@ -189,14 +189,14 @@ def eval_command(
         help="Write a self-contained HTML report (figures embedded).")] = None,
     voxel_3d: Annotated[float, typer.Option(
         "--voxel-3d", help="Working voxel of the 3D registration of two 3D clouds, metres "
-        "(0.5-1 for outdoor maps).", min=0.01)] = DEFAULTS.voxel_3d,
+        "(0.5-1 for outdoor maps).", min=0.01)] = DEFAULTS.alignment.voxel_3d,
     tau: Annotated[str, typer.Option(
         help="Distance thresholds of the F-score, metres, comma-separated.")
-    ] = ",".join(f"{t:g}" for t in DEFAULTS.taus),
+    ] = ",".join(f"{t:g}" for t in DEFAULTS.distances.taus),
     footprint: Annotated[str, typer.Option(
         help="The area the map observed: 'known' cells of an image, the area its 'walls' "
         "enclose, 'all' of its rectangle; 'auto': known cells for an image with unknown "
-        "regions, walls for a binary image or a cloud.")] = DEFAULTS.footprint,
+        "regions, walls for a binary image or a cloud.")] = DEFAULTS.footprint.rule,
     full: Annotated[bool, typer.Option(
         "--full", help="Score against the whole truth, not only the part the map covers.")
     ] = False,
@@ -208,14 +208,18 @@ def eval_command(
     truth_path = paths[-1]
     resolution, auto = options.parse_resolution(map_resolution, scale)
     settings = Settings(
-        map_resolution=resolution, truth_resolution=truth_resolution, scale=auto,
-        map_thresholds=options.thresholds(map_occupied_thresh, map_free_thresh, map_negate),
-        truth_thresholds=options.thresholds(truth_occupied_thresh, truth_free_thresh,
-                                            truth_negate),
-        band_low=band_low, band_high=band_high, init=options.parse_init(init),
-        align=not no_align, force=force, threshold=threshold, min_hits=min_hits,
-        detectors=options.parse_detectors(detectors), full=full, taus=options.parse_taus(tau),
-        voxel_3d=voxel_3d, footprint=options.parse_footprint(footprint))
+        map=SourceConfig(resolution, options.thresholds(map_occupied_thresh, map_free_thresh,
+                                                        map_negate)),
+        truth=SourceConfig(truth_resolution, options.thresholds(
+            truth_occupied_thresh, truth_free_thresh, truth_negate)),
+        raster=replace(DEFAULTS.raster, band_low=band_low, band_high=band_high,
+                       min_hits=min_hits),
+        alignment=replace(DEFAULTS.alignment, enabled=not no_align,
+                          init=options.parse_init(init), scale=auto, voxel_3d=voxel_3d,
+                          force=force),
+        footprint=replace(DEFAULTS.footprint, rule=options.parse_footprint(footprint), full=full),
+        matching=MatchingConfig(options.parse_detectors(detectors), threshold),
+        distances=DistancesConfig(options.parse_taus(tau)))
     quiet = json_path == "-"
     err = Console(stderr=True)
     out = Console(quiet=quiet, width=None if err.is_terminal else 132)

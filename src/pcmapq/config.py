@@ -1,8 +1,9 @@
-"""Settings: every option of a run in one object, every length in metres."""
+"""Settings: every option of a run in one object, nested by pipeline stage, every length in
+metres. Each default is defined here once; the command line and the docs read it from here."""
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass, fields
+from dataclasses import dataclass, field, fields, is_dataclass
 
 from pcmapq.features import DETECTORS
 from pcmapq.io.occupancy import Thresholds
@@ -14,73 +15,128 @@ DETECTOR_NAMES = tuple(DETECTORS)
 
 
 @dataclass(frozen=True)
-class Settings:
-    """Options of ``pcmapq eval``; defaults are the documented ones.
+class SourceConfig:
+    """How one input is read (load stage).
 
-    map_resolution, truth_resolution: metres per pixel of an image that has no YAML (overrides
-        the YAML's); for a cloud truth, the cell size of its grid (default ``cloud_resolution``).
-    map_thresholds, truth_thresholds: map_server's occupied_thresh, free_thresh and negate for
-        an image map / truth, overriding its YAML (``--map-occupied-thresh`` ...).
+    resolution: metres per pixel of an image that has no YAML (overrides the YAML's); for a
+        cloud truth, the cell size of its grid (default ``RasterConfig.cloud_resolution``).
+    thresholds: map_server's occupied_thresh, free_thresh and negate for an image, overriding
+        its YAML (``--map-occupied-thresh`` ...).
+    """
+
+    resolution: float | None = None
+    thresholds: Thresholds | None = None
+
+
+@dataclass(frozen=True)
+class RasterConfig:
+    """How inputs become plans and grids (raster stage).
+
     cloud_resolution: cell size used for a point-cloud truth when none is given, metres.
     band_low, band_high: the wall band of a 3D cloud, metres above the floor.
-    scale: estimate the map's scale too (a similarity); for maps whose resolution is unknown
-        or wrong. A map image without resolution then starts from the truth's.
-    init: initial guess of the map -> truth transform; skips the global step.
-    align: False trusts the map's frame (``--no-align``): no global step, no ICP.
-    fit_tolerance: a map point is an inlier of the alignment within this distance, metres.
-    min_confidence: the map is taken to show another place when its ``confidence`` (see
-        :func:`pcmapq.pipeline.confidence`) is below this.
-    force: evaluate even when the confidence is below ``min_confidence``.
-    footprint: how the map's footprint (the area it observed) is found, one of
-        ``pcmapq.raster.footprint.FOOTPRINT_RULES``: ``known`` cells of an image, the area its
-        ``walls`` enclose, ``all`` of its rectangle, or ``auto``: known cells for an image with
-        unknown regions, walls for a binary image or a cloud.
-    footprint_margin: the map's footprint is grown by this much, metres.
-    threshold: largest distance between matched features, metres.
     min_hits: a cloud cell is occupied when it holds at least this many points; by default 2
         for a 3D cloud (its wall band stacks many points on a wall cell, and a lone outlier is
         dropped) and 1 for a 2D cloud (a laser map puts one or two points per wall cell).
-    detectors: which detectors to run.
-    taus: distance thresholds of the F-score, metres.
-    voxel_3d: working voxel of the 3D registration when both sides are 3D clouds, metres
-        (0.3 indoors; 0.5-1 for outdoor maps).
-    full: score against the whole truth; by default truth features outside the map's footprint
-        (the area it observed) are not counted as missing.
     """
 
-    map_resolution: float | None = None
-    truth_resolution: float | None = None
-    map_thresholds: Thresholds | None = None
-    truth_thresholds: Thresholds | None = None
     cloud_resolution: float = 0.05
     band_low: float = 0.3
     band_high: float = 2.0
-    scale: bool = False
+    min_hits: int | None = None
+
+
+@dataclass(frozen=True)
+class AlignmentConfig:
+    """How the map is put in the truth's frame (align stage).
+
+    enabled: False trusts the map's frame (``--no-align``): no global step, no ICP.
+    init: initial guess of the map -> truth transform; skips the global step.
+    scale: estimate the map's scale too (a similarity); for maps whose resolution is unknown
+        or wrong. A map image without resolution then starts from the truth's.
+    tolerance: a map point is an inlier of the alignment within this distance, metres.
+    voxel_3d: working voxel of the 3D registration when both sides are 3D clouds, metres
+        (0.3 indoors; 0.5-1 for outdoor maps).
+    min_confidence: the map is taken to show another place when its ``confidence`` (see
+        :func:`pcmapq.pipeline.confidence`) is below this.
+    force: evaluate even when the confidence is below ``min_confidence``.
+    """
+
+    enabled: bool = True
     init: Similarity2D | None = None
-    align: bool = True
-    fit_tolerance: float = 0.2
+    scale: bool = False
+    tolerance: float = 0.2
+    voxel_3d: float = 0.3
     min_confidence: float = 0.5
     force: bool = False
-    footprint: str = "auto"
-    footprint_margin: float = 0.3
-    threshold: float = 0.5
-    min_hits: int | None = None
-    detectors: tuple[str, ...] = DETECTOR_NAMES
+
+
+@dataclass(frozen=True)
+class FootprintConfig:
+    """What part of the truth the map is scored against.
+
+    rule: how the map's footprint (the area it observed) is found, one of
+        ``pcmapq.raster.footprint.FOOTPRINT_RULES``: ``known`` cells of an image, the area its
+        ``walls`` enclose, ``all`` of its rectangle, or ``auto``: known cells for an image with
+        unknown regions, walls for a binary image or a cloud.
+    margin: the map's footprint is grown by this much, metres.
+    full: score against the whole truth; by default truth features outside the map's footprint
+        are not counted as missing.
+    """
+
+    rule: str = "auto"
+    margin: float = 0.3
     full: bool = False
+
+
+@dataclass(frozen=True)
+class MatchingConfig:
+    """Which features are found and when two match (features and match stages).
+
+    detectors: which detectors to run.
+    threshold: largest distance between matched features, metres.
+    """
+
+    detectors: tuple[str, ...] = DETECTOR_NAMES
+    threshold: float = 0.5
+
+
+@dataclass(frozen=True)
+class DistancesConfig:
+    """The distance metrics (metrics stage). taus: thresholds of the F-score, metres."""
+
     taus: tuple[float, ...] = DEFAULT_TAUS
-    voxel_3d: float = 0.3
+
+
+@dataclass(frozen=True)
+class Settings:
+    """Options of ``pcmapq eval``, one group per stage; defaults are the documented ones.
+
+    ``Settings(alignment=AlignmentConfig(scale=True), matching=MatchingConfig(threshold=0.3))``
+    changes two options and keeps every other default.
+    """
+
+    map: SourceConfig = field(default_factory=SourceConfig)
+    truth: SourceConfig = field(default_factory=SourceConfig)
+    raster: RasterConfig = field(default_factory=RasterConfig)
+    alignment: AlignmentConfig = field(default_factory=AlignmentConfig)
+    footprint: FootprintConfig = field(default_factory=FootprintConfig)
+    matching: MatchingConfig = field(default_factory=MatchingConfig)
+    distances: DistancesConfig = field(default_factory=DistancesConfig)
 
     def to_dict(self) -> dict:
-        """Every option as plain JSON types, in metres and degrees: ``init`` as
-        ``{"x_m", "y_m", "yaw_deg"}``, tuples as lists, thresholds as dicts."""
-        out = {}
-        for f in fields(self):
-            value = getattr(self, f.name)
-            if isinstance(value, Similarity2D):
-                value = {"x_m": value.tx, "y_m": value.ty, "yaw_deg": value.yaw_deg}
-            elif isinstance(value, Thresholds):
-                value = asdict(value)
-            elif isinstance(value, tuple):
-                value = list(value)
-            out[f.name] = value
-        return out
+        """Every option as plain JSON types, one object per stage, in metres and degrees:
+        ``init`` as ``{"x_m", "y_m", "yaw_deg"}``, tuples as lists."""
+        return _plain(self)
+
+
+def _plain(value):
+    """A settings value as plain JSON types (see :meth:`Settings.to_dict`)."""
+    if isinstance(value, Similarity2D):
+        return {"x_m": value.tx, "y_m": value.ty, "yaw_deg": value.yaw_deg}
+    if is_dataclass(value):
+        return {f.name: _plain(getattr(value, f.name)) for f in fields(value)}
+    if isinstance(value, dict):
+        return {k: _plain(v) for k, v in value.items()}
+    if isinstance(value, tuple):
+        return [_plain(v) for v in value]
+    return value

@@ -37,7 +37,8 @@ def plan_points(source: OccupancyMap | PointMap,
         xy = source.grid.cell_centres(source.state == OCCUPIED)
     elif source.is_3d:
         try:
-            xy, levelling = wall_band(source.points, settings.band_low, settings.band_high)
+            xy, levelling = wall_band(source.points, settings.raster.band_low,
+                                       settings.raster.band_high)
         except ValueError as err:
             raise InputError(f"{source.path}: {err}") from None
     else:
@@ -48,28 +49,30 @@ def plan_points(source: OccupancyMap | PointMap,
 
 
 def min_hits(cloud: PointMap, settings: Settings) -> int:
-    """Points needed to mark a cell of this cloud occupied (see Settings.min_hits)."""
-    if settings.min_hits is not None:
-        return settings.min_hits
+    """Points needed to mark a cell of this cloud occupied (see RasterConfig.min_hits)."""
+    if settings.raster.min_hits is not None:
+        return settings.raster.min_hits
     return 2 if cloud.is_3d else 1
 
 
 def truth_raster(truth: OccupancyMap | PointMap, truth_xy: np.ndarray,
                  settings: Settings) -> tuple[MetricGrid, np.ndarray]:
     """The truth's grid and its occupied cells. An image keeps its own grid; a cloud gets an
-    axis-aligned grid around its points at ``truth_resolution`` (or ``cloud_resolution``)."""
+    axis-aligned grid around its points at the truth's resolution (or the raster's
+    ``cloud_resolution``)."""
     if isinstance(truth, OccupancyMap):
         return truth.grid, truth.state == OCCUPIED
-    grid = MetricGrid.covering(truth_xy, settings.truth_resolution or settings.cloud_resolution)
+    grid = MetricGrid.covering(truth_xy,
+                               settings.truth.resolution or settings.raster.cloud_resolution)
     return grid, points_to_grid(truth_xy, grid, min_hits(truth, settings))
 
 
 def map_footprint_rule(source: OccupancyMap | PointMap, settings: Settings) -> str:
-    """The footprint rule this map follows: ``settings.footprint`` with ``auto`` resolved (see
+    """The footprint rule this map follows: ``settings.footprint.rule`` with ``auto`` resolved (see
     :func:`pcmapq.raster.footprint.footprint_rule`); a rule the map cannot follow is bad input."""
     image = isinstance(source, OccupancyMap)
     try:
-        return footprint_rule(settings.footprint, source.state == UNKNOWN if image else None,
+        return footprint_rule(settings.footprint.rule, source.state == UNKNOWN if image else None,
                               source.grid.resolution if image else 0.0)
     except ValueError as err:
         raise InputError(f"{source.path}: {err}") from None
@@ -95,7 +98,7 @@ def map_raster(source: OccupancyMap | PointMap, map_xy: np.ndarray, transform: S
         known = None
         (x0, y0), (x1, y1) = map_xy.min(axis=0), map_xy.max(axis=0)
         corners = np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]])
-    footprint = map_footprint(rule, occupied, grid, settings.footprint_margin, known=known,
+    footprint = map_footprint(rule, occupied, grid, settings.footprint.margin, known=known,
                               rectangle=transform.apply(corners))
     return occupied, footprint
 
@@ -155,18 +158,19 @@ def refusal(map_path: Path, truth_path: Path, alignment: Alignment, cover: Overl
            ("" if distinct is None else
             f", the best pose scores {distinct:.0%} above the best one elsewhere"))
     size = _radius(map_xy) / max(_radius(truth_xy), 1e-12)
-    if settings.init is not None or not settings.align:
+    option = settings.alignment
+    if option.init is not None or not option.enabled:
         cause = ("the given frame: a wrong --init guess or --no-align; drop them for a "
                  "global search")
-    elif not settings.scale and size > OVERSIZE:
+    elif not option.scale and size > OVERSIZE:
         cause = (f"a scale that differs: the map spans {size:.1f} times the truth; try "
                  "--scale auto")
-    elif not settings.scale:
+    elif not option.scale:
         cause = "a map of another place, or of another scale (--scale auto)"
     else:
         cause = f"a map of another place (best scale found {alignment.transform.scale:.3g})"
     return (f"{map_path}: does not seem to show the place of {truth_path}: confidence "
-            f"{cover.confidence:.2f} < {settings.min_confidence} ({why}); likely cause: "
+            f"{cover.confidence:.2f} < {option.min_confidence} ({why}); likely cause: "
             f"{cause}; --force scores it anyway")
 
 
@@ -183,9 +187,10 @@ def align_clouds_3d(source: OccupancyMap | PointMap, truth: OccupancyMap | Point
     """When both sides are 3D clouds (and no guess or --no-align says otherwise), register them
     in 3D first; returns the map moved into the truth frame and the registration."""
     both_3d = all(isinstance(s, PointMap) and s.is_3d for s in (source, truth))
-    if not (both_3d and settings.align and settings.init is None and not settings.scale):
+    option = settings.alignment
+    if not (both_3d and option.enabled and option.init is None and not option.scale):
         return source, None
-    reg = align_3d(source.points, truth.points, voxel=settings.voxel_3d)
+    reg = align_3d(source.points, truth.points, voxel=option.voxel_3d)
     return replace(source, points=apply(reg.transform, source.points)), reg
 
 
@@ -195,14 +200,14 @@ def evaluate(map_path: str | Path | PointMap, truth_path: str | Path,
     truth at ``truth_path``."""
     settings = Settings() if settings is None else settings
     progress("loading")
-    truth = load_map(truth_path, settings.truth_resolution,
-                     thresholds=settings.truth_thresholds)
-    guess = settings.truth_resolution or settings.cloud_resolution
+    truth = load_map(truth_path, settings.truth.resolution,
+                     thresholds=settings.truth.thresholds)
+    guess = settings.truth.resolution or settings.raster.cloud_resolution
     if isinstance(truth, OccupancyMap):
         guess = truth.grid.resolution
     source = map_path if isinstance(map_path, PointMap) else load_map(
-        map_path, settings.map_resolution, guess if settings.scale else None,
-        settings.map_thresholds)
+        map_path, settings.map.resolution, guess if settings.alignment.scale else None,
+        settings.map.thresholds)
     return score(source, truth, settings, progress)
 
 
@@ -215,12 +220,13 @@ def score(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap, setti
     source, registration = align_clouds_3d(source, truth, settings)
     (map_xy, map_level), (truth_xy, truth_level) = (plan_points(source, settings),
                                                     plan_points(truth, settings))
+    option = settings.alignment
     if registration is None:
-        alignment = align(map_xy, truth_xy, init=settings.init, refine=settings.align,
-                          tolerance=settings.fit_tolerance, scale=settings.scale)
+        alignment = align(map_xy, truth_xy, init=option.init, refine=option.enabled,
+                          tolerance=option.tolerance, scale=option.scale)
     else:  # already aligned in 3D: score its plan in 2D as it is
         alignment = replace(align(map_xy, truth_xy, init=Similarity2D(), refine=False,
-                                  tolerance=settings.fit_tolerance), method="3d")
+                                  tolerance=option.tolerance), method="3d")
     frames = Frames(alignment.transform, map_level, truth_level,
                     None if registration is None else registration.transform)
 
@@ -229,30 +235,30 @@ def score(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap, setti
     map_occ, footprint = map_raster(source, map_xy, alignment.transform, grid, settings, rule)
     to_map = nearest_distance(map_occ, grid)
     cover = overlap(truth_occ, to_map, footprint, alignment)
-    if cover.confidence < settings.min_confidence and not settings.force:
+    if cover.confidence < option.min_confidence and not option.force:
         raise EvaluationError(refusal(map_path, truth_path, alignment, cover, settings, map_xy,
                                       truth_xy))
 
     progress("drawing the walls' centre lines")
     truth_walls, map_walls = walls_of(truth_occ, grid), walls_of(map_occ, grid)
     detectors = {}
-    for name in settings.detectors:
+    full, threshold = settings.footprint.full, settings.matching.threshold
+    for name in settings.matching.detectors:
         progress(f"detecting {name}")
         truth_f, map_f = detect_in(name, truth_walls), detect_in(name, map_walls)
-        if not settings.full:  # truth features the map never saw are not missing
+        if not full:  # truth features the map never saw are not missing
             truth_f = truth_f.counted_where(inside(truth_f, footprint, grid))
-        detectors[name] = DetectorResult(truth_f, map_f,
-                                         match(name, truth_f, map_f, settings.threshold))
+        detectors[name] = DetectorResult(truth_f, map_f, match(name, truth_f, map_f, threshold))
     cloud_distances = None
     if registration is not None:
         progress("distances in 3D")
-        cloud_distances = distances_3d(source.points, truth.points, settings.cloud_resolution,
-                                       settings.taus)
+        cloud_distances = distances_3d(source.points, truth.points,
+                                       settings.raster.cloud_resolution, settings.distances.taus)
     return Result(map_path=Path(map_path), map_kind=source.kind, truth_path=Path(truth_path),
                   truth_kind=truth.kind, grid=grid, alignment=alignment, overlap=cover,
-                  distances=distances(truth_occ, map_occ, footprint, grid, settings.taus,
-                                      to_map),
+                  distances=distances(truth_occ, map_occ, footprint, grid,
+                                      settings.distances.taus, to_map),
                   registration_3d=registration, distances_3d=cloud_distances,
-                  threshold=settings.threshold, full=settings.full, detectors=detectors,
+                  threshold=threshold, full=full, detectors=detectors,
                   footprint_rule=rule, frames=frames, settings=settings.to_dict(),
                   truth_occupied=truth_occ, map_occupied=map_occ)
