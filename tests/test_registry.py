@@ -16,11 +16,13 @@ def test_cli_defaults_are_the_settings_defaults():
     eval_command = typer.main.get_command(app).commands["eval"]
     defaults = {p.name: p.default for p in eval_command.params}
     s = Settings()
-    assert defaults["threshold"] == s.threshold
-    assert (defaults["band_low"], defaults["band_high"]) == (s.band_low, s.band_high)
-    assert defaults["voxel_3d"] == s.voxel_3d and defaults["footprint"] == s.footprint
-    assert defaults["detectors"] == ",".join(s.detectors) == ",".join(DETECTOR_NAMES)
-    assert tuple(float(t) for t in defaults["tau"].split(",")) == s.taus
+    assert defaults["threshold"] == s.matching.threshold
+    assert (defaults["band_low"], defaults["band_high"]) == (s.raster.band_low,
+                                                             s.raster.band_high)
+    assert defaults["voxel_3d"] == s.alignment.voxel_3d
+    assert defaults["footprint"] == s.footprint.rule
+    assert defaults["detectors"] == ",".join(s.matching.detectors) == ",".join(DETECTOR_NAMES)
+    assert tuple(float(t) for t in defaults["tau"].split(",")) == s.distances.taus
 
 
 def test_a_detector_is_one_file(tmp_path, monkeypatch):
