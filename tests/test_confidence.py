@@ -209,7 +209,8 @@ PLAN = Settings(alignment=AlignmentConfig(scale=True),
 def test_real_plans_same_or_other_place(image, plan, same):
     """Measured confidence: Freiburg 079 1.0, KPT4A_01 1.0; HIH_01 on KPT4A's layout 0,
     Freiburg's map on Intel's plan 0."""
-    result = evaluate(shared(*image), shared(*plan), replace(PLAN, force=True))
+    forced = replace(PLAN, alignment=replace(PLAN.alignment, force=True))
+    result = evaluate(shared(*image), shared(*plan), forced)
     assert (result.overlap.confidence >= 0.5) == same, result.overlap.confidence
 
 

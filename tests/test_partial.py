@@ -64,7 +64,7 @@ def test_partial_image_map(plan, truth_png, tmp_path, box, tf):
     assert 0.3 <= share <= 0.62
     result = evaluate(write_partial_image(plan, box, tf, tmp_path / "part.png"), truth_png)
     assert result.footprint_rule == "known"  # its unknown cells say what it did not observe
-    got = result.alignment.transform
+    got = result.transform
     assert np.hypot(got.tx - tf.tx, got.ty - tf.ty) < 0.1
     assert abs(result.overlap.coverage - share) < 0.1, (result.overlap.coverage, share)
     for name, det in result.detectors.items():
@@ -108,7 +108,7 @@ def test_binary_partial_image_map(plan, truth_png, tmp_path, box, tf):
     assert 0.24 <= share <= 0.6
     result = evaluate(write_binary_partial(plan, box, tf, tmp_path / "part.png"), truth_png)
     assert result.footprint_rule == "walls"
-    got = result.alignment.transform
+    got = result.transform
     assert np.hypot(got.tx - tf.tx, got.ty - tf.ty) < 0.1
     assert abs(result.overlap.coverage - share) < 0.1, (result.overlap.coverage, share)
     for name, det in result.detectors.items():

@@ -23,7 +23,7 @@ def test_map_equal_to_truth_scores_at_least_098(truth_png):
     result = evaluate(truth_png, truth_png)
     for name, q in qualities(result).items():
         assert q >= 0.98, (name, q)
-    assert abs(result.alignment.transform.yaw_deg) < 0.5
+    assert abs(result.transform.yaw_deg) < 0.5
     assert result.alignment.fitness > 0.95
 
 
@@ -31,7 +31,7 @@ RIGID = [(15.0, (3.0, -4.0)), (90.0, (-7.5, 2.0)), (172.0, (12.0, 9.0)), (-47.0,
 
 
 def _check_recovered(result, tf: Similarity2D) -> None:
-    got = result.alignment.transform
+    got = result.transform
     assert np.hypot(got.tx - tf.tx, got.ty - tf.ty) < 0.1, got
     assert abs((got.yaw_deg - tf.yaw_deg + 180) % 360 - 180) < 0.5, got
     for name, q in qualities(result).items():
@@ -146,7 +146,7 @@ def test_map_of_unknown_scale(plan, truth_png, tmp_path):
     path = tmp_path / "picture.png"  # no YAML beside it
     cv2.imwrite(str(path), synth.render(segments, grid, thickness=0.075))
     result = evaluate(path, truth_png, Settings(alignment=AlignmentConfig(scale=True)))
-    got = result.alignment.transform
+    got = result.transform
     # the picture's frame has its origin at the image's lower-left corner, in guessed metres
     want = tf.compose(Similarity2D(grid.origin[0], grid.origin[1]))
     assert abs(got.scale - 2.0) < 0.02, got

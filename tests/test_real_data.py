@@ -71,7 +71,7 @@ def test_real_slam_map_turned_and_shifted_is_recovered(fr79, tmp_path):
                             cv2.WARP_INVERSE_MAP, borderValue=153)
     path = _write_ros_map(turned, tmp_path / "turned.png", FR79_RES, dst.origin[:2])
     result = evaluate(path, fr79)
-    got, want = result.alignment.transform, tf.inverse()
+    got, want = result.transform, tf.inverse()
     assert np.hypot(got.tx - want.tx, got.ty - want.ty) < 0.1, got
     assert abs((got.yaw_deg - want.yaw_deg + 180) % 360 - 180) < 0.5, got
     for name, det in result.detectors.items():
@@ -85,7 +85,7 @@ def test_lidar_pair_aligns_to_its_known_transform():
     truth = np.loadtxt(shared("registration", "T_target_source.txt"))
     want = Similarity2D.from_matrix(truth)
     result = evaluate(source, target, Settings(alignment=AlignmentConfig(force=True)))
-    got = result.alignment.transform
+    got = result.transform
     assert np.hypot(got.tx - want.tx, got.ty - want.ty) < 0.05, got
     assert abs(got.yaw_deg - want.yaw_deg) < 0.5, got
     assert result.alignment.fitness > 0.8
@@ -118,7 +118,7 @@ def test_real_binary_partial_map_footprint_from_its_walls(fr79, tmp_path):
     result = evaluate(_write_ros_map(turned, tmp_path / "part.png", FR79_RES, dst.origin[:2]),
                       fr79)
     assert result.footprint_rule == "walls"
-    got, want = result.alignment.transform, tf.inverse()
+    got, want = result.transform, tf.inverse()
     assert np.hypot(got.tx - want.tx, got.ty - want.ty) < 0.1, got
     assert abs(result.overlap.coverage - share) < 0.1, (result.overlap.coverage, share)
     for name, det in result.detectors.items():

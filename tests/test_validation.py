@@ -37,8 +37,8 @@ def test_gazebo_slam_map_mean_accuracy_under_8_cm():
     run = validate_tool().gazebo_run(data)
     acc = run.result.distances.accuracy
     assert acc.mean is not None and acc.mean < 0.08
-    assert abs(run.result.alignment.transform.scale - 1.99) < 0.04  # size ratios 2.00, 1.96
-    assert abs(run.result.alignment.transform.yaw_deg) < 1.0
+    assert abs(run.result.transform.scale - 1.99) < 0.04  # size ratios 2.00, 1.96
+    assert abs(run.result.transform.yaw_deg) < 1.0
     # the truth's walls are one 1.89 mm cell wide, the map's 2-3 cells of 3.8 mm: a good map,
     # so every detector finds the truth's corners, walls and keypoints in it (Harris found 8
     # corners in that truth before the detectors saw wall centre lines, and scored 1.00 on them)
@@ -56,7 +56,7 @@ def test_slam_map_aligns_to_its_plan(index, image, yaw):
     tool = validate_tool()
     shared("floorplans", image)
     case = tool.FLOORPLANS[index]
-    tf = tool.floorplan_run(case, shared("floorplans").parent).result.alignment.transform
+    tf = tool.floorplan_run(case, shared("floorplans").parent).result.transform
     assert tool.yaw_error(tf.yaw_deg, yaw) < 5.0
     assert abs(tf.scale / case.survey_scale - 1.0) < 0.05
 

@@ -59,7 +59,7 @@ def main(argv: list[str] | None = None) -> int:
         for deg in (float(t) for t in args.turns.split(",")):
             tf = Similarity2D(-3.0, 21.0, np.radians(deg))
             result = evaluate(turned(image, tf, Path(tmp)), truth)
-            cells = [f"{deg:g} deg", f"{result.alignment.transform.yaw_deg:.3f}"]
+            cells = [f"{deg:g} deg", f"{result.transform.yaw_deg:.3f}"]
             for det in result.detectors.values():
                 m = det.matching
                 cells.append(f"{m.truth_features} / {m.map_features}, "

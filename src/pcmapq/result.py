@@ -17,6 +17,7 @@ from pcmapq.grid import MetricGrid
 from pcmapq.match import Matching
 from pcmapq.metrics.distances import Distances, FScore
 from pcmapq.stats import Stats
+from pcmapq.transform import Similarity2D
 
 if TYPE_CHECKING:  # the alignment modules load Open3D; a Result only holds their outputs
     from pcmapq.align import Alignment
@@ -106,6 +107,12 @@ class Result:
     settings: dict | None = None
     command: str | None = None
 
+    @property
+    def transform(self) -> Similarity2D:
+        """The map -> truth transform in the plane (``p_truth = s * R(yaw) * p_map + t``): the
+        2D alignment after the 3D registration's planar part, when there is one."""
+        return self.frames.map_to_truth()
+
     def note(self, name: str) -> str | None:
         """Why detector ``name``'s quality, precision or f1 is undefined (None if defined)."""
         scope = "" if self.full else "inside the footprint"
@@ -118,7 +125,7 @@ class Result:
 
     def to_dict(self) -> dict:
         """The JSON document (see README): plain types, floats rounded to DECIMALS."""
-        tf = self.frames.map_to_truth()
+        tf = self.transform
         x0, y0, yaw0 = self.grid.origin
         doc = {
             "pcmapq": {"version": __version__, "command": self.command},

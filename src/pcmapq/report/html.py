@@ -60,7 +60,7 @@ def _stats_table(counted: str, rows: list[tuple[str, Stats]]) -> str:
 
 def report_html(result: Result) -> str:
     """The whole report as one HTML document (figures as embedded PNGs, no network needed)."""
-    a, tf, o = result.alignment, result.alignment.transform, result.overlap
+    a, tf, o = result.alignment, result.transform, result.overlap
     inputs = _table(["", "path", "kind"], [
         ["map", str(result.map_path), result.map_kind],
         ["truth", str(result.truth_path),

@@ -12,7 +12,7 @@ from pcmapq.result import Result
 def print_table(result: Result, console: Console) -> None:
     """Print the alignment and the per-detector qualities (metres, degrees)."""
     a = result.alignment
-    tf = a.transform
+    tf = result.transform
     console.print(
         f"[bold]{result.map_path}[/] -> [bold]{result.truth_path}[/]  "
         f"x {tf.tx:.3f} m  y {tf.ty:.3f} m  yaw {tf.yaw_deg:.2f} deg  scale {tf.scale:.4f}  "
