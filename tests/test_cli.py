@@ -6,21 +6,47 @@ import json
 import shlex
 import subprocess
 import sys
+import traceback
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import pytest
+from typer.testing import CliRunner
 
 import pcmapq
+from pcmapq.cli import app
 from pcmapq.config import Settings
 
 ROOT = Path(__file__).resolve().parents[1]
 SAMPLE = ROOT / "data" / "sample"
 
 
-def run(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess:
+@dataclass(frozen=True)
+class Run:
+    """What a command did: exit code, stdout, stderr (with the traceback of an exception that
+    escaped the command, as a user would see it)."""
+
+    returncode: int
+    stdout: str
+    stderr: str
+
+
+def run(*args: str) -> Run:
+    """``pcmapq ARGS`` in this process (typer's CliRunner): the same exit codes and streams as
+    the installed command, without a new interpreter per call."""
+    got = CliRunner().invoke(app, list(args))
+    stderr = got.stderr
+    if got.exception is not None and not isinstance(got.exception, SystemExit):
+        stderr += "".join(traceback.format_exception(got.exception))
+    return Run(got.exit_code, got.stdout, stderr)
+
+
+def run_process(*args: str) -> subprocess.CompletedProcess:
+    """``python -m pcmapq ARGS`` in a new interpreter: for what one process cannot show
+    (identical output across processes, the module entry point)."""
     return subprocess.run([sys.executable, "-m", "pcmapq", *args], capture_output=True,
-                          text=True, cwd=cwd, timeout=600)
+                          text=True, timeout=600)
 
 
 @pytest.fixture(scope="module")
@@ -70,7 +96,7 @@ def test_vectors_csv_has_one_row_per_match(sample_json):
 def test_json_is_byte_identical_between_runs(sample_json):
     first, _, _ = sample_json
     args = ("eval", str(SAMPLE / "scan.ply"), str(SAMPLE / "truth.png"), "--json", "-")
-    runs = [run(*args) for _ in range(2)]
+    runs = [run_process(*args) for _ in range(2)]  # two interpreters, two hash seeds
     assert all(p.returncode == 0 for p in runs), runs[0].stderr
     assert runs[0].stdout == runs[1].stdout  # also: nothing but the JSON on stdout
     again = json.loads(runs[0].stdout)
