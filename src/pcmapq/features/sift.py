@@ -24,22 +24,24 @@ unlike as those of unrelated keypoints).
 
 Hysteresis: a keypoint is kept at ``support * threshold`` response and an edge ratio under
 ``support_edge * edge``; it is strong at ``threshold`` and under ``edge``, if it is also the
-strongest keypoint within ``radius`` metres. Keypoints closer than 0.1 m (one sample of the
-octave most keypoints are found in; an extremum shared by two octaves is found twice) are one,
-the strongest. ``strength`` is the response.
+strongest keypoint within ``radius`` metres. Keypoints closer than ``duplicate`` (0.1 m, one
+sample of the octave most keypoints are found in; an extremum shared by two octaves is found
+twice) are one, the strongest. ``strength`` is the response.
 
 Matching: pairs within the threshold in metres are candidates if their descriptors are alike:
-an L2 distance at most the descriptors' own length (512; an angle of at most 60 degrees, cosine
->= 0.5). The same keypoint on a re-drawn plan stays under about half of that; in a map built
-from drifted poses each wall is smeared over a band, and the keypoints of the smear that lie
-within the threshold of a truth keypoint no longer look like it. Without this gate any
-keypoint within the threshold matched, however unlike, and SIFT's quality stayed near 0.8 on
-maps whose poses were off by tens of metres. The cost is the mean of the distance over the
-threshold and the descriptor distance over the gate, so among nearby alike keypoints the most
-alike are paired.
+an L2 distance at most ``descriptor_gate``, by default the descriptors' own length (512; an
+angle of at most 60 degrees, cosine >= 0.5). The same keypoint on a re-drawn plan stays under
+about half of that; in a map built from drifted poses each wall is smeared over a band, and the
+keypoints of the smear that lie within the threshold of a truth keypoint no longer look like
+it. Without this gate any keypoint within the threshold matched, however unlike, and SIFT's
+quality stayed near 0.8 on maps whose poses were off by tens of metres. The cost is the mean of
+the distance over the threshold and the descriptor distance over the gate, so among nearby
+alike keypoints the most alike are paired.
 """
 
 from __future__ import annotations
+
+from dataclasses import dataclass
 
 import cv2
 import numpy as np
@@ -57,8 +59,47 @@ from pcmapq.features.base import (
 from pcmapq.features.scale_space import Extrema, extrema, gaussian_pyramid, octave_count
 from pcmapq.features.walls import WallImage
 
-#: Keypoints closer than this are one keypoint, metres.
-_DUPLICATE = 0.1
+#: Length of an OpenCV SIFT descriptor (L2 norm; its entries are non-negative).
+DESCRIPTOR_NORM = 512.0
+
+
+@dataclass(frozen=True)
+class Params:
+    """Parameters of the SIFT detector and of its matching rule.
+
+    window: sigma of the entropy window, metres.
+    threshold: detection threshold on the response (DoG contrast, image in [0, 1]).
+    support: support threshold, as a fraction of ``threshold``.
+    radius: a strong keypoint must be the strongest within this radius, metres.
+    octave_layers: DoG layers searched per octave (``cv2.SIFT_create``'s nOctaveLayers).
+    edge: edge test: a keypoint whose DoG principal curvatures differ by a ratio of ``edge``
+        or more is edge-like, not strong (``cv2.SIFT_create``'s edgeThreshold).
+    sigma: blur of the first scale, pixels of the working image (``cv2.SIFT_create``'s sigma).
+    max_size: largest keypoint diameter kept, metres: room-sized blobs are not local features,
+        and whether they are found depends on the whole room.
+    support_edge: support-level keypoints may be edge-like up to a ratio of this multiple of
+        ``edge``: a keypoint near the edge test's limit passes it on one side only.
+    duplicate: keypoints closer than this are one keypoint, the strongest, metres (one sample
+        of the octave most keypoints are found in; an extremum shared by two octaves is found
+        twice).
+    descriptor_gate: largest descriptor distance (L2) of an acceptable pair; by default the
+        descriptors' own length :data:`DESCRIPTOR_NORM`, i.e. an angle of at most 60 degrees
+        between them (cosine >= 0.5). The same keypoint on a re-drawn plan (half-cell shift,
+        turned and warped back, 0.025 vs 0.05 m, LiDAR faces) stays under about half of it;
+        unrelated keypoints are mostly beyond it.
+    """
+
+    window: float = 0.15
+    threshold: float = 0.025
+    support: float = 0.5
+    radius: float = 0.3
+    octave_layers: int = 3
+    edge: float = 10.0
+    sigma: float = 1.6
+    max_size: float = 1.0
+    support_edge: float = 2.0
+    duplicate: float = 0.1
+    descriptor_gate: float = DESCRIPTOR_NORM
 
 
 def entropy(image: np.ndarray, window_px: float) -> np.ndarray:
@@ -78,49 +119,27 @@ def entropy(image: np.ndarray, window_px: float) -> np.ndarray:
     return np.where((p <= 1e-7) | (p >= 1 - 1e-7), 0.0, h).astype(np.float32)
 
 
-def detect(walls: WallImage, *, window: float = 0.15, threshold: float = 0.025,
-           support: float = 0.5, radius: float = 0.3, octave_layers: int = 3,
-           edge: float = 10.0, sigma: float = 1.6, max_size: float = 1.0,
-           support_edge: float = 2.0) -> Features:
-    """SIFT keypoints and descriptors of the entropy image of a binary map.
-
-    Parameters
-    ----------
-    walls : the walls as detectors see them (:func:`pcmapq.features.walls.wall_image`);
-        features are returned in the metric frame of its grid.
-    window : sigma of the entropy window, metres.
-    threshold : detection threshold on the response (DoG contrast, image in [0, 1]).
-    support : support threshold, as a fraction of ``threshold``.
-    radius : a strong keypoint must be the strongest within this radius, metres.
-    octave_layers : DoG layers searched per octave (``cv2.SIFT_create``'s nOctaveLayers).
-    edge : edge test: a keypoint whose DoG principal curvatures differ by a ratio of ``edge``
-        or more is edge-like, not strong (``cv2.SIFT_create``'s edgeThreshold).
-    sigma : blur of the first scale, pixels of the working image (``cv2.SIFT_create``'s sigma).
-    max_size : largest keypoint diameter kept, metres: room-sized blobs are not local
-        features, and whether they are found depends on the whole room.
-    support_edge : support-level keypoints may be edge-like up to a ratio of this multiple of
-        ``edge``: a keypoint near the edge test's limit passes it on one side only.
-
-    Returns
-    -------
-    Features with ``strength`` the response and ``descriptors`` (N, 128) float32.
-    """
-    image, work = walls.image, walls.grid
+def detect(walls: WallImage, params: Params) -> Features:
+    """SIFT keypoints and descriptors of the entropy image of a binary map, seen as ``walls``
+    (see :func:`pcmapq.features.walls.wall_image`), in the metric frame of its grid:
+    ``strength`` is the response and ``descriptors`` (N, 128) float32."""
+    p, work = params, walls.grid
     resolution = work.resolution
-    ent = entropy(image, window / resolution)
-    octaves = octave_count(ent.shape, sigma, octave_layers, max_size / resolution)
+    ent = entropy(walls.image, p.window / resolution)
+    octaves = octave_count(ent.shape, p.sigma, p.octave_layers, p.max_size / resolution)
     if octaves < 1:
         return empty_features(with_descriptors=True)
-    kp = extrema(gaussian_pyramid(ent, sigma, octave_layers, octaves), sigma,
-                 0.5 * support * threshold)
+    kp = extrema(gaussian_pyramid(ent, p.sigma, p.octave_layers, octaves), p.sigma,
+                 0.5 * p.support * p.threshold)
     size = kp.size * resolution
     response = np.abs(kp.contrast)
 
     def edge_ok(r: float) -> np.ndarray:  # Lowe's test: tr^2 / det < (r + 1)^2 / r
         return kp.edge_ratio < (r + 1.0) ** 2 / r
 
-    keep = (size <= max_size) & (response >= support * threshold) & edge_ok(support_edge * edge)
-    strong = (response >= threshold) & edge_ok(edge)
+    keep = ((size <= p.max_size) & (response >= p.support * p.threshold)
+            & edge_ok(p.support_edge * p.edge))
+    strong = (response >= p.threshold) & edge_ok(p.edge)
     kp, response, strong = kp.where(keep), response[keep], strong[keep]
     if not len(kp):
         return empty_features(with_descriptors=True)
@@ -128,11 +147,11 @@ def detect(walls: WallImage, *, window: float = 0.15, threshold: float = 0.025,
     # one keypoint per place; strong ones are also the strongest within radius. Support ones
     # are not suppressed by neighbours, so a keypoint suppressed by a slightly stronger
     # neighbour on one side still confirms the other's.
-    once = suppress(xy, response, _DUPLICATE)
-    strong &= suppress(xy, response, radius)
+    once = suppress(xy, response, p.duplicate)
+    strong &= suppress(xy, response, p.radius)
     kp, xy, response, strong = kp.where(once), xy[once], response[once], strong[once]
     grey = np.round(ent * 255).astype(np.uint8)
-    desc = descriptors(grey, kp, response, octave_layers, sigma)
+    desc = descriptors(grey, kp, response, p.octave_layers, p.sigma)
     return sorted_features(xy, response, strong, descriptors=desc)
 
 
@@ -152,24 +171,16 @@ def descriptors(grey: np.ndarray, kp: Extrema, response: np.ndarray, layers: int
     return np.asarray(desc, dtype=np.float32).reshape(-1, 128)
 
 
-#: Length of an OpenCV SIFT descriptor (L2 norm; its entries are non-negative).
-DESCRIPTOR_NORM = 512.0
-#: Largest descriptor distance of an acceptable pair: the descriptors' own length, i.e. an
-#: angle of at most 60 degrees between them (cosine >= 0.5). The same keypoint on a re-drawn
-#: plan (half-cell shift, turned and warped back, 0.025 vs 0.05 m, LiDAR faces) stays under
-#: about half of it; unrelated keypoints are mostly beyond it.
-DESCRIPTOR_GATE = DESCRIPTOR_NORM
-
-
-def candidates(truth: Features, map_: Features, threshold: float) -> Candidates:
+def candidates(truth: Features, map_: Features, threshold: float, params: Params) -> Candidates:
     """Keypoint pairs within ``threshold`` metres whose descriptors are alike (L2 distance at
-    most :data:`DESCRIPTOR_GATE`); cost = the mean of their distance over the threshold and
+    most ``params.descriptor_gate``); cost = the mean of their distance over the threshold and
     their descriptor distance over the gate, so that among nearby alike keypoints the most
     alike are paired, and no far pair is taken for a near one."""
+    gate = params.descriptor_gate
     i, j, dist, disp = point_candidates(truth, map_, threshold)
     desc = np.linalg.norm(truth.descriptors[i] - map_.descriptors[j], axis=1)
-    alike = desc <= DESCRIPTOR_GATE
-    return i[alike], j[alike], 0.5 * (dist[alike] + desc[alike] / DESCRIPTOR_GATE), disp[alike]
+    alike = desc <= gate
+    return i[alike], j[alike], 0.5 * (dist[alike] + desc[alike] / gate), disp[alike]
 
 
-DETECTOR = Detector("sift", detect, candidates)
+DETECTOR = Detector("sift", detect, candidates, Params)
