@@ -24,6 +24,7 @@ import numpy as np
 from scipy import ndimage
 
 from pcmapq.grid import MetricGrid
+from pcmapq.morphology import distance_to
 
 #: The footprint rules, ``auto`` first (the default).
 FOOTPRINT_RULES = ("auto", "known", "walls", "all")
@@ -69,8 +70,7 @@ def grow(area: np.ndarray, grid: MetricGrid, margin: float) -> np.ndarray:
     if margin <= 0 or not area.any():
         return area
     radius = max(1, int(round(margin / grid.resolution)))
-    outside = (~area).astype(np.uint8)
-    return cv2.distanceTransform(outside, cv2.DIST_L2, cv2.DIST_MASK_PRECISE) <= radius
+    return distance_to(area) <= radius
 
 
 def unknown_regions(unknown: np.ndarray, resolution: float,
@@ -80,11 +80,10 @@ def unknown_regions(unknown: np.ndarray, resolution: float,
     known, so a thin unknown border is not a region. ``resolution``: metres per cell."""
     r = width / 2.0 / resolution  # cells
     pad = int(np.ceil(r)) + 1
-    padded = np.pad(unknown, pad).astype(np.uint8)
-    core = cv2.distanceTransform(padded, cv2.DIST_L2, cv2.DIST_MASK_PRECISE) > r
-    opened = cv2.distanceTransform((~core).astype(np.uint8), cv2.DIST_L2,
-                                   cv2.DIST_MASK_PRECISE) <= r
-    return (opened & padded.astype(bool))[pad:-pad, pad:-pad]
+    padded = np.pad(unknown.astype(bool), pad)
+    core = distance_to(~padded) > r
+    opened = distance_to(core) <= r
+    return (opened & padded)[pad:-pad, pad:-pad]
 
 
 def footprint_rule(requested: str, unknown: np.ndarray | None, resolution: float) -> str:
