@@ -1,4 +1,5 @@
-"""Distances on a raster, in cells: the one Euclidean distance transform every module uses."""
+"""Raster morphology in cells: the one Euclidean distance transform every module uses, and the
+disc that closings use."""
 
 from __future__ import annotations
 
@@ -20,3 +21,11 @@ def distance_to(mask: np.ndarray) -> np.ndarray:
         return np.full(mask.shape, np.inf, dtype=np.float32)
     return cv2.distanceTransform(np.logical_not(mask).view(np.uint8), cv2.DIST_L2,
                                  cv2.DIST_MASK_PRECISE)
+
+
+def disc(radius: float) -> np.ndarray:
+    """OpenCV's elliptic structuring element of ``radius`` cells, rounded (at least 1):
+    (2 r + 1, 2 r + 1) uint8. Not quite the Euclidean disc (:func:`pcmapq.features.base.disk`):
+    OpenCV rasterises an ellipse, whose rows next to the centre row are as wide as it."""
+    r = max(1, int(round(radius)))
+    return cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * r + 1, 2 * r + 1))

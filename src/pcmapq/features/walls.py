@@ -34,7 +34,7 @@ from scipy import sparse
 from skimage.morphology import skeletonize
 
 from pcmapq.grid import MetricGrid
-from pcmapq.morphology import distance_to
+from pcmapq.morphology import disc, distance_to
 
 #: 8-neighbourhood of a pixel (the centre excluded).
 _NEIGHBOURS = np.array([[1, 1, 1], [1, 0, 1], [1, 1, 1]], dtype=np.float32)
@@ -69,11 +69,6 @@ def resample(image: np.ndarray, grid: MetricGrid,
     out = ay @ image[::-1]
     out = (ax @ out.T).T[::-1]
     return np.ascontiguousarray(out, dtype=np.float32), work
-
-
-def _disc(radius_px: float) -> np.ndarray:
-    r = max(1, int(round(radius_px)))
-    return cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * r + 1, 2 * r + 1))
 
 
 def _neighbours(mask: np.ndarray) -> np.ndarray:
@@ -114,7 +109,7 @@ def centreline(occupied: np.ndarray, grid: MetricGrid, resolution: float, closin
     """
     frac, fine = resample(occupied, grid, resolution)
     wall = (frac > 1e-6).astype(np.uint8)
-    kernel = _disc(closing / resolution)
+    kernel = disc(closing / resolution)
     pad = kernel.shape[0]
     wall = cv2.morphologyEx(np.pad(wall, pad), cv2.MORPH_CLOSE, kernel)[pad:-pad, pad:-pad]
     n, label, stats, _ = cv2.connectedComponentsWithStats(wall, connectivity=8)

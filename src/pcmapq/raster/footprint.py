@@ -24,7 +24,7 @@ import numpy as np
 from scipy import ndimage
 
 from pcmapq.grid import MetricGrid
-from pcmapq.morphology import distance_to
+from pcmapq.morphology import disc, distance_to
 
 #: The footprint rules, ``auto`` first (the default).
 FOOTPRINT_RULES = ("auto", "known", "walls", "all")
@@ -34,11 +34,6 @@ UNKNOWN_WIDTH = 0.5
 #: An image whose unknown regions make up at least this share of it has ``known`` cells that
 #: say what it observed (``auto``); below it, it is treated as binary (``walls``).
 UNKNOWN_SHARE = 0.01
-
-
-def _disc(radius_m: float, resolution: float) -> np.ndarray:
-    r = max(1, int(round(radius_m / resolution)))
-    return cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * r + 1, 2 * r + 1))
 
 
 def enclosed_area(occupied: np.ndarray, grid: MetricGrid, close: float = 1.5) -> np.ndarray:
@@ -51,7 +46,7 @@ def enclosed_area(occupied: np.ndarray, grid: MetricGrid, close: float = 1.5) ->
         pad = np.pad(occupied, ((0, -rows % step), (0, -cols % step)))
         small = pad.reshape(pad.shape[0] // step, step, pad.shape[1] // step, step).any(axis=(1, 3))
     # pad so the closing does not stick to the border of the grid
-    kernel = _disc(close, grid.resolution * step)
+    kernel = disc(close / (grid.resolution * step))
     r = kernel.shape[0]
     padded = np.pad(small.astype(np.uint8), r)
     closed = cv2.morphologyEx(padded, cv2.MORPH_CLOSE, kernel)
