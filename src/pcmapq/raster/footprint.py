@@ -25,6 +25,7 @@ from scipy import ndimage
 
 from pcmapq.grid import MetricGrid
 from pcmapq.morphology import disc, distance_to
+from pcmapq.raster.draw import polygon_cells
 
 #: The footprint rules, ``auto`` first (the default).
 FOOTPRINT_RULES = ("auto", "known", "walls", "all")
@@ -100,16 +101,6 @@ def footprint_rule(requested: str, unknown: np.ndarray | None, resolution: float
     return "known" if share >= UNKNOWN_SHARE else "walls"
 
 
-def polygon_area(corners: np.ndarray, grid: MetricGrid) -> np.ndarray:
-    """The cells of ``grid`` (bool) the convex polygon ``corners`` ((K, 2) metres, in the grid's
-    frame) covers (OpenCV's fill: cells its edges touch included)."""
-    shift = 8  # fixed-point bits: cell centres are at integer pixel coordinates
-    uv = np.round(grid.xy_to_pixels(corners) * (1 << shift)).astype(np.int32)
-    area = np.zeros(grid.shape, np.uint8)
-    cv2.fillConvexPoly(area, uv, 1, lineType=cv2.LINE_8, shift=shift)
-    return area.astype(bool)
-
-
 def map_footprint(rule: str, occupied: np.ndarray, grid: MetricGrid, margin: float = 0.3,
                   known: np.ndarray | None = None,
                   rectangle: np.ndarray | None = None) -> np.ndarray:
@@ -120,7 +111,7 @@ def map_footprint(rule: str, occupied: np.ndarray, grid: MetricGrid, margin: flo
     if rule == "known" and known is not None:
         area = known
     elif rule == "all" and rectangle is not None:
-        area = polygon_area(rectangle, grid)
+        area = polygon_cells(rectangle, grid)
     elif rule == "walls":
         area = enclosed_area(occupied, grid)
     else:
