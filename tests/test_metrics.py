@@ -4,9 +4,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from scipy import ndimage
 
 from pcmapq.grid import MetricGrid
-from pcmapq.metrics.distances import distances
+from pcmapq.metrics.distances import distances, nearest_distance
+from pcmapq.morphology import distance_to
 
 GRID = MetricGrid(0.05, (0.0, 0.0, 0.0), (200, 200))
 
@@ -46,3 +48,21 @@ def test_missing_map_gives_no_accuracy():
     assert d.accuracy.count == 0 and d.accuracy.mean is None and d.chamfer_m is None
     assert d.completeness.mean is None and d.completeness.count == 160
     assert all(f.f == 0.0 for f in d.fscores)
+
+
+def test_distance_transform_is_exact_euclidean():
+    """The one distance transform: a 3-4-5 triangle, whole cells that compare exactly with a
+    threshold in metres, SciPy's exact transform within float32 rounding, inf to nothing."""
+    target = np.zeros((60, 70), bool)
+    target[10, 20] = target[45, 3] = True
+    cells = distance_to(target)
+    assert cells.dtype == np.float32 and cells[13, 24] == 5.0 and cells[10, 20] == 0.0
+    grid = MetricGrid(0.05, (0.0, 0.0, 0.0), target.shape)
+    metres = nearest_distance(target, grid)
+    assert metres.dtype == np.float64 and metres[14, 20] == 4 * 0.05  # as 4 cells times 0.05
+    rng = np.random.default_rng(0)
+    sparse = rng.random((300, 400)) < 0.001
+    exact = ndimage.distance_transform_edt(~sparse)
+    np.testing.assert_allclose(distance_to(sparse), exact, rtol=1.2e-7, atol=0)
+    assert np.isinf(distance_to(np.zeros((5, 5), bool))).all()
+    assert np.isinf(nearest_distance(np.zeros(GRID.shape, bool), GRID)).all()

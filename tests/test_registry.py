@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+from dataclasses import FrozenInstanceError, asdict, replace
+
+import numpy as np
 import pytest
 import typer
 
@@ -9,6 +12,8 @@ import pcmapq.features as features
 from pcmapq import synth
 from pcmapq.cli import app
 from pcmapq.config import DETECTOR_NAMES, Settings
+from pcmapq.errors import InputError
+from pcmapq.grid import MetricGrid
 from pcmapq.match import match
 
 
@@ -26,21 +31,59 @@ def test_cli_defaults_are_the_settings_defaults():
 
 
 def test_a_detector_is_one_file(tmp_path, monkeypatch):
-    """A module dropped beside the detectors is found, run and matched by name."""
+    """A module dropped beside the detectors is found, run with its own parameters and matched
+    by name."""
     (tmp_path / "corners_again.py").write_text(
+        "from dataclasses import dataclass\n"
+        "from pcmapq.features import harris\n"
         "from pcmapq.features.base import Detector\n"
-        "from pcmapq.features.harris import candidates, detect\n"
-        "DETECTOR = Detector('corners_again', detect, candidates)\n")
+        "@dataclass(frozen=True)\n"
+        "class Params(harris.Params):\n"
+        "    radius: float = 0.6\n"
+        "DETECTOR = Detector('corners_again', harris.detect, harris.candidates, Params)\n")
     monkeypatch.setattr(features, "__path__", [*features.__path__, str(tmp_path)])
     found = features._discover()
     assert "corners_again" in found and set(DETECTOR_NAMES) <= set(found)
     monkeypatch.setitem(features.DETECTORS, "corners_again", found["corners_again"])
+    assert features.default_params()["corners_again"].radius == 0.6
     plan = synth.building_plan(0)
     grid = synth.plan_grid(plan, 0.05)
     occ = synth.render(plan, grid) == synth.OCCUPIED
     f = features.detect("corners_again", occ, grid)
     m = match("corners_again", f, f)
     assert f.strong.sum() >= 10 and m.quality == 1.0
+    wide = features.detect("harris", occ, grid, features.harris.Params(radius=0.6))
+    np.testing.assert_array_equal(f.xy, wide.xy)
+
+
+def test_parameters_are_data():
+    """Every detector's defaults are a frozen dataclass of plain numbers; None means them."""
+    defaults = features.default_params()
+    assert set(defaults) == set(DETECTOR_NAMES)
+    for name, params in defaults.items():
+        assert params == features.DETECTORS[name].params()
+        assert all(isinstance(v, int | float) for v in asdict(params).values()), name
+        with pytest.raises(FrozenInstanceError):
+            params.threshold = 1.0
+    plan = synth.building_plan(0)
+    grid = synth.plan_grid(plan, 0.05)
+    occ = synth.render(plan, grid) == synth.OCCUPIED
+    walls = features.walls_of(occ, grid)
+    for name, params in defaults.items():
+        np.testing.assert_array_equal(features.detect_in(name, walls).xy,
+                                      features.detect_in(name, walls, params).xy)
+    stricter = features.detect_in("harris", walls, replace(defaults["harris"], threshold=2e-4))
+    assert 0 < stricter.strong.sum() < features.detect_in("harris", walls).strong.sum()
+
+
+def test_another_detectors_parameters_are_refused():
+    harris = features.default_params()["harris"]
+    with pytest.raises(InputError, match="takes pcmapq.features.sift.Params"):
+        features.detect("sift", np.zeros((20, 20), bool), MetricGrid(0.05, (0, 0, 0), (20, 20)),
+                        harris)
+    with pytest.raises(InputError, match="takes pcmapq.features.hough.Params"):
+        match("hough", features.base.empty_features(), features.base.empty_features(), 0.5,
+              harris)
 
 
 def test_an_unknown_detector_is_refused():

@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from pcmapq.config import Settings
 from pcmapq.pipeline import evaluate
 from pcmapq.result import Result
 from pcmapq.stats import FIELDS, Stats
@@ -136,3 +137,20 @@ def test_a_3d_registration_in_the_chain_and_back(tmp_path: Path):
     assert not same_document(back, r)
     np.testing.assert_allclose(back.registration_3d.transform, r.registration_3d.transform,
                                atol=1e-6)
+
+
+def test_settings_read_back_from_their_dict():
+    from dataclasses import replace
+
+    from pcmapq.config import AlignmentConfig, SourceConfig
+    from pcmapq.features import harris
+    from pcmapq.io import Thresholds
+    from pcmapq.transform import Similarity2D
+
+    s = Settings(map=SourceConfig(0.1, Thresholds(0.4, 0.05, None)),
+                 alignment=AlignmentConfig(init=Similarity2D(1.0, 2.0, 0.5), scale=True))
+    s = replace(s, matching=replace(s.matching, params={"harris": harris.Params(sigma=0.2)}))
+    back = Settings.from_dict(json.loads(json.dumps(s.to_dict())))
+    assert back.to_dict() == s.to_dict()
+    assert back.alignment.init.yaw == pytest.approx(0.5)
+    assert back.matching.params["harris"] == harris.Params(sigma=0.2)

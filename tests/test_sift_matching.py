@@ -8,7 +8,7 @@ import pytest
 
 from pcmapq import synth
 from pcmapq.features import Features, detect
-from pcmapq.features.sift import DESCRIPTOR_GATE, DESCRIPTOR_NORM
+from pcmapq.features.sift import DESCRIPTOR_NORM, Params
 from pcmapq.grid import MetricGrid
 from pcmapq.match import match
 from pcmapq.raster import draw
@@ -36,7 +36,7 @@ def at_angle(degrees: float) -> np.ndarray:
 
 
 def test_gate_is_the_descriptor_length():
-    assert DESCRIPTOR_GATE == DESCRIPTOR_NORM == 512.0
+    assert Params().descriptor_gate == DESCRIPTOR_NORM == 512.0
     assert np.linalg.norm(at_angle(60.0) - unit(1)) == pytest.approx(512.0, rel=1e-6)
 
 
@@ -93,4 +93,4 @@ def test_same_keypoints_of_a_redrawn_plan_are_well_within_the_gate():
         assert m.quality >= 0.95 and m.precision >= 0.95
         desc = np.linalg.norm(truth.descriptors[m.truth_idx] - map_.descriptors[m.map_idx],
                               axis=1)
-        assert desc.max() < 0.6 * DESCRIPTOR_GATE, desc.max()
+        assert desc.max() < 0.6 * Params().descriptor_gate, desc.max()

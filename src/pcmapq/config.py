@@ -3,9 +3,11 @@ metres. Each default is defined here once; the command line and the docs read it
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field, fields, is_dataclass
+from typing import Any
 
-from pcmapq.features import DETECTORS
+from pcmapq.features import DETECTORS, default_params
 from pcmapq.io.occupancy import Thresholds
 from pcmapq.metrics.distances import DEFAULT_TAUS
 from pcmapq.transform import Similarity2D
@@ -94,10 +96,13 @@ class MatchingConfig:
 
     detectors: which detectors to run.
     threshold: largest distance between matched features, metres.
+    params: each detector's parameters by name (its ``Params``, lengths in metres; see
+        :func:`pcmapq.features.default_params`); a detector left out uses its defaults.
     """
 
     detectors: tuple[str, ...] = DETECTOR_NAMES
     threshold: float = 0.5
+    params: dict[str, Any] = field(default_factory=default_params, hash=False)
 
 
 @dataclass(frozen=True)
@@ -127,6 +132,26 @@ class Settings:
         """Every option as plain JSON types, one object per stage, in metres and degrees:
         ``init`` as ``{"x_m", "y_m", "yaw_deg"}``, tuples as lists."""
         return _plain(self)
+
+    @classmethod
+    def from_dict(cls, doc: dict) -> Settings:
+        """The inverse of :meth:`to_dict` (e.g. the ``settings`` of a saved result)."""
+        def source(d: dict) -> SourceConfig:
+            t = d["thresholds"]
+            return SourceConfig(d["resolution"], None if t is None else Thresholds(**t))
+
+        a, m = doc["alignment"], doc["matching"]
+        init = a["init"]
+        return cls(
+            map=source(doc["map"]), truth=source(doc["truth"]),
+            raster=RasterConfig(**doc["raster"]),
+            alignment=AlignmentConfig(**{**a, "init": None if init is None else Similarity2D(
+                init["x_m"], init["y_m"], math.radians(init["yaw_deg"]))}),
+            footprint=FootprintConfig(**doc["footprint"]),
+            matching=MatchingConfig(tuple(m["detectors"]), m["threshold"],
+                                    {name: DETECTORS[name].params(**p)
+                                     for name, p in m["params"].items()}),
+            distances=DistancesConfig(tuple(doc["distances"]["taus"])))
 
 
 def _plain(value):

@@ -21,14 +21,14 @@ corner, and its perfect map must not score 0 for missing none. f1 is None when e
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from scipy import sparse
 from scipy.optimize import linear_sum_assignment
 from scipy.sparse.csgraph import connected_components
 
-from pcmapq.errors import InputError
-from pcmapq.features import DETECTORS, Features
+from pcmapq.features import Features, detector
 
 
 @dataclass(frozen=True)
@@ -137,7 +137,8 @@ def harmonic_mean(quality: float | None, precision: float | None) -> float | Non
     return 2 * quality * precision / (quality + precision) if quality + precision > 0 else 0.0
 
 
-def match(name: str, truth: Features, map_: Features, threshold: float = 0.5) -> Matching:
+def match(name: str, truth: Features, map_: Features, threshold: float = 0.5,
+          params: Any = None) -> Matching:
     """Match ``map_`` features to ``truth`` features of detector ``name``, one to one.
 
     Parameters
@@ -146,14 +147,15 @@ def match(name: str, truth: Features, map_: Features, threshold: float = 0.5) ->
     truth, map_ : features of the truth and of the map, in the same metric frame (metres).
     threshold : largest distance between matched features, metres (its exact meaning is the
         detector's: point distance, or perpendicular offset of segments for Hough).
+    params : the detector's parameters (its ``Params``), whose matching rule applies; None: its
+        defaults.
 
     Returns
     -------
     The :class:`Matching`.
     """
-    if name not in DETECTORS:
-        raise InputError(f"unknown feature detector {name!r}; known: {', '.join(DETECTORS)}")
-    i, j, cost, disp = DETECTORS[name].candidates(truth, map_, threshold)
+    found = detector(name)
+    i, j, cost, disp = found.candidates(truth, map_, threshold, found.checked(params))
     weight = truth.strong[i].astype(np.int64) + map_.strong[j].astype(np.int64)
     keep = weight > 0
     i, j, cost, disp, weight = i[keep], j[keep], cost[keep], disp[keep], weight[keep]

@@ -245,10 +245,12 @@ def score(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap, setti
     full, threshold = settings.footprint.full, settings.matching.threshold
     for name in settings.matching.detectors:
         progress(f"detecting {name}")
-        truth_f, map_f = detect_in(name, truth_walls), detect_in(name, map_walls)
+        params = settings.matching.params.get(name)
+        truth_f, map_f = detect_in(name, truth_walls, params), detect_in(name, map_walls, params)
         if not full:  # truth features the map never saw are not missing
             truth_f = truth_f.counted_where(inside(truth_f, footprint, grid))
-        detectors[name] = DetectorResult(truth_f, map_f, match(name, truth_f, map_f, threshold))
+        detectors[name] = DetectorResult(truth_f, map_f,
+                                         match(name, truth_f, map_f, threshold, params))
     cloud_distances = None
     if registration is not None:
         progress("distances in 3D")

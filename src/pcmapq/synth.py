@@ -137,27 +137,18 @@ def render(segments: np.ndarray, grid: MetricGrid, thickness: float = 0.15,
     """Draw walls into an occupancy image on ``grid`` (ROS values: 0 occupied, 254 free, 205
     unknown). ``free_box`` (x0, y0, x1, y1, metres) is free space; elsewhere is unknown; default:
     the bounding box of the walls."""
-    import cv2
+    from pcmapq.raster.draw import polygon_cells
 
     img = np.full(grid.shape, UNKNOWN, dtype=np.uint8)
     if free_box is None:
         pts = segments.reshape(-1, 2)
         free_box = (*pts.min(axis=0), *pts.max(axis=0))
     x0, y0, x1, y1 = free_box
-    box = np.array([[[x0, y0], [x1, y0], [x1, y1], [x0, y1]]])
-    shift = 8
-
-    def fill(polys: np.ndarray, value: int) -> None:
-        uv = grid.xy_to_pixels(polys.reshape(-1, 2)).reshape(polys.shape)
-        # pixel centres are at integer (u, v): a cell is filled when its centre is inside
-        fixed = np.round(uv * (1 << shift)).astype(np.int32)
-        for poly in fixed:  # one call each: fillPoly's even-odd rule would punch out overlaps
-            cv2.fillConvexPoly(img, poly, int(value), lineType=cv2.LINE_8, shift=shift)
-
-    fill(box, FREE)
+    img[polygon_cells(np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]]), grid)] = FREE
     # OpenCV also fills the cells its polygon edges touch: inset by half a cell so that a cell is
     # filled when its centre is inside the wall, at any resolution
-    fill(wall_quads(segments, max(thickness - grid.resolution, 1e-6)), OCCUPIED)
+    walls = wall_quads(segments, max(thickness - grid.resolution, 1e-6))
+    img[polygon_cells(walls, grid)] = OCCUPIED
     return img
 
 

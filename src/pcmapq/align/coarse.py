@@ -23,6 +23,7 @@ import numpy as np
 
 from pcmapq.align.icp import voxel_downsample
 from pcmapq.grid import MetricGrid
+from pcmapq.morphology import distance_to
 from pcmapq.raster.draw import hit_counts
 from pcmapq.transform import Similarity2D
 
@@ -84,8 +85,7 @@ def distinctiveness(search: Search, tf: Similarity2D) -> float:
 def likelihood_field(truth_xy: np.ndarray, grid: MetricGrid, sigma: float) -> np.ndarray:
     """``exp(-d^2 / 2 sigma^2)`` on ``grid``, d = metres to the nearest cell holding a truth point
     (N, 2, metres). (rows, cols) float32 in [0, 1]."""
-    free = (hit_counts(truth_xy, grid) == 0).astype(np.uint8)
-    dist = cv2.distanceTransform(free, cv2.DIST_L2, cv2.DIST_MASK_PRECISE) * grid.resolution
+    dist = distance_to(hit_counts(truth_xy, grid) > 0) * grid.resolution
     return np.exp(-0.5 * (dist / sigma) ** 2).astype(np.float32)
 
 

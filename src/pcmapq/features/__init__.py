@@ -1,13 +1,15 @@
 """Feature detectors behind one registry: Harris corners, Hough wall segments, SIFT on entropy.
 
 Each detector is a module of this package that defines ``DETECTOR`` (a
-:class:`~pcmapq.features.base.Detector`): adding a detector is adding a file.
+:class:`~pcmapq.features.base.Detector`) and its parameters ``Params`` (a frozen dataclass,
+lengths in metres): adding a detector is adding a file.
 """
 
 from __future__ import annotations
 
 import importlib
 import pkgutil
+from typing import Any
 
 import numpy as np
 
@@ -16,8 +18,8 @@ from pcmapq.features.base import Candidates, Detector, Features
 from pcmapq.features.walls import WallImage, wall_image
 from pcmapq.grid import MetricGrid
 
-__all__ = ["DETECTORS", "Candidates", "Detector", "Features", "WallImage", "detect", "detect_in",
-           "walls_of"]
+__all__ = ["DETECTORS", "Candidates", "Detector", "Features", "WallImage", "default_params",
+           "detect", "detect_in", "detector", "walls_of"]
 
 
 def _discover() -> dict[str, Detector]:
@@ -35,6 +37,19 @@ def _discover() -> dict[str, Detector]:
 DETECTORS: dict[str, Detector] = _discover()
 
 
+def detector(name: str) -> Detector:
+    """The detector ``name`` (a key of :data:`DETECTORS`); InputError for an unknown name."""
+    if name not in DETECTORS:
+        raise InputError(f"unknown feature detector {name!r}; known: {', '.join(DETECTORS)}")
+    return DETECTORS[name]
+
+
+def default_params() -> dict[str, Any]:
+    """Every detector's default parameters by name: frozen dataclasses, lengths in metres;
+    ``dataclasses.asdict`` of each is plain JSON."""
+    return {name: d.params() for name, d in DETECTORS.items()}
+
+
 def walls_of(occupied: np.ndarray, grid: MetricGrid) -> WallImage:
     """The walls of a binary map as every detector sees them (see :mod:`pcmapq.features.walls`).
 
@@ -46,16 +61,15 @@ def walls_of(occupied: np.ndarray, grid: MetricGrid) -> WallImage:
     return wall_image(occupied, grid)
 
 
-def detect_in(name: str, walls: WallImage, **params) -> Features:
+def detect_in(name: str, walls: WallImage, params: Any = None) -> Features:
     """Features of detector ``name`` (a key of :data:`DETECTORS`) in ``walls``, in the metric
-    frame of its grid; ``params`` are the detector's own (see its ``detect``), lengths in
-    metres."""
-    if name not in DETECTORS:
-        raise InputError(f"unknown feature detector {name!r}; known: {', '.join(DETECTORS)}")
-    return DETECTORS[name].detect(walls, **params)
+    frame of its grid; ``params`` are the detector's own (its ``Params``, lengths in metres),
+    its defaults when None."""
+    found = detector(name)
+    return found.detect(walls, found.checked(params))
 
 
-def detect(name: str, occupied: np.ndarray, grid: MetricGrid, **params) -> Features:
+def detect(name: str, occupied: np.ndarray, grid: MetricGrid, params: Any = None) -> Features:
     """Features of detector ``name`` on a binary map: :func:`detect_in` of :func:`walls_of`.
 
     Parameters
@@ -63,6 +77,6 @@ def detect(name: str, occupied: np.ndarray, grid: MetricGrid, **params) -> Featu
     name : a key of :data:`DETECTORS`.
     occupied : (rows, cols) bool raster drawn on ``grid``, walls true.
     grid : the raster's grid; features are in its metric frame, metres.
-    **params : the detector's own parameters (see its ``detect``), lengths in metres.
+    params : the detector's parameters (its ``Params``, lengths in metres); None: its defaults.
     """
-    return detect_in(name, walls_of(occupied, grid), **params)
+    return detect_in(name, walls_of(occupied, grid), params)

@@ -11,10 +11,14 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, replace
+from typing import Any
 
 import cv2
 import numpy as np
 from scipy.spatial import cKDTree
+
+from pcmapq.errors import InputError
+from pcmapq.features.walls import WallImage
 
 #: Candidate pairs: truth indices, map indices, costs, displacements (M, 2) in metres.
 Candidates = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
@@ -50,19 +54,34 @@ class Features:
 
 @dataclass(frozen=True)
 class Detector:
-    """A feature detector: how to find features, and which pairs of features may match.
+    """A feature detector: how to find features, which pairs of features may match, and the
+    parameters of both.
 
-    detect: ``detect(walls, **params) -> Features``; ``walls`` is a
-        :class:`~pcmapq.features.walls.WallImage`, the walls as every detector sees them.
-    candidates: ``candidates(truth, map_, threshold) -> (i, j, cost, displacement)``: the pairs
-        (truth ``i``, map ``j``) that may match under ``threshold`` metres, their costs in
-        [0, 1] (0 a perfect pair, 1 the worst acceptable one) and displacements (M, 2) in
-        metres, from the truth feature to the map feature.
+    detect: ``detect(walls, params) -> Features``; ``walls`` is a
+        :class:`~pcmapq.features.walls.WallImage`, the walls as every detector sees them, and
+        ``params`` an instance of ``params``.
+    candidates: ``candidates(truth, map_, threshold, params) -> (i, j, cost, displacement)``:
+        the pairs (truth ``i``, map ``j``) that may match under ``threshold`` metres, their
+        costs in [0, 1] (0 a perfect pair, 1 the worst acceptable one) and displacements
+        (M, 2) in metres, from the truth feature to the map feature.
+    params: the detector's parameters, a frozen dataclass whose field defaults are the
+        documented ones (``params()``), lengths in metres.
     """
 
     name: str
-    detect: Callable[..., Features]
-    candidates: Callable[[Features, Features, float], Candidates]
+    detect: Callable[[WallImage, Any], Features]
+    candidates: Callable[[Features, Features, float, Any], Candidates]
+    params: type
+
+    def checked(self, params: Any = None) -> Any:
+        """``params``, or the defaults when None; InputError when they are not this
+        detector's."""
+        if params is None:
+            return self.params()
+        if not isinstance(params, self.params):
+            raise InputError(f"detector {self.name!r} takes {self.params.__module__}."
+                             f"{self.params.__qualname__}, not {type(params).__qualname__}")
+        return params
 
 
 def empty_features(with_descriptors: bool = False, with_segments: bool = False) -> Features:

@@ -10,6 +10,8 @@ on the resolution or on what else is in the map. Corners are the local maxima wi
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import cv2
 import numpy as np
 from scipy import ndimage
@@ -25,6 +27,27 @@ from pcmapq.features.base import (
     suppress,
 )
 from pcmapq.features.walls import WallImage
+
+
+@dataclass(frozen=True)
+class Params:
+    """Parameters of the Harris detector.
+
+    sigma: derivative (smoothing) scale, metres.
+    integration: structure tensor integration scale, metres.
+    k: Harris sensitivity, dimensionless.
+    threshold: detection threshold on the scale-normalised response (dimensionless). An L corner
+        of a 0.15 m wall scores about 5e-4, a T junction about 1e-4.
+    support: support threshold, as a fraction of ``threshold``.
+    radius: non-maximum suppression radius, metres.
+    """
+
+    sigma: float = 0.1
+    integration: float = 0.2
+    k: float = 0.05
+    threshold: float = 4e-5
+    support: float = 0.5
+    radius: float = 0.3
 
 
 def response(image: np.ndarray, resolution: float, sigma: float, integration: float,
@@ -73,38 +96,22 @@ def peaks(resp: np.ndarray, radius_px: float, floor: float) -> tuple[np.ndarray,
     return np.column_stack([u + np.clip(du, -0.5, 0.5), v + np.clip(dv, -0.5, 0.5)]), c
 
 
-def detect(walls: WallImage, *, sigma: float = 0.1, integration: float = 0.2, k: float = 0.05,
-           threshold: float = 4e-5, support: float = 0.5, radius: float = 0.3) -> Features:
-    """Harris corners of a binary map.
-
-    Parameters
-    ----------
-    walls : the walls as detectors see them (:func:`pcmapq.features.walls.wall_image`);
-        features are returned in the metric frame of its grid.
-    sigma : derivative scale, metres.
-    integration : structure tensor integration scale, metres.
-    k : Harris sensitivity.
-    threshold : detection threshold on the scale-normalised response (dimensionless). An
-        L corner of a 0.15 m wall scores about 5e-4, a T junction about 1e-4.
-    support : support threshold, as a fraction of ``threshold``.
-    radius : non-maximum suppression radius, metres.
-
-    Returns
-    -------
-    Features with ``strength`` the response.
-    """
-    image, work = walls.image, walls.grid
-    resolution = work.resolution
-    resp = response(image, resolution, sigma, integration, k)
-    uv, value = peaks(resp, radius / resolution, support * threshold)
+def detect(walls: WallImage, params: Params) -> Features:
+    """Harris corners of a binary map, seen as ``walls`` (see
+    :func:`pcmapq.features.walls.wall_image`), in the metric frame of its grid; ``strength`` is
+    the response."""
+    work = walls.grid
+    resp = response(walls.image, work.resolution, params.sigma, params.integration, params.k)
+    uv, value = peaks(resp, params.radius / work.resolution, params.support * params.threshold)
     xy = work.pixels_to_xy(uv)
-    keep = suppress(xy, value, radius)  # plateaus give equal neighbouring maxima
-    return sorted_features(xy[keep], value[keep], value[keep] >= threshold)
+    keep = suppress(xy, value, params.radius)  # plateaus give equal neighbouring maxima
+    return sorted_features(xy[keep], value[keep], value[keep] >= params.threshold)
 
 
-def candidates(truth: Features, map_: Features, threshold: float) -> Candidates:
-    """Pairs of corners within ``threshold`` metres; cost = distance, metres."""
+def candidates(truth: Features, map_: Features, threshold: float, params: Params) -> Candidates:
+    """Pairs of corners within ``threshold`` metres; cost = distance / threshold (``params``
+    hold no matching rule)."""
     return point_candidates(truth, map_, threshold)
 
 
-DETECTOR = Detector("harris", detect, candidates)
+DETECTOR = Detector("harris", detect, candidates, Params)

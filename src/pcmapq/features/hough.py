@@ -13,7 +13,7 @@ Segments come from two sources:
   across a curve. At least ``support * min_length`` long.
 - probabilistic Hough (``cv2.HoughLinesP``, rho = one working cell) on the ridge lines, where
   the pieces leave a wall out: segments at least ``min_length`` long, cut where they leave the
-  wall (smoothed image below ``segments.INSIDE``), and kept only when no piece passes within
+  wall (smoothed image below ``inside``), and kept only when no piece passes within
   ``merge_offset`` of their midpoint. So a Hough line may span a ridge that is broken or
   rounded inside a wall (the ring-shaped centre line of a small box) but never open floor, and
   it never adds a second, differently cut copy of a wall the pieces already hold.
@@ -27,7 +27,7 @@ metres; strong segments are at least ``min_length`` long, support-level ones at 
 ``support * min_length``.
 
 Matching rule: a truth segment and a map segment are candidates when their directions differ
-by less than ``MAX_ANGLE`` (10) degrees, the map segment projected on the truth segment's line
+by less than ``max_angle`` (10) degrees, the map segment projected on the truth segment's line
 overlaps the truth segment, and the perpendicular offset, the larger of the two
 midpoint-to-other-line distances, is within the threshold; the cost is that offset divided by
 the threshold. The
@@ -36,6 +36,8 @@ segment's line: a wall moved by 0.5 m shows 0.5 m, whatever the segments' extent
 """
 
 from __future__ import annotations
+
+from dataclasses import dataclass
 
 import cv2
 import numpy as np
@@ -50,80 +52,92 @@ from pcmapq.features.base import (
     sorted_features,
 )
 from pcmapq.features.ridges import pieces, ridges
-from pcmapq.features.segments import INSIDE, SOLID, away, directions, inside_runs, merge, wall_test
+from pcmapq.features.segments import away, directions, inside_runs, merge, wall_test
 from pcmapq.features.walls import WallImage
 
-#: Largest direction difference of matching segments, degrees.
-MAX_ANGLE = 10.0
 
+@dataclass(frozen=True)
+class Params:
+    """Parameters of the Hough wall segment detector and of its matching rule.
 
-def detect(walls: WallImage, *, sigma: float = 0.1, ridge: float = 0.05, min_length: float = 0.5,
-           max_gap: float = 0.2, support: float = 0.5, angle_step: float = 0.5,
-           merge_angle: float = 15.0, merge_offset: float = 0.15,
-           max_bridge: float = 1.5) -> Features:
-    """Maximal wall segments of a binary map.
-
-    Parameters
-    ----------
-    walls : the walls as detectors see them (:func:`pcmapq.features.walls.wall_image`);
-        segments are returned in the metric frame of its grid, whose cell is also the Hough
-        rho step.
-    sigma : smoothing scale of the ridge (centre line) detection, metres.
-    ridge : least scale-normalised ridge strength; a one-cell (0.05 m) line scores about 0.2.
-    min_length : length of a strong segment, metres.
-    max_gap : largest gap bridged inside one segment, metres.
-    support : support-level segments are at least ``support * min_length`` long.
-    angle_step : Hough theta step, degrees.
-    merge_angle, merge_offset : collinear fragments within this angle (degrees) and
+    sigma: smoothing scale of the ridge (centre line) detection, metres.
+    ridge: least scale-normalised ridge strength; a one-cell (0.05 m) line scores about 0.2.
+    min_length: length of a strong segment, metres.
+    max_gap: largest gap bridged inside one segment, metres.
+    support: support-level segments are at least ``support * min_length`` long.
+    angle_step: Hough theta step, degrees (rho is one working cell).
+    merge_angle, merge_offset: collinear fragments within this angle (degrees) and
         perpendicular offset (metres) are merged when at most ``max_gap`` apart along the line,
         or at most ``max_bridge`` (metres) apart with the wall solid all along the gap: this
         joins a wall across the break of its centre line at a T junction, but not across a
         door.
-
-    Returns
-    -------
-    Features with ``segments`` (N, 4), ``xy`` the midpoints and ``strength`` the lengths.
+    max_bridge: see ``merge_angle``, metres.
+    inside: smoothed occupied fraction a Hough segment keeps all along; it is cut where it
+        drops below.
+    solid: smoothed occupied fraction above which a cell is inside a wall, for bridging.
+    max_angle: largest direction difference of matching segments, degrees.
     """
-    image, work = walls.image, walls.grid
+
+    sigma: float = 0.1
+    ridge: float = 0.05
+    min_length: float = 0.5
+    max_gap: float = 0.2
+    support: float = 0.5
+    angle_step: float = 0.5
+    merge_angle: float = 15.0
+    merge_offset: float = 0.15
+    max_bridge: float = 1.5
+    inside: float = 0.5
+    solid: float = 0.3
+    max_angle: float = 10.0
+
+
+def detect(walls: WallImage, params: Params) -> Features:
+    """Maximal wall segments of a binary map, seen as ``walls`` (see
+    :func:`pcmapq.features.walls.wall_image`), in the metric frame of its grid, whose cell is
+    also the Hough rho step: ``segments`` (N, 4), ``xy`` their midpoints and ``strength`` their
+    lengths, metres."""
+    p, image, work = params, walls.image, walls.grid
     resolution = work.resolution
-    mask, direction = ridges(image, sigma / resolution, ridge)
-    smooth = gaussian(image, sigma / resolution)
-    shortest = support * min_length
+    mask, direction = ridges(image, p.sigma / resolution, p.ridge)
+    smooth = gaussian(image, p.sigma / resolution)
+    shortest = p.support * p.min_length
     px = pieces(mask, direction)
     _, size = directions(px)
     parts = [work.pixels_to_xy(px[size >= shortest / resolution].reshape(-1, 2)).reshape(-1, 4)]
-    lines = cv2.HoughLinesP(mask.astype(np.uint8) * 255, 1.0, np.radians(angle_step),
-                            max(2, int(0.8 * min_length / resolution)),
-                            minLineLength=min_length / resolution, maxLineGap=max_gap / resolution)
+    lines = cv2.HoughLinesP(mask.astype(np.uint8) * 255, 1.0, np.radians(p.angle_step),
+                            max(2, int(0.8 * p.min_length / resolution)),
+                            minLineLength=p.min_length / resolution,
+                            maxLineGap=p.max_gap / resolution)
     if lines is not None:
         hough = work.pixels_to_xy(lines.reshape(-1, 2).astype(np.float64)).reshape(-1, 4)
-        hough = inside_runs(hough, wall_test(smooth, work, INSIDE), 0.5 * resolution, min_length)
+        hough = inside_runs(hough, wall_test(smooth, work, p.inside), 0.5 * resolution,
+                            p.min_length)
         # only where no piece is: never a second, differently cut copy of a wall
         mid = 0.5 * (hough[:, :2] + hough[:, 2:])
-        parts.append(hough[away(mid, parts[0], merge_offset, 0.5 * resolution)])
+        parts.append(hough[away(mid, parts[0], p.merge_offset, 0.5 * resolution)])
     seg = np.concatenate(parts)
     if len(seg) == 0:
         return empty_features(with_segments=True)
-    solid = wall_test(smooth, work, SOLID)
-    seg = merge(seg, merge_angle, merge_offset, max_gap, solid, max_bridge)
+    solid = wall_test(smooth, work, p.solid)
+    seg = merge(seg, p.merge_angle, p.merge_offset, p.max_gap, solid, p.max_bridge)
     _, length = directions(seg)
-    seg = seg[length >= support * min_length]
-    length = length[length >= support * min_length]
+    seg, length = seg[length >= shortest], length[length >= shortest]
     # canonical endpoint order: the lexicographically smaller endpoint first
     flip = (seg[:, 0] > seg[:, 2]) | ((seg[:, 0] == seg[:, 2]) & (seg[:, 1] > seg[:, 3]))
     seg[flip] = seg[flip][:, [2, 3, 0, 1]]
     mid = 0.5 * (seg[:, :2] + seg[:, 2:])
-    return sorted_features(mid, length, length >= min_length, segments=seg)
+    return sorted_features(mid, length, length >= p.min_length, segments=seg)
 
 
-def candidates(truth: Features, map_: Features, threshold: float) -> Candidates:
-    """Candidate segment pairs under the rule of the module docstring; cost = offset /
-    threshold."""
+def candidates(truth: Features, map_: Features, threshold: float, params: Params) -> Candidates:
+    """Candidate segment pairs under the rule of the module docstring (directions within
+    ``params.max_angle`` degrees); cost = offset / threshold."""
     if len(truth) == 0 or len(map_) == 0:
         return no_candidates()
     dt, lt = directions(truth.segments)
     dm, _ = directions(map_.segments)
-    i, j = np.nonzero(np.abs(dt @ dm.T) >= np.cos(np.radians(MAX_ANGLE)))
+    i, j = np.nonzero(np.abs(dt @ dm.T) >= np.cos(np.radians(params.max_angle)))
     either = truth.strong[i] | map_.strong[j]
     i, j = i[either], j[either]
     mt, mm = truth.xy[i], map_.xy[j]
@@ -140,4 +154,4 @@ def candidates(truth: Features, map_: Features, threshold: float) -> Candidates:
     return i[keep], j[keep], cost[keep] / threshold, disp
 
 
-DETECTOR = Detector("hough", detect, candidates)
+DETECTOR = Detector("hough", detect, candidates, Params)

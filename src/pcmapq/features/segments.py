@@ -21,12 +21,8 @@ def directions(seg: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 #: Regroup-and-refit rounds of one merged segment.
 _REFITS = 4
-#: Smoothed occupied fraction above which a cell is inside a wall, for bridging.
-SOLID = 0.3
 #: Points tested along a gap to bridge.
 _BRIDGE_SAMPLES = 16
-#: Smoothed occupied fraction a Hough segment keeps all along; it is cut where it drops below.
-INSIDE = 0.5
 
 
 def _line(ends: np.ndarray, weight: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

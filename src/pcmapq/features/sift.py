@@ -7,43 +7,44 @@ As in the paper, a binary map is first turned into a grey image of its local ent
 Keypoints are the extrema of SIFT's difference-of-Gaussians (DoG) scale space of that image,
 built as ``cv2.SIFT`` builds it (``octave_layers`` layers per octave, base blur ``sigma``
 pixels of the working image; no doubled first octave), so the fixed working resolution makes
-the scales metric. Detection is done here rather than by ``cv2.SIFT``, which loses keypoints
-in two ways that come and go with a half-cell shift of the map: its sub-pixel refinement drops
-an extremum whose quadratic fit keeps stepping between two samples (the extremum lies about
-half a sample from both), and an extremum at the scale limit of an octave can fail the test in
-both octaves, which sample it differently. Here every sample that is an extremum of its 26
-neighbours is a keypoint, refined by one quadratic step clipped to half a sample in space and
-scale, and each octave has one layer more than ``cv2.SIFT`` so that consecutive octaves share
-a searched DoG layer. Its response is the refined DoG contrast (image in [0, 1]); keypoints
-wider than ``max_size`` metres (room-sized blobs) are dropped. ``cv2.SIFT`` computes the
-descriptors of these keypoints, upright: features are detected on rasters in the truth's frame,
-after alignment, so rotation invariance buys nothing, and SIFT's dominant orientation flips
-between the walls of a corner (on a plan drawn half a cell shifted, a quarter of the
-keypoints turned by tens of degrees or more, and their descriptors were as unlike as those of
-unrelated keypoints).
+the scales metric. The extrema are found by :mod:`pcmapq.features.scale_space` rather than by
+``cv2.SIFT``, which loses keypoints in two ways that come and go with a half-cell shift of the
+map: its sub-pixel refinement drops an extremum whose quadratic fit keeps stepping between two
+samples (the extremum lies about half a sample from both), and an extremum at the scale limit
+of an octave can fail the test in both octaves, which sample it differently. Here every sample
+that is an extremum of its 26 neighbours is a keypoint, refined by one quadratic step clipped
+to half a sample in space and scale, and each octave has one layer more than ``cv2.SIFT`` so
+that consecutive octaves share a searched DoG layer. Its response is the refined DoG contrast
+(image in [0, 1]); keypoints wider than ``max_size`` metres (room-sized blobs) are dropped.
+``cv2.SIFT`` computes the descriptors of these keypoints, upright: features are detected on
+rasters in the truth's frame, after alignment, so rotation invariance buys nothing, and SIFT's
+dominant orientation flips between the walls of a corner (on a plan drawn half a cell shifted,
+a quarter of the keypoints turned by tens of degrees or more, and their descriptors were as
+unlike as those of unrelated keypoints).
 
 Hysteresis: a keypoint is kept at ``support * threshold`` response and an edge ratio under
 ``support_edge * edge``; it is strong at ``threshold`` and under ``edge``, if it is also the
-strongest keypoint within ``radius`` metres. Keypoints closer than 0.1 m (one sample of the
-octave most keypoints are found in; an extremum shared by two octaves is found twice) are one,
-the strongest. ``strength`` is the response.
+strongest keypoint within ``radius`` metres. Keypoints closer than ``duplicate`` (0.1 m, one
+sample of the octave most keypoints are found in; an extremum shared by two octaves is found
+twice) are one, the strongest. ``strength`` is the response.
 
 Matching: pairs within the threshold in metres are candidates if their descriptors are alike:
-an L2 distance at most the descriptors' own length (512; an angle of at most 60 degrees, cosine
->= 0.5). The same keypoint on a re-drawn plan stays under about half of that; in a map built
-from drifted poses each wall is smeared over a band, and the keypoints of the smear that lie
-within the threshold of a truth keypoint no longer look like it. Without this gate any
-keypoint within the threshold matched, however unlike, and SIFT's quality stayed near 0.8 on
-maps whose poses were off by tens of metres. The cost is the mean of the distance over the
-threshold and the descriptor distance over the gate, so among nearby alike keypoints the most
-alike are paired.
+an L2 distance at most ``descriptor_gate``, by default the descriptors' own length (512; an
+angle of at most 60 degrees, cosine >= 0.5). The same keypoint on a re-drawn plan stays under
+about half of that; in a map built from drifted poses each wall is smeared over a band, and the
+keypoints of the smear that lie within the threshold of a truth keypoint no longer look like
+it. Without this gate any keypoint within the threshold matched, however unlike, and SIFT's
+quality stayed near 0.8 on maps whose poses were off by tens of metres. The cost is the mean of
+the distance over the threshold and the descriptor distance over the gate, so among nearby
+alike keypoints the most alike are paired.
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import cv2
 import numpy as np
-from scipy import ndimage
 
 from pcmapq.features.base import (
     Candidates,
@@ -55,12 +56,50 @@ from pcmapq.features.base import (
     sorted_features,
     suppress,
 )
+from pcmapq.features.scale_space import Extrema, extrema, gaussian_pyramid, octave_count
 from pcmapq.features.walls import WallImage
 
-#: Keypoints closer than this are one keypoint, metres.
-_DUPLICATE = 0.1
-#: Samples this close to the image border are not searched for extrema (as in cv2.SIFT).
-_BORDER = 5
+#: Length of an OpenCV SIFT descriptor (L2 norm; its entries are non-negative).
+DESCRIPTOR_NORM = 512.0
+
+
+@dataclass(frozen=True)
+class Params:
+    """Parameters of the SIFT detector and of its matching rule.
+
+    window: sigma of the entropy window, metres.
+    threshold: detection threshold on the response (DoG contrast, image in [0, 1]).
+    support: support threshold, as a fraction of ``threshold``.
+    radius: a strong keypoint must be the strongest within this radius, metres.
+    octave_layers: DoG layers searched per octave (``cv2.SIFT_create``'s nOctaveLayers).
+    edge: edge test: a keypoint whose DoG principal curvatures differ by a ratio of ``edge``
+        or more is edge-like, not strong (``cv2.SIFT_create``'s edgeThreshold).
+    sigma: blur of the first scale, pixels of the working image (``cv2.SIFT_create``'s sigma).
+    max_size: largest keypoint diameter kept, metres: room-sized blobs are not local features,
+        and whether they are found depends on the whole room.
+    support_edge: support-level keypoints may be edge-like up to a ratio of this multiple of
+        ``edge``: a keypoint near the edge test's limit passes it on one side only.
+    duplicate: keypoints closer than this are one keypoint, the strongest, metres (one sample
+        of the octave most keypoints are found in; an extremum shared by two octaves is found
+        twice).
+    descriptor_gate: largest descriptor distance (L2) of an acceptable pair; by default the
+        descriptors' own length :data:`DESCRIPTOR_NORM`, i.e. an angle of at most 60 degrees
+        between them (cosine >= 0.5). The same keypoint on a re-drawn plan (half-cell shift,
+        turned and warped back, 0.025 vs 0.05 m, LiDAR faces) stays under about half of it;
+        unrelated keypoints are mostly beyond it.
+    """
+
+    window: float = 0.15
+    threshold: float = 0.025
+    support: float = 0.5
+    radius: float = 0.3
+    octave_layers: int = 3
+    edge: float = 10.0
+    sigma: float = 1.6
+    max_size: float = 1.0
+    support_edge: float = 2.0
+    duplicate: float = 0.1
+    descriptor_gate: float = DESCRIPTOR_NORM
 
 
 def entropy(image: np.ndarray, window_px: float) -> np.ndarray:
@@ -80,167 +119,51 @@ def entropy(image: np.ndarray, window_px: float) -> np.ndarray:
     return np.where((p <= 1e-7) | (p >= 1 - 1e-7), 0.0, h).astype(np.float32)
 
 
-def detect(walls: WallImage, *, window: float = 0.15, threshold: float = 0.025,
-           support: float = 0.5, radius: float = 0.3, octave_layers: int = 3,
-           edge: float = 10.0, sigma: float = 1.6, max_size: float = 1.0,
-           support_edge: float = 2.0) -> Features:
-    """SIFT keypoints and descriptors of the entropy image of a binary map.
-
-    Parameters
-    ----------
-    walls : the walls as detectors see them (:func:`pcmapq.features.walls.wall_image`);
-        features are returned in the metric frame of its grid.
-    window : sigma of the entropy window, metres.
-    threshold : detection threshold on the response (DoG contrast, image in [0, 1]).
-    support : support threshold, as a fraction of ``threshold``.
-    radius : a strong keypoint must be the strongest within this radius, metres.
-    octave_layers : DoG layers searched per octave (``cv2.SIFT_create``'s nOctaveLayers).
-    edge : edge test: a keypoint whose DoG principal curvatures differ by a ratio of ``edge``
-        or more is edge-like, not strong (``cv2.SIFT_create``'s edgeThreshold).
-    sigma : blur of the first scale, pixels of the working image (``cv2.SIFT_create``'s sigma).
-    max_size : largest keypoint diameter kept, metres: room-sized blobs are not local
-        features, and whether they are found depends on the whole room.
-    support_edge : support-level keypoints may be edge-like up to a ratio of this multiple of
-        ``edge``: a keypoint near the edge test's limit passes it on one side only.
-
-    Returns
-    -------
-    Features with ``strength`` the response and ``descriptors`` (N, 128) float32.
-    """
-    image, work = walls.image, walls.grid
+def detect(walls: WallImage, params: Params) -> Features:
+    """SIFT keypoints and descriptors of the entropy image of a binary map, seen as ``walls``
+    (see :func:`pcmapq.features.walls.wall_image`), in the metric frame of its grid:
+    ``strength`` is the response and ``descriptors`` (N, 128) float32."""
+    p, work = params, walls.grid
     resolution = work.resolution
-    ent = entropy(image, window / resolution)
-    # octaves whose smallest keypoint (layer 1, refined half a layer down) is under max_size
-    first = 2.0 * sigma * 2.0 ** (0.5 / octave_layers) * resolution
-    wanted = int(np.floor(np.log2(max_size / first))) + 1 if max_size >= first else 0
-    octaves = min(wanted, int(round(np.log2(max(min(ent.shape), 1)))) - 2)
+    ent = entropy(walls.image, p.window / resolution)
+    octaves = octave_count(ent.shape, p.sigma, p.octave_layers, p.max_size / resolution)
     if octaves < 1:
         return empty_features(with_descriptors=True)
-    gauss = _gaussian_pyramid(ent, sigma, octave_layers, octaves)
-    kp = _extrema(gauss, sigma, 0.5 * support * threshold)
-    size = kp["size"] * resolution
-    response = np.abs(kp["contrast"])
-    ratio = kp["edge_ratio"]
+    kp = extrema(gaussian_pyramid(ent, p.sigma, p.octave_layers, octaves), p.sigma,
+                 0.5 * p.support * p.threshold)
+    size = kp.size * resolution
+    response = np.abs(kp.contrast)
 
     def edge_ok(r: float) -> np.ndarray:  # Lowe's test: tr^2 / det < (r + 1)^2 / r
-        return ratio < (r + 1.0) ** 2 / r
+        return kp.edge_ratio < (r + 1.0) ** 2 / r
 
-    keep = (size <= max_size) & (response >= support * threshold) & edge_ok(support_edge * edge)
-    strong = (response >= threshold) & edge_ok(edge)
-    kp = {k: v[keep] for k, v in kp.items()}
-    response, strong = response[keep], strong[keep]
-    if not len(response):
+    keep = ((size <= p.max_size) & (response >= p.support * p.threshold)
+            & edge_ok(p.support_edge * p.edge))
+    strong = (response >= p.threshold) & edge_ok(p.edge)
+    kp, response, strong = kp.where(keep), response[keep], strong[keep]
+    if not len(kp):
         return empty_features(with_descriptors=True)
-    xy = work.pixels_to_xy(kp["pt"])
+    xy = work.pixels_to_xy(kp.pt)
     # one keypoint per place; strong ones are also the strongest within radius. Support ones
     # are not suppressed by neighbours, so a keypoint suppressed by a slightly stronger
     # neighbour on one side still confirms the other's.
-    once = suppress(xy, response, _DUPLICATE)
-    strong &= suppress(xy, response, radius)
-    kp = {k: v[once] for k, v in kp.items()}
-    xy, response, strong = xy[once], response[once], strong[once]
+    once = suppress(xy, response, p.duplicate)
+    strong &= suppress(xy, response, p.radius)
+    kp, xy, response, strong = kp.where(once), xy[once], response[once], strong[once]
     grey = np.round(ent * 255).astype(np.uint8)
-    desc = _descriptors(grey, kp, response, octave_layers, sigma)
+    desc = descriptors(grey, kp, response, p.octave_layers, p.sigma)
     return sorted_features(xy, response, strong, descriptors=desc)
 
 
-def _gaussian_pyramid(image: np.ndarray, sigma: float, layers: int,
-                      octaves: int) -> list[np.ndarray]:
-    """SIFT's Gaussian scale space of ``image``, as ``cv2.SIFT`` builds it without doubling the
-    image: per octave a stack (layers + 4, rows, cols) float32 of blurs ``sigma 2^(i / layers)``
-    pixels of the octave, each octave starting from the previous one's layer ``layers``, halved.
-    ``cv2.SIFT`` has one layer fewer; the extra one makes consecutive octaves share a DoG layer
-    where extrema are searched, so an extremum at an octave's scale limit is not lost between
-    two octaves sampled differently."""
-    k = 2.0 ** (1.0 / layers)
-    step = [np.sqrt(max(sigma * sigma - 0.25, 0.01))]  # the input counts as blurred by 0.5 px
-    step += [sigma * k ** (i - 1) * np.sqrt(k * k - 1.0) for i in range(1, layers + 4)]
-    pyramid: list[np.ndarray] = []
-    for o in range(octaves):
-        if o == 0:
-            current = image.astype(np.float32)
-        else:
-            prev = pyramid[-1][layers]
-            current = np.ascontiguousarray(prev[: prev.shape[0] // 2 * 2 : 2,
-                                                : prev.shape[1] // 2 * 2 : 2])
-        stack = []
-        for i in range(layers + 4):
-            if i > 0 or o == 0:
-                current = cv2.GaussianBlur(current, (0, 0), step[i])
-            stack.append(current)
-        pyramid.append(np.stack(stack))
-        if min(current.shape) < 2 * _BORDER + 3:  # no sample left to search
-            break
-    return pyramid
-
-
-def _extrema(gauss: list[np.ndarray], sigma: float, floor: float) -> dict[str, np.ndarray]:
-    """Every DoG sample that is an extremum of its 26 neighbours with ``|DoG| >= floor``, in
-    layers 1 to ``layers + 1`` of each octave, refined by one quadratic step clipped to half a
-    sample in space and scale (a sample is an extremum's nearest one when the fit says more:
-    the fit overshoots, and stepping to the next sample is what loses keypoints).
-
-    Returns per keypoint: octave, layer, the integer sample (row, col), pt (N, 2) (u, v) in
-    working pixels, xi (scale offset, layers), size (diameter 2 * scale, working pixels),
-    contrast (refined DoG) and edge_ratio (trace^2 / det of the spatial Hessian, inf when
-    the curvatures differ in sign).
-    """
-    found = [_octave_extrema(stack[1:] - stack[:-1], o, sigma, floor)
-             for o, stack in enumerate(gauss)]
-    keys = ("octave", "layer", "row", "col", "pt", "xi", "size", "contrast", "edge_ratio")
-    return {k: np.concatenate([f[k] for f in found]) for k in keys}
-
-
-def _octave_extrema(dog: np.ndarray, octave: int, sigma: float,
-                    floor: float) -> dict[str, np.ndarray]:
-    """:func:`_extrema` in one octave's DoG stack (layers + 3, rows, cols)."""
-    layers = dog.shape[0] - 3
-    peak = (((dog >= floor) & (dog == ndimage.maximum_filter(dog, size=3, mode="nearest")))
-            | ((dog <= -floor) & (dog == ndimage.minimum_filter(dog, size=3, mode="nearest"))))
-    peak[[0, -1]] = False
-    peak[:, :_BORDER], peak[:, peak.shape[1] - _BORDER :] = False, False
-    peak[:, :, :_BORDER], peak[:, :, peak.shape[2] - _BORDER :] = False, False
-    lay, r, c = np.nonzero(peak)
-
-    def at(dl: int, dr: int, dc: int) -> np.ndarray:
-        return dog[lay + dl, r + dr, c + dc].astype(np.float64)
-
-    v = at(0, 0, 0)
-    grad = 0.5 * np.stack([at(0, 0, 1) - at(0, 0, -1), at(0, 1, 0) - at(0, -1, 0),
-                           at(1, 0, 0) - at(-1, 0, 0)], axis=1)
-    dxx = at(0, 0, 1) + at(0, 0, -1) - 2 * v
-    dyy = at(0, 1, 0) + at(0, -1, 0) - 2 * v
-    dss = at(1, 0, 0) + at(-1, 0, 0) - 2 * v
-    dxy = 0.25 * (at(0, 1, 1) - at(0, 1, -1) - at(0, -1, 1) + at(0, -1, -1))
-    dxs = 0.25 * (at(1, 0, 1) - at(1, 0, -1) - at(-1, 0, 1) + at(-1, 0, -1))
-    dys = 0.25 * (at(1, 1, 0) - at(1, -1, 0) - at(-1, 1, 0) + at(-1, -1, 0))
-    hess = np.stack([np.stack([dxx, dxy, dxs], 1), np.stack([dxy, dyy, dys], 1),
-                     np.stack([dxs, dys, dss], 1)], 1)
-    offset = np.clip(-np.einsum("nij,nj->ni", np.linalg.pinv(hess), grad), -0.5, 0.5)
-    det, trace = dxx * dyy - dxy * dxy, dxx + dyy
-    scale = 2.0 ** octave  # working pixels per pixel of the octave
-    return {
-        "octave": np.full(len(lay), octave),
-        "layer": lay,
-        "row": r,
-        "col": c,
-        "pt": np.column_stack([c + offset[:, 0], r + offset[:, 1]]) * scale,
-        "xi": offset[:, 2],
-        "size": 2.0 * sigma * 2.0 ** ((lay + offset[:, 2]) / layers) * scale,
-        "contrast": v + 0.5 * np.sum(grad * offset, axis=1),
-        "edge_ratio": np.where(det > 0, trace * trace / np.where(det > 0, det, 1.0), np.inf),
-    }
-
-
-def _descriptors(grey: np.ndarray, kp: dict[str, np.ndarray], response: np.ndarray,
-                 layers: int, sigma: float) -> np.ndarray:
-    """Upright ``cv2.SIFT`` descriptors (N, 128) float32 of the keypoints on the uint8 image:
-    every keypoint's orientation is 0 (the grid's +u axis), as both maps are in the truth's
-    frame when features are detected."""
-    octave = (kp["octave"] + (kp["layer"] << 8)
-              + (np.round((kp["xi"] + 0.5) * 255).astype(np.int64) << 16))
+def descriptors(grey: np.ndarray, kp: Extrema, response: np.ndarray, layers: int,
+                sigma: float) -> np.ndarray:
+    """Upright ``cv2.SIFT`` descriptors (N, 128) float32 of the extrema ``kp`` (found with
+    ``layers`` and ``sigma``, pixels of ``grey``) on the uint8 image ``grey``: every keypoint's
+    orientation is 0 (the grid's +u axis), as both maps are in the truth's frame when features
+    are detected."""
+    octave = kp.octave + (kp.layer << 8) + (np.round((kp.xi + 0.5) * 255).astype(np.int64) << 16)
     points = [cv2.KeyPoint(float(u), float(v), float(s), 0.0, float(r), int(oc))
-              for (u, v), s, r, oc in zip(kp["pt"], kp["size"], response, octave, strict=True)]
+              for (u, v), s, r, oc in zip(kp.pt, kp.size, response, octave, strict=True)]
     sift = cv2.SIFT_create(nOctaveLayers=layers, sigma=sigma)
     got, desc = sift.compute(grey, points)
     if len(got) != len(points):
@@ -248,24 +171,16 @@ def _descriptors(grey: np.ndarray, kp: dict[str, np.ndarray], response: np.ndarr
     return np.asarray(desc, dtype=np.float32).reshape(-1, 128)
 
 
-#: Length of an OpenCV SIFT descriptor (L2 norm; its entries are non-negative).
-DESCRIPTOR_NORM = 512.0
-#: Largest descriptor distance of an acceptable pair: the descriptors' own length, i.e. an
-#: angle of at most 60 degrees between them (cosine >= 0.5). The same keypoint on a re-drawn
-#: plan (half-cell shift, turned and warped back, 0.025 vs 0.05 m, LiDAR faces) stays under
-#: about half of it; unrelated keypoints are mostly beyond it.
-DESCRIPTOR_GATE = DESCRIPTOR_NORM
-
-
-def candidates(truth: Features, map_: Features, threshold: float) -> Candidates:
+def candidates(truth: Features, map_: Features, threshold: float, params: Params) -> Candidates:
     """Keypoint pairs within ``threshold`` metres whose descriptors are alike (L2 distance at
-    most :data:`DESCRIPTOR_GATE`); cost = the mean of their distance over the threshold and
+    most ``params.descriptor_gate``); cost = the mean of their distance over the threshold and
     their descriptor distance over the gate, so that among nearby alike keypoints the most
     alike are paired, and no far pair is taken for a near one."""
+    gate = params.descriptor_gate
     i, j, dist, disp = point_candidates(truth, map_, threshold)
     desc = np.linalg.norm(truth.descriptors[i] - map_.descriptors[j], axis=1)
-    alike = desc <= DESCRIPTOR_GATE
-    return i[alike], j[alike], 0.5 * (dist[alike] + desc[alike] / DESCRIPTOR_GATE), disp[alike]
+    alike = desc <= gate
+    return i[alike], j[alike], 0.5 * (dist[alike] + desc[alike] / gate), disp[alike]
 
 
-DETECTOR = Detector("sift", detect, candidates)
+DETECTOR = Detector("sift", detect, candidates, Params)

@@ -34,6 +34,7 @@ from scipy import sparse
 from skimage.morphology import skeletonize
 
 from pcmapq.grid import MetricGrid
+from pcmapq.morphology import disc, distance_to
 
 #: 8-neighbourhood of a pixel (the centre excluded).
 _NEIGHBOURS = np.array([[1, 1, 1], [1, 0, 1], [1, 1, 1]], dtype=np.float32)
@@ -68,11 +69,6 @@ def resample(image: np.ndarray, grid: MetricGrid,
     out = ay @ image[::-1]
     out = (ax @ out.T).T[::-1]
     return np.ascontiguousarray(out, dtype=np.float32), work
-
-
-def _disc(radius_px: float) -> np.ndarray:
-    r = max(1, int(round(radius_px)))
-    return cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * r + 1, 2 * r + 1))
 
 
 def _neighbours(mask: np.ndarray) -> np.ndarray:
@@ -113,7 +109,7 @@ def centreline(occupied: np.ndarray, grid: MetricGrid, resolution: float, closin
     """
     frac, fine = resample(occupied, grid, resolution)
     wall = (frac > 1e-6).astype(np.uint8)
-    kernel = _disc(closing / resolution)
+    kernel = disc(closing / resolution)
     pad = kernel.shape[0]
     wall = cv2.morphologyEx(np.pad(wall, pad), cv2.MORPH_CLOSE, kernel)[pad:-pad, pad:-pad]
     n, label, stats, _ = cv2.connectedComponentsWithStats(wall, connectivity=8)
@@ -146,8 +142,7 @@ def cores(objects: np.ndarray, width_px: float) -> np.ndarray:
     if not objects.any():
         return objects
     _, label = cv2.connectedComponents(objects.astype(np.uint8), connectivity=8)
-    depth = cv2.distanceTransform(np.pad(objects.astype(np.uint8), 1), cv2.DIST_L2,
-                                  cv2.DIST_MASK_PRECISE)[1:-1, 1:-1]
+    depth = distance_to(np.pad(~objects, 1, constant_values=True))[1:-1, 1:-1]
     deepest = np.zeros(label.max() + 1, dtype=np.float32)
     np.maximum.at(deepest, label[objects], depth[objects])
     return objects & (depth >= deepest[label] - 0.5 * width_px)
@@ -191,6 +186,6 @@ def wall_image(occupied: np.ndarray, grid: MetricGrid, resolution: float = 0.05,
     line, core, fine = centreline(occupied, grid, fine_res, closing, spur, small, width)
     band = core.astype(np.float32)
     if line.any():
-        dist = cv2.distanceTransform((~line).astype(np.uint8), cv2.DIST_L2, cv2.DIST_MASK_PRECISE)
+        dist = distance_to(line)
         band = np.maximum(band, np.clip(0.5 + (0.5 * width / fine_res - dist), 0.0, 1.0))
     return WallImage(*resample(band, fine, resolution))

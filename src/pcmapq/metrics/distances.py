@@ -1,15 +1,16 @@
 """Cloud-to-cloud style distance metrics on the truth's grid: accuracy, completeness, Chamfer
 distance and precision / recall / F-score at distance thresholds (definitions in
-docs/metrics.md). Exact Euclidean distance transforms; metres."""
+docs/metrics.md). Exact Euclidean distance transforms (:func:`pcmapq.morphology.distance_to`);
+metres."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import ndimage
 
 from pcmapq.grid import MetricGrid
+from pcmapq.morphology import distance_to
 from pcmapq.stats import Stats
 
 #: Default distance thresholds of the F-score, metres.
@@ -36,10 +37,10 @@ class Distances:
 
 
 def nearest_distance(target: np.ndarray, grid: MetricGrid) -> np.ndarray:
-    """Distance in metres from every cell to the nearest true cell of ``target`` (inf if none)."""
-    if not target.any():
-        return np.full(target.shape, np.inf)
-    return ndimage.distance_transform_edt(~target) * grid.resolution
+    """Distance in metres from every cell to the nearest true cell of ``target`` (inf if none):
+    (rows, cols) float64, so that a distance of whole cells compares exactly with a threshold
+    in metres (the transform itself is float32, exact up to its rounding)."""
+    return np.multiply(distance_to(target), grid.resolution, dtype=np.float64)
 
 
 def distances(truth_occ: np.ndarray, map_occ: np.ndarray, footprint: np.ndarray,

@@ -1,4 +1,5 @@
-"""Drawing maps into a MetricGrid: points as hit counts, occupancy images by warping."""
+"""Drawing maps into a MetricGrid: points as hit counts, convex polygons as cells, occupancy
+images by warping."""
 
 from __future__ import annotations
 
@@ -22,6 +23,21 @@ def hit_counts(xy: np.ndarray, grid: MetricGrid) -> np.ndarray:
     inside = (uv[:, 0] >= 0) & (uv[:, 0] < cols) & (uv[:, 1] >= 0) & (uv[:, 1] < rows)
     flat = uv[inside, 1] * cols + uv[inside, 0]
     return np.bincount(flat, minlength=rows * cols).reshape(rows, cols).astype(np.int32)
+
+
+def polygon_cells(polygons: np.ndarray, grid: MetricGrid) -> np.ndarray:
+    """The cells of ``grid`` (bool) that convex polygons cover: (K, M, 2) or one (M, 2) corners,
+    metres, in the grid's frame. OpenCV's fill with 8 fixed-point bits: the cells whose centres
+    are inside and the cells the edges touch. Each polygon is filled on its own, so overlaps are
+    covered (``cv2.fillPoly``'s even-odd rule would leave them out)."""
+    shift = 8  # fixed-point bits: cell centres are at integer pixel coordinates
+    polygons = np.asarray(polygons, dtype=np.float64)
+    polygons = polygons.reshape(-1, *polygons.shape[-2:])
+    uv = grid.xy_to_pixels(polygons.reshape(-1, 2)).reshape(polygons.shape)
+    area = np.zeros(grid.shape, np.uint8)
+    for poly in np.round(uv * (1 << shift)).astype(np.int32):
+        cv2.fillConvexPoly(area, poly, 1, lineType=cv2.LINE_8, shift=shift)
+    return area.astype(bool)
 
 
 def points_to_grid(xy: np.ndarray, grid: MetricGrid, min_hits: int = 1) -> np.ndarray:

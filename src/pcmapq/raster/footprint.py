@@ -24,6 +24,8 @@ import numpy as np
 from scipy import ndimage
 
 from pcmapq.grid import MetricGrid
+from pcmapq.morphology import disc, distance_to
+from pcmapq.raster.draw import polygon_cells
 
 #: The footprint rules, ``auto`` first (the default).
 FOOTPRINT_RULES = ("auto", "known", "walls", "all")
@@ -33,11 +35,6 @@ UNKNOWN_WIDTH = 0.5
 #: An image whose unknown regions make up at least this share of it has ``known`` cells that
 #: say what it observed (``auto``); below it, it is treated as binary (``walls``).
 UNKNOWN_SHARE = 0.01
-
-
-def _disc(radius_m: float, resolution: float) -> np.ndarray:
-    r = max(1, int(round(radius_m / resolution)))
-    return cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * r + 1, 2 * r + 1))
 
 
 def enclosed_area(occupied: np.ndarray, grid: MetricGrid, close: float = 1.5) -> np.ndarray:
@@ -50,7 +47,7 @@ def enclosed_area(occupied: np.ndarray, grid: MetricGrid, close: float = 1.5) ->
         pad = np.pad(occupied, ((0, -rows % step), (0, -cols % step)))
         small = pad.reshape(pad.shape[0] // step, step, pad.shape[1] // step, step).any(axis=(1, 3))
     # pad so the closing does not stick to the border of the grid
-    kernel = _disc(close, grid.resolution * step)
+    kernel = disc(close / (grid.resolution * step))
     r = kernel.shape[0]
     padded = np.pad(small.astype(np.uint8), r)
     closed = cv2.morphologyEx(padded, cv2.MORPH_CLOSE, kernel)
@@ -69,8 +66,7 @@ def grow(area: np.ndarray, grid: MetricGrid, margin: float) -> np.ndarray:
     if margin <= 0 or not area.any():
         return area
     radius = max(1, int(round(margin / grid.resolution)))
-    outside = (~area).astype(np.uint8)
-    return cv2.distanceTransform(outside, cv2.DIST_L2, cv2.DIST_MASK_PRECISE) <= radius
+    return distance_to(area) <= radius
 
 
 def unknown_regions(unknown: np.ndarray, resolution: float,
@@ -80,11 +76,10 @@ def unknown_regions(unknown: np.ndarray, resolution: float,
     known, so a thin unknown border is not a region. ``resolution``: metres per cell."""
     r = width / 2.0 / resolution  # cells
     pad = int(np.ceil(r)) + 1
-    padded = np.pad(unknown, pad).astype(np.uint8)
-    core = cv2.distanceTransform(padded, cv2.DIST_L2, cv2.DIST_MASK_PRECISE) > r
-    opened = cv2.distanceTransform((~core).astype(np.uint8), cv2.DIST_L2,
-                                   cv2.DIST_MASK_PRECISE) <= r
-    return (opened & padded.astype(bool))[pad:-pad, pad:-pad]
+    padded = np.pad(unknown.astype(bool), pad)
+    core = distance_to(~padded) > r
+    opened = distance_to(core) <= r
+    return (opened & padded)[pad:-pad, pad:-pad]
 
 
 def footprint_rule(requested: str, unknown: np.ndarray | None, resolution: float) -> str:
@@ -106,16 +101,6 @@ def footprint_rule(requested: str, unknown: np.ndarray | None, resolution: float
     return "known" if share >= UNKNOWN_SHARE else "walls"
 
 
-def polygon_area(corners: np.ndarray, grid: MetricGrid) -> np.ndarray:
-    """The cells of ``grid`` (bool) the convex polygon ``corners`` ((K, 2) metres, in the grid's
-    frame) covers (OpenCV's fill: cells its edges touch included)."""
-    shift = 8  # fixed-point bits: cell centres are at integer pixel coordinates
-    uv = np.round(grid.xy_to_pixels(corners) * (1 << shift)).astype(np.int32)
-    area = np.zeros(grid.shape, np.uint8)
-    cv2.fillConvexPoly(area, uv, 1, lineType=cv2.LINE_8, shift=shift)
-    return area.astype(bool)
-
-
 def map_footprint(rule: str, occupied: np.ndarray, grid: MetricGrid, margin: float = 0.3,
                   known: np.ndarray | None = None,
                   rectangle: np.ndarray | None = None) -> np.ndarray:
@@ -126,7 +111,7 @@ def map_footprint(rule: str, occupied: np.ndarray, grid: MetricGrid, margin: flo
     if rule == "known" and known is not None:
         area = known
     elif rule == "all" and rectangle is not None:
-        area = polygon_area(rectangle, grid)
+        area = polygon_cells(rectangle, grid)
     elif rule == "walls":
         area = enclosed_area(occupied, grid)
     else:

@@ -16,9 +16,9 @@ from matplotlib.collections import LineCollection  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
 from mpl_toolkits.axes_grid1.anchored_artists import AnchoredSizeBar  # noqa: E402
-from scipy import ndimage  # noqa: E402
 
-from pcmapq.report.text import score
+from pcmapq.metrics.distances import nearest_distance  # noqa: E402
+from pcmapq.report.text import score  # noqa: E402
 from pcmapq.result import DetectorResult, Result  # noqa: E402
 
 TRUTH_GREY, MAP_BLUE = (0.62, 0.62, 0.62), (0.25, 0.55, 0.95)
@@ -118,7 +118,7 @@ def vectorial_figure(result: Result) -> Figure:
 def distance_heatmap(result: Result, clip: float = 0.5) -> Figure:
     """Each occupied cell of the aligned map coloured by its distance to the nearest truth wall,
     metres (clipped at ``clip``); the truth's walls in grey beneath."""
-    dist = ndimage.distance_transform_edt(~result.truth_occupied) * result.grid.resolution
+    dist = nearest_distance(result.truth_occupied, result.grid)
     shown = np.where(result.map_occupied, np.minimum(dist, clip), np.nan)
     width, height = result.grid.size_m
     fig, ax = plt.subplots(figsize=(8.0, float(np.clip(8.0 * height / width, 3.0, 10.0))),

@@ -1,0 +1,138 @@
+"""SIFT's difference-of-Gaussians (DoG) scale space of an image and its extrema, in pixels.
+
+The Gaussian pyramid is built as ``cv2.SIFT`` builds it without doubling the image (``layers``
+DoG layers searched per octave, base blur ``sigma`` pixels), with one layer more per octave so
+that consecutive octaves share a searched DoG layer. Extrema are every sample that is an
+extremum of its 26 neighbours, refined by one quadratic step clipped to half a sample in space
+and scale (see :mod:`pcmapq.features.sift` for why ``cv2.SIFT``'s own detection is not used).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, fields
+
+import cv2
+import numpy as np
+from scipy import ndimage
+
+#: Samples this close to the image border are not searched for extrema (as in cv2.SIFT).
+BORDER = 5
+
+
+@dataclass(frozen=True)
+class Extrema:
+    """DoG extrema, one entry per extremum.
+
+    octave: (N,) int, octave index (0: the input's resolution).
+    layer: (N,) int, DoG layer within the octave, 1 to ``layers + 1``.
+    pt: (N, 2) refined position (u, v), pixels of the input image.
+    xi: (N,) refined scale offset, layers, in [-0.5, 0.5].
+    size: (N,) diameter ``2 * scale``, pixels of the input image.
+    contrast: (N,) refined DoG value, units of the image.
+    edge_ratio: (N,) ``trace^2 / det`` of the spatial Hessian, inf when the curvatures differ
+        in sign.
+    """
+
+    octave: np.ndarray
+    layer: np.ndarray
+    pt: np.ndarray
+    xi: np.ndarray
+    size: np.ndarray
+    contrast: np.ndarray
+    edge_ratio: np.ndarray
+
+    def __len__(self) -> int:
+        return len(self.octave)
+
+    def where(self, keep: np.ndarray) -> Extrema:
+        """The extrema selected by ``keep``, an (N,) bool mask or an index array."""
+        return Extrema(**{f.name: getattr(self, f.name)[keep] for f in fields(self)})
+
+
+def octave_count(shape: tuple[int, int], sigma: float, layers: int, largest: float) -> int:
+    """How many octaves to build for extrema at most ``largest`` pixels across on an image of
+    ``shape``: those whose smallest extremum (layer 1, refined half a layer down) is at most
+    that, and at most ``round(log2(min(shape))) - 2`` (``cv2.SIFT``'s count). 0 or less: none."""
+    first = 2.0 * sigma * 2.0 ** (0.5 / layers)
+    wanted = int(np.floor(np.log2(largest / first))) + 1 if largest >= first else 0
+    return min(wanted, int(round(np.log2(max(min(shape), 1)))) - 2)
+
+
+def gaussian_pyramid(image: np.ndarray, sigma: float, layers: int,
+                     octaves: int) -> list[np.ndarray]:
+    """SIFT's Gaussian scale space of ``image``: per octave a stack (layers + 4, rows, cols)
+    float32 of blurs ``sigma 2^(i / layers)`` pixels of the octave, each octave starting from
+    the previous one's layer ``layers``, halved. ``cv2.SIFT`` has one layer fewer; the extra one
+    makes consecutive octaves share a DoG layer where extrema are searched, so an extremum at an
+    octave's scale limit is not lost between two octaves sampled differently. Stops early when
+    an octave has no sample left to search."""
+    k = 2.0 ** (1.0 / layers)
+    step = [np.sqrt(max(sigma * sigma - 0.25, 0.01))]  # the input counts as blurred by 0.5 px
+    step += [sigma * k ** (i - 1) * np.sqrt(k * k - 1.0) for i in range(1, layers + 4)]
+    pyramid: list[np.ndarray] = []
+    for o in range(octaves):
+        if o == 0:
+            current = image.astype(np.float32)
+        else:
+            prev = pyramid[-1][layers]
+            current = np.ascontiguousarray(prev[: prev.shape[0] // 2 * 2 : 2,
+                                                : prev.shape[1] // 2 * 2 : 2])
+        stack = []
+        for i in range(layers + 4):
+            if i > 0 or o == 0:
+                current = cv2.GaussianBlur(current, (0, 0), step[i])
+            stack.append(current)
+        pyramid.append(np.stack(stack))
+        if min(current.shape) < 2 * BORDER + 3:
+            break
+    return pyramid
+
+
+def extrema(pyramid: list[np.ndarray], sigma: float, floor: float) -> Extrema:
+    """Every DoG sample of :func:`gaussian_pyramid`'s ``pyramid`` that is an extremum of its 26
+    neighbours with ``|DoG| >= floor``, in layers 1 to ``layers + 1`` of each octave, refined by
+    one quadratic step clipped to half a sample in space and scale (a sample is an extremum's
+    nearest one when the fit says more: the fit overshoots, and stepping to the next sample is
+    what loses keypoints). ``sigma``: the pyramid's base blur, pixels."""
+    found = [_octave_extrema(stack[1:] - stack[:-1], o, sigma, floor)
+             for o, stack in enumerate(pyramid)]
+    return Extrema(**{f.name: np.concatenate([getattr(e, f.name) for e in found])
+                      for f in fields(Extrema)})
+
+
+def _octave_extrema(dog: np.ndarray, octave: int, sigma: float, floor: float) -> Extrema:
+    """:func:`extrema` in one octave's DoG stack (layers + 3, rows, cols)."""
+    layers = dog.shape[0] - 3
+    peak = (((dog >= floor) & (dog == ndimage.maximum_filter(dog, size=3, mode="nearest")))
+            | ((dog <= -floor) & (dog == ndimage.minimum_filter(dog, size=3, mode="nearest"))))
+    peak[[0, -1]] = False
+    peak[:, :BORDER], peak[:, peak.shape[1] - BORDER :] = False, False
+    peak[:, :, :BORDER], peak[:, :, peak.shape[2] - BORDER :] = False, False
+    lay, r, c = np.nonzero(peak)
+
+    def at(dl: int, dr: int, dc: int) -> np.ndarray:
+        return dog[lay + dl, r + dr, c + dc].astype(np.float64)
+
+    v = at(0, 0, 0)
+    grad = 0.5 * np.stack([at(0, 0, 1) - at(0, 0, -1), at(0, 1, 0) - at(0, -1, 0),
+                           at(1, 0, 0) - at(-1, 0, 0)], axis=1)
+    dxx = at(0, 0, 1) + at(0, 0, -1) - 2 * v
+    dyy = at(0, 1, 0) + at(0, -1, 0) - 2 * v
+    dss = at(1, 0, 0) + at(-1, 0, 0) - 2 * v
+    dxy = 0.25 * (at(0, 1, 1) - at(0, 1, -1) - at(0, -1, 1) + at(0, -1, -1))
+    dxs = 0.25 * (at(1, 0, 1) - at(1, 0, -1) - at(-1, 0, 1) + at(-1, 0, -1))
+    dys = 0.25 * (at(1, 1, 0) - at(1, -1, 0) - at(-1, 1, 0) + at(-1, -1, 0))
+    hess = np.stack([np.stack([dxx, dxy, dxs], 1), np.stack([dxy, dyy, dys], 1),
+                     np.stack([dxs, dys, dss], 1)], 1)
+    offset = np.clip(-np.einsum("nij,nj->ni", np.linalg.pinv(hess), grad), -0.5, 0.5)
+    det, trace = dxx * dyy - dxy * dxy, dxx + dyy
+    scale = 2.0 ** octave  # input pixels per pixel of the octave
+    return Extrema(
+        octave=np.full(len(lay), octave),
+        layer=lay,
+        pt=np.column_stack([c + offset[:, 0], r + offset[:, 1]]) * scale,
+        xi=offset[:, 2],
+        size=2.0 * sigma * 2.0 ** ((lay + offset[:, 2]) / layers) * scale,
+        contrast=v + 0.5 * np.sum(grad * offset, axis=1),
+        edge_ratio=np.where(det > 0, trace * trace / np.where(det > 0, det, 1.0), np.inf),
+    )

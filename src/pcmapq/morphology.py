@@ -1,0 +1,31 @@
+"""Raster morphology in cells: the one Euclidean distance transform every module uses, and the
+disc that closings use."""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+
+
+def distance_to(mask: np.ndarray) -> np.ndarray:
+    """Euclidean distance, in cells, from every cell to the nearest true cell of ``mask``.
+
+    mask: (rows, cols) bool (or 0/nonzero). Returns (rows, cols) float32, inf everywhere when
+    ``mask`` has no true cell. OpenCV's precise transform (``DIST_MASK_PRECISE``, an exact
+    Euclidean transform computed in float32): against SciPy's ``distance_transform_edt`` in
+    float64 it differs by float32 rounding (relative 1.2e-7) on every real map tried (the
+    largest 8904 x 6936 cells); on an 8000 x 8000 plan 12 of 64 M cells, about 600 cells from
+    the nearest wall, got the next squared distance (relative 1.4e-6).
+    """
+    if not mask.any():
+        return np.full(mask.shape, np.inf, dtype=np.float32)
+    return cv2.distanceTransform(np.logical_not(mask).view(np.uint8), cv2.DIST_L2,
+                                 cv2.DIST_MASK_PRECISE)
+
+
+def disc(radius: float) -> np.ndarray:
+    """OpenCV's elliptic structuring element of ``radius`` cells, rounded (at least 1):
+    (2 r + 1, 2 r + 1) uint8. Not quite the Euclidean disc (:func:`pcmapq.features.base.disk`):
+    OpenCV rasterises an ellipse, whose rows next to the centre row are as wide as it."""
+    r = max(1, int(round(radius)))
+    return cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * r + 1, 2 * r + 1))
