@@ -1,5 +1,5 @@
 """3D rigid registration of two point clouds with no initial guess: FPFH features + RANSAC,
-then point-to-plane ICP with a robust (Tukey) kernel.
+then point-to-plane ICP.
 
 Frames: the result ``T`` (4x4) takes source points to the target frame,
 ``p_target = T @ p_source``; metres.
@@ -10,15 +10,15 @@ Frames: the result ``T`` (4x4) takes source points to the target frame,
    nearest neighbours in feature space, best Lowe ratios first), then Open3D's RANSAC on those
    matches (3 per hypothesis, edge-length and distance checkers, inliers within 1.5 ``voxel``),
    seeded with ``open3d.utility.random.seed(0)``.
-3. ICP: Gauss-Newton point-to-plane with Tukey weights, in NumPy (bit-for-bit repeatable),
-   three stages with correspondence distances 2, 1 and 0.5 ``voxel`` (the last on clouds
-   downsampled at ``voxel / 2``), at most ``ICP_ITERATIONS`` each.
+3. ICP (:mod:`pcmapq.align.refine3d`): small_gicp's point-to-plane ICP on one thread, three
+   stages with correspondence distances 2, 1 and 0.5 ``voxel`` (the last on clouds downsampled
+   at ``voxel / 2``).
 4. Scores: ``fitness`` is the share of the source (downsampled at ``voxel / 2``) within
    ``tolerance`` (default ``voxel``) of the target (downsampled at ``voxel / 4``), ``rmse`` the
    RMSE of those inlier distances, metres.
 
-Repeated runs give identical results. Cost grows with the clouds mostly through ICP; on outdoor
-maps a ``voxel`` of 0.5-1 m is the practical choice (20 KITTI scans: 8 s at 0.5 m, 20 s at 0.3).
+Repeated runs give identical results. Cost grows with the clouds; on outdoor maps a ``voxel`` of
+0.5-1 m is the practical choice (20 KITTI scans, one CPU: 5 s at 0.5 m, 11 s at 0.3).
 """
 
 from __future__ import annotations
@@ -28,8 +28,8 @@ from typing import NamedTuple
 import numpy as np
 import open3d as o3d
 from scipy.spatial import cKDTree
-from scipy.spatial.transform import Rotation
 
+from pcmapq.align.refine3d import refine
 from pcmapq.errors import EvaluationError, InputError
 from pcmapq.voxels import voxel_centroids, voxel_keys
 
@@ -40,16 +40,12 @@ reg = o3d.pipelines.registration
 #: RANSAC budget: hypotheses, and the confidence at which it stops early.
 RANSAC_ITERATIONS = 100_000
 RANSAC_CONFIDENCE = 0.999
-#: ICP stages: (max correspondence distance, downsampling voxel), in units of ``voxel``.
-ICP_STAGES = ((2.0, 1.0), (1.0, 1.0), (0.5, 0.5))
 #: Fewest points left after downsampling for features to mean anything.
 MIN_POINTS = 10
 #: Feature matches given to RANSAC, at most.
 MAX_MATCHES = 10_000
 #: Points whose features are matched, per cloud, at most.
 MAX_KEYPOINTS = 8_000
-#: Gauss-Newton iterations per ICP stage, at most.
-ICP_ITERATIONS = 50
 
 
 class Registration3D(NamedTuple):
@@ -89,7 +85,8 @@ def align_3d(source_xyz: np.ndarray, target_xyz: np.ndarray, *, voxel: float = 0
     else:
         guess = tgt_shift @ np.asarray(init, dtype=np.float64).reshape(4, 4) @ np.linalg.inv(
             src_shift)
-    transform = refine(source, target, src_down, tgt_down, guess, voxel)
+    transform = refine(source, target, guess, voxel,
+                       (np.asarray(src_down.points), np.asarray(tgt_down.points)))
     fitness, rmse = score(source, target, transform, tolerance or voxel, voxel / 2)
     return Registration3D(np.linalg.inv(tgt_shift) @ transform @ src_shift, fitness, rmse)
 
@@ -144,66 +141,6 @@ def feature_matches(source: np.ndarray, target: np.ndarray, limit: int = 0) -> n
     ratio = forward_dist[mutual, 0] / np.maximum(forward_dist[mutual, 1], 1e-12)
     keep = mutual[np.argsort(ratio, kind="stable")[:limit]]
     return np.column_stack([keep, forward[keep, 0]]).astype(np.int32)
-
-
-def refine(source: np.ndarray, target: np.ndarray, src_down: o3d.geometry.PointCloud,
-           tgt_down: o3d.geometry.PointCloud, guess: np.ndarray, voxel: float) -> np.ndarray:
-    """Point-to-plane ICP with a Tukey kernel from ``guess``, coarse to fine; 4x4."""
-    transform = guess
-    clouds = {1.0: (src_down, tgt_down)}
-    for distance_units, voxel_units in ICP_STAGES:
-        if voxel_units not in clouds:
-            fine = voxel * voxel_units
-            src, tgt = _cloud(voxel_centroids(source, fine)), _cloud(voxel_centroids(target, fine))
-            _normals(tgt, fine)
-            clouds[voxel_units] = (src, tgt)
-        src, tgt = clouds[voxel_units]
-        transform = point_to_plane_icp(np.asarray(src.points), np.asarray(tgt.points),
-                                       np.asarray(tgt.normals), transform,
-                                       voxel * distance_units)
-    return transform
-
-
-def point_to_plane_icp(source: np.ndarray, target: np.ndarray, normals: np.ndarray,
-                       init: np.ndarray, distance: float, iterations: int = ICP_ITERATIONS,
-                       ) -> np.ndarray:
-    """Gauss-Newton point-to-plane ICP, Tukey weights of scale ``distance`` (metres).
-
-    source (N, 3), target (M, 3) with unit normals (M, 3); pairs are nearest neighbours within
-    ``distance``. Stops when an update moves less than 1e-6 (radians + metres). Returns the 4x4
-    source -> target transform. NumPy only, so bit-for-bit repeatable (Open3D's multithreaded
-    reductions are not).
-    """
-    tree = cKDTree(target)
-    transform = np.array(init, dtype=np.float64)
-    for _ in range(iterations):
-        moved = apply(transform, source)
-        dist, index = tree.query(moved, distance_upper_bound=distance, workers=-1)
-        found = np.isfinite(dist)
-        if found.sum() < 6:
-            break
-        p, q, n = moved[found], target[index[found]], normals[index[found]]
-        residual = np.einsum("ij,ij->i", p - q, n)
-        weight = np.clip(1.0 - (residual / distance) ** 2, 0.0, None) ** 2
-        jacobian = np.hstack([np.cross(p, n), n])
-        hessian = np.einsum("ni,n,nj->ij", jacobian, weight, jacobian)
-        gradient = np.einsum("ni,n->i", jacobian, weight * residual)
-        try:
-            step = -np.linalg.solve(hessian, gradient)
-        except np.linalg.LinAlgError:
-            break
-        transform = _se3(step) @ transform
-        if np.abs(step).sum() < 1e-6:
-            break
-    return transform
-
-
-def _se3(step: np.ndarray) -> np.ndarray:
-    """4x4 transform of a small motion (wx, wy, wz rad, tx, ty, tz m): exact rotation."""
-    out = np.eye(4)
-    out[:3, :3] = Rotation.from_rotvec(step[:3]).as_matrix()
-    out[:3, 3] = step[3:]
-    return out
 
 
 def score(source: np.ndarray, target: np.ndarray, transform: np.ndarray, tolerance: float,
