@@ -7,7 +7,8 @@ import open3d as o3d
 import pytest
 from scipy.spatial.transform import Rotation
 
-from pcmapq.align.rigid3d import align_3d, feature_matches, keypoints
+from pcmapq.align.features3d import feature_matches, keypoints
+from pcmapq.align.rigid3d import align_3d
 from pcmapq.errors import EvaluationError, InputError
 
 from .conftest import shared

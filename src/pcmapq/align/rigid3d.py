@@ -1,24 +1,25 @@
 """3D rigid registration of two point clouds with no initial guess: FPFH features + RANSAC,
-then point-to-plane ICP with a robust (Tukey) kernel.
+then point-to-plane ICP.
 
 Frames: the result ``T`` (4x4) takes source points to the target frame,
-``p_target = T @ p_source``; metres.
+``p_target = T @ p_source``; metres. Both clouds are first moved to their centroids (voxel keys
+stay small and sums precise with UTM coordinates); ``T`` is given back in the input frames.
 
 1. Both clouds are voxel-downsampled at ``voxel`` (centroid per cell, numpy, deterministic
-   order); normals from 2 ``voxel`` neighbourhoods (at most 30 points), FPFH from 5 ``voxel``.
-2. Global: FPFH matched on at most ``MAX_KEYPOINTS`` evenly spread points per cloud (mutual
-   nearest neighbours in feature space, best Lowe ratios first), then Open3D's RANSAC on those
-   matches (3 per hypothesis, edge-length and distance checkers, inliers within 1.5 ``voxel``),
-   seeded with ``open3d.utility.random.seed(0)``.
-3. ICP: Gauss-Newton point-to-plane with Tukey weights, in NumPy (bit-for-bit repeatable),
-   three stages with correspondence distances 2, 1 and 0.5 ``voxel`` (the last on clouds
-   downsampled at ``voxel / 2``), at most ``ICP_ITERATIONS`` each.
+   order).
+2. Global (:mod:`pcmapq.align.features3d`, skipped when ``init`` is given): FPFH at no more
+   than 8,000 evenly spread points per cloud, matched as mutual nearest neighbours in feature
+   space, then Open3D's RANSAC on those matches, seeded and on one thread.
+3. ICP (:mod:`pcmapq.align.refine3d`): small_gicp's point-to-plane ICP on one thread, three
+   stages with correspondence distances 2, 1 and 0.5 ``voxel`` (the last on clouds downsampled
+   at ``voxel / 2``).
 4. Scores: ``fitness`` is the share of the source (downsampled at ``voxel / 2``) within
    ``tolerance`` (default ``voxel``) of the target (downsampled at ``voxel / 4``), ``rmse`` the
    RMSE of those inlier distances, metres.
 
-Repeated runs give identical results. Cost grows with the clouds mostly through ICP; on outdoor
-maps a ``voxel`` of 0.5-1 m is the practical choice (20 KITTI scans: 8 s at 0.5 m, 20 s at 0.3).
+Repeated runs give identical results. Cost grows with the clouds; on outdoor maps a ``voxel`` of
+0.5-1 m is the practical choice (20 KITTI scans: 4 s of CPU at 0.5 m, 9 s at 0.3; about half
+of it ICP, most of the rest normals and FPFH).
 """
 
 from __future__ import annotations
@@ -26,30 +27,17 @@ from __future__ import annotations
 from typing import NamedTuple
 
 import numpy as np
-import open3d as o3d
 from scipy.spatial import cKDTree
-from scipy.spatial.transform import Rotation
 
+from pcmapq.align.features3d import global_registration
+from pcmapq.align.refine3d import refine
 from pcmapq.errors import EvaluationError, InputError
-from pcmapq.voxels import voxel_centroids, voxel_keys
+from pcmapq.voxels import voxel_centroids
 
 __all__ = ["Registration3D", "align_3d"]
 
-reg = o3d.pipelines.registration
-
-#: RANSAC budget: hypotheses, and the confidence at which it stops early.
-RANSAC_ITERATIONS = 100_000
-RANSAC_CONFIDENCE = 0.999
-#: ICP stages: (max correspondence distance, downsampling voxel), in units of ``voxel``.
-ICP_STAGES = ((2.0, 1.0), (1.0, 1.0), (0.5, 0.5))
 #: Fewest points left after downsampling for features to mean anything.
 MIN_POINTS = 10
-#: Feature matches given to RANSAC, at most.
-MAX_MATCHES = 10_000
-#: Points whose features are matched, per cloud, at most.
-MAX_KEYPOINTS = 8_000
-#: Gauss-Newton iterations per ICP stage, at most.
-ICP_ITERATIONS = 50
 
 
 class Registration3D(NamedTuple):
@@ -74,136 +62,20 @@ def align_3d(source_xyz: np.ndarray, target_xyz: np.ndarray, *, voxel: float = 0
         raise InputError(f"voxel must be positive, got {voxel}")
     source = _usable(source_xyz, "source")
     target = _usable(target_xyz, "target")
-    # Work about each cloud's centroid: voxel keys stay small and sums precise (UTM maps).
     src_shift, tgt_shift = _translation(-source.mean(axis=0)), _translation(-target.mean(axis=0))
     source, target = apply(src_shift, source), apply(tgt_shift, target)
-    src_down = _cloud(voxel_centroids(source, voxel))
-    tgt_down = _cloud(voxel_centroids(target, voxel))
-    if len(src_down.points) < MIN_POINTS or len(tgt_down.points) < MIN_POINTS:
+    src_down, tgt_down = voxel_centroids(source, voxel), voxel_centroids(target, voxel)
+    if len(src_down) < MIN_POINTS or len(tgt_down) < MIN_POINTS:
         raise EvaluationError(f"too few points at voxel {voxel} m to register "
-                              f"({len(src_down.points)} source, {len(tgt_down.points)} target)")
-    for cloud in (src_down, tgt_down):
-        _normals(cloud, voxel)
+                              f"({len(src_down)} source, {len(tgt_down)} target)")
     if init is None:
         guess = global_registration(src_down, tgt_down, voxel)
     else:
         guess = tgt_shift @ np.asarray(init, dtype=np.float64).reshape(4, 4) @ np.linalg.inv(
             src_shift)
-    transform = refine(source, target, src_down, tgt_down, guess, voxel)
+    transform = refine(source, target, guess, voxel, (src_down, tgt_down))
     fitness, rmse = score(source, target, transform, tolerance or voxel, voxel / 2)
     return Registration3D(np.linalg.inv(tgt_shift) @ transform @ src_shift, fitness, rmse)
-
-
-def global_registration(source: o3d.geometry.PointCloud, target: o3d.geometry.PointCloud,
-                        voxel: float) -> np.ndarray:
-    """Seeded FPFH + RANSAC on clouds downsampled at ``voxel`` with normals; 4x4 source->target.
-
-    FPFH is computed on every point but matched only on keypoints (see :func:`keypoints`):
-    mutual nearest neighbours in FPFH space, at most ``MAX_MATCHES`` (the best Lowe ratios).
-    RANSAC scores hypotheses on these matches only, so its cost does not grow with the clouds.
-    """
-    search = o3d.geometry.KDTreeSearchParamHybrid(radius=5.0 * voxel, max_nn=100)
-    src_keys = keypoints(np.asarray(source.points), 2.0 * voxel)
-    tgt_keys = keypoints(np.asarray(target.points), 2.0 * voxel)
-    src_fpfh = np.asarray(reg.compute_fpfh_feature(source, search).data).T[src_keys]
-    tgt_fpfh = np.asarray(reg.compute_fpfh_feature(target, search).data).T[tgt_keys]
-    pairs = feature_matches(src_fpfh, tgt_fpfh)
-    matches = np.column_stack([src_keys[pairs[:, 0]], tgt_keys[pairs[:, 1]]]).astype(np.int32)
-    if len(matches) < 3:
-        raise EvaluationError("too few feature matches to register the clouds")
-    distance = 1.5 * voxel
-    o3d.utility.random.seed(0)
-    result = reg.registration_ransac_based_on_correspondence(
-        source, target, o3d.utility.Vector2iVector(matches), distance,
-        reg.TransformationEstimationPointToPoint(False), 3,
-        [reg.CorrespondenceCheckerBasedOnEdgeLength(0.9),
-         reg.CorrespondenceCheckerBasedOnDistance(distance)],
-        reg.RANSACConvergenceCriteria(RANSAC_ITERATIONS, RANSAC_CONFIDENCE))
-    return np.array(result.transformation, dtype=np.float64)
-
-
-def keypoints(points: np.ndarray, cell: float) -> np.ndarray:
-    """Indices of a spatially even subset of ``points`` (N, 3), at most ``MAX_KEYPOINTS``: the
-    first point of each cell, the cell (metres) starting at ``cell`` and doubling until few
-    enough. Sorted, deterministic."""
-    while True:
-        _, first = np.unique(voxel_keys(points, cell), return_index=True)
-        if len(first) <= MAX_KEYPOINTS:
-            return np.sort(first)
-        cell *= 2.0
-
-
-def feature_matches(source: np.ndarray, target: np.ndarray, limit: int = 0) -> np.ndarray:
-    """Mutual nearest neighbours between descriptors (N, D) and (M, D): (K, 2) int32 index pairs
-    (source, target), the ``limit`` (default ``MAX_MATCHES``) with the lowest ratio of nearest to
-    second-nearest distance first, ties by source index."""
-    limit = limit or MAX_MATCHES
-    forward_dist, forward = cKDTree(target).query(source, k=2, workers=-1)
-    _, backward = cKDTree(source).query(target, k=1, workers=-1)
-    mutual = np.flatnonzero(backward[forward[:, 0]] == np.arange(len(source)))
-    ratio = forward_dist[mutual, 0] / np.maximum(forward_dist[mutual, 1], 1e-12)
-    keep = mutual[np.argsort(ratio, kind="stable")[:limit]]
-    return np.column_stack([keep, forward[keep, 0]]).astype(np.int32)
-
-
-def refine(source: np.ndarray, target: np.ndarray, src_down: o3d.geometry.PointCloud,
-           tgt_down: o3d.geometry.PointCloud, guess: np.ndarray, voxel: float) -> np.ndarray:
-    """Point-to-plane ICP with a Tukey kernel from ``guess``, coarse to fine; 4x4."""
-    transform = guess
-    clouds = {1.0: (src_down, tgt_down)}
-    for distance_units, voxel_units in ICP_STAGES:
-        if voxel_units not in clouds:
-            fine = voxel * voxel_units
-            src, tgt = _cloud(voxel_centroids(source, fine)), _cloud(voxel_centroids(target, fine))
-            _normals(tgt, fine)
-            clouds[voxel_units] = (src, tgt)
-        src, tgt = clouds[voxel_units]
-        transform = point_to_plane_icp(np.asarray(src.points), np.asarray(tgt.points),
-                                       np.asarray(tgt.normals), transform,
-                                       voxel * distance_units)
-    return transform
-
-
-def point_to_plane_icp(source: np.ndarray, target: np.ndarray, normals: np.ndarray,
-                       init: np.ndarray, distance: float, iterations: int = ICP_ITERATIONS,
-                       ) -> np.ndarray:
-    """Gauss-Newton point-to-plane ICP, Tukey weights of scale ``distance`` (metres).
-
-    source (N, 3), target (M, 3) with unit normals (M, 3); pairs are nearest neighbours within
-    ``distance``. Stops when an update moves less than 1e-6 (radians + metres). Returns the 4x4
-    source -> target transform. NumPy only, so bit-for-bit repeatable (Open3D's multithreaded
-    reductions are not).
-    """
-    tree = cKDTree(target)
-    transform = np.array(init, dtype=np.float64)
-    for _ in range(iterations):
-        moved = apply(transform, source)
-        dist, index = tree.query(moved, distance_upper_bound=distance, workers=-1)
-        found = np.isfinite(dist)
-        if found.sum() < 6:
-            break
-        p, q, n = moved[found], target[index[found]], normals[index[found]]
-        residual = np.einsum("ij,ij->i", p - q, n)
-        weight = np.clip(1.0 - (residual / distance) ** 2, 0.0, None) ** 2
-        jacobian = np.hstack([np.cross(p, n), n])
-        hessian = np.einsum("ni,n,nj->ij", jacobian, weight, jacobian)
-        gradient = np.einsum("ni,n->i", jacobian, weight * residual)
-        try:
-            step = -np.linalg.solve(hessian, gradient)
-        except np.linalg.LinAlgError:
-            break
-        transform = _se3(step) @ transform
-        if np.abs(step).sum() < 1e-6:
-            break
-    return transform
-
-
-def _se3(step: np.ndarray) -> np.ndarray:
-    """4x4 transform of a small motion (wx, wy, wz rad, tx, ty, tz m): exact rotation."""
-    out = np.eye(4)
-    out[:3, :3] = Rotation.from_rotvec(step[:3]).as_matrix()
-    out[:3, 3] = step[3:]
-    return out
 
 
 def score(source: np.ndarray, target: np.ndarray, transform: np.ndarray, tolerance: float,
@@ -240,11 +112,3 @@ def _usable(xyz: np.ndarray, name: str) -> np.ndarray:
     if not keep.any():
         raise InputError(f"{name}: no usable points")
     return points[keep]
-
-
-def _cloud(points: np.ndarray) -> o3d.geometry.PointCloud:
-    return o3d.geometry.PointCloud(o3d.utility.Vector3dVector(points))
-
-
-def _normals(cloud: o3d.geometry.PointCloud, voxel: float) -> None:
-    cloud.estimate_normals(o3d.geometry.KDTreeSearchParamHybrid(radius=2.0 * voxel, max_nn=30))
