@@ -67,9 +67,9 @@ for _ in range(2):
 (seconds, cpu, first), (seconds2, cpu2, second) = runs
 print(json.dumps({
     "transform": (first.transform @ turn).tolist(), "fitness": first.fitness,
-    "rmse": first.rmse, "seconds": min(seconds, seconds2), "cpu": min(cpu, cpu2),
+    "rmse": first.rmse_m, "seconds": min(seconds, seconds2), "cpu": min(cpu, cpu2),
     "same": bool(np.array_equal(first.transform, second.transform)
-                 and (first.fitness, first.rmse) == (second.fitness, second.rmse)),
+                 and (first.fitness, first.rmse_m) == (second.fitness, second.rmse_m)),
     "peak_mb": status_mb("VmHWM"),
     "rss_before_mb": rss_before, "points": [len(source), len(target)]}))
 """

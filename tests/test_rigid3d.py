@@ -73,7 +73,7 @@ def test_recovers_the_registration_pair(registration_pair) -> None:
     result = align_3d(source, target, voxel=0.3)
     shift, angle = errors(result.transform, truth)
     assert shift < 0.05 and angle < 0.5
-    assert result.fitness > 0.8 and 0.0 < result.rmse < 0.3
+    assert result.fitness > 0.8 and 0.0 < result.rmse_m < 0.3
 
 
 def test_recovers_the_registration_pair_turned_around(registration_pair) -> None:
@@ -89,7 +89,7 @@ def test_is_repeatable(registration_pair) -> None:
     first = align_3d(source, target, voxel=0.5)
     second = align_3d(source, target, voxel=0.5)
     assert np.array_equal(first.transform, second.transform)
-    assert (first.fitness, first.rmse) == (second.fitness, second.rmse)
+    assert (first.fitness, first.rmse_m) == (second.fitness, second.rmse_m)
 
 
 def test_synthetic_room_any_pose() -> None:

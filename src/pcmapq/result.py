@@ -155,7 +155,7 @@ class Result:
         if self.registration_3d is not None:
             reg = self.registration_3d
             doc["alignment_3d"] = {"matrix": reg.transform.tolist(), "fitness": reg.fitness,
-                                   "rmse_m": reg.rmse}
+                                   "rmse_m": reg.rmse_m}
             doc["distances_3d"] = _distances_dict(self.distances_3d)
         for name, det in self.detectors.items():
             m = det.matching

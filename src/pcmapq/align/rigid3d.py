@@ -14,7 +14,7 @@ stay small and sums precise with UTM coordinates); ``T`` is given back in the in
    stages with correspondence distances 2, 1 and 0.5 ``voxel`` (the last on clouds downsampled
    at ``voxel / 2``).
 4. Scores: ``fitness`` is the share of the source (downsampled at ``voxel / 2``) within
-   ``tolerance`` (default ``voxel``) of the target (downsampled at ``voxel / 4``), ``rmse`` the
+   ``tolerance`` (default ``voxel``) of the target (downsampled at ``voxel / 4``), ``rmse_m`` the
    RMSE of those inlier distances, metres.
 
 Repeated runs give identical results. Cost grows with the clouds; on outdoor maps a ``voxel`` of
@@ -42,11 +42,11 @@ MIN_POINTS = 10
 
 class Registration3D(NamedTuple):
     """transform: 4x4 source -> target. fitness: share of source points within the tolerance
-    of the target, [0, 1]. rmse: RMSE of those inlier distances, metres. Unpacks as a tuple."""
+    of the target, [0, 1]. rmse_m: RMSE of those inlier distances, metres. Unpacks as a tuple."""
 
     transform: np.ndarray
     fitness: float
-    rmse: float
+    rmse_m: float
 
 
 def align_3d(source_xyz: np.ndarray, target_xyz: np.ndarray, *, voxel: float = 0.3,

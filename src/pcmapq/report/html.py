@@ -94,7 +94,7 @@ def report_html(result: Result) -> str:
     if result.registration_3d is not None and result.distances_3d is not None:
         reg, d3 = result.registration_3d, result.distances_3d
         dist += "<p class=\"note\">Both inputs are 3D clouds: registered in 3D (fitness " \
-                f"{number(reg.fitness)}, RMSE {number(reg.rmse)} m); distances between the " \
+                f"{number(reg.fitness)}, RMSE {number(reg.rmse_m)} m); distances between the " \
                 "clouds:</p>"
         dist += _stats_table("points", [("3D accuracy (map to truth)", d3.accuracy),
                                         ("3D completeness (truth to map)", d3.completeness)])

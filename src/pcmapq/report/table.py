@@ -36,7 +36,7 @@ def print_table(result: Result, console: Console) -> None:
         console.print(line, highlight=False)
     if result.registration_3d is not None and result.distances_3d is not None:
         reg, d3 = result.registration_3d, result.distances_3d
-        console.print(f"3D registration: fitness {reg.fitness:.3f}, rmse {reg.rmse:.3f} m; "
+        console.print(f"3D registration: fitness {reg.fitness:.3f}, rmse {reg.rmse_m:.3f} m; "
                       f"3D accuracy mean {number(d3.accuracy.mean)} m, completeness mean "
                       f"{number(d3.completeness.mean)} m, Chamfer {number(d3.chamfer_m)} m")
     d = result.distances
