@@ -8,8 +8,9 @@ import pytest
 
 from pcmapq import synth
 from pcmapq.align import align
-from pcmapq.align.icp import fit_similarity, refine_point_to_line, voxel_downsample
+from pcmapq.align.icp import fit_similarity, refine_point_to_line
 from pcmapq.transform import Similarity2D
+from pcmapq.voxels import voxel_centroids
 
 from .conftest import HEIGHT, PLAN, WIDTH, shared
 
@@ -108,7 +109,7 @@ def test_fit_similarity_is_exact():
 
 def test_point_to_line_refines_scale(truth):
     """From 3 % off in scale, the point-to-line stage with scale lands on the truth."""
-    xy = voxel_downsample(truth, 0.05)
+    xy = voxel_centroids(truth, 0.05)
     got = refine_point_to_line(xy, xy, Similarity2D(0.1, 0.0, 0.0, 1.03), with_scale=True)
     assert errors(Similarity2D(), got) == pytest.approx((0.0, 0.0, 0.0), abs=1e-4)
 

@@ -25,10 +25,10 @@ from pcmapq.align.icp import (
     SimilarityTarget,
     refine_point_to_line,
     refine_similarity,
-    voxel_downsample,
 )
 from pcmapq.align.icp import refine as icp_refine
 from pcmapq.transform import Similarity2D
+from pcmapq.voxels import voxel_centroids
 
 __all__ = ["Alignment", "Similarity2D", "align", "align_similarity", "score"]
 
@@ -101,8 +101,8 @@ def align(map_xy: np.ndarray, truth_xy: np.ndarray, *, init: Similarity2D | None
                                 voxel=voxel, resolution=resolution, top_k=top_k,
                                 finalists=finalists or 3, scale_range=scale_range)
     finalists = finalists or 2
-    map_ds = voxel_downsample(map_xy, voxel)
-    truth_ds = voxel_downsample(truth_xy, voxel)
+    map_ds = voxel_centroids(map_xy, voxel)
+    truth_ds = voxel_centroids(truth_xy, voxel)
     if len(map_ds) == 0 or len(truth_ds) == 0:
         return Alignment(Similarity2D() if init is None else init, 0.0, 0.0, tolerance, "none")
     tree = cKDTree(truth_ds)
@@ -143,7 +143,7 @@ def _result(map_xy: np.ndarray, tree: cKDTree, tf: Similarity2D, tolerance: floa
 
 def _map_at_scale(map_xy: np.ndarray, tf: Similarity2D, voxel: float) -> np.ndarray:
     """The map (N, 2, map units) downsampled to ``voxel`` truth units under ``tf``'s scale."""
-    return voxel_downsample(map_xy, voxel / tf.scale)
+    return voxel_centroids(map_xy, voxel / tf.scale)
 
 
 def similarity_schedule(resolution: float, tolerance: float,
@@ -176,7 +176,7 @@ def align_similarity(map_xy: np.ndarray, truth_xy: np.ndarray, *,
     search. fitness and rmse_m are in the truth frame, as in :func:`align`.
     """
     map_xy = np.asarray(map_xy, dtype=np.float64).reshape(-1, 2)
-    truth_ds = voxel_downsample(truth_xy, voxel)
+    truth_ds = voxel_centroids(truth_xy, voxel)
     start = Similarity2D() if init is None else init
     if len(map_xy) == 0 or len(truth_ds) < 2:  # the truth must have a size
         return Alignment(start, 0.0, 0.0, tolerance, "none")

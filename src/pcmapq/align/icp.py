@@ -13,28 +13,13 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from pcmapq.transform import Similarity2D
+from pcmapq.voxels import voxel_centroids
 
 if TYPE_CHECKING:
     import open3d as o3d
 
 #: ICP stages: (max correspondence distance, voxel size), metres. Both shrink stage by stage.
 DEFAULT_SCHEDULE: tuple[tuple[float, float], ...] = ((1.0, 0.2), (0.5, 0.1), (0.2, 0.05))
-
-
-def voxel_downsample(xy: np.ndarray, voxel: float) -> np.ndarray:
-    """The centroid of the points (N, 2, metres) in each ``voxel``-metre square cell, (M, 2).
-
-    Deterministic: cells come out sorted by their (x, y) index.
-    """
-    xy = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
-    if voxel <= 0 or len(xy) == 0:
-        return xy
-    cells = np.floor(xy / voxel).astype(np.int64)
-    cells -= cells.min(axis=0)
-    keys = cells[:, 0] * (cells[:, 1].max() + 1) + cells[:, 1]
-    _, inverse, counts = np.unique(keys, return_inverse=True, return_counts=True)
-    sums = np.column_stack([np.bincount(inverse, weights=xy[:, k]) for k in range(2)])
-    return sums / counts[:, None]
 
 
 def _cloud(xy: np.ndarray) -> o3d.geometry.PointCloud:
@@ -66,7 +51,7 @@ class IcpTarget:
                  schedule: tuple[tuple[float, float], ...] = DEFAULT_SCHEDULE) -> None:
         """truth_xy: (N, 2) metres, truth frame; schedule: (max distance, voxel) pairs, metres."""
         self.schedule = schedule
-        self.clouds = [_cloud(voxel_downsample(truth_xy, voxel)) for _, voxel in schedule]
+        self.clouds = [_cloud(voxel_centroids(truth_xy, voxel)) for _, voxel in schedule]
 
 
 def refine(map_xy: np.ndarray, target: IcpTarget, init: Similarity2D,
@@ -83,7 +68,7 @@ def refine(map_xy: np.ndarray, target: IcpTarget, init: Similarity2D,
         relative_fitness=1e-6, relative_rmse=1e-6, max_iteration=max_iterations)
     method = o3d.pipelines.registration.TransformationEstimationPointToPoint()
     for (max_dist, voxel), truth in zip(target.schedule, target.clouds, strict=True):
-        source = _cloud(voxel_downsample(map_xy, voxel))
+        source = _cloud(voxel_centroids(map_xy, voxel))
         result = o3d.pipelines.registration.registration_icp(
             source, truth, max_dist, _matrix4(tf), method, criteria)
         tf = _to_se2(np.asarray(result.transformation))
@@ -158,7 +143,7 @@ class SimilarityTarget:
     def __init__(self, truth_xy: np.ndarray, schedule: tuple[tuple[float, float], ...]) -> None:
         """truth_xy: (N, 2) truth units; schedule: (max distance, voxel) pairs, truth units."""
         self.schedule = schedule
-        self.points = [voxel_downsample(truth_xy, voxel) for _, voxel in schedule]
+        self.points = [voxel_centroids(truth_xy, voxel) for _, voxel in schedule]
         self.trees = [cKDTree(points) for points in self.points]
 
 
@@ -174,7 +159,7 @@ def refine_similarity(map_xy: np.ndarray, target: SimilarityTarget, init: Simila
     tf = init
     for (max_dist, voxel), truth, tree in zip(target.schedule, target.points, target.trees,
                                              strict=True):
-        source = voxel_downsample(map_xy, voxel / tf.scale)
+        source = voxel_centroids(map_xy, voxel / tf.scale)
         for _ in range(max_iterations):
             moved = tf.apply(source)
             dist, j = tree.query(moved, distance_upper_bound=max_dist)
