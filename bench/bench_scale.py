@@ -18,7 +18,7 @@ import cv2
 import numpy as np
 
 from pcmapq.align import align
-from pcmapq.align.icp import fit_similarity
+from pcmapq.align.similarity_icp import fit_similarity
 from pcmapq.transform import Similarity2D
 
 DATA = Path(__file__).resolve().parents[2] / "shared" / "data" / "halmstad"

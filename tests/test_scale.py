@@ -8,7 +8,8 @@ import pytest
 
 from pcmapq import synth
 from pcmapq.align import align
-from pcmapq.align.icp import fit_similarity, refine_point_to_line
+from pcmapq.align.point_to_line import refine_point_to_line
+from pcmapq.align.similarity_icp import fit_similarity
 from pcmapq.transform import Similarity2D
 from pcmapq.voxels import voxel_centroids
 
