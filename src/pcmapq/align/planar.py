@@ -1,15 +1,21 @@
 """2D alignment of a map to the truth with no initial guess: a global raster search
 (:mod:`~pcmapq.align.coarse`), then ICP from its best candidates. ``Alignment.transform`` takes
-map-frame points to the truth frame, ``p_truth = s * R(yaw) * p_map + t``."""
+map-frame points to the truth frame, ``p_truth = s * R(yaw) * p_map + t``.
+
+Rigid and similarity alignment run the same refinement (:func:`refine_best`): a rough ICP stage
+from every candidate of the search, the best ``finalists`` of those by fitness through the fine
+stages and a point-to-line finish, and the best of these by fitness, then RMSE."""
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy.spatial import cKDTree
 
 from pcmapq.align.coarse import (
+    Search,
     auto_resolution,
     coarse_search,
     distinctiveness,
@@ -21,6 +27,9 @@ from pcmapq.align.point_to_point import DEFAULT_SCHEDULE, IcpTarget, refine_poin
 from pcmapq.align.similarity_icp import SimilarityTarget, refine_similarity, similarity_schedule
 from pcmapq.transform import Similarity2D
 from pcmapq.voxels import voxel_centroids
+
+#: One refinement: a map -> truth transform in, the refined one out.
+Refine = Callable[[Similarity2D], Similarity2D]
 
 
 @dataclass(frozen=True)
@@ -90,50 +99,34 @@ def align(map_xy: np.ndarray, truth_xy: np.ndarray, *, init: Similarity2D | None
         return align_similarity(map_xy, truth_xy, init=init, refine=refine, tolerance=tolerance,
                                 voxel=voxel, resolution=resolution, top_k=top_k,
                                 finalists=finalists or 3, scale_range=scale_range)
-    finalists = finalists or 2
     map_ds = voxel_centroids(map_xy, voxel)
     truth_ds = voxel_centroids(truth_xy, voxel)
+    start = Similarity2D() if init is None else init
     if len(map_ds) == 0 or len(truth_ds) == 0:
-        return Alignment(Similarity2D() if init is None else init, 0.0, 0.0, tolerance, "none")
+        return Alignment(start, 0.0, 0.0, tolerance, "none")
     tree = cKDTree(truth_ds)
+
+    def scored(tf: Similarity2D) -> Alignment:
+        return _scored(map_ds, tree, tf, tolerance)
+
     if not refine:
-        tf = Similarity2D() if init is None else init
-        return _result(map_ds, tree, tf, tolerance, "none" if init is None else "init")
-    if init is not None:
-        tf = refine_point_to_point(map_ds, IcpTarget(truth_ds), init)
-        tf = refine_point_to_line(map_ds, truth_ds, tf, DEFAULT_SCHEDULE[-1][0])
-        return _result(map_ds, tree, tf, tolerance, "init+icp")
-    resolution = auto_resolution(map_ds) if resolution is None else resolution
-    search = coarse_search(map_ds, truth_ds, resolution=resolution, top_k=top_k)
-    starts = search.candidates
+        return replace(scored(start), method="none" if init is None else "init")
     (first_dist, first_voxel), *fine_stages = DEFAULT_SCHEDULE
-    rough = IcpTarget(truth_ds, ((max(first_dist, 2 * resolution), first_voxel),))
+    search = None
+    if init is None:
+        resolution = auto_resolution(map_ds) if resolution is None else resolution
+        search = coarse_search(map_ds, truth_ds, resolution=resolution, top_k=top_k)
+        first_dist = max(first_dist, 2 * resolution)
+    rough = IcpTarget(truth_ds, ((first_dist, first_voxel),))
     fine = IcpTarget(truth_ds, tuple(fine_stages))
-    firsts = [_result(map_ds, tree, refine_point_to_point(map_ds, rough, c.transform),
-                      tolerance, "") for c in starts]
-    finals = [_result(map_ds, tree, refine_point_to_point(map_ds, fine, r.transform),
-                      tolerance, "coarse+icp") for r in sorted(firsts, key=_rank)[:finalists]]
-    best = min(finals, key=_rank).transform
-    best = refine_point_to_line(map_ds, truth_ds, best, DEFAULT_SCHEDULE[-1][0])
-    return replace(_result(map_ds, tree, best, tolerance, "coarse+icp"),
-                   distinctiveness=distinctiveness(search, best))
 
+    def finish(tf: Similarity2D) -> Similarity2D:
+        tf = refine_point_to_point(map_ds, fine, tf)
+        return refine_point_to_line(map_ds, truth_ds, tf, fine_stages[-1][0])
 
-def _rank(a: Alignment) -> tuple[float, float]:
-    """Sort key: higher fitness first, then lower RMSE."""
-    return -a.fitness, a.rmse_m
-
-
-def _result(map_xy: np.ndarray, tree: cKDTree, tf: Similarity2D, tolerance: float,
-            method: str) -> Alignment:
-    """Score ``tf`` on the map against the truth tree."""
-    fitness, rmse = _score_tree(map_xy, tree, tf, tolerance)
-    return Alignment(tf, fitness, rmse, tolerance, method)
-
-
-def _map_at_scale(map_xy: np.ndarray, tf: Similarity2D, voxel: float) -> np.ndarray:
-    """The map (N, 2, map units) downsampled to ``voxel`` truth units under ``tf``'s scale."""
-    return voxel_centroids(map_xy, voxel / tf.scale)
+    best = refine_best(_starts(search, start), lambda tf: refine_point_to_point(map_ds, rough, tf),
+                       finish, scored, finalists or 2)
+    return _labelled(best, search, "coarse+icp")
 
 
 def align_similarity(map_xy: np.ndarray, truth_xy: np.ndarray, *,
@@ -149,11 +142,12 @@ def align_similarity(map_xy: np.ndarray, truth_xy: np.ndarray, *,
     :func:`align`; the map is downsampled to ``voxel`` truth units at the current scale.
     resolution: cell of the global search (default: the truth's radius / 20, see
     :func:`~pcmapq.align.coarse.similarity_search`), which also sets the ICP schedule
-    (:func:`~pcmapq.align.similarity_icp.similarity_schedule`). The ``top_k`` candidates of the search over scale, yaw and
-    position are refined by a first scaled ICP stage, the best ``finalists`` by fitness through
-    the others and a point-to-line stage with scale (pairs within ``tolerance``); the final pose
-    with the highest fitness wins. init: a starting similarity (its scale kept), skips the
-    search. fitness and rmse_m are in the truth frame, as in :func:`align`.
+    (:func:`~pcmapq.align.similarity_icp.similarity_schedule`). The ``top_k`` candidates of the
+    search over scale, yaw and position are refined by a first scaled ICP stage, the best
+    ``finalists`` by fitness through the others and a point-to-line stage with scale (pairs
+    within ``tolerance``); the final pose with the highest fitness wins. init: a starting
+    similarity (its scale kept), skips the search. fitness and rmse_m are in the truth frame, as
+    in :func:`align`.
     """
     map_xy = np.asarray(map_xy, dtype=np.float64).reshape(-1, 2)
     truth_ds = voxel_centroids(truth_xy, voxel)
@@ -161,33 +155,62 @@ def align_similarity(map_xy: np.ndarray, truth_xy: np.ndarray, *,
     if len(map_xy) == 0 or len(truth_ds) < 2:  # the truth must have a size
         return Alignment(start, 0.0, 0.0, tolerance, "none")
     tree = cKDTree(truth_ds)
+
+    def scored(tf: Similarity2D) -> Alignment:
+        """Scored on the map downsampled to ``voxel`` truth units at ``tf``'s scale."""
+        return _scored(_map_at_scale(map_xy, tf, voxel), tree, tf, tolerance)
+
     if not refine:
-        return _result(_map_at_scale(map_xy, start, voxel), tree, start, tolerance,
-                       "none" if init is None else "init")
+        return replace(scored(start), method="none" if init is None else "init")
     resolution = similarity_resolution(truth_ds) if resolution is None else resolution
     search = None
     if init is None:
         search = similarity_search(map_xy, truth_ds, scale_range=scale_range,
                                    resolution=resolution, top_k=top_k)
-        starts, method = [c.transform for c in search.candidates], "similarity+icp"
-    else:
-        starts, method = [init], "init+icp"
     first, *rest = similarity_schedule(resolution, tolerance, voxel)
     rough, fine = SimilarityTarget(truth_ds, (first,)), SimilarityTarget(truth_ds, tuple(rest))
-    firsts = [_scaled_result(map_xy, tree, refine_similarity(map_xy, rough, s), tolerance, voxel)
-              for s in starts]
-    finals = []
-    for r in sorted(firsts, key=_rank)[:finalists]:
-        tf = refine_similarity(map_xy, fine, r.transform)
-        tf = refine_point_to_line(_map_at_scale(map_xy, tf, voxel), truth_ds, tf, tolerance,
-                                  with_scale=True)
-        finals.append(_scaled_result(map_xy, tree, tf, tolerance, voxel))
-    best = min(finals, key=_rank)
-    distinct = None if search is None else distinctiveness(search, best.transform)
-    return Alignment(best.transform, best.fitness, best.rmse_m, tolerance, method, distinct)
+
+    def finish(tf: Similarity2D) -> Similarity2D:
+        tf = refine_similarity(map_xy, fine, tf)
+        return refine_point_to_line(_map_at_scale(map_xy, tf, voxel), truth_ds, tf, tolerance,
+                                    with_scale=True)
+
+    best = refine_best(_starts(search, start), lambda tf: refine_similarity(map_xy, rough, tf),
+                       finish, scored, finalists)
+    return _labelled(best, search, "similarity+icp")
 
 
-def _scaled_result(map_xy: np.ndarray, tree: cKDTree, tf: Similarity2D, tolerance: float,
-                   voxel: float) -> Alignment:
-    """Score ``tf`` on the map (map units) downsampled to ``voxel`` truth units at its scale."""
-    return _result(_map_at_scale(map_xy, tf, voxel), tree, tf, tolerance, "")
+def refine_best(starts: Sequence[Similarity2D], rough: Refine, fine: Refine,
+                scored: Callable[[Similarity2D], Alignment], finalists: int) -> Alignment:
+    """Every start refined by ``rough``; the ``finalists`` best of those (highest fitness, then
+    lowest RMSE, by ``scored``) refined by ``fine``; the best of these, scored."""
+    firsts = sorted((scored(rough(s)) for s in starts), key=_rank)
+    return min((scored(fine(r.transform)) for r in firsts[:finalists]), key=_rank)
+
+
+def _starts(search: Search | None, init: Similarity2D) -> list[Similarity2D]:
+    """The search's candidate poses, best first; ``init`` alone when there was no search."""
+    return [init] if search is None else [c.transform for c in search.candidates]
+
+
+def _labelled(best: Alignment, search: Search | None, method: str) -> Alignment:
+    """``best`` with its method ("init+icp" with no search) and its distinctiveness."""
+    if search is None:
+        return replace(best, method="init+icp")
+    return replace(best, method=method, distinctiveness=distinctiveness(search, best.transform))
+
+
+def _rank(a: Alignment) -> tuple[float, float]:
+    """Sort key: higher fitness first, then lower RMSE."""
+    return -a.fitness, a.rmse_m
+
+
+def _scored(map_xy: np.ndarray, tree: cKDTree, tf: Similarity2D, tolerance: float) -> Alignment:
+    """``tf`` scored on the map (N, 2, map frame) against the truth tree; method unset."""
+    fitness, rmse = _score_tree(map_xy, tree, tf, tolerance)
+    return Alignment(tf, fitness, rmse, tolerance, "")
+
+
+def _map_at_scale(map_xy: np.ndarray, tf: Similarity2D, voxel: float) -> np.ndarray:
+    """The map (N, 2, map units) downsampled to ``voxel`` truth units under ``tf``'s scale."""
+    return voxel_centroids(map_xy, voxel / tf.scale)
