@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from pcmapq import synth
-from pcmapq.align import Alignment, align, score
+from pcmapq.align import Alignment, AlignParams, align, score
 from pcmapq.align.coarse import coarse_search
 from pcmapq.transform import Similarity2D
 from pcmapq.voxels import voxel_centroids
@@ -107,6 +107,16 @@ def test_no_refine_scores_identity(truth, scan):
     assert result.fitness > 0.99
     turned = align(to_map_frame(scan, 90, 0.0, 0.0)[1], truth, refine=False)
     assert turned.fitness < 0.3
+
+
+def test_params_reach_the_alignment(scan, truth):
+    """A tighter tolerance counts fewer inliers (1.5 cm noise: about 2/3 within 2 cm)."""
+    loose = align(scan, truth, refine=False)
+    tight = align(scan, truth, AlignParams(tolerance=0.02), refine=False)
+    assert tight.tolerance_m == 0.02 and 0.5 < tight.fitness < loose.fitness
+    assert AlignParams().finalists_for(scale=False) == 2
+    assert AlignParams().finalists_for(scale=True) == 3
+    assert AlignParams(finalists=1).finalists_for(scale=True) == 1
 
 
 def test_deterministic(truth, scan):

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from pcmapq.align import Alignment, align
+from pcmapq.align import Alignment, AlignParams, align
 from pcmapq.align.rigid3d import Registration3D, align_3d, apply
 from pcmapq.config import Settings
 from pcmapq.errors import EvaluationError, InputError
@@ -210,12 +210,12 @@ def score(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap, setti
     progress("aligning")
     source, registration = align_clouds_3d(source, truth, settings)
     map_xy, truth_xy = plan_points(source, settings), plan_points(truth, settings)
+    params = AlignParams(tolerance=settings.fit_tolerance)
     if registration is None:
-        alignment = align(map_xy, truth_xy, init=settings.init, refine=settings.align,
-                          tolerance=settings.fit_tolerance, scale=settings.scale)
+        alignment = align(map_xy, truth_xy, params, init=settings.init, refine=settings.align,
+                          scale=settings.scale)
     else:  # already aligned in 3D: score it in 2D as it is
-        alignment = align(map_xy, truth_xy, init=Similarity2D(), refine=False,
-                          tolerance=settings.fit_tolerance)
+        alignment = align(map_xy, truth_xy, params, init=Similarity2D(), refine=False)
 
     progress("rasterising")
     grid, truth_occ = truth_raster(truth, truth_xy, settings)

@@ -5,7 +5,8 @@ Frames: an :class:`Alignment`'s ``transform`` takes map-frame points to the trut
 ``scale=True`` the estimated scale of a map of unknown unit (a scanned plan, a map exported as a
 picture), truth units per map unit.
 
-Modules: :mod:`~pcmapq.align.planar` (:func:`align`: global search, then ICP),
+Modules: :mod:`~pcmapq.align.params` (:class:`AlignParams`, the tunables),
+:mod:`~pcmapq.align.planar` (:func:`align`: global search, then ICP),
 :mod:`~pcmapq.align.coarse` (the global search), :mod:`~pcmapq.align.point_to_point`,
 :mod:`~pcmapq.align.point_to_line` and :mod:`~pcmapq.align.similarity_icp` (the ICP stages),
 :mod:`~pcmapq.align.rigid3d` (3D clouds; it loads Open3D on import, so it is not imported
@@ -14,7 +15,8 @@ here). Importing this package loads no Open3D: it is imported where ICP runs.
 
 from __future__ import annotations
 
+from pcmapq.align.params import AlignParams
 from pcmapq.align.planar import Alignment, align, align_similarity, score
 from pcmapq.transform import Similarity2D
 
-__all__ = ["Alignment", "Similarity2D", "align", "align_similarity", "score"]
+__all__ = ["AlignParams", "Alignment", "Similarity2D", "align", "align_similarity", "score"]

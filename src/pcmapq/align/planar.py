@@ -22,6 +22,7 @@ from pcmapq.align.coarse import (
     similarity_resolution,
     similarity_search,
 )
+from pcmapq.align.params import AlignParams
 from pcmapq.align.point_to_line import refine_point_to_line
 from pcmapq.align.point_to_point import DEFAULT_SCHEDULE, IcpTarget, refine_point_to_point
 from pcmapq.align.similarity_icp import SimilarityTarget, refine_similarity, similarity_schedule
@@ -72,33 +73,33 @@ def score(map_xy: np.ndarray, truth_xy: np.ndarray, tf: Similarity2D,
     return _score_tree(np.asarray(map_xy, dtype=np.float64).reshape(-1, 2), tree, tf, tolerance)
 
 
-def align(map_xy: np.ndarray, truth_xy: np.ndarray, *, init: Similarity2D | None = None,
-          refine: bool = True, tolerance: float = 0.2, voxel: float = 0.05,
-          resolution: float | None = None, top_k: int = 6, finalists: int | None = None,
-          scale: bool = False, scale_range: tuple[float, float] = (0.2, 5.0)) -> Alignment:
+def align(map_xy: np.ndarray, truth_xy: np.ndarray, params: AlignParams = AlignParams(), *,
+          init: Similarity2D | None = None, refine: bool = True,
+          scale: bool = False) -> Alignment:
     """Align a map to the truth with no initial guess needed; never fails on a bad match (an
     empty map or truth gives fitness 0).
 
-    map_xy: (N, 2) metres, map frame; truth_xy: (M, 2) metres, truth frame: occupied cell centres
-    or wall-band points.
+    map_xy: (N, 2) metres, map frame (map units with ``scale``); truth_xy: (M, 2) metres, truth
+    frame: occupied cell centres or wall-band points. params: the tunables (tolerance, voxel,
+    search, finalists; see :class:`~pcmapq.align.params.AlignParams`).
     init: a starting map -> truth transform; given, the global search is skipped and ICP starts
-    there (its scale is dropped). refine: False with no ``init`` scores the identity ("none");
-    False with ``init`` scores ``init`` as it is ("init").
-    tolerance: inlier distance for fitness and RMSE, metres (default 0.2).
-    voxel: both clouds are voxel-downsampled to this cell size, metres, before anything else;
-    fitness and RMSE are measured on the downsampled clouds.
-    resolution: raster cell size of the global search, metres (default: the map's radius / 40,
-    at least 0.25). top_k: candidate poses of the global search, each refined by a first, coarse
-    ICP stage; finalists: how many of those, by fitness, go through the fine ICP stages (default
-    2 rigid; 3 with ``scale``, where the rough stage ranks less surely: the Freiburg 079 map's
-    right pose came third). The final pose with the highest fitness wins.
-    scale: also estimate the scale, for a map in an unknown unit (see :func:`align_similarity`);
-    scale_range: (lowest, highest) scale it may have, truth units per map unit.
+    there (its scale dropped unless ``scale``). refine: False with no ``init`` scores the
+    identity ("none"); False with ``init`` scores ``init`` as it is ("init").
+    scale: also estimate the scale, for a map in an unknown unit (see :func:`align_similarity`).
     """
+    map_xy = np.asarray(map_xy, dtype=np.float64).reshape(-1, 2)
+    truth_xy = np.asarray(truth_xy, dtype=np.float64).reshape(-1, 2)
     if scale:
-        return align_similarity(map_xy, truth_xy, init=init, refine=refine, tolerance=tolerance,
-                                voxel=voxel, resolution=resolution, top_k=top_k,
-                                finalists=finalists or 3, scale_range=scale_range)
+        return align_similarity(map_xy, truth_xy, params, init=init, refine=refine)
+    return _align_rigid(map_xy, truth_xy, params, init, refine)
+
+
+def _align_rigid(map_xy: np.ndarray, truth_xy: np.ndarray, params: AlignParams,
+                 init: Similarity2D | None, refine: bool) -> Alignment:
+    """:func:`align` with scale 1: the search of :func:`~pcmapq.align.coarse.coarse_search`,
+    Open3D point-to-point ICP stages (:data:`~pcmapq.align.point_to_point.DEFAULT_SCHEDULE`,
+    the first widened to twice the search's cell), then point-to-line."""
+    voxel, tolerance = params.voxel, params.tolerance
     map_ds = voxel_centroids(map_xy, voxel)
     truth_ds = voxel_centroids(truth_xy, voxel)
     start = Similarity2D() if init is None else init
@@ -114,8 +115,8 @@ def align(map_xy: np.ndarray, truth_xy: np.ndarray, *, init: Similarity2D | None
     (first_dist, first_voxel), *fine_stages = DEFAULT_SCHEDULE
     search = None
     if init is None:
-        resolution = auto_resolution(map_ds) if resolution is None else resolution
-        search = coarse_search(map_ds, truth_ds, resolution=resolution, top_k=top_k)
+        resolution = auto_resolution(map_ds) if params.resolution is None else params.resolution
+        search = coarse_search(map_ds, truth_ds, resolution=resolution, top_k=params.top_k)
         first_dist = max(first_dist, 2 * resolution)
     rough = IcpTarget(truth_ds, ((first_dist, first_voxel),))
     fine = IcpTarget(truth_ds, tuple(fine_stages))
@@ -125,30 +126,26 @@ def align(map_xy: np.ndarray, truth_xy: np.ndarray, *, init: Similarity2D | None
         return refine_point_to_line(map_ds, truth_ds, tf, fine_stages[-1][0])
 
     best = refine_best(_starts(search, start), lambda tf: refine_point_to_point(map_ds, rough, tf),
-                       finish, scored, finalists or 2)
+                       finish, scored, params.finalists_for(scale=False))
     return _labelled(best, search, "coarse+icp")
 
 
-def align_similarity(map_xy: np.ndarray, truth_xy: np.ndarray, *,
-                     init: Similarity2D | None = None, refine: bool = True,
-                     tolerance: float = 0.2, voxel: float = 0.05,
-                     resolution: float | None = None, top_k: int = 6, finalists: int = 3,
-                     scale_range: tuple[float, float] = (0.2, 5.0)) -> Alignment:
+def align_similarity(map_xy: np.ndarray, truth_xy: np.ndarray,
+                     params: AlignParams = AlignParams(), *, init: Similarity2D | None = None,
+                     refine: bool = True) -> Alignment:
     """Align a map of unknown unit to the truth: scale, rotation and translation, with no
     initial guess needed; never fails on a bad match.
 
     map_xy: (N, 2) in the map's own unit, map frame; truth_xy: (M, 2) truth units (metres),
-    truth frame. Every length parameter is in truth units: ``tolerance`` and ``voxel`` as in
-    :func:`align`; the map is downsampled to ``voxel`` truth units at the current scale.
-    resolution: cell of the global search (default: the truth's radius / 20, see
-    :func:`~pcmapq.align.coarse.similarity_search`), which also sets the ICP schedule
-    (:func:`~pcmapq.align.similarity_icp.similarity_schedule`). The ``top_k`` candidates of the
-    search over scale, yaw and position are refined by a first scaled ICP stage, the best
-    ``finalists`` by fitness through the others and a point-to-line stage with scale (pairs
-    within ``tolerance``); the final pose with the highest fitness wins. init: a starting
-    similarity (its scale kept), skips the search. fitness and rmse_m are in the truth frame, as
-    in :func:`align`.
+    truth frame. Every length of ``params`` is in truth units; the map is downsampled to
+    ``voxel`` truth units at the current scale. The search over scale, yaw and position
+    (:func:`~pcmapq.align.coarse.similarity_search`) works on cells of ``resolution`` (default:
+    the truth's radius / 20), which also sets the scaled ICP stages
+    (:func:`~pcmapq.align.similarity_icp.similarity_schedule`); the point-to-line finish, with
+    scale, pairs points within ``tolerance``. init: a starting similarity (its scale kept),
+    skips the search. fitness and rmse_m are in the truth frame, as in :func:`align`.
     """
+    voxel, tolerance = params.voxel, params.tolerance
     map_xy = np.asarray(map_xy, dtype=np.float64).reshape(-1, 2)
     truth_ds = voxel_centroids(truth_xy, voxel)
     start = Similarity2D() if init is None else init
@@ -162,11 +159,12 @@ def align_similarity(map_xy: np.ndarray, truth_xy: np.ndarray, *,
 
     if not refine:
         return replace(scored(start), method="none" if init is None else "init")
+    resolution = params.resolution
     resolution = similarity_resolution(truth_ds) if resolution is None else resolution
     search = None
     if init is None:
-        search = similarity_search(map_xy, truth_ds, scale_range=scale_range,
-                                   resolution=resolution, top_k=top_k)
+        search = similarity_search(map_xy, truth_ds, scale_range=params.scale_range,
+                                   resolution=resolution, top_k=params.top_k)
     first, *rest = similarity_schedule(resolution, tolerance, voxel)
     rough, fine = SimilarityTarget(truth_ds, (first,)), SimilarityTarget(truth_ds, tuple(rest))
 
@@ -176,7 +174,7 @@ def align_similarity(map_xy: np.ndarray, truth_xy: np.ndarray, *,
                                     with_scale=True)
 
     best = refine_best(_starts(search, start), lambda tf: refine_similarity(map_xy, rough, tf),
-                       finish, scored, finalists)
+                       finish, scored, params.finalists_for(scale=True))
     return _labelled(best, search, "similarity+icp")
 
 
