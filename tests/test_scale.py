@@ -8,7 +8,7 @@ import pytest
 
 from pcmapq import synth
 from pcmapq.align import AlignParams, align
-from pcmapq.align.point_to_line import refine_point_to_line
+from pcmapq.align.point_to_line import LineTarget, refine_point_to_line
 from pcmapq.align.similarity_icp import fit_similarity
 from pcmapq.transform import Similarity2D
 from pcmapq.voxels import voxel_centroids
@@ -111,7 +111,8 @@ def test_fit_similarity_is_exact():
 def test_point_to_line_refines_scale(truth):
     """From 3 % off in scale, the point-to-line stage with scale lands on the truth."""
     xy = voxel_centroids(truth, 0.05)
-    got = refine_point_to_line(xy, xy, Similarity2D(0.1, 0.0, 0.0, 1.03), with_scale=True)
+    got = refine_point_to_line(xy, LineTarget(xy), Similarity2D(0.1, 0.0, 0.0, 1.03),
+                               with_scale=True)
     assert errors(Similarity2D(), got) == pytest.approx((0.0, 0.0, 0.0), abs=1e-4)
 
 

@@ -23,7 +23,7 @@ from pcmapq.align.coarse import (
     similarity_search,
 )
 from pcmapq.align.params import AlignParams
-from pcmapq.align.point_to_line import refine_point_to_line
+from pcmapq.align.point_to_line import LineTarget, refine_point_to_line
 from pcmapq.align.point_to_point import DEFAULT_SCHEDULE, IcpTarget, refine_point_to_point
 from pcmapq.align.similarity_icp import SimilarityTarget, refine_similarity, similarity_schedule
 from pcmapq.transform import Similarity2D
@@ -119,11 +119,11 @@ def _align_rigid(map_xy: np.ndarray, truth_xy: np.ndarray, params: AlignParams,
         search = coarse_search(map_ds, truth_ds, resolution=resolution, top_k=params.top_k)
         first_dist = max(first_dist, 2 * resolution)
     rough = IcpTarget(truth_ds, ((first_dist, first_voxel),))
-    fine = IcpTarget(truth_ds, tuple(fine_stages))
+    fine, lines = IcpTarget(truth_ds, tuple(fine_stages)), LineTarget(truth_ds)
 
     def finish(tf: Similarity2D) -> Similarity2D:
         tf = refine_point_to_point(map_ds, fine, tf)
-        return refine_point_to_line(map_ds, truth_ds, tf, fine_stages[-1][0])
+        return refine_point_to_line(map_ds, lines, tf, fine_stages[-1][0])
 
     best = refine_best(_starts(search, start), lambda tf: refine_point_to_point(map_ds, rough, tf),
                        finish, scored, params.finalists_for(scale=False))
@@ -167,10 +167,11 @@ def align_similarity(map_xy: np.ndarray, truth_xy: np.ndarray,
                                    resolution=resolution, top_k=params.top_k)
     first, *rest = similarity_schedule(resolution, tolerance, voxel)
     rough, fine = SimilarityTarget(truth_ds, (first,)), SimilarityTarget(truth_ds, tuple(rest))
+    lines = LineTarget(truth_ds)
 
     def finish(tf: Similarity2D) -> Similarity2D:
         tf = refine_similarity(map_xy, fine, tf)
-        return refine_point_to_line(_map_at_scale(map_xy, tf, voxel), truth_ds, tf, tolerance,
+        return refine_point_to_line(_map_at_scale(map_xy, tf, voxel), lines, tf, tolerance,
                                     with_scale=True)
 
     best = refine_best(_starts(search, start), lambda tf: refine_similarity(map_xy, rough, tf),

@@ -9,25 +9,36 @@ from scipy.spatial import cKDTree
 from pcmapq.transform import Similarity2D
 
 
-def line_normals(xy: np.ndarray, neighbours: int = 8) -> np.ndarray:
-    """Unit normal (N, 2) of the local line through each point (N, 2, metres): the direction of
-    least spread of its nearest neighbours (PCA)."""
-    _, idx = cKDTree(xy).query(xy, k=min(neighbours, len(xy)))
+def line_normals(xy: np.ndarray, tree: cKDTree, neighbours: int = 8) -> np.ndarray:
+    """Unit normal (N, 2) of the local line through each point (N >= 2, 2, metres): the
+    direction of least spread of its nearest neighbours (PCA); ``tree`` holds the points."""
+    _, idx = tree.query(xy, k=min(neighbours, len(xy)))
     near = xy[idx] - xy[idx].mean(axis=1, keepdims=True)
     _, vectors = np.linalg.eigh(np.einsum("nki,nkj->nij", near, near))
     return vectors[:, :, 0]
 
 
-def refine_point_to_line(map_xy: np.ndarray, truth_xy: np.ndarray, init: Similarity2D,
+class LineTarget:
+    """The truth prepared once for point-to-line ICP from many starts: its points (M, 2, metres,
+    truth frame), their KD-tree and line normals (none under 3 points: nothing to refine on)."""
+
+    def __init__(self, truth_xy: np.ndarray) -> None:
+        self.points = np.asarray(truth_xy, dtype=np.float64).reshape(-1, 2)
+        self.tree = cKDTree(self.points)
+        self.normals = (line_normals(self.points, self.tree) if len(self.points) >= 3
+                        else np.empty((0, 2)))
+
+
+def refine_point_to_line(map_xy: np.ndarray, target: LineTarget, init: Similarity2D,
                          max_distance: float = 0.2, iterations: int = 30,
                          with_scale: bool = False) -> Similarity2D:
     """2D point-to-line ICP (Gauss-Newton with Tukey weights) of the map (N, 2, metres, map
-    frame) onto the truth (M, 2, metres, truth frame), from ``init``; pairs farther apart than
+    frame) onto the truth (``target``), from ``init``; pairs farther apart than
     ``max_distance`` metres are ignored. Returns the map -> truth transform: scale 1, or with
     ``with_scale`` the scale refined too (the map then in any unit, starting at ``init``'s)."""
-    if len(truth_xy) < 3:
+    if len(target.normals) == 0:
         return init
-    normals, tree = line_normals(truth_xy), cKDTree(truth_xy)
+    truth_xy, normals, tree = target.points, target.normals, target.tree
     tf = init if with_scale else Similarity2D(init.tx, init.ty, init.yaw)
     for _ in range(iterations):
         p = tf.apply(map_xy)
