@@ -8,6 +8,7 @@ that transform, which no rigid fit can fully recover; the other building has no 
 
 from __future__ import annotations
 
+import resource
 import time
 
 import numpy as np
@@ -63,10 +64,12 @@ def main() -> None:
     print("| case | map pts | truth pts | yaw error (deg) | shift error (m) | fitness | "
           "RMSE (m) | seconds |")
     print("|---|---:|---:|---:|---:|---:|---:|---:|")
+    total = 0.0
     for name, map_xy, truth, t_true in cases():
         start = time.perf_counter()
         result = align(map_xy, truth)
         seconds = time.perf_counter() - start
+        total += seconds
         if t_true is None:
             yaw_err = shift_err = "-"
         else:
@@ -75,6 +78,8 @@ def main() -> None:
             shift_err = f"{np.hypot(tf.tx - t_true.tx, tf.ty - t_true.ty):.3f}"
         print(f"| {name} | {len(map_xy)} | {len(truth)} | {yaw_err} | {shift_err} | "
               f"{result.fitness:.3f} | {result.rmse_m:.3f} | {seconds:.2f} |")
+    peak_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    print(f"\nAll cases: {total:.2f} s; peak RSS {peak_mb:.0f} MB.")
 
 
 if __name__ == "__main__":

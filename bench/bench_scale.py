@@ -17,13 +17,15 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from pcmapq.align import align
-from pcmapq.align.icp import fit_similarity
+from pcmapq.align import AlignParams, align
+from pcmapq.align.similarity_icp import fit_similarity
 from pcmapq.transform import Similarity2D
 
 DATA = Path(__file__).resolve().parents[2] / "shared" / "data" / "halmstad"
 SKIP = {"E5_08"}
 TARGET_PX = 20.0
+#: Lengths in layout pixels: 1 px voxels, 4 px inlier tolerance.
+PIXELS = AlignParams(tolerance=4.0, voxel=1.0)
 
 
 def occupied_pixels(mask: np.ndarray) -> np.ndarray:
@@ -56,7 +58,7 @@ def run(data: Path) -> list[tuple[str, Similarity2D, Similarity2D, float, float]
         map_xy = occupied_pixels(cv2.imread(str(path), cv2.IMREAD_GRAYSCALE) == 0)
         map_keys, layout_keys = keypoint_pairs(data, name, building)
         start = time.perf_counter()
-        got = align(map_xy, truth_xy, scale=True, tolerance=4.0, voxel=1.0).transform
+        got = align(map_xy, truth_xy, PIXELS, scale=True).transform
         seconds = time.perf_counter() - start
         residual = np.linalg.norm(got.apply(map_keys) - layout_keys, axis=1)
         rows.append((name, fit_similarity(map_keys, layout_keys), got,

@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 
 from pcmapq import synth
-from pcmapq.align import Alignment, align, score
+from pcmapq.align import Alignment, AlignParams, align, score
 from pcmapq.align.coarse import coarse_search
-from pcmapq.align.icp import voxel_downsample
 from pcmapq.transform import Similarity2D
+from pcmapq.voxels import voxel_centroids
 
 from .conftest import HEIGHT, PLAN, WIDTH
 
@@ -109,6 +109,16 @@ def test_no_refine_scores_identity(truth, scan):
     assert turned.fitness < 0.3
 
 
+def test_params_reach_the_alignment(scan, truth):
+    """A tighter tolerance counts fewer inliers (1.5 cm noise: about 2/3 within 2 cm)."""
+    loose = align(scan, truth, refine=False)
+    tight = align(scan, truth, AlignParams(tolerance=0.02), refine=False)
+    assert tight.tolerance_m == 0.02 and 0.5 < tight.fitness < loose.fitness
+    assert AlignParams().finalists_for(scale=False) == 2
+    assert AlignParams().finalists_for(scale=True) == 3
+    assert AlignParams(finalists=1).finalists_for(scale=True) == 1
+
+
 def test_deterministic(truth, scan):
     _, map_xy = to_map_frame(inside(scan, (-1.0, -1.0, 14.0, 17.0)), -47, -12.0, -30.0)
     assert align(map_xy, truth) == align(map_xy, truth)
@@ -116,8 +126,8 @@ def test_deterministic(truth, scan):
 
 def test_coarse_candidates_rank_right_pose_first(truth, scan):
     t_true, map_xy = to_map_frame(scan, 90, -20.0, 12.0)
-    best = coarse_search(voxel_downsample(map_xy, 0.05),
-                         voxel_downsample(truth, 0.05)).candidates[0]
+    best = coarse_search(voxel_centroids(map_xy, 0.05),
+                         voxel_centroids(truth, 0.05)).candidates[0]
     dxy, dyaw = pose_error(t_true, best.transform)
     assert dxy < 0.6 and dyaw < 2.0 and 0.0 < best.score <= 1.0
 
@@ -131,10 +141,11 @@ def test_score_counts_inliers_and_rmse():
     assert score(map_xy, truth, Similarity2D(tx=100.0)) == (0.0, 0.0)
 
 
-def test_voxel_downsample_takes_cell_centroids():
-    xy = np.array([[0.01, 0.01], [0.03, 0.03], [0.51, 0.0], [0.52, 0.02]])
-    out = voxel_downsample(xy, 0.1)
-    np.testing.assert_allclose(out, [[0.02, 0.02], [0.515, 0.01]])
+def test_voxel_centroids_in_the_plane():
+    """2D points: one centroid per cell, cells sorted by x index, then y index."""
+    xy = np.array([[0.51, 0.0], [0.01, 0.31], [0.52, 0.02], [0.03, -0.17], [0.01, -0.13]])
+    out = voxel_centroids(xy, 0.1)
+    np.testing.assert_allclose(out, [[0.02, -0.15], [0.01, 0.31], [0.515, 0.01]])
 
 
 def test_empty_map_scores_zero(truth):

@@ -10,7 +10,7 @@ import pytest
 
 HEAVY = ("open3d", "kiss_icp", "matplotlib")
 CORE = ("pcmapq.config", "pcmapq.match", "pcmapq.metrics.distances", "pcmapq.result",
-        "pcmapq.features", "pcmapq.io", "pcmapq.align")
+        "pcmapq.features", "pcmapq.io", "pcmapq.align", "pcmapq.align.params")
 
 
 @pytest.mark.parametrize("module", CORE)

@@ -7,9 +7,11 @@ import numpy as np
 import pytest
 
 from pcmapq import synth
-from pcmapq.align import align
-from pcmapq.align.icp import fit_similarity, refine_point_to_line, voxel_downsample
+from pcmapq.align import AlignParams, align
+from pcmapq.align.point_to_line import LineTarget, refine_point_to_line
+from pcmapq.align.similarity_icp import fit_similarity
 from pcmapq.transform import Similarity2D
+from pcmapq.voxels import voxel_centroids
 
 from .conftest import HEIGHT, PLAN, WIDTH, shared
 
@@ -60,7 +62,7 @@ def test_plan_picture_in_pixels(truth):
     segments = synth.transform_segments(PLAN, t_true.inverse())
     grid = synth.plan_grid(segments, 1.0, margin=20.0)  # one pixel = one map unit
     pixels = grid.cell_centres(synth.render(segments, grid, thickness=4.0) == synth.OCCUPIED)
-    result = align(pixels, truth, scale=True, scale_range=(0.01, 1.0))
+    result = align(pixels, truth, AlignParams(scale_range=(0.01, 1.0)), scale=True)
     ds, dyaw, dxy = errors(t_true, result.transform)
     assert ds < 0.01 and dyaw < 0.5 and dxy < 0.1
 
@@ -108,8 +110,9 @@ def test_fit_similarity_is_exact():
 
 def test_point_to_line_refines_scale(truth):
     """From 3 % off in scale, the point-to-line stage with scale lands on the truth."""
-    xy = voxel_downsample(truth, 0.05)
-    got = refine_point_to_line(xy, xy, Similarity2D(0.1, 0.0, 0.0, 1.03), with_scale=True)
+    xy = voxel_centroids(truth, 0.05)
+    got = refine_point_to_line(xy, LineTarget(xy), Similarity2D(0.1, 0.0, 0.0, 1.03),
+                               with_scale=True)
     assert errors(Similarity2D(), got) == pytest.approx((0.0, 0.0, 0.0), abs=1e-4)
 
 
@@ -136,7 +139,7 @@ def test_halmstad_e5_09_against_layout():
     map_xy = occupied_pixels(robot == 0)
     truth_xy = occupied_pixels(layout[..., :3].mean(axis=2) < 100)
     # Lengths in layout pixels: 1 px voxels, 4 px inlier tolerance.
-    result = align(map_xy, truth_xy, scale=True, tolerance=4.0, voxel=1.0)
+    result = align(map_xy, truth_xy, AlignParams(tolerance=4.0, voxel=1.0), scale=True)
     residual = np.linalg.norm(result.transform.apply(map_keys) - layout_keys, axis=1)
     assert np.median(residual) < 20.0
     assert abs(result.transform.scale - 0.829) < 0.02 and abs(result.transform.yaw_deg - 91) < 2

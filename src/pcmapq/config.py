@@ -7,6 +7,7 @@ import math
 from dataclasses import dataclass, field, fields, is_dataclass
 from typing import Any
 
+from pcmapq.align.params import AlignParams
 from pcmapq.features import DETECTORS, default_params
 from pcmapq.io.occupancy import Thresholds
 from pcmapq.metrics.distances import DEFAULT_TAUS
@@ -55,21 +56,22 @@ class AlignmentConfig:
     init: initial guess of the map -> truth transform; skips the global step.
     scale: estimate the map's scale too (a similarity); for maps whose resolution is unknown
         or wrong. A map image without resolution then starts from the truth's.
-    tolerance: a map point is an inlier of the alignment within this distance, metres.
     voxel_3d: working voxel of the 3D registration when both sides are 3D clouds, metres
         (0.3 indoors; 0.5-1 for outdoor maps).
     min_confidence: the map is taken to show another place when its ``confidence`` (see
         :func:`pcmapq.pipeline.confidence`) is below this.
     force: evaluate even when the confidence is below ``min_confidence``.
+    params: the 2D alignment's tunables (:class:`~pcmapq.align.AlignParams`: the inlier
+        tolerance, voxel, global search cell, candidates, finalists, scale range).
     """
 
     enabled: bool = True
     init: Similarity2D | None = None
     scale: bool = False
-    tolerance: float = 0.2
     voxel_3d: float = 0.3
     min_confidence: float = 0.5
     force: bool = False
+    params: AlignParams = field(default_factory=AlignParams)
 
 
 @dataclass(frozen=True)
@@ -145,8 +147,11 @@ class Settings:
         return cls(
             map=source(doc["map"]), truth=source(doc["truth"]),
             raster=RasterConfig(**doc["raster"]),
-            alignment=AlignmentConfig(**{**a, "init": None if init is None else Similarity2D(
-                init["x_m"], init["y_m"], math.radians(init["yaw_deg"]))}),
+            alignment=AlignmentConfig(**{
+                **a, "init": None if init is None else Similarity2D(
+                    init["x_m"], init["y_m"], math.radians(init["yaw_deg"])),
+                "params": AlignParams(**{**a["params"], "scale_range": tuple(
+                    a["params"]["scale_range"])})}),
             footprint=FootprintConfig(**doc["footprint"]),
             matching=MatchingConfig(tuple(m["detectors"]), m["threshold"],
                                     {name: DETECTORS[name].params(**p)

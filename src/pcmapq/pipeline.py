@@ -222,11 +222,11 @@ def score(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap, setti
                                                     plan_points(truth, settings))
     option = settings.alignment
     if registration is None:
-        alignment = align(map_xy, truth_xy, init=option.init, refine=option.enabled,
-                          tolerance=option.tolerance, scale=option.scale)
+        alignment = align(map_xy, truth_xy, option.params, init=option.init,
+                          refine=option.enabled, scale=option.scale)
     else:  # already aligned in 3D: score its plan in 2D as it is
-        alignment = replace(align(map_xy, truth_xy, init=Similarity2D(), refine=False,
-                                  tolerance=option.tolerance), method="3d")
+        alignment = replace(align(map_xy, truth_xy, option.params, init=Similarity2D(),
+                                  refine=False), method="3d")
     frames = Frames(alignment.transform, map_level, truth_level,
                     None if registration is None else registration.transform)
 

@@ -1,11 +1,12 @@
-"""A global point map accumulated scan by scan, one point per voxel, memory bounded.
+"""Voxel centroids: a global point map accumulated scan by scan, one point per voxel, memory
+bounded; and the one-shot downsampling of a cloud (2D or 3D) to one point per voxel.
 
 Points are buffered and merged into the map whenever the buffer holds as many points as the map
 (at least ``min_flush`` points): the merge keys each point by its voxel, and each voxel keeps the
 centroid of **every** point that ever fell in it (running sums and counts), so the result does
 not depend on when merges happen. Memory stays within about twice the final map plus one scan;
 the total merge cost is O(n log n) over the sequence. Deterministic: voxels come out sorted by
-their integer index.
+their integer index (x, then y, then z).
 """
 
 from __future__ import annotations
@@ -16,24 +17,21 @@ from pcmapq.errors import InputError
 
 __all__ = ["VoxelMap", "voxel_centroids"]
 
-#: Bits per axis of a packed voxel key: indices in [-2**20, 2**20), e.g. +-104 km at 0.1 m.
-_BITS = 21
-_OFFSET = 1 << (_BITS - 1)
-
 
 class VoxelMap:
     """Voxel-hash accumulator of world-frame points (metres).
 
     voxel: cell edge, metres. min_flush: buffered points that always trigger a merge.
+    dims: coordinates per point (3; 2 for planar points).
     """
 
-    def __init__(self, voxel: float, min_flush: int = 1_000_000) -> None:
+    def __init__(self, voxel: float, min_flush: int = 1_000_000, dims: int = 3) -> None:
         if not voxel > 0:
             raise InputError(f"voxel must be positive, got {voxel}")
         self.voxel = float(voxel)
         self.min_flush = int(min_flush)
         self._keys = np.empty(0, dtype=np.int64)
-        self._sums = np.empty((0, 3), dtype=np.float64)
+        self._sums = np.empty((0, dims), dtype=np.float64)
         self._counts = np.empty(0, dtype=np.int64)
         self._buffer: list[np.ndarray] = []
         self._buffered = 0
@@ -44,8 +42,8 @@ class VoxelMap:
         return len(self._keys)
 
     def add(self, points: np.ndarray) -> None:
-        """Add world-frame points (N, 3), metres; merges when the buffer is large enough."""
-        points = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+        """Add world-frame points (N, dims), metres; merges when the buffer is large enough."""
+        points = np.asarray(points, dtype=np.float64).reshape(-1, self._sums.shape[1])
         if len(points) == 0:
             return
         self._buffer.append(points)
@@ -54,7 +52,7 @@ class VoxelMap:
             self._merge()
 
     def points(self) -> np.ndarray:
-        """The map: (M, 3) float64 voxel centroids, metres, sorted by voxel index."""
+        """The map: (M, dims) float64 voxel centroids, metres, sorted by voxel index."""
         self._merge()
         return self._sums / self._counts[:, None]
 
@@ -69,24 +67,31 @@ class VoxelMap:
         self._keys, inverse = np.unique(keys, return_inverse=True)
         self._counts = np.bincount(inverse, weights=counts).astype(np.int64)
         self._sums = np.column_stack([np.bincount(inverse, weights=sums[:, axis])
-                                      for axis in range(3)])
+                                      for axis in range(new.shape[1])])
 
 
 def voxel_keys(points: np.ndarray, voxel: float) -> np.ndarray:
-    """One int64 key per point (N, 3, metres): its voxel index (x, y, z) packed in 21 bits each.
+    """One int64 key per point (N, d, metres), d <= 3: its voxel index packed in 63 // d bits an
+    axis (21 in 3D: +-104 km at 0.1 m; 31 in 2D), so keys sort as the indices (x, then y, ...).
 
-    Raises InputError when a point lies beyond +-2**20 voxels of the origin.
+    Raises InputError when a point lies beyond +-2**(bits - 1) voxels of the origin.
     """
-    index = np.floor(points / voxel).astype(np.int64) + _OFFSET
-    if len(index) and (index.min() < 0 or index.max() >= (1 << _BITS)):
-        reach = _OFFSET * voxel
-        raise InputError(f"map extends beyond +-{reach:.0f} m of its origin at voxel {voxel} m; "
-                         "use a larger voxel")
-    return (index[:, 0] << (2 * _BITS)) | (index[:, 1] << _BITS) | index[:, 2]
+    bits = 63 // points.shape[1]
+    offset = 1 << (bits - 1)
+    index = np.floor(points / voxel).astype(np.int64) + offset
+    if len(index) and (index.min() < 0 or index.max() >= (1 << bits)):
+        raise InputError(f"map extends beyond +-{offset * voxel:.0f} m of its origin at voxel "
+                         f"{voxel} m; use a larger voxel")
+    keys = index[:, 0]
+    for axis in range(1, index.shape[1]):
+        keys = (keys << bits) | index[:, axis]
+    return keys
 
 
 def voxel_centroids(points: np.ndarray, voxel: float) -> np.ndarray:
-    """The centroid of the points (N, 3, metres) in each voxel, (M, 3), sorted by voxel index."""
-    grid = VoxelMap(voxel)
+    """The centroid of the points (N, d, metres; d = 2 or 3) in each ``voxel``-metre cell,
+    (M, d), sorted by voxel index (x, then y, ...). Deterministic."""
+    points = np.asarray(points, dtype=np.float64)
+    grid = VoxelMap(voxel, dims=points.shape[1])
     grid.add(points)
     return grid.points()

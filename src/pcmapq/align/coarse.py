@@ -21,11 +21,11 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from pcmapq.align.icp import voxel_downsample
 from pcmapq.grid import MetricGrid
 from pcmapq.morphology import distance_to
 from pcmapq.raster.draw import hit_counts
 from pcmapq.transform import Similarity2D
+from pcmapq.voxels import voxel_centroids
 
 
 @dataclass(frozen=True)
@@ -256,7 +256,7 @@ def similarity_search(map_xy: np.ndarray, truth_xy: np.ndarray, *,
     baseline = float(field[v1:v0 + 1, u0:u1 + 1].mean())
     rows = []
     for scale in scales:
-        points = voxel_downsample(centred, 0.5 * resolution / scale) * (scale / resolution)
+        points = voxel_centroids(centred, 0.5 * resolution / scale) * (scale / resolution)
         radius = scale * map_radius / resolution  # cells
         half = int(np.ceil(radius)) + 1
         offset = fgrid.pixels_to_xy(np.array([[half, half]]))[0]
