@@ -24,6 +24,12 @@ from pcmapq.transform import Similarity2D
 DATA = Path(__file__).resolve().parents[2] / "shared" / "data" / "halmstad"
 SKIP = {"E5_08"}
 TARGET_PX = 20.0
+#: Share of the maps that should be under TARGET_PX.
+TARGET_SHARE = 0.8
+#: Alignment in pixel units: voxel and inlier tolerance.
+VOXEL_PX, TOLERANCE_PX = 1.0, 4.0
+#: A layout's walls: pixels darker than this grey.
+WALL_GREY = 100
 
 
 def occupied_pixels(mask: np.ndarray) -> np.ndarray:
@@ -52,11 +58,11 @@ def run(data: Path) -> list[tuple[str, Similarity2D, Similarity2D, float, float]
             continue
         layout = cv2.imread(str(data / "maps" / building / "layout" / f"{building}_layout.png"),
                             cv2.IMREAD_UNCHANGED)
-        truth_xy = occupied_pixels(layout[..., :3].mean(axis=2) < 100)
+        truth_xy = occupied_pixels(layout[..., :3].mean(axis=2) < WALL_GREY)
         map_xy = occupied_pixels(cv2.imread(str(path), cv2.IMREAD_GRAYSCALE) == 0)
         map_keys, layout_keys = keypoint_pairs(data, name, building)
         start = time.perf_counter()
-        got = align(map_xy, truth_xy, scale=True, tolerance=4.0, voxel=1.0).transform
+        got = align(map_xy, truth_xy, scale=True, tolerance=TOLERANCE_PX, voxel=VOXEL_PX).transform
         seconds = time.perf_counter() - start
         residual = np.linalg.norm(got.apply(map_keys) - layout_keys, axis=1)
         rows.append((name, fit_similarity(map_keys, layout_keys), got,

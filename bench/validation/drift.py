@@ -9,10 +9,11 @@ rotation and translation increments of step k are multiplied by ``1 + e * (1 + z
 plus a per-step random one of standard deviation e. Each map is written as a .npy point cloud
 and scored with ``pcmapq.pipeline.evaluate(map, reference)`` (``Settings(force=True)``).
 
-    python tools/carmen_drift.py LOG [LOG ...] [--levels 0,0.0005,0.001,0.002,0.005,0.01,0.02,0.04]
-        [--seed 0] [--max-range 30] [--scans K]
+    python -m bench.validation.drift LOG [LOG ...] [--levels 0,0.0005,...] [--seed 0]
+        [--max-range 30] [--scans K]
 
-Prints one markdown table per log, and the steps where a detector's f1 does not fall.
+Prints one markdown table per log, and the steps where a detector's f1 does not fall
+(docs/validation.md's CARMEN section: :mod:`bench.validation.carmen`).
 """
 
 from __future__ import annotations
@@ -20,16 +21,17 @@ from __future__ import annotations
 import argparse
 import sys
 import tempfile
-import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
 
 from pcmapq.config import Settings
 from pcmapq.io.carmen import DEFAULT_MAX_RANGE, endpoints, read_flaser
-from pcmapq.pipeline import evaluate
 from pcmapq.report.text import number, score
+
+from .common import f_at, timed_evaluate
 
 #: Drift levels: relative gain errors of the rotation and translation increments.
 DEFAULT_LEVELS = (0.0, 0.0005, 0.001, 0.002, 0.005, 0.01, 0.02, 0.04)
@@ -41,7 +43,7 @@ class Rung:
 
     pose_error_m: largest distance between a drifted and a corrected laser position (both in
         the world frame, unaligned: drift starts at the first pose); yaw_error_deg: largest
-        heading difference.
+        heading difference; figures: what the rung's reference keeps of its result.
     """
 
     level: float
@@ -56,6 +58,10 @@ class Rung:
     chamfer_m: float | None
     f_at_01: float | None
     seconds: float
+    figures: dict = field(default_factory=dict)
+
+    def summary(self) -> dict:
+        return self.figures
 
 
 def wrap(angle: np.ndarray) -> np.ndarray:
@@ -102,39 +108,45 @@ def save_cloud(xy: np.ndarray, path: Path) -> Path:
     return path
 
 
-def ladder(log: Path, levels: tuple[float, ...] = DEFAULT_LEVELS, seed: int = 0,
-           max_range: float = DEFAULT_MAX_RANGE, settings: Settings | None = None,
-           scans: int | None = None) -> list[Rung]:
-    """Score the maps of ``log`` at each drift level against its corrected map, both made of
-    its first ``scans`` scans (all by default) and their readings up to ``max_range`` metres."""
+@lru_cache(maxsize=2)
+def _scans(log: Path, scans: int | None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The log's first ``scans`` poses, ranges and angles (read once)."""
+    poses, ranges, angles = read_flaser(log)
+    return poses[:scans], ranges[:scans], angles[:scans]
+
+
+def rung(log: Path, level: float, seed: int = 0, max_range: float = DEFAULT_MAX_RANGE,
+         settings: Settings | None = None, scans: int | None = None) -> Rung:
+    """Score the map of ``log`` at one drift level against its corrected map, both made of its
+    first ``scans`` scans (all by default) and their readings up to ``max_range`` metres."""
     settings = Settings(force=True) if settings is None else settings
-    poses, ranges, angles = (part[:scans] for part in read_flaser(log))
-    rungs = []
+    poses, ranges, angles = _scans(log, scans)
+    path_poses = drifted(poses, level, seed)
     with tempfile.TemporaryDirectory(prefix="carmen_drift_") as tmp:
         reference = save_cloud(endpoints(poses, ranges, angles, max_range),
                                Path(tmp) / "reference.npy")
-        for level in levels:
-            path_poses = drifted(poses, level, seed)
-            cloud = save_cloud(endpoints(path_poses, ranges, angles, max_range),
-                               Path(tmp) / f"drift_{level:g}.npy")
-            start = time.perf_counter()
-            result = evaluate(cloud, reference, settings)
-            seconds = time.perf_counter() - start
-            dist = result.distances
-            f01 = next((f.f for f in dist.fscores if abs(f.tau_m - 0.1) < 1e-9), None)
-            rungs.append(Rung(
-                level=level,
-                pose_error_m=float(np.max(np.linalg.norm(path_poses[:, :2] - poses[:, :2],
-                                                         axis=1))),
-                yaw_error_deg=float(np.degrees(np.max(np.abs(wrap(path_poses[:, 2]
-                                                                  - poses[:, 2]))))),
-                fitness=result.alignment.fitness,
-                quality={k: d.matching.quality for k, d in result.detectors.items()},
-                precision={k: d.matching.precision for k, d in result.detectors.items()},
-                f1={k: d.matching.f1 for k, d in result.detectors.items()},
-                accuracy_mean_m=dist.accuracy.mean, completeness_mean_m=dist.completeness.mean,
-                chamfer_m=dist.chamfer_m, f_at_01=f01, seconds=seconds))
-    return rungs
+        cloud = save_cloud(endpoints(path_poses, ranges, angles, max_range),
+                           Path(tmp) / f"drift_{level:g}.npy")
+        run = timed_evaluate(cloud, reference, settings)
+    result, dist = run.result, run.result.distances
+    return Rung(
+        level=level,
+        pose_error_m=float(np.max(np.linalg.norm(path_poses[:, :2] - poses[:, :2], axis=1))),
+        yaw_error_deg=float(np.degrees(np.max(np.abs(wrap(path_poses[:, 2] - poses[:, 2]))))),
+        fitness=result.alignment.fitness,
+        quality={k: d.matching.quality for k, d in result.detectors.items()},
+        precision={k: d.matching.precision for k, d in result.detectors.items()},
+        f1={k: d.matching.f1 for k, d in result.detectors.items()},
+        accuracy_mean_m=dist.accuracy.mean, completeness_mean_m=dist.completeness.mean,
+        chamfer_m=dist.chamfer_m, f_at_01=f_at(result, 0.1), seconds=run.seconds,
+        figures=run.summary())
+
+
+def ladder(log: Path, levels: tuple[float, ...] = DEFAULT_LEVELS, seed: int = 0,
+           max_range: float = DEFAULT_MAX_RANGE, settings: Settings | None = None,
+           scans: int | None = None) -> list[Rung]:
+    """:func:`rung` at each drift level."""
+    return [rung(log, level, seed, max_range, settings, scans) for level in levels]
 
 
 def markdown(rungs: list[Rung]) -> str:
@@ -178,7 +190,8 @@ def falls_text(rungs: list[Rung]) -> str:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog="python -m bench.validation.drift",
+                                     description=__doc__.splitlines()[0])
     parser.add_argument("logs", nargs="+", type=Path)
     parser.add_argument("--levels", default=",".join(f"{v:g}" for v in DEFAULT_LEVELS),
                         help="drift levels, relative gain errors (default: %(default)s)")
