@@ -1,6 +1,8 @@
-"""Real maps of ../shared/data (docs/validation.md, bench/validation/) with stated bounds.
+"""Real maps of ../shared/data (docs/validation.md, bench/validation/): stated bounds, and the
+cheap cases' figures against their stored references (tests/reference/validation/: behaviour
+unchanged, numbers within 1e-6). ``python -m bench.validation --check`` compares every case.
 
-About 45 s in all on 2 cores, 30 s of it the Gazebo pair (62 M truth cells, about 3 GB peak).
+About 75 s in all on 2 cores, 30 s of it the Gazebo pair (62 M truth cells, about 3 GB peak).
 """
 
 from __future__ import annotations
@@ -20,10 +22,31 @@ from .conftest import SHARED_DATA, shared
 
 ROOT = Path(__file__).resolve().parents[1]
 
+#: Cases compared with their references here (a few seconds each); the others (Gazebo, KITTI,
+#: the ladders, the same-place matrix...) are left to ``python -m bench.validation --check``.
+CHEAP = ("floorplans-intel", "floorplans-freiburg79", "halmstad-e5_09", "fr79-turn-123",
+         "lidar-pair", "carmen-fhw-0.05", "drawings-synthetic-0", "drawings-halmstad-e5-layout",
+         "same-place-sample-scan-vs-its-plan", "same-place-intel-map-vs-freiburg-s-plan",
+         "same-place-carmen-intel-vs-fhw")
+
+
 @cache
 def measured(name: str) -> Measured:
     """A case of docs/validation.md, measured once per test session."""
     return document.cases(SHARED_DATA)[name].measure()
+
+
+@pytest.mark.parametrize("name", CHEAP)
+def test_case_equals_its_reference(name):
+    shared()
+    found = reference.compare(name, measured(name).summary())
+    assert not found, "\n".join(found[:20])
+
+
+def test_every_case_has_a_reference_and_every_reference_a_case():
+    names = set(document.cases(shared()))
+    stored = {p.stem for p in reference.FOLDER.glob("*.json")}
+    assert names == stored, sorted(names ^ stored)
 
 
 def test_a_reference_keeps_named_fields_only():
