@@ -12,8 +12,11 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Generic, Protocol, TypeVar
 
+import numpy as np
+
 from pcmapq.config import Settings
 from pcmapq.io import PointMap
+from pcmapq.io.occupancy import MapMeta, read_grey
 from pcmapq.pipeline import evaluate
 from pcmapq.report.text import score
 from pcmapq.result import Result
@@ -118,6 +121,23 @@ def with_yaml(image: Path, folder: Path, resolution: float, **thresholds: float)
                          f"negate: 0\noccupied_thresh: {meta['occupied_thresh']}\n"
                          f"free_thresh: {meta['free_thresh']}\n")
     return yaml_path
+
+
+def commonest_greys(image: Path, count: int = 3) -> list[int]:
+    """The ``count`` most frequent grey values of an image as pcmapq's loader reads it (0..255),
+    darkest first."""
+    grey, _ = read_grey(image)
+    values, counts = np.unique(np.rint(grey), return_counts=True)
+    return sorted(int(v) for v in values[np.argsort(-counts, kind="stable")[:count]])
+
+
+def occupancy(grey: int) -> str:
+    """'p = 0.50' for a grey value, map_server's occupancy probability (not negated)."""
+    return f"p = {(255 - grey) / 255:.2f}"
+
+
+#: map_server's default thresholds (a map without YAML or options).
+ROS = MapMeta(resolution=None)
 
 
 def cm(value: float | None) -> str:

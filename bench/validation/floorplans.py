@@ -11,7 +11,20 @@ from pcmapq.io import Thresholds
 from pcmapq.report.text import number
 from pcmapq.result import Result
 
-from .common import Case, Record, Run, Section, header, q_p, row, timed_evaluate, yaw_error
+from .common import (
+    ROS,
+    Case,
+    Record,
+    Run,
+    Section,
+    commonest_greys,
+    header,
+    occupancy,
+    q_p,
+    row,
+    timed_evaluate,
+    yaw_error,
+)
 
 #: Assumed resolution of every plan image, metres per pixel.
 PLAN_RESOLUTION = 0.05
@@ -94,6 +107,7 @@ def section(data: Path, record: Record) -> Section:
             f"{run.seconds:.1f}"]))
         files[plan.figure] = figure_png(r)
     intel = FLOORPLANS[0].thresholds
+    wall, unexplored, _ = commonest_greys(data / "floorplans" / FLOORPLANS[0].map_file)
     return Section("\n".join([
         "## Floor plans: SLAM maps vs hand-drawn plans, scale and rotation unknown", "",
         "`floorplans/intel_map.png` vs `lab_intel.png` (walls drawn as black double outlines "
@@ -101,8 +115,10 @@ def section(data: Path, record: Record) -> Section:
         f"resolution is given: the plan is taken at {PLAN_RESOLUTION} m per pixel and the map's "
         "scale is estimated from the same start, so the scale is plan pixels per map pixel. "
         f"`Settings(scale=True, truth_resolution={PLAN_RESOLUTION})`, no `force`. The Intel "
-        "map's walls are grey 127 (unknown under ROS's thresholds) and its unexplored area "
-        "grey 230 (free under them), so it is read with "
+        f"map's commonest greys besides white are {wall}, its walls ({occupancy(wall)}: unknown "
+        f"under ROS's occupied_thresh {ROS.occupied_thresh}), and {unexplored}, its "
+        f"unexplored area ({occupancy(unexplored)}: free under ROS's free_thresh "
+        f"{ROS.free_thresh}), so it is read with "
         f"`--map-occupied-thresh {intel.occupied} --map-free-thresh {intel.free}` "
         "(`Settings.map_thresholds`), no YAML. The Freiburg images read correctly with ROS's "
         "defaults. The survey scale and the expected yaw are the expected answers, set when the "

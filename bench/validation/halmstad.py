@@ -13,17 +13,19 @@ import numpy as np
 from bench import bench_scale
 from pcmapq.config import Settings
 from pcmapq.io import OccupancyMap, load_map
-from pcmapq.io.occupancy import MapMeta, classify, read_grey
+from pcmapq.io.occupancy import classify, read_grey
 from pcmapq.raster.draw import OCCUPIED
 from pcmapq.report.text import number
 from pcmapq.result import Result
 from pcmapq.transform import Similarity2D
 
 from .common import (
+    ROS,
     Case,
     Record,
     Run,
     Section,
+    commonest_greys,
     f_at,
     header,
     q_p,
@@ -46,7 +48,7 @@ def walls_read_occupied(image: Path, dark: float = DARK) -> float:
     """Share of an image's dark pixels (grey < ``dark``, opaque) that pcmapq's loader, with
     ROS's default thresholds, reads as occupied."""
     grey, transparent = read_grey(image)
-    state = classify(grey, transparent, MapMeta(resolution=None))
+    state = classify(grey, transparent, ROS)
     walls = (grey < dark) & ~transparent
     return float((state[walls] == OCCUPIED).mean()) if walls.any() else 0.0
 
@@ -150,20 +152,24 @@ def section(data: Path, record: Record) -> Section:
     """The Halmstad maps against their layouts."""
     bench, *runs = (case.run(record) for case in cases(data))
     greys = np.arange(256.0)
-    occupied = greys[classify(greys, np.zeros(256, bool), MapMeta(None)) == OCCUPIED]
+    occupied = greys[classify(greys, np.zeros(256, bool), ROS) == OCCUPIED]
+    first_map, first_layout = paths(data, MAPS[0])
+    occ, unknown, free = commonest_greys(first_map)
+    wall, outside, inside = commonest_greys(first_layout)
     return Section("\n".join([
         "## Halmstad: robot maps vs building layouts, scale unknown", "",
-        "`halmstad/maps/<B>/pseudo_occupancy/*.png` (0 occupied, 127 unknown, 255 free) against "
-        "`maps/<B>/layout/<B>_layout.png` (RGBA, opaque; walls 0 with anti-aliased greys, "
-        "outside 128, inside 255). The reference is the least-squares similarity of the "
-        "annotated keypoint pairs.", "",
+        f"`halmstad/maps/<B>/pseudo_occupancy/*.png` ({MAPS[0]}'s commonest greys: {occ} "
+        f"occupied, {unknown} unknown, {free} free) against `maps/<B>/layout/<B>_layout.png` "
+        f"(RGBA, opaque; {first_layout.stem}'s commonest greys: walls {wall} with "
+        f"anti-aliased greys, outside {outside}, inside {inside}). The reference is the "
+        "least-squares similarity of the annotated keypoint pairs.", "",
         alignment_text(bench.rows), "",
         f"Full pipeline, `Settings(scale=True, truth_resolution={PLAN_RESOLUTION})` (no "
         "`force`), map image vs layout image, one map per building. The layout's walls are "
         "read as occupied by ROS's default thresholds, so no YAML is needed: column 2 is the "
         f"share of its pixels darker than {DARK} (wall cores) and than "
         f"{bench_scale.WALL_GREY} (the bench's wall mask) that the loader marks occupied; "
-        f"greys up to {occupied.max():.0f} count (p > {MapMeta(None).occupied_thresh}), the "
+        f"greys up to {occupied.max():.0f} count (p > {ROS.occupied_thresh}), the "
         f"lighter anti-aliased edge pixels ({occupied.max() + 1:.0f}-"
         f"{bench_scale.WALL_GREY - 1}) are read unknown, a one-pixel thinning of no "
         "consequence. Both images have no resolution: the layout is taken at "
