@@ -219,7 +219,7 @@ def section(data: Path, record: Record) -> Section:
         *e5.rows("Halmstad E5 layout"), "",
         f"The Halmstad layout (thick walls, no clutter) scores like its skeleton (lowest "
         f"{e5.lowest():.2f}). The Freiburg 079 SLAM map's lowest quality or precision is "
-        f"{fr79_lowest} for the three variants"
+        f"{fr79_lowest} for its {len(fr79.variants)} variants"
         + (f" (under the {BAR} the synthetic drawings reach)" if worst < BAR else "")
         + ": it is full of furniture and speckles "
         "a few cells apart, and thickening it by "
