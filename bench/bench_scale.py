@@ -24,8 +24,12 @@ from pcmapq.transform import Similarity2D
 DATA = Path(__file__).resolve().parents[2] / "shared" / "data" / "halmstad"
 SKIP = {"E5_08"}
 TARGET_PX = 20.0
-#: Lengths in layout pixels: 1 px voxels, 4 px inlier tolerance.
+#: Share of the maps that should be under TARGET_PX.
+TARGET_SHARE = 0.8
+#: Alignment in pixel units: 1 px voxels, 4 px inlier tolerance.
 PIXELS = AlignParams(tolerance=4.0, voxel=1.0)
+#: A layout's walls: pixels darker than this grey.
+WALL_GREY = 100
 
 
 def occupied_pixels(mask: np.ndarray) -> np.ndarray:
@@ -54,7 +58,7 @@ def run(data: Path) -> list[tuple[str, Similarity2D, Similarity2D, float, float]
             continue
         layout = cv2.imread(str(data / "maps" / building / "layout" / f"{building}_layout.png"),
                             cv2.IMREAD_UNCHANGED)
-        truth_xy = occupied_pixels(layout[..., :3].mean(axis=2) < 100)
+        truth_xy = occupied_pixels(layout[..., :3].mean(axis=2) < WALL_GREY)
         map_xy = occupied_pixels(cv2.imread(str(path), cv2.IMREAD_GRAYSCALE) == 0)
         map_keys, layout_keys = keypoint_pairs(data, name, building)
         start = time.perf_counter()

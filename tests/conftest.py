@@ -72,7 +72,7 @@ def shared(*parts: str) -> Path:
 REALDATA_FIXTURES = {"fr79", "kitti_maps", "registration_pair"}
 E2E_FIXTURES = {"moved_result", "perfect_result", "sample_json", "round_png"}
 E2E_CALLS = ("evaluate(", "score(", ".invoke(", "subprocess", "run(", "build_map", "_ladder(",
-             "carmen_drift", "validate_tool", "main(")
+             "main(")
 
 
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:

@@ -4,13 +4,12 @@ real logs of ../shared/data/carmen (skipped, saying why, where absent)."""
 from __future__ import annotations
 
 import gzip
-import importlib.util
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 
+from bench.validation import drift
 from pcmapq.config import AlignmentConfig, Settings
 from pcmapq.errors import InputError
 from pcmapq.io import PointMap, load_map
@@ -18,8 +17,6 @@ from pcmapq.io.carmen import beam_angles, endpoints, load_carmen, read_flaser
 from pcmapq.pipeline import evaluate
 
 from .conftest import shared
-
-TOOLS = Path(__file__).resolve().parents[1] / "tools"
 
 #: Other message types a log holds, which the reader must skip.
 HEADER = ("# message formats defined: PARAM SYNC ODOM FLASER RLASER\n"
@@ -153,30 +150,20 @@ def test_intel_log_against_itself() -> None:
         assert det.matching.precision >= 0.95, name
 
 
-def _drift_tool():
-    spec = importlib.util.spec_from_file_location("carmen_drift", TOOLS / "carmen_drift.py")
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module  # dataclasses look their module up there
-    spec.loader.exec_module(module)
-    return module
-
-
 def test_not_falling_lists_the_steps_where_f1_does_not_fall() -> None:
-    tool = _drift_tool()
-
     def rung(level: float, harris: float, sift: float | None):
-        return tool.Rung(level=level, pose_error_m=0.0, yaw_error_deg=0.0, fitness=1.0,
-                         quality={}, precision={}, f1={"harris": harris, "sift": sift},
-                         accuracy_mean_m=None, completeness_mean_m=None, chamfer_m=None,
-                         f_at_01=None, seconds=0.0)
+        return drift.Rung(level=level, pose_error_m=0.0, yaw_error_deg=0.0, fitness=1.0,
+                          quality={}, precision={}, f1={"harris": harris, "sift": sift},
+                          accuracy_mean_m=None, completeness_mean_m=None, chamfer_m=None,
+                          f_at_01=None, seconds=0.0)
 
     rungs = [rung(0.0, 1.0, 1.0), rung(0.01, 0.5, None), rung(0.02, 0.5, 0.4),
              rung(0.04, 0.6, 0.3)]
-    assert tool.not_falling(rungs) == [("harris", 0.01, 0.02, 0.5, 0.5),
-                                       ("harris", 0.02, 0.04, 0.5, 0.6)]
-    assert tool.falls_text(rungs) == ("f1 does not fall: harris from 1 to 2 % (0.500, 0.500); "
-                                      "harris from 2 to 4 % (0.500, 0.600).")
-    assert tool.falls_text(rungs[:2]) == "f1 falls at every step for every detector."
+    assert drift.not_falling(rungs) == [("harris", 0.01, 0.02, 0.5, 0.5),
+                                        ("harris", 0.02, 0.04, 0.5, 0.6)]
+    assert drift.falls_text(rungs) == ("f1 does not fall: harris from 1 to 2 % (0.500, 0.500); "
+                                       "harris from 2 to 4 % (0.500, 0.600).")
+    assert drift.falls_text(rungs[:2]) == "f1 falls at every step for every detector."
 
 
 def test_drift_ranks_maps() -> None:
@@ -184,9 +171,8 @@ def test_drift_ranks_maps() -> None:
     trajectory (4 % gain errors) scores worse than the corrected one on every detector's
     quality and precision and on the distance figures."""
     log = shared("carmen", "orebro-corrected.log.gz")
-    forced = Settings(alignment=AlignmentConfig(force=True))
-    none, large = _drift_tool().ladder(log, levels=(0.0, 0.04), max_range=10.0,
-                                       settings=forced, scans=80)
+    none, large = drift.ladder(log, levels=(0.0, 0.04), max_range=10.0,
+                               settings=Settings(alignment=AlignmentConfig(force=True)), scans=80)
     for name in none.quality:
         assert large.quality[name] < none.quality[name], name
         assert large.precision[name] < none.precision[name], name
@@ -200,10 +186,9 @@ def test_drift_ladder_every_f1_falls_and_sift_quality_with_it():
     quality falls below 0.6 at 4 % (it saturated near 0.8 when any keypoint within the
     threshold matched, however unlike its descriptor)."""
     log = shared("carmen", "orebro-corrected.log.gz")
-    tool = _drift_tool()
-    rungs = tool.ladder(log, levels=(0.01, 0.02, 0.04), max_range=10.0,
-                        settings=Settings(alignment=AlignmentConfig(force=True)), scans=180)
-    assert tool.not_falling(rungs) == []
+    rungs = drift.ladder(log, levels=(0.01, 0.02, 0.04), max_range=10.0,
+                         settings=Settings(alignment=AlignmentConfig(force=True)), scans=180)
+    assert drift.not_falling(rungs) == []
     for name in rungs[0].f1:
         values = [r.f1[name] for r in rungs]
         assert all(b < a for a, b in zip(values, values[1:], strict=False)), (name, values)

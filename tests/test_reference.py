@@ -7,6 +7,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+from bench.validation.reference import differences
 from pcmapq.pipeline import evaluate
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -26,25 +27,6 @@ def sample_document() -> dict:
 def write_reference() -> None:
     """Store the current result as the reference (run by hand, never by a test)."""
     REFERENCE.write_text(json.dumps(sample_document(), indent=1) + "\n")
-
-
-def differences(got, want, where: str = "", tol: float = 1e-6) -> list[str]:
-    """Where two JSON values differ: keys of the reference that are gone, lengths, strings, or
-    numbers by more than ``tol``. Keys the reference does not have are new fields, not changes."""
-    if isinstance(want, dict) and isinstance(got, dict):
-        if set(want) - set(got):
-            return [f"{where}: keys {sorted(set(want) - set(got))} gone"]
-        return [d for k in want for d in differences(got[k], want[k], f"{where}.{k}", tol)]
-    if isinstance(want, list) and isinstance(got, list):
-        if len(got) != len(want):
-            return [f"{where}: {len(got)} items, reference {len(want)}"]
-        return [d for i, (g, w) in enumerate(zip(got, want, strict=True))
-                for d in differences(g, w, f"{where}[{i}]", tol)]
-    numbers = (int, float)
-    if (isinstance(got, numbers) and isinstance(want, numbers)
-            and not isinstance(got, bool) and not isinstance(want, bool)):
-        return [] if abs(got - want) <= tol else [f"{where}: {got} != {want}"]
-    return [] if got == want else [f"{where}: {got!r} != {want!r}"]
 
 
 def test_sample_result_equals_the_reference():

@@ -9,11 +9,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from bench.validation.reference import differences
 from pcmapq.config import Settings
 from pcmapq.pipeline import evaluate
 from pcmapq.result import Result
 from pcmapq.stats import FIELDS, Stats
-from tests.test_reference import differences
 
 ROOT = Path(__file__).resolve().parents[1]
 SAMPLE = ROOT / "data" / "sample"

@@ -1,32 +1,66 @@
-"""Real maps of ../shared/data with stated bounds (docs/validation.md, tools/validate.py).
+"""Real maps of ../shared/data (docs/validation.md, bench/validation/): stated bounds, and the
+cheap cases' figures against their stored references (tests/reference/validation/: behaviour
+unchanged, numbers within 1e-6). ``python -m bench.validation --check`` compares every case.
 
-About 45 s in all, most of it the Gazebo pair (62 M truth cells, about 2.7 GB peak).
+About 75 s in all on 2 cores, 30 s of it the Gazebo pair (62 M truth cells, about 3 GB peak).
 """
 
 from __future__ import annotations
 
-import importlib.util
-import sys
+import json
+from functools import cache
 from pathlib import Path
-from types import ModuleType
 
 import numpy as np
 import pytest
 
-from .conftest import shared
+from bench import bench_scale
+from bench.validation import document, floorplans, gazebo, halmstad, reference
+from bench.validation.common import Measured
 
-TOOLS = Path(__file__).resolve().parents[1] / "tools"
+from .conftest import SHARED_DATA, shared
+
+ROOT = Path(__file__).resolve().parents[1]
+
+#: Cases compared with their references here (a few seconds each); the others (Gazebo, KITTI,
+#: the ladders, the same-place matrix...) are left to ``python -m bench.validation --check``.
+CHEAP = ("floorplans-intel", "floorplans-freiburg79", "halmstad-e5_09", "fr79-turn-123",
+         "lidar-pair", "carmen-fhw-0.05", "drawings-synthetic-0", "drawings-halmstad-e5-layout",
+         "same-place-sample-scan-vs-its-plan", "same-place-intel-map-vs-freiburg-s-plan",
+         "same-place-carmen-intel-vs-fhw")
 
 
-def validate_tool() -> ModuleType:
-    """tools/validate.py as a module (tools/ is not a package)."""
-    if "validate" in sys.modules:
-        return sys.modules["validate"]
-    spec = importlib.util.spec_from_file_location("validate", TOOLS / "validate.py")
-    module = importlib.util.module_from_spec(spec)
-    sys.modules["validate"] = module
-    spec.loader.exec_module(module)
-    return module
+@cache
+def measured(name: str) -> Measured:
+    """A case of docs/validation.md, measured once per test session."""
+    return document.cases(SHARED_DATA)[name].measure()
+
+
+@pytest.mark.parametrize("name", CHEAP)
+def test_case_equals_its_reference(name):
+    shared()
+    found = reference.compare(name, measured(name).summary())
+    assert not found, "\n".join(found[:20])
+
+
+def test_every_case_has_a_reference_and_every_reference_a_case():
+    names = set(document.cases(shared()))
+    stored = {p.stem for p in reference.FOLDER.glob("*.json")}
+    assert names == stored, sorted(names ^ stored)
+
+
+def test_a_reference_keeps_named_fields_only():
+    """New fields of the JSON document do not change the summary a reference stores."""
+    doc = json.loads((ROOT / "tests" / "reference" / "sample.json").read_text())
+    kept = reference.summary(doc)
+    assert set(kept) == {"alignment", "coverage", "footprint", "distances", "detectors"}
+    assert set(kept["detectors"]["sift"]) == {"quality", "precision", "f1", "truth_features",
+                                              "map_features", "matched"}
+    doc["alignment"]["new_figure"] = 1.0
+    doc["detectors"]["sift"]["new_figure"] = 2.0
+    doc["new_section"] = {"x": 3}
+    assert reference.summary(doc) == kept
+    assert reference.differences(kept, kept) == []
 
 
 def test_gazebo_slam_map_mean_accuracy_under_8_cm():
@@ -34,56 +68,44 @@ def test_gazebo_slam_map_mean_accuracy_under_8_cm():
     per-axis rescaling: 4.06 cm; pcmapq measured 4.30 cm, scale 1.987)."""
     data = shared("gazebo", "Ground_Truth.png").parents[1]
     shared("gazebo", "SLAM_Gen_Map.png")
-    run = validate_tool().gazebo_run(data)
-    acc = run.result.distances.accuracy
-    assert acc.mean is not None and acc.mean < 0.08
-    assert abs(run.result.transform.scale - 1.99) < 0.04  # size ratios 2.00, 1.96
-    assert abs(run.result.transform.yaw_deg) < 1.0
+    result = gazebo.run(data).result
+    acc = result.distances.accuracy
+    assert acc.mean is not None and acc.mean < gazebo.BOUND_M
+    assert abs(result.transform.scale - 1.99) < 0.04  # size ratios 2.00, 1.96
+    assert abs(result.transform.yaw_deg) < 1.0
     # the truth's walls are one 1.89 mm cell wide, the map's 2-3 cells of 3.8 mm: a good map,
     # so every detector finds the truth's corners, walls and keypoints in it (Harris found 8
     # corners in that truth before the detectors saw wall centre lines, and scored 1.00 on them)
-    for name, det in run.result.detectors.items():
+    for name, det in result.detectors.items():
         assert det.matching.truth_features >= 20, name
         assert det.matching.quality >= 0.8 and det.matching.precision >= 0.8, name
 
 
-@pytest.mark.parametrize(("index", "image", "yaw"), [(0, "intel_map.png", 180.0),
-                                                     (1, "freiburg_building79.png", 0.0)])
-def test_slam_map_aligns_to_its_plan(index, image, yaw):
+@pytest.mark.parametrize("plan", floorplans.FLOORPLANS, ids=lambda p: p.case)
+def test_slam_map_aligns_to_its_plan(plan):
     """SLAM map vs hand-drawn plan: yaw within 5 degrees of the expected one (Intel's plan is
     turned about 180 degrees, Freiburg's not) and scale within 5 % of the survey's plan px per
     map px (Intel 1.168: measured 177.4 deg, 1.164; Freiburg 0.863: measured -0.2 deg, 0.901)."""
-    tool = validate_tool()
-    shared("floorplans", image)
-    case = tool.FLOORPLANS[index]
-    tf = tool.floorplan_run(case, shared("floorplans").parent).result.transform
-    assert tool.yaw_error(tf.yaw_deg, yaw) < 5.0
-    assert abs(tf.scale / case.survey_scale - 1.0) < 0.05
+    shared("floorplans", plan.map_file)
+    assert floorplans.recovered(plan, measured(plan.case).result)
 
 
 def test_halmstad_layout_walls_read_occupied_by_ros_thresholds():
     """The layouts' walls (0 with anti-aliased greys, outside 128) are occupied under ROS's
     default thresholds: no YAML needed."""
-    tool = validate_tool()
     for building in ("E5", "F5", "HIH", "KPT4A"):
         layout = shared("halmstad", "maps", building, "layout", f"{building}_layout.png")
-        assert tool.walls_read_occupied(layout) > 0.95
-        assert tool.halmstad_truth(layout, Path("/nonexistent")) == layout
+        assert halmstad.walls_read_occupied(layout) > 0.95
+        assert halmstad.halmstad_truth(layout, Path("/nonexistent")) == layout
 
 
 def test_halmstad_full_pipeline_puts_keypoints_within_20_px():
     """E5_09 vs the E5 layout through evaluate(): the annotated keypoints land within 20 px
     (median) of their partners, with no force: the map is taken to show the layout's place."""
-    tool = validate_tool()
     root = shared("halmstad")
-    map_path = shared("halmstad", "maps", "E5", "pseudo_occupancy", "E5_09.png")
-    layout = shared("halmstad", "maps", "E5", "layout", "E5_layout.png")
-    settings = tool.Settings(alignment=tool.AlignmentConfig(scale=True),
-                             truth=tool.SourceConfig(resolution=0.05))
-    result = tool.timed_evaluate(map_path, layout, settings).result
-    bench = tool.load_tool(tool.ROOT / "bench" / "bench_scale.py")
-    map_keys, layout_keys = bench.keypoint_pairs(root, "E5_09", "E5")
-    residual = tool.keypoint_residual(result, map_path, map_keys, layout_keys)
-    assert residual < 20.0
+    map_path, _ = halmstad.paths(root.parent, "E5_09")
+    result = measured("halmstad-e5_09").result
+    map_keys, layout_keys = bench_scale.keypoint_pairs(root, "E5_09", "E5")
+    assert halmstad.keypoint_residual(result, map_path, map_keys, layout_keys) < 20.0
     assert np.isfinite(result.distances.accuracy.mean)
     assert result.overlap.confidence >= 0.5

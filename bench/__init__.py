@@ -1,0 +1,1 @@
+"""Benchmarks (``bench/bench_*.py``) and the validation on real data (:mod:`bench.validation`)."""
