@@ -159,8 +159,8 @@ def align_similarity(map_xy: np.ndarray, truth_xy: np.ndarray,
 
     if not refine:
         return replace(scored(start), method="none" if init is None else "init")
-    resolution = params.resolution
-    resolution = similarity_resolution(truth_ds) if resolution is None else resolution
+    resolution = (similarity_resolution(truth_ds) if params.resolution is None
+                  else params.resolution)
     search = None
     if init is None:
         search = similarity_search(map_xy, truth_ds, scale_range=params.scale_range,
