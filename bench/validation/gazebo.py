@@ -29,7 +29,8 @@ MAP, TRUTH = "SLAM_Gen_Map.png", "Ground_Truth.png"
 def run(data: Path, footprint: str = "auto") -> Run:
     """The Gazebo SLAM map scored against its truth, scale estimated."""
     folder = data / "gazebo"
-    return timed_evaluate(folder / MAP, folder / TRUTH, replace(SETTINGS, footprint=footprint))
+    settings = replace(SETTINGS, footprint=replace(SETTINGS.footprint, rule=footprint))
+    return timed_evaluate(folder / MAP, folder / TRUTH, settings)
 
 
 def cases(data: Path) -> list[Case]:

@@ -34,8 +34,9 @@ def section(data: Path, record: Record) -> Section:
         "`registration/source.ply` and `target.ply`, two LiDAR scans, with the true 4x4 "
         "transform. Both inputs are 3D clouds, so pcmapq "
         "registers them in 3D first (FPFH + seeded RANSAC + point-to-plane ICP, voxel "
-        f"{settings.voxel_3d} m, no initial guess), then scores the wall bands "
-        f"({settings.band_low}-{settings.band_high} m above the floor) in 2D: `pcmapq eval "
+        f"{settings.alignment.voxel_3d} m, no initial guess), then scores the wall bands "
+        f"({settings.raster.band_low}-{settings.raster.band_high} m above the floor) in 2D: "
+        "`pcmapq eval "
         "source.ply target.ply`, default settings "
         "(`tests/test_real_data.py::test_lidar_pair_aligns_to_its_known_transform`).", "",
         header(["", "x [m]", "y [m]", "yaw [deg]"]),

@@ -168,7 +168,7 @@ def measure(pair: Pair) -> Row:
     source = pair.map_source if isinstance(pair.map_source, Path) else pair.map_source()
     result = evaluate(source, pair.truth, pair.settings)
     a, o = result.alignment, result.overlap
-    return Row(pair, "scale" if pair.settings.scale else "rigid", a.distinctiveness,
+    return Row(pair, "scale" if pair.settings.alignment.scale else "rigid", a.distinctiveness,
                o.truth_recall, a.fitness, o.agreement, o.confidence,
                time.perf_counter() - start, summary(result.to_dict()))
 
