@@ -52,7 +52,7 @@ def section(data: Path, record: Record) -> Section:
     longest = sorted(main.steps, key=main.steps.__getitem__)[-2:][::-1]
     pub = PUBLISHED_CM
     met = acc.mean is not None and acc.mean < BOUND_M
-    margin = SETTINGS.footprint_margin
+    margin = SETTINGS.footprint.margin
     return Section("\n".join([
         "## Gazebo: SLAM map of unknown pixel size vs the rendered world", "",
         f"`gazebo/{MAP}` ({map_cols} x {map_rows}) against `gazebo/{TRUTH}` ({cols} x {rows}, "
