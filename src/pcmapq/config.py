@@ -1,5 +1,5 @@
 """Settings: every option of a run in one object, nested by pipeline stage, every length in
-metres. Each default is defined here once; the command line and the docs read it from here."""
+metres. Each default is defined here once; the command line reads it from here."""
 
 from __future__ import annotations
 
