@@ -120,7 +120,7 @@ def alignment_text(rows: list) -> str:
     worst = rows[int(np.argmax(residuals))][0]
     return (
         f"Alignment only (`bench/bench_scale.py`, both images in pixels, "
-        f"{bench_scale.VOXEL_PX:g} px voxels, {bench_scale.TOLERANCE_PX:g} px tolerance; "
+        f"{bench_scale.PIXELS.voxel:g} px voxels, {bench_scale.PIXELS.tolerance:g} px tolerance; "
         f"{', '.join(sorted(bench_scale.SKIP))} skipped, its annotation is broken): "
         f"**{good} of {len(rows)} maps ({good / len(rows):.0%}) have a median keypoint "
         f"residual under {bench_scale.TARGET_PX:.0f} px** (target: "
