@@ -3,7 +3,6 @@ metres. Each default is defined here once; the command line reads it from here."
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field, fields, is_dataclass
 from typing import Any
 
@@ -132,7 +131,7 @@ class Settings:
 
     def to_dict(self) -> dict:
         """Every option as plain JSON types, one object per stage, in metres and degrees:
-        ``init`` as ``{"x_m", "y_m", "yaw_deg"}``, tuples as lists."""
+        ``init`` as ``{"x_m", "y_m", "yaw_deg", "scale"}``, tuples as lists."""
         return _plain(self)
 
     @classmethod
@@ -148,8 +147,7 @@ class Settings:
             map=source(doc["map"]), truth=source(doc["truth"]),
             raster=RasterConfig(**doc["raster"]),
             alignment=AlignmentConfig(**{
-                **a, "init": None if init is None else Similarity2D(
-                    init["x_m"], init["y_m"], math.radians(init["yaw_deg"])),
+                **a, "init": None if init is None else Similarity2D.from_dict(init),
                 "params": AlignParams(**{**a["params"], "scale_range": tuple(
                     a["params"]["scale_range"])})}),
             footprint=FootprintConfig(**doc["footprint"]),
@@ -162,7 +160,7 @@ class Settings:
 def _plain(value):
     """A settings value as plain JSON types (see :meth:`Settings.to_dict`)."""
     if isinstance(value, Similarity2D):
-        return {"x_m": value.tx, "y_m": value.ty, "yaw_deg": value.yaw_deg}
+        return value.to_dict()
     if is_dataclass(value):
         return {f.name: _plain(getattr(value, f.name)) for f in fields(value)}
     if isinstance(value, dict):

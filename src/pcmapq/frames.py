@@ -67,21 +67,19 @@ class Frames:
         return self.planar.compose(Similarity2D.from_matrix(self.registration_3d))
 
     def to_dict(self) -> dict:
-        tf = self.planar
         return {"convention": CONVENTION,
                 "map_levelling": None if self.map_levelling is None
                 else self.map_levelling.to_dict(),
                 "registration_3d": None if self.registration_3d is None
                 else np.asarray(self.registration_3d).tolist(),
-                "planar": {"x_m": tf.tx, "y_m": tf.ty, "yaw_deg": tf.yaw_deg, "scale": tf.scale},
+                "planar": self.planar.to_dict(),
                 "truth_levelling": None if self.truth_levelling is None
                 else self.truth_levelling.to_dict()}
 
     @classmethod
     def from_dict(cls, doc: dict) -> Frames:
-        p = doc["planar"]
         reg = doc["registration_3d"]
-        return cls(Similarity2D(p["x_m"], p["y_m"], float(np.radians(p["yaw_deg"])), p["scale"]),
+        return cls(Similarity2D.from_dict(doc["planar"]),
                    Levelling.from_dict(doc["map_levelling"]),
                    Levelling.from_dict(doc["truth_levelling"]),
                    None if reg is None else np.asarray(reg, dtype=np.float64))

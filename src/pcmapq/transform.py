@@ -48,6 +48,15 @@ class Similarity2D:
         """The transform that applies ``first``, then ``self``."""
         return Similarity2D.from_matrix(self.matrix @ first.matrix)
 
+    def to_dict(self) -> dict[str, float]:
+        """``{"x_m", "y_m", "yaw_deg", "scale"}``: the form every saved transform takes."""
+        return {"x_m": self.tx, "y_m": self.ty, "yaw_deg": self.yaw_deg, "scale": self.scale}
+
+    @classmethod
+    def from_dict(cls, doc: dict) -> Similarity2D:
+        """The inverse of :meth:`to_dict`."""
+        return cls(doc["x_m"], doc["y_m"], float(np.radians(doc["yaw_deg"])), doc["scale"])
+
     @property
     def yaw_deg(self) -> float:
         """Yaw in degrees, wrapped to (-180, 180]."""
