@@ -62,6 +62,16 @@ def building_plan(seed: int = 0, width: float = 24.0, height: float = 16.0) -> n
     return np.asarray(walls, dtype=np.float64)
 
 
+def campus(columns: int, rows: int, seed: int = 0, gap: float = 4.0) -> np.ndarray:
+    """A campus: ``columns`` x ``rows`` copies of :func:`building_plan` (24 x 16 m) on a lattice
+    with ``gap`` metres between them, lower-left corner at (0, 0). A large map of repeated
+    structure: only the campus's outline tells one copy from the next. (N, 4) metres."""
+    one = building_plan(seed)
+    i, j = np.meshgrid(np.arange(columns), np.arange(rows), indexing="ij")
+    shifts = np.column_stack([i.ravel() * (24.0 + gap), j.ravel() * (16.0 + gap)])
+    return (one[None, :, :] + np.tile(shifts, 2)[:, None, :]).reshape(-1, 4)
+
+
 def transform_segments(segments: np.ndarray, tf: Similarity2D) -> np.ndarray:
     """Apply a similarity to both endpoints of every segment."""
     return tf.apply(segments.reshape(-1, 2)).reshape(-1, 4)
