@@ -45,13 +45,16 @@ class Search:
     poses: (K, 4) rows (score, yaw rad, x, y) of the per-yaw peaks (rigid search), or (K, 5)
     with a fifth column, the log of the scale (similarity search); sorted by score, descending.
     x, y: where the map's centroid lands, truth units. centre: the map's centroid, map frame;
-    radius: the map's largest distance from it, map units.
+    radius: the map's largest distance from it, map units. cell: the raster cell, truth units;
+    yaw_step: the yaw step, radians (rigid search).
     """
 
     candidates: list[Candidate]
     poses: np.ndarray
     centre: np.ndarray
     radius: float
+    cell: float = 0.0
+    yaw_step: float = 0.0
 
 
 #: Poses within these of the final one are "near" it (see :func:`distinctiveness`): yaw,
@@ -182,7 +185,7 @@ def coarse_search(map_xy: np.ndarray, truth_xy: np.ndarray, *,
     poses = poses[np.argsort(-poses[:, 0], kind="stable")]
     best = _suppress(poses, top_k, np.radians(3 * angle_step_deg), 4 * resolution)
     return Search([Candidate(_pose(yaw, xy, centre), float(score)) for score, yaw, *xy in best],
-                  poses, centre, radius)
+                  poses, centre, radius, resolution, float(np.radians(angle_step_deg)))
 
 
 def _pose(yaw: float, centre_truth: np.ndarray, centre_map: np.ndarray,
@@ -272,4 +275,4 @@ def similarity_search(map_xy: np.ndarray, truth_xy: np.ndarray, *,
     poses = poses[np.argsort(-poses[:, 0], kind="stable")]
     best = _suppress(poses, top_k, np.radians(9.0), 4 * resolution, np.log(1.15))
     return Search([Candidate(_pose(yaw, xy, centre, float(np.exp(log_s))), float(score))
-                   for score, yaw, *xy, log_s in best], poses, centre, map_radius)
+                   for score, yaw, *xy, log_s in best], poses, centre, map_radius, resolution)

@@ -26,9 +26,14 @@ from pcmapq.align.coarse import (
 from pcmapq.align.params import AlignParams
 from pcmapq.align.point_to_line import LineTarget, refine_point_to_line
 from pcmapq.align.point_to_point import DEFAULT_SCHEDULE, IcpTarget, refine_point_to_point
+from pcmapq.align.pyramid import descend
 from pcmapq.align.similarity_icp import SimilarityTarget, refine_similarity, similarity_schedule
 from pcmapq.transform import Similarity2D
 from pcmapq.voxels import voxel_centroids
+
+#: The truth keeps this many times the map's ``max_points``: a sparse target would put map points
+#: on its walls farther than the tolerance from its nearest point.
+TRUTH_POINTS = 10
 
 #: One refinement: a map -> truth transform in, the refined one out.
 Refine = Callable[[Similarity2D], Similarity2D]
@@ -101,8 +106,8 @@ def _align_rigid(map_xy: np.ndarray, truth_xy: np.ndarray, params: AlignParams,
     Open3D point-to-point ICP stages (:data:`~pcmapq.align.point_to_point.DEFAULT_SCHEDULE`,
     the first widened to twice the search's cell), then point-to-line on the winner."""
     voxel, tolerance = params.voxel, params.tolerance
-    map_ds = voxel_centroids(map_xy, voxel)
-    truth_ds = voxel_centroids(truth_xy, voxel)
+    map_ds = _thinned(map_xy, voxel, params.max_points)
+    truth_ds = _thinned(truth_xy, voxel, TRUTH_POINTS * params.max_points)
     start = Similarity2D() if init is None else init
     if len(map_ds) == 0 or len(truth_ds) == 0:
         return Alignment(start, 0.0, 0.0, tolerance, "none")
@@ -118,7 +123,10 @@ def _align_rigid(map_xy: np.ndarray, truth_xy: np.ndarray, params: AlignParams,
     if init is None:
         resolution = auto_resolution(map_ds) if params.resolution is None else params.resolution
         search = coarse_search(map_ds, truth_ds, resolution=resolution, top_k=params.top_k)
-        first_dist = max(first_dist, 2 * resolution)
+        if search.cell > params.finest:
+            search = descend(search, map_ds, truth_ds, finest=params.finest, beam=params.beam,
+                             top_k=params.top_k)
+        first_dist = max(first_dist, 2 * search.cell)
     rough = IcpTarget(truth_ds, ((first_dist, first_voxel),))
     fine = IcpTarget(truth_ds, tuple(fine_stages))
     best = refine_best(_starts(search, start), lambda tf: refine_point_to_point(map_ds, rough, tf),
@@ -208,6 +216,15 @@ def _scored(map_xy: np.ndarray, tree: cKDTree, tf: Similarity2D, tolerance: floa
     """``tf`` scored on the map (N, 2, map frame) against the truth tree; method unset."""
     fitness, rmse = _score_tree(map_xy, tree, tf, tolerance)
     return Alignment(tf, fitness, rmse, tolerance, "")
+
+
+def _thinned(xy: np.ndarray, voxel: float, max_points: int) -> np.ndarray:
+    """Voxel centroids of ``xy`` (N, 2, metres) at ``voxel`` metres; when more than
+    ``max_points``, at the voxel grown by the ratio (about ``max_points`` remain on walls)."""
+    ds = voxel_centroids(xy, voxel)
+    if len(ds) <= max_points:
+        return ds
+    return voxel_centroids(xy, voxel * len(ds) / max_points)
 
 
 def _map_at_scale(map_xy: np.ndarray, tf: Similarity2D, voxel: float) -> np.ndarray:

@@ -22,10 +22,17 @@ thin one has none). So the detectors never see the cells as drawn. They see the 
    Euclidean distance transform) and area-averaged onto the working grid.
 
 What the detectors see then depends on where the walls are, not on how many cells paint them.
+
+A large raster is drawn tile by tile (:data:`TILE` working cells a side, each with a halo of
+:data:`HALO` metres that is drawn and dropped), on as many threads as there are cores (at most
+4): every step looks no farther than the halo, so the tiles join into the image the whole raster
+would give, in a bounded memory.
 """
 
 from __future__ import annotations
 
+import os
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import cv2
@@ -35,6 +42,12 @@ from skimage.morphology import skeletonize
 
 from pcmapq.grid import MetricGrid
 from pcmapq.morphology import disc, distance_to
+
+#: Working cells a side of a tile of a large raster, and the halo drawn around each, metres:
+#: more than any step looks (a small object's 1 m, a spur's 0.25 m, the closing's 0.1 m).
+TILE, HALO = 2048, 4.0
+#: Threads drawing tiles, at most.
+THREADS = 4
 
 #: 8-neighbourhood of a pixel (the centre excluded).
 _NEIGHBOURS = np.array([[1, 1, 1], [1, 0, 1], [1, 1, 1]], dtype=np.float32)
@@ -162,7 +175,7 @@ class WallImage:
 
 def wall_image(occupied: np.ndarray, grid: MetricGrid, resolution: float = 0.05,
                closing: float = 0.1, width: float = 0.15, spur: float = 0.25,
-               small: float = 1.0) -> WallImage:
+               small: float = 1.0, tile: int = TILE) -> WallImage:
     """The walls as the detectors see them: their centre lines drawn ``width`` metres wide.
 
     Parameters
@@ -177,15 +190,59 @@ def wall_image(occupied: np.ndarray, grid: MetricGrid, resolution: float = 0.05,
     small : an object at most this wide and high, metres (a pillar, a box), is drawn as its
         core instead, ``width`` across: a ring of thin walls and a solid block of thick ones
         are the same object.
+    tile : working cells a side of the tiles a raster larger than that is drawn in, when the
+        working cell is a whole number of raster cells (otherwise drawn whole).
 
     Returns
     -------
     The :class:`WallImage` on a grid of ``resolution`` metres.
     """
+    k = int(round(resolution / grid.resolution))
+    if k < 1 or abs(resolution - k * grid.resolution) > 1e-9 * resolution or \
+            max(grid.shape) <= tile * k:
+        return WallImage(_band(occupied, grid, resolution, closing, width, spur, small),
+                         grid.resampled(resolution))
+    return _tiled(occupied, grid, resolution, k, tile,
+                  lambda crop, sub: _band(crop, sub, resolution, closing, width, spur, small))
+
+
+def _tiled(occupied: np.ndarray, grid: MetricGrid, resolution: float, k: int, tile: int,
+           band) -> WallImage:
+    """:func:`wall_image` tile by tile: ``band(crop, crop_grid)`` draws one haloed crop; the
+    working cell is ``k`` raster cells. Rows are counted from the bottom here, where the working
+    grid is anchored (the grid's origin is the image's lower-left corner)."""
+    rows, cols = occupied.shape
+    work = grid.resampled(resolution)
+    halo = k * int(np.ceil(HALO / resolution))
+    step = tile * k
+    below = occupied[::-1]  # row 0 at the bottom
+    out = np.zeros(work.shape, np.float32)[::-1]
+
+    def draw(p: int, c: int) -> None:
+        lo, hi = max(0, p - halo), min(rows, p + step + halo)
+        left, right = max(0, c - halo), min(cols, c + step + halo)
+        corner = grid.pixels_to_xy(np.array([[left - 0.5, rows - lo - 0.5]]))[0]
+        sub = MetricGrid(grid.resolution, (float(corner[0]), float(corner[1]), grid.origin[2]),
+                         (hi - lo, right - left))
+        got = band(np.ascontiguousarray(below[lo:hi, left:right][::-1]), sub)[::-1]
+        top, end = -(-min(rows, p + step) // k), -(-min(cols, c + step) // k)
+        out[p // k:top, c // k:end] = got[(p - lo) // k:(p - lo) // k + top - p // k,
+                                          (c - left) // k:(c - left) // k + end - c // k]
+
+    starts = [(p, c) for p in range(0, rows, step) for c in range(0, cols, step)]
+    with ThreadPoolExecutor(min(THREADS, os.cpu_count() or 1)) as pool:
+        list(pool.map(lambda pc: draw(*pc), starts))
+    return WallImage(np.ascontiguousarray(out[::-1]), work)
+
+
+def _band(occupied: np.ndarray, grid: MetricGrid, resolution: float, closing: float,
+          width: float, spur: float, small: float) -> np.ndarray:
+    """:func:`wall_image`'s image for the whole raster: (rows, cols) float32 on
+    ``grid.resampled(resolution)``."""
     fine_res = 0.5 * resolution
     line, core, fine = centreline(occupied, grid, fine_res, closing, spur, small, width)
     band = core.astype(np.float32)
     if line.any():
         dist = distance_to(line)
         band = np.maximum(band, np.clip(0.5 + (0.5 * width / fine_res - dist), 0.0, 1.0))
-    return WallImage(*resample(band, fine, resolution))
+    return resample(band, fine, resolution)[0]
