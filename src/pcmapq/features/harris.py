@@ -14,7 +14,6 @@ from dataclasses import dataclass
 
 import cv2
 import numpy as np
-from scipy import ndimage
 
 from pcmapq.features.base import (
     Candidates,
@@ -82,10 +81,8 @@ def peaks(resp: np.ndarray, radius_px: float, floor: float) -> tuple[np.ndarray,
     Returns sub-pixel (N, 2) pixel coordinates (u, v) and the (N,) peak values.
     """
     padded = np.pad(resp, 1, mode="edge")
-    is_max = (resp >= floor) & (
-        ndimage.maximum_filter(resp, footprint=disk(radius_px).astype(bool), mode="nearest")
-        <= resp
-    )
+    # OpenCV's dilation ignores pixels beyond the border, as repeating the border would
+    is_max = (resp >= floor) & (cv2.dilate(resp, disk(radius_px)) <= resp)
     v, u = np.nonzero(is_max)
     c = resp[v, u]
     # a parabola through the 3 values along each axis (padded indices are +1)

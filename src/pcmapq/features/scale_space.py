@@ -13,7 +13,6 @@ from dataclasses import dataclass, fields
 
 import cv2
 import numpy as np
-from scipy import ndimage
 
 #: Samples this close to the image border are not searched for extrema (as in cv2.SIFT).
 BORDER = 5
@@ -100,12 +99,30 @@ def extrema(pyramid: list[np.ndarray], sigma: float, floor: float) -> Extrema:
                       for f in fields(Extrema)})
 
 
+def _peaks(dog: np.ndarray, floor: float) -> np.ndarray:
+    """(layers, rows, cols) bool: samples of layers 1 to n - 2 of the DoG stack that equal the
+    maximum (at least ``floor``) or the minimum (at most ``-floor``) of their 3 x 3 x 3
+    neighbourhood. Each layer's 3 x 3 maximum and minimum (OpenCV, which ignores samples beyond
+    the border, as repeating the border would) is computed once and kept for three layers."""
+    square = np.ones((3, 3), np.uint8)
+    peak = np.zeros(dog.shape, dtype=bool)
+    high = [cv2.dilate(layer, square) for layer in dog[:2]]
+    low = [cv2.erode(layer, square) for layer in dog[:2]]
+    for i in range(1, dog.shape[0] - 1):
+        high.append(cv2.dilate(dog[i + 1], square))
+        low.append(cv2.erode(dog[i + 1], square))
+        top = np.maximum(np.maximum(high[0], high[1]), high[2])
+        bottom = np.minimum(np.minimum(low[0], low[1]), low[2])
+        peak[i] = (((dog[i] >= floor) & (dog[i] == top))
+                   | ((dog[i] <= -floor) & (dog[i] == bottom)))
+        del high[0], low[0]
+    return peak
+
+
 def _octave_extrema(dog: np.ndarray, octave: int, sigma: float, floor: float) -> Extrema:
     """:func:`extrema` in one octave's DoG stack (layers + 3, rows, cols)."""
     layers = dog.shape[0] - 3
-    peak = (((dog >= floor) & (dog == ndimage.maximum_filter(dog, size=3, mode="nearest")))
-            | ((dog <= -floor) & (dog == ndimage.minimum_filter(dog, size=3, mode="nearest"))))
-    peak[[0, -1]] = False
+    peak = _peaks(dog, floor)
     peak[:, :BORDER], peak[:, peak.shape[1] - BORDER :] = False, False
     peak[:, :, :BORDER], peak[:, :, peak.shape[2] - BORDER :] = False, False
     lay, r, c = np.nonzero(peak)

@@ -61,6 +61,39 @@ def _grow(t: np.ndarray, fits: np.ndarray, group: np.ndarray, max_gap: float,
         group = group | near
 
 
+#: Tiles a side of the index of :func:`merge`'s segments.
+_TILES = 64
+
+
+class _Index:
+    """Segments (N, 4, metres) bucketed by the square tile holding their midpoint, so that
+    those near a line are found without testing them all."""
+
+    def __init__(self, seg: np.ndarray) -> None:
+        mid = 0.5 * (seg[:, :2] + seg[:, 2:])
+        lo = mid.min(axis=0)
+        self.size = max(float(np.ptp(mid, axis=0).max()) / _TILES, 1e-9)
+        cell = np.floor((mid - lo) / self.size).astype(np.int64)
+        shape = cell.max(axis=0) + 1
+        tile = cell[:, 0] * shape[1] + cell[:, 1]
+        self.order = np.argsort(tile, kind="stable")
+        counts = np.bincount(tile, minlength=int(np.prod(shape)))
+        self.filled = np.flatnonzero(counts)
+        self.counts = counts[self.filled]
+        self.starts = (np.cumsum(counts) - counts)[self.filled]
+        ix, iy = np.divmod(self.filled, shape[1])
+        self.centres = lo + (np.column_stack([ix, iy]) + 0.5) * self.size
+
+    def near_line(self, point: np.ndarray, normal: np.ndarray, width: float) -> np.ndarray:
+        """Sorted indices of every segment whose midpoint may lie within ``width`` metres of
+        the line through ``point`` with unit ``normal`` (and of some beyond it)."""
+        reach = width + self.size / np.sqrt(2.0)  # a midpoint is this near its tile's centre
+        hit = np.abs((self.centres - point) @ normal) <= reach
+        starts, counts = self.starts[hit], self.counts[hit]
+        first = np.repeat(starts - (np.cumsum(counts) - counts), counts)
+        return np.sort(self.order[first + np.arange(counts.sum())])
+
+
 def merge(seg: np.ndarray, max_angle: float, max_offset: float, max_gap: float,
           solid: Callable[[np.ndarray], np.ndarray] | None = None,
           max_bridge: float = 0.0) -> np.ndarray:
@@ -97,15 +130,19 @@ def merge(seg: np.ndarray, max_angle: float, max_offset: float, max_gap: float,
     cos_near = np.cos(np.radians(min(2 * max_angle, 90.0)))
     steps = np.linspace(0.0, 1.0, _BRIDGE_SAMPLES)
     left = np.ones(len(seg), dtype=bool)
+    index = _Index(seg) if len(seg) else None
     out = []
     for seed in np.lexsort((seg[:, 1], seg[:, 0], -length)):  # longest first
         if not left[seed]:
             continue
         # the group's line stays near its seed's: only fragments within twice the angle and
-        # offset of the seed's line can join (this keeps the loop cheap on large maps)
+        # offset of the seed's line can join (this keeps the loop cheap on large maps); the
+        # index hands over those whose midpoints may be that near (both ends being so)
         u = d[seed]
-        off = np.abs((ends - ends[seed, 0]) @ np.array([-u[1], u[0]])).max(axis=1)
-        near = np.flatnonzero(left & (np.abs(d @ u) >= cos_near) & (off <= 2 * max_offset))
+        normal = np.array([-u[1], u[0]])
+        near = index.near_line(ends[seed, 0], normal, 2 * max_offset)
+        off = np.abs((ends[near] - ends[seed, 0]) @ normal).max(axis=1)
+        near = near[left[near] & (np.abs(d[near] @ u) >= cos_near) & (off <= 2 * max_offset)]
         e, dn, ln = ends[near], d[near], length[near]
         group = near == seed
         for _ in range(_REFITS):
