@@ -84,3 +84,18 @@ def test_tiles_join_into_the_whole_image(resolution):
     assert tiled.grid == whole.grid
     assert (whole.image > 0).sum() > 10_000
     np.testing.assert_array_equal(tiled.image, whole.image)
+
+
+def test_ridges_by_strips_equal_the_whole():
+    """Hough's ridge lines computed strip by strip (each with its halo) equal the whole
+    image's, mask and direction, cell for cell."""
+    from pcmapq.features.base import by_strips
+    from pcmapq.features.ridges import ridges
+
+    grid = synth.plan_grid(synth.campus(2, 2), 0.05)
+    walls = wall_image(synth.render(synth.campus(2, 2), grid) == synth.OCCUPIED, grid)
+    whole = ridges(walls.image, 2.0, 0.1)
+    strips = by_strips(walls.image, 10, lambda s: ridges(s, 2.0, 0.1), rows=64)
+    assert whole[0].sum() > 5000
+    for a, b in zip(whole, strips, strict=True):
+        np.testing.assert_array_equal(a, b)

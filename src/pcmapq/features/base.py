@@ -129,6 +129,29 @@ def gaussian(image: np.ndarray, sigma_px: float) -> np.ndarray:
     return cv2.GaussianBlur(image, (k, k), sigma_px, borderType=cv2.BORDER_REFLECT)
 
 
+#: Rows of a strip of :func:`by_strips`.
+STRIP = 1024
+
+
+def by_strips(image: np.ndarray, halo: int, fn: Callable[[np.ndarray], tuple[np.ndarray, ...]],
+              rows: int = STRIP) -> tuple[np.ndarray, ...]:
+    """``fn(image)`` computed on strips of ``rows`` rows, each with ``halo`` rows of the image
+    above and below it, and joined: the same arrays, cell for cell, when ``fn`` looks no
+    farther than ``halo`` rows (reflected borders stay the image's own), in the memory of one
+    strip. ``fn`` returns arrays of the strip's shape."""
+    if image.shape[0] <= rows + 2 * halo:
+        return fn(image)
+    out: tuple[np.ndarray, ...] = ()
+    for top in range(0, image.shape[0], rows):
+        lo, hi = max(0, top - halo), min(image.shape[0], top + rows + halo)
+        got = fn(image[lo:hi])
+        if not out:
+            out = tuple(np.empty(image.shape, a.dtype) for a in got)
+        for whole, part in zip(out, got, strict=True):
+            whole[top:top + rows] = part[top - lo:top - lo + min(rows, image.shape[0] - top)]
+    return out
+
+
 def suppress(xy: np.ndarray, strength: np.ndarray, radius: float) -> np.ndarray:
     """Non-maximum suppression of points: keep a point (N, 2, metres) unless a stronger one
     lies within ``radius`` metres (ties: the later one in canonical order is dropped).

@@ -46,6 +46,7 @@ from pcmapq.features.base import (
     Candidates,
     Detector,
     Features,
+    by_strips,
     empty_features,
     gaussian,
     no_candidates,
@@ -99,8 +100,11 @@ def detect(walls: WallImage, params: Params) -> Features:
     lengths, metres."""
     p, image, work = params, walls.image, walls.grid
     resolution = work.resolution
-    mask, direction = ridges(image, p.sigma / resolution, p.ridge)
-    smooth = gaussian(image, p.sigma / resolution)
+    sigma_px = p.sigma / resolution
+    # the blur reaches 4 sigma, its derivatives one pixel more
+    mask, direction = by_strips(image, int(np.ceil(4 * sigma_px)) + 2,
+                                lambda strip: ridges(strip, sigma_px, p.ridge))
+    smooth = gaussian(image, sigma_px)
     shortest = p.support * p.min_length
     px = pieces(mask, direction)
     _, size = directions(px)

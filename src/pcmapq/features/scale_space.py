@@ -9,6 +9,7 @@ and scale (see :mod:`pcmapq.features.sift` for why ``cv2.SIFT``'s own detection 
 
 from __future__ import annotations
 
+from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, fields
 
 import cv2
@@ -58,45 +59,51 @@ def octave_count(shape: tuple[int, int], sigma: float, layers: int, largest: flo
 
 
 def gaussian_pyramid(image: np.ndarray, sigma: float, layers: int,
-                     octaves: int) -> list[np.ndarray]:
-    """SIFT's Gaussian scale space of ``image``: per octave a stack (layers + 4, rows, cols)
-    float32 of blurs ``sigma 2^(i / layers)`` pixels of the octave, each octave starting from
-    the previous one's layer ``layers``, halved. ``cv2.SIFT`` has one layer fewer; the extra one
-    makes consecutive octaves share a DoG layer where extrema are searched, so an extremum at an
-    octave's scale limit is not lost between two octaves sampled differently. Stops early when
-    an octave has no sample left to search."""
+                     octaves: int) -> Iterator[np.ndarray]:
+    """SIFT's Gaussian scale space of ``image``, octave by octave: per octave a stack
+    (layers + 4, rows, cols) float32 of blurs ``sigma 2^(i / layers)`` pixels of the octave,
+    each octave starting from the previous one's layer ``layers``, halved (taken before the
+    stack is handed over: the consumer may overwrite it). ``cv2.SIFT`` has one layer fewer; the
+    extra one makes consecutive octaves share a DoG layer where extrema are searched, so an
+    extremum at an octave's scale limit is not lost between two octaves sampled differently.
+    Stops early when an octave has no sample left to search."""
     k = 2.0 ** (1.0 / layers)
     step = [np.sqrt(max(sigma * sigma - 0.25, 0.01))]  # the input counts as blurred by 0.5 px
     step += [sigma * k ** (i - 1) * np.sqrt(k * k - 1.0) for i in range(1, layers + 4)]
-    pyramid: list[np.ndarray] = []
+    current = image.astype(np.float32)
     for o in range(octaves):
-        if o == 0:
-            current = image.astype(np.float32)
-        else:
-            prev = pyramid[-1][layers]
-            current = np.ascontiguousarray(prev[: prev.shape[0] // 2 * 2 : 2,
-                                                : prev.shape[1] // 2 * 2 : 2])
-        stack = []
+        stack = np.empty((layers + 4, *current.shape), np.float32)
         for i in range(layers + 4):
             if i > 0 or o == 0:
                 current = cv2.GaussianBlur(current, (0, 0), step[i])
-            stack.append(current)
-        pyramid.append(np.stack(stack))
-        if min(current.shape) < 2 * BORDER + 3:
+            stack[i] = current
+        last = min(current.shape) < 2 * BORDER + 3
+        prev = stack[layers]
+        current = np.ascontiguousarray(prev[: prev.shape[0] // 2 * 2 : 2,
+                                            : prev.shape[1] // 2 * 2 : 2])
+        yield stack
+        if last:
             break
-    return pyramid
 
 
-def extrema(pyramid: list[np.ndarray], sigma: float, floor: float) -> Extrema:
+def extrema(pyramid: Iterable[np.ndarray], sigma: float, floor: float) -> Extrema:
     """Every DoG sample of :func:`gaussian_pyramid`'s ``pyramid`` that is an extremum of its 26
     neighbours with ``|DoG| >= floor``, in layers 1 to ``layers + 1`` of each octave, refined by
     one quadratic step clipped to half a sample in space and scale (a sample is an extremum's
     nearest one when the fit says more: the fit overshoots, and stepping to the next sample is
-    what loses keypoints). ``sigma``: the pyramid's base blur, pixels."""
-    found = [_octave_extrema(stack[1:] - stack[:-1], o, sigma, floor)
-             for o, stack in enumerate(pyramid)]
+    what loses keypoints). ``sigma``: the pyramid's base blur, pixels. Each octave's stack is
+    turned into its DoG in place, so one octave is held at a time."""
+    found = [_octave_extrema(_dog(stack), o, sigma, floor) for o, stack in enumerate(pyramid)]
     return Extrema(**{f.name: np.concatenate([getattr(e, f.name) for e in found])
                       for f in fields(Extrema)})
+
+
+def _dog(stack: np.ndarray) -> np.ndarray:
+    """The difference of consecutive layers of ``stack`` (n, rows, cols), written over its
+    first n - 1 layers (each layer is read before it is overwritten): a view of n - 1 layers."""
+    for i in range(len(stack) - 1):
+        np.subtract(stack[i + 1], stack[i], out=stack[i])
+    return stack[:-1]
 
 
 def _peaks(dog: np.ndarray, floor: float) -> np.ndarray:
