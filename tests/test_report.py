@@ -5,16 +5,28 @@ from __future__ import annotations
 import re
 import shutil
 import subprocess
+from dataclasses import replace
 
 import cv2
+import matplotlib
 import numpy as np
 import pytest
 
 from pcmapq import synth
 from pcmapq.config import MatchingConfig, Settings
+from pcmapq.grid import MetricGrid
 from pcmapq.pipeline import evaluate
 from pcmapq.report.html import report_html
-from pcmapq.report.plot import distance_heatmap, png_bytes, vectorial_figure
+from pcmapq.report.plot import (
+    DPI,
+    MAP_BLUE,
+    TRUTH_GREY,
+    distance_heatmap,
+    extent,
+    png_bytes,
+    vectorial_figure,
+    wall_distances,
+)
 
 from .conftest import write_image_map
 
@@ -95,3 +107,86 @@ def test_report_renders_in_chromium(moved_result, tmp_path):
     assert img is not None and img.shape[:2] == (2400, 1400)
     # the embedded figures rendered: many non-white, coloured pixels
     assert np.count_nonzero(img.min(axis=2) < 200) > 20000
+
+
+#: A grid ten times finer (0.005 m, 3610 x 5210 cells) over the moved result's extent, more
+#: cells than a panel has pixels: truth walls one cell thin at these x (vertical) and y
+#: (horizontal), metres; the map's one-cell walls MAP_SHIFT east of the vertical ones.
+FINE = 0.005
+TRUTH_X, TRUTH_Y, MAP_SHIFT = (3.0025, 9.0025, 15.0025), 12.0475, 0.3
+
+
+@pytest.fixture(scope="module")
+def fine_result(moved_result):
+    """The moved result with its rasters replaced by the one-cell walls above (footprint: all)."""
+    coarse = moved_result.grid
+    n = round(coarse.resolution / FINE)
+    grid = MetricGrid(FINE, coarse.origin, (coarse.shape[0] * n, coarse.shape[1] * n))
+    u_truth, v_truth = np.round(grid.xy_to_pixels([(x, TRUTH_Y) for x in TRUTH_X])).astype(int).T
+    u_map = np.round(grid.xy_to_pixels([(x + MAP_SHIFT, 0.0) for x in TRUTH_X])[:, 0]).astype(int)
+    truth, walls = np.zeros(grid.shape, bool), np.zeros(grid.shape, bool)
+    truth[:, u_truth] = True
+    truth[v_truth[0], :] = True
+    walls[:, u_map] = True
+    return replace(moved_result, grid=grid, truth_occupied=truth, map_occupied=walls,
+                   overlap=replace(moved_result.overlap, footprint=np.ones(grid.shape, bool)))
+
+
+def runs(line: np.ndarray, box: tuple[float, float, float, float], axis: int) -> list[float]:
+    """Centres, metres, of the runs of true pixels along a row (``axis`` 0: x) or column (1: y)
+    of the pixels that show the data ``box`` (x0, x1, y0, y1)."""
+    idx = np.flatnonzero(line)
+    groups = np.split(idx, np.flatnonzero(np.diff(idx) > 1) + 1) if len(idx) else []
+    lo, hi = (box[0], box[1]) if axis == 0 else (box[3], box[2])  # image rows run down
+    return [lo + (g.mean() + 0.5) / len(line) * (hi - lo) for g in groups]
+
+
+def coloured(img: np.ndarray, rgb: tuple[float, float, float]) -> np.ndarray:
+    """Pixels of the BGR ``img`` within 3 levels of the colour ``rgb`` (0-1 floats)."""
+    bgr = np.array(rgb[::-1]) * 255
+    return np.abs(img.astype(float) - bgr).max(axis=2) <= 3
+
+
+def test_large_grids_are_pooled_and_one_cell_walls_drawn_in_place(fine_result, moved_result):
+    """Every one-cell wall of a grid larger than the panel shows, where it stands in metres
+    (within one pooled cell and one pixel), and the pooled raster has no more cells than the
+    axes pixels; a grid that fits is drawn cell for cell."""
+    fig = vectorial_figure(fine_result)
+    ax = fig.axes[0]
+    box = extent(fine_result)
+    img = region(fig, ax, box)
+    shown = ax.images[0].get_array().shape[:2]
+    factor = -(-fine_result.grid.shape[1] // shown[1])
+    bb = ax.get_window_extent()
+    assert factor > 1 and shown == tuple(-(-np.array(fine_result.grid.shape) // factor))
+    assert shown[0] <= bb.height * DPI / fig.dpi and shown[1] <= bb.width * DPI / fig.dpi
+    tol = factor * FINE + (box[1] - box[0]) / img.shape[1]
+    grey, blue = coloured(img, TRUTH_GREY), coloured(img, MAP_BLUE)
+    np.testing.assert_allclose(runs(grey.mean(axis=0) > 0.5, box, 0), TRUTH_X, atol=tol)
+    np.testing.assert_allclose(runs(grey.mean(axis=1) > 0.5, box, 1), [TRUTH_Y], atol=tol)
+    np.testing.assert_allclose(runs(blue.mean(axis=0) > 0.5, box, 0),
+                               np.add(TRUTH_X, MAP_SHIFT), atol=tol)
+    small = vectorial_figure(moved_result)
+    assert small.axes[0].images[0].get_array().shape[:2] == moved_result.grid.shape
+
+
+def test_heatmap_of_a_large_grid_colours_each_wall_by_its_distance(fine_result):
+    """The map's walls, 0.3 m from the truth's, in viridis' colour of 0.3 m (of 0.5), where
+    they stand."""
+    fig = distance_heatmap(fine_result)
+    box = extent(fine_result)
+    img = region(fig, fig.axes[0], box)
+    at_shift = coloured(img, matplotlib.colormaps["viridis"](MAP_SHIFT / 0.5)[:3])
+    tol = 2 * (box[1] - box[0]) / img.shape[1]
+    np.testing.assert_allclose(runs(at_shift.mean(axis=0) > 0.5, box, 0),
+                               np.add(TRUTH_X, MAP_SHIFT), atol=tol)
+
+
+def test_wall_distances_keep_the_nearest_cell_of_each_block():
+    """Truth wall in column 0 of 0.01 m cells; map cells 3 and 7 cells from it in one 10 x 10
+    block, 12 cells in another: 0.03 m and 0.12 m, NaN where a block has no map cell."""
+    truth, walls = np.zeros((20, 20), bool), np.zeros((20, 20), bool)
+    truth[:, 0] = True
+    walls[2, 3] = walls[5, 7] = walls[15, 12] = True
+    np.testing.assert_allclose(wall_distances(truth, walls, 0.01, 10),
+                               [[0.03, np.nan], [np.nan, 0.12]], rtol=1e-6)
