@@ -179,3 +179,15 @@ def test_map_command_bad_input_exits_2(tmp_path):
     assert proc.returncode == 2 and "Traceback" not in proc.stderr
     lines = proc.stderr.strip().splitlines()
     assert len(lines) == 1 and "none" in lines[0], proc.stderr
+
+
+def test_memory_guard_stops_before_the_work(tmp_path):
+    """A run estimated past --max-memory stops with exit 2 and one line saying how much it needs
+    and what needs less; nothing is written."""
+    out = tmp_path / "r.json"
+    proc = run("eval", str(SAMPLE / "scan.ply"), str(SAMPLE / "truth.png"), "--max-memory",
+               "0.1", "--json", str(out))
+    assert proc.returncode == 2 and not out.exists()
+    line, = proc.stderr.strip().splitlines()
+    assert "needs about 0.4 GB of memory, more than the limit of 0.1 GB" in line
+    assert "--truth-resolution" in line and "Traceback" not in proc.stderr

@@ -200,6 +200,9 @@ def eval_command(
     full: Annotated[bool, typer.Option(
         "--full", help="Score against the whole truth, not only the part the map covers.")
     ] = False,
+    max_memory: Annotated[float | None, typer.Option(
+        help="Stop (exit 2) before a run estimated to need more than this many GB "
+        "(default: 75 % of this machine's memory).", min=0.0, show_default=False)] = None,
 ) -> None:
     """Align MAP to TRUTH, then score it with Harris, Hough and SIFT features."""
     if len(paths) != (1 if scans else 2):
@@ -230,7 +233,8 @@ def eval_command(
             progress("mapping the scans with KISS-ICP")
             points, _ = build_map_kiss(scans, max_scans=max_scans)
             map_path = PointMap(scans, points, True, kind="scans")
-        result = replace(evaluate(map_path, truth_path, settings, progress),
+        limit = None if max_memory is None else int(max_memory * 1e9)
+        result = replace(evaluate(map_path, truth_path, settings, progress, limit),
                          command=options.command_line(ctx))
         progress("writing outputs")
         if json_path == "-":

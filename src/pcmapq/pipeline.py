@@ -8,6 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
+from pcmapq import memory
 from pcmapq.align import Alignment, align
 from pcmapq.align.rigid3d import Registration3D, align_3d, apply
 from pcmapq.config import Settings
@@ -195,9 +196,11 @@ def align_clouds_3d(source: OccupancyMap | PointMap, truth: OccupancyMap | Point
 
 
 def evaluate(map_path: str | Path | PointMap, truth_path: str | Path,
-             settings: Settings | None = None, progress: Progress = lambda step: None) -> Result:
+             settings: Settings | None = None, progress: Progress = lambda step: None,
+             memory_limit: int | None = None) -> Result:
     """Score the map at ``map_path`` (or a map already built, e.g. from scans) against the
-    truth at ``truth_path``."""
+    truth at ``truth_path``; stop (InputError) when the run would need more than
+    ``memory_limit`` bytes (None: :func:`pcmapq.memory.default_limit`)."""
     settings = Settings() if settings is None else settings
     progress("loading")
     truth = load_map(truth_path, settings.truth.resolution,
@@ -208,18 +211,37 @@ def evaluate(map_path: str | Path | PointMap, truth_path: str | Path,
     source = map_path if isinstance(map_path, PointMap) else load_map(
         map_path, settings.map.resolution, guess if settings.alignment.scale else None,
         settings.map.thresholds)
-    return score(source, truth, settings, progress)
+    return score(source, truth, settings, progress, memory_limit)
+
+
+def needed_memory(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap,
+                  truth_xy: np.ndarray, settings: Settings) -> int:
+    """Estimated peak memory, bytes, of scoring ``source`` against ``truth`` (whose plan points
+    are ``truth_xy``, metres): see :mod:`pcmapq.memory`."""
+    images = sum(int(np.prod(s.grid.shape)) for s in (source, truth)
+                 if isinstance(s, OccupancyMap))
+    points = sum(len(s.points) for s in (source, truth) if isinstance(s, PointMap))
+    if isinstance(truth, OccupancyMap):
+        grid = truth.grid
+    else:
+        grid = MetricGrid.covering(truth_xy, settings.truth.resolution
+                                   or settings.raster.cloud_resolution)
+    cells = int(np.prod(grid.shape))
+    return memory.needed_bytes(images, cells, cells * grid.resolution**2, points)
 
 
 def score(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap, settings: Settings,
-          progress: Progress = lambda step: None) -> Result:
-    """Score a loaded map against a loaded truth: align, raster, detect, match."""
+          progress: Progress = lambda step: None, memory_limit: int | None = None) -> Result:
+    """Score a loaded map against a loaded truth: align, raster, detect, match; stop first
+    (InputError) when that would need more than ``memory_limit`` bytes (None: the default)."""
     map_path, truth_path = source.path, truth.path
     rule = map_footprint_rule(source, settings)
+    truth_xy, truth_level = plan_points(truth, settings)
+    memory.guard(needed_memory(source, truth, truth_xy, settings), memory_limit,
+                 f"{map_path} against {truth_path}")
     progress("aligning")
     source, registration = align_clouds_3d(source, truth, settings)
-    (map_xy, map_level), (truth_xy, truth_level) = (plan_points(source, settings),
-                                                    plan_points(truth, settings))
+    map_xy, map_level = plan_points(source, settings)
     option = settings.alignment
     if registration is None:
         alignment = align(map_xy, truth_xy, option.params, init=option.init,
