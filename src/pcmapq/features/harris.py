@@ -19,6 +19,7 @@ from pcmapq.features.base import (
     Candidates,
     Detector,
     Features,
+    by_strips,
     disk,
     gaussian,
     point_candidates,
@@ -98,7 +99,11 @@ def detect(walls: WallImage, params: Params) -> Features:
     :func:`pcmapq.features.walls.wall_image`), in the metric frame of its grid; ``strength`` is
     the response."""
     work = walls.grid
-    resp = response(walls.image, work.resolution, params.sigma, params.integration, params.k)
+    # the blurs reach 4 sigma each, the derivatives one pixel more
+    reach = int(np.ceil(4 * params.sigma / work.resolution)) + int(
+        np.ceil(4 * params.integration / work.resolution)) + 2
+    resp, = by_strips(walls.image, reach, lambda strip: (response(
+        strip, work.resolution, params.sigma, params.integration, params.k),))
     uv, value = peaks(resp, params.radius / work.resolution, params.support * params.threshold)
     xy = work.pixels_to_xy(uv)
     keep = suppress(xy, value, params.radius)  # plateaus give equal neighbouring maxima
