@@ -81,17 +81,23 @@ def _band_by_chunks(points: np.ndarray, rotation: np.ndarray, low: float,
     peak = _floor_bin(bins, counts)
     # The floor lies in bins peak - 1 .. peak + 1; one bin more each side covers rounding.
     lo, hi = (peak - 2) * FLOOR_BIN + low, (peak + 3) * FLOOR_BIN + high
-    near, candidates = [], []
+    near, heights, plans = [], [], []  # per chunk: the floor bins' z; the candidates' z, x y
     for rows in _finite_chunks(points):
         z = _turned(rows, rotation[2])
         near.append(z[np.abs(np.floor(z / FLOOR_BIN).astype(np.int64) - peak) <= 1])
         keep = (z >= lo) & (z <= hi)
         kept = rows[keep]
-        candidates.append((z[keep], np.column_stack([_turned(kept, rotation[0]),
-                                                     _turned(kept, rotation[1])])))
+        heights.append(z[keep])
+        plans.append(np.column_stack([_turned(kept, rotation[0]), _turned(kept, rotation[1])]))
     floor = float(np.median(np.concatenate(near)))
-    band = [xy[(z - floor >= low) & (z - floor <= high)] for z, xy in candidates]
-    return floor, np.concatenate(band)
+    inside = [(z - floor >= low) & (z - floor <= high) for z in heights]
+    band = np.empty((sum(int(np.count_nonzero(keep)) for keep in inside), 2))
+    start = 0
+    for keep in inside:
+        xy = plans.pop(0)[keep]  # each chunk's candidates freed once copied
+        band[start:start + len(xy)] = xy
+        start += len(xy)
+    return floor, band
 
 
 def _finite_chunks(points: np.ndarray) -> Iterator[np.ndarray]:
