@@ -43,8 +43,9 @@ def wall_band(points: np.ndarray, low: float = 0.3,
     points or the band is empty.
 
     Up to CHUNK points this is computed in one go. A larger cloud is read CHUNK rows at a time
-    (memory: the band and a few chunks, whatever its size): the levelling is found on every k-th
-    point (k = ceil(N / CHUNK)), the floor and the band from all points, in two passes.
+    (memory: a chunk, and about 2.5 times the band for the band and the points near it, however
+    large the cloud): the levelling is found on every k-th point (k = ceil(N / CHUNK)), the
+    floor and the band from all points, in two passes.
     """
     if not low < high:
         raise ValueError(f"wall band: low ({low} m) must be below high ({high} m)")
