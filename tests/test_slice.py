@@ -7,6 +7,7 @@ import pytest
 from scipy.spatial import cKDTree
 
 from pcmapq import synth
+from pcmapq.raster import slice as slice_module
 from pcmapq.raster.slice import floor_height, level_rotation, wall_band
 
 FLOOR_Z = 1.7
@@ -99,3 +100,52 @@ def test_empty_band_raises(cloud: np.ndarray) -> None:
         wall_band(np.full((5, 3), np.nan))
     with pytest.raises(ValueError, match=r"expected \(N, 3\) points"):
         wall_band(cloud[:, :2])
+
+
+# --- clouds larger than one chunk ---------------------------------------------------------------
+
+
+@pytest.fixture
+def small_chunks(monkeypatch: pytest.MonkeyPatch) -> int:
+    """wall_band works 50,000 points at a time (the building has about 440,000)."""
+    monkeypatch.setattr(slice_module, "CHUNK", 50_000)
+    return 50_000
+
+
+def test_chunked_floor_and_band_equal_the_one_shot_ones(tilted: np.ndarray,
+                                                        small_chunks: int) -> None:
+    """With the same levelling, the two passes over chunks give the floor and the band that the
+    whole levelled cloud gives."""
+    rotation = level_rotation(tilted)
+    levelled = tilted @ rotation.T
+    floor = floor_height(levelled)
+    z = levelled[:, 2] - floor
+    band = levelled[(z >= 0.3) & (z <= 2.0), :2]
+    got_floor, got_band = slice_module._band_by_chunks(tilted, rotation, 0.3, 2.0)
+    assert got_floor == pytest.approx(floor, abs=1e-12)
+    assert got_band.shape == band.shape
+    np.testing.assert_allclose(got_band, band, atol=1e-12)
+
+
+def test_chunked_wall_band_is_the_one_shot_band(tilted: np.ndarray, cloud: np.ndarray,
+                                                small_chunks: int) -> None:
+    """Levelled on every 9th point, in float32 with rows to skip, the band is the same walls:
+    the known tilt and floor, the same number of points to 0.5 %."""
+    whole, whole_levelling = wall_band(tilted)
+    noisy = tilted.astype(np.float32)
+    noisy[::1000, 1] = np.nan
+    band, levelling = wall_band(noisy)
+    assert levelling.tilt_deg == pytest.approx(TILT_DEG, abs=0.1)
+    assert levelling.floor_z_m == pytest.approx(FLOOR_Z, abs=0.02)
+    assert angle_deg(levelling.rotation @ whole_levelling.rotation.T) < 0.02
+    assert levelling.floor_z_m == pytest.approx(whole_levelling.floor_z_m, abs=0.003)
+    assert len(band) == pytest.approx(len(whole) * (1 - 1 / 1000), rel=0.005)
+    np.testing.assert_array_equal(wall_band(noisy)[0], band)  # deterministic
+
+
+def test_histogram_with_far_outliers() -> None:
+    """Heights kilometres apart are binned by sorting, not counted in one huge array."""
+    z = np.array([0.01, 0.02, 0.07, 5e4, -3e6])
+    bins, counts = slice_module._histogram(z)
+    np.testing.assert_array_equal(bins, [-60_000_000, 0, 1, 1_000_000])
+    np.testing.assert_array_equal(counts, [1, 2, 1, 1])

@@ -7,6 +7,11 @@ centroid of **every** point that ever fell in it (running sums and counts), so t
 not depend on when merges happen. Memory stays within about twice the final map plus one scan;
 the total merge cost is O(n log n) over the sequence. Deterministic: voxels come out sorted by
 their integer index (x, then y, then z).
+
+Points merged into an empty map whose bounding box holds few voxels for their number (a plan's
+walls at 0.05 m, a downsampled cloud) are grouped by counting on that box instead of sorting:
+the same voxels, the same order and the same sums (every voxel adds its points in their order),
+in linear time.
 """
 
 from __future__ import annotations
@@ -16,6 +21,11 @@ import numpy as np
 from pcmapq.errors import InputError
 
 __all__ = ["VoxelMap", "voxel_centroids"]
+
+#: Grouping by counting is used when the points' box holds at most this many voxels per point
+#: and at most DENSE_CELLS voxels (8 bytes of memory each).
+DENSE_PER_POINT = 4
+DENSE_CELLS = 1 << 27
 
 
 class VoxelMap:
@@ -61,7 +71,15 @@ class VoxelMap:
             return
         new = np.concatenate(self._buffer)
         self._buffer, self._buffered = [], 0
-        keys = np.concatenate([self._keys, voxel_keys(new, self.voxel)])
+        index = voxel_index(new, self.voxel)
+        dense = _dense_groups(index) if len(self._keys) == 0 else None
+        if dense is not None:
+            self._keys, inverse = dense
+            self._counts = np.bincount(inverse).astype(np.int64)
+            self._sums = np.column_stack([np.bincount(inverse, weights=new[:, axis])
+                                          for axis in range(new.shape[1])])
+            return
+        keys = np.concatenate([self._keys, _packed(index)])
         sums = np.concatenate([self._sums, new])
         counts = np.concatenate([self._counts, np.ones(len(new), dtype=np.int64)])
         self._keys, inverse = np.unique(keys, return_inverse=True)
@@ -76,16 +94,49 @@ def voxel_keys(points: np.ndarray, voxel: float) -> np.ndarray:
 
     Raises InputError when a point lies beyond +-2**(bits - 1) voxels of the origin.
     """
+    return _packed(voxel_index(points, voxel))
+
+
+def voxel_index(points: np.ndarray, voxel: float) -> np.ndarray:
+    """Each point's (N, d, metres) voxel index (N, d) int64, shifted by 2**(bits - 1) so that it
+    is in [0, 2**bits) (see :func:`voxel_keys`); InputError beyond."""
     bits = 63 // points.shape[1]
     offset = 1 << (bits - 1)
     index = np.floor(points / voxel).astype(np.int64) + offset
     if len(index) and (index.min() < 0 or index.max() >= (1 << bits)):
         raise InputError(f"map extends beyond +-{offset * voxel:.0f} m of its origin at voxel "
                          f"{voxel} m; use a larger voxel")
+    return index
+
+
+def _packed(index: np.ndarray) -> np.ndarray:
+    """:func:`voxel_index` (N, d) packed into one int64 key per point."""
+    bits = 63 // index.shape[1]
     keys = index[:, 0]
     for axis in range(1, index.shape[1]):
         keys = (keys << bits) | index[:, axis]
     return keys
+
+
+def _dense_groups(index: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+    """The sorted unique keys of voxel indices (N, d) and each point's position among them,
+    as ``np.unique(_packed(index), return_inverse=True)`` gives them, found by counting on the
+    indices' bounding box; None when that box is too large (DENSE_PER_POINT, DENSE_CELLS)."""
+    if len(index) == 0:
+        return None
+    lo = index.min(axis=0)
+    span = index.max(axis=0) - lo + 1
+    cells = int(np.prod(span.astype(object)))
+    if cells > min(DENSE_PER_POINT * len(index) + 4096, DENSE_CELLS):
+        return None
+    linear = index[:, 0] - lo[0]  # row-major in the box: sorts as the packed keys
+    for axis in range(1, index.shape[1]):
+        linear = linear * span[axis] + (index[:, axis] - lo[axis])
+    slots = np.bincount(linear, minlength=cells)  # points per cell, then each cell's rank
+    occupied = np.flatnonzero(slots)
+    slots[occupied] = np.arange(len(occupied))
+    keys = _packed(np.column_stack(np.unravel_index(occupied, tuple(span))) + lo)
+    return keys, slots[linear]
 
 
 def voxel_centroids(points: np.ndarray, voxel: float) -> np.ndarray:

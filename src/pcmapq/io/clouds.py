@@ -2,6 +2,12 @@
 
 Points are (N, 3) float64 metres in the file's own frame. Rows with a non-finite coordinate are
 dropped. A cloud whose z is constant (to 1e-6 m) is 2D: its z is set to 0.
+
+Binary PLY is read by :mod:`pcmapq.io.ply` (the values Open3D's reader gives, without its
+copies); a large one (more than ``MAP_POINTS`` vertices, 3D, every coordinate finite) is not
+read at all here but mapped: its points are a read-only array onto the file, in the file's own
+coordinate type, that the steps using them read chunk by chunk. ASCII PLY and PCD go through
+Open3D.
 """
 
 from __future__ import annotations
@@ -14,12 +20,15 @@ from pathlib import Path
 import numpy as np
 
 from pcmapq.errors import InputError
+from pcmapq.io.ply import CHUNK, VertexBlock, vertex_block
 from pcmapq.io.writers import one_line
 
 CLOUD_SUFFIXES = (".ply", ".pcd", ".xyz", ".txt", ".npy", ".bin")
 
 #: z range (metres) above which a cloud counts as 3D.
 FLAT_TOLERANCE = 1e-6
+#: A binary PLY with more vertices than this is mapped, not read (see the module's docstring).
+MAP_POINTS = CHUNK
 
 
 @dataclass(frozen=True)
@@ -27,7 +36,9 @@ class PointMap:
     """A point-cloud map.
 
     path: the file given.
-    points: (N, 3) float64 metres; z = 0 for 2D clouds.
+    points: (N, 3) float64 metres, every row finite; z = 0 for 2D clouds. For a large binary PLY
+        (see the module's docstring) a read-only (N, 3) float32 or float64 array mapped onto the
+        file: read it in chunks (``pcmapq.io.ply.CHUNK`` rows), never convert it whole.
     is_3d: False when z is constant (a 2D cloud).
     """
 
@@ -44,17 +55,42 @@ def load_cloud(path: Path) -> PointMap:
         ".npy": read_npy, ".bin": read_kitti_bin,
     }
     try:
-        raw = readers[path.suffix.lower()](path)
+        block = vertex_block(path) if path.suffix.lower() == ".ply" else None
+        if block is not None:
+            mapped = _mapped_3d(block) if block.count > MAP_POINTS else None
+            if mapped is not None:
+                return PointMap(path, mapped, True)
+            points = np.empty((block.count, 3), dtype=np.float64)
+            for start in range(0, block.count, CHUNK):
+                points[start:start + CHUNK] = block.read(start, start + CHUNK)
+        else:
+            points = with_z(path, readers[path.suffix.lower()](path))
     except OSError as exc:
         raise InputError(f"{path}: cannot read: {one_line(exc)}") from None
-    points = with_z(path, raw)
-    points = points[np.isfinite(points).all(axis=1)]
+    if not np.isfinite(points).all():
+        points = points[np.isfinite(points).all(axis=1)]
     if len(points) == 0:
         raise InputError(f"{path}: no points")
     is_3d = bool(np.ptp(points[:, 2]) > FLAT_TOLERANCE)
     if not is_3d:
         points[:, 2] = 0.0
     return PointMap(path, points, is_3d)
+
+
+def _mapped_3d(block: VertexBlock) -> np.ndarray | None:
+    """The block's x, y, z mapped onto the file (:meth:`VertexBlock.mapped`) when every
+    coordinate is finite and z is not constant; else None (the caller reads it). Reads the
+    file once, in chunks."""
+    mapped = block.mapped()
+    if mapped is None:
+        return None
+    z_lo, z_hi = np.inf, -np.inf
+    for start in range(0, len(mapped), CHUNK):
+        chunk = mapped[start:start + CHUNK]
+        if not np.isfinite(chunk).all():
+            return None
+        z_lo, z_hi = min(z_lo, float(chunk[:, 2].min())), max(z_hi, float(chunk[:, 2].max()))
+    return mapped if z_hi - z_lo > FLAT_TOLERANCE else None
 
 
 def with_z(path: Path, table: np.ndarray) -> np.ndarray:

@@ -1,0 +1,47 @@
+"""Voxel centroids: grouping by counting on the points' box gives exactly what sorting gives."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from pcmapq import voxels
+from pcmapq.voxels import VoxelMap, voxel_centroids, voxel_index, voxel_keys
+
+
+def by_sorting(points: np.ndarray, voxel: float) -> np.ndarray:
+    """Centroids the plain way: unique keys, then sums and counts per key."""
+    _, inverse = np.unique(voxel_keys(points, voxel), return_inverse=True)
+    sums = np.column_stack([np.bincount(inverse, weights=points[:, axis])
+                            for axis in range(points.shape[1])])
+    return sums / np.bincount(inverse)[:, None]
+
+
+@pytest.mark.parametrize("dims", [2, 3])
+def test_counting_gives_the_sorted_centroids_bit_for_bit(dims: int) -> None:
+    rng = np.random.default_rng(dims)
+    # a bent wall: negative coordinates, many points a voxel
+    t = rng.uniform(0, 1, 200_000)
+    points = np.column_stack([-3 + 5 * t, 0.3 * np.sin(9 * t), rng.uniform(0, 2.6, len(t))])
+    points = points[:, :dims] + rng.normal(0, 0.01, (len(t), dims))
+    assert voxels._dense_groups(voxel_index(points, 0.05)) is not None  # counted
+    np.testing.assert_array_equal(voxel_centroids(points, 0.05), by_sorting(points, 0.05))
+
+
+def test_sparse_points_are_sorted() -> None:
+    """Points far apart for their number: the box would be too large to count on."""
+    points = np.array([[0.0, 0.0, 0.0], [500.0, 1.0, 2.0], [0.01, 0.02, 0.0], [-300, 4, 1]])
+    assert voxels._dense_groups(voxel_index(points, 0.05)) is None
+    np.testing.assert_array_equal(voxel_centroids(points, 0.05),
+                                  [[-300, 4, 1], [0.005, 0.01, 0.0], [500, 1, 2]])
+
+
+def test_voxel_map_counts_its_first_merge_and_sorts_the_next() -> None:
+    rng = np.random.default_rng(0)
+    first, second = rng.uniform(0, 3, (5000, 3)), rng.uniform(1, 4, (5000, 3))
+    grid = VoxelMap(0.5, min_flush=100)
+    grid.add(first)
+    grid.add(second)
+    np.testing.assert_allclose(grid.points(), by_sorting(np.vstack([first, second]), 0.5),
+                               rtol=0, atol=1e-12)
+    assert len(grid) == len(by_sorting(np.vstack([first, second]), 0.5))
