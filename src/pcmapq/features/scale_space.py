@@ -109,20 +109,17 @@ def _dog(stack: np.ndarray) -> np.ndarray:
 def _peaks(dog: np.ndarray, floor: float) -> np.ndarray:
     """(layers, rows, cols) bool: samples of layers 1 to n - 2 of the DoG stack that equal the
     maximum (at least ``floor``) or the minimum (at most ``-floor``) of their 3 x 3 x 3
-    neighbourhood. Each layer's 3 x 3 maximum and minimum (OpenCV, which ignores samples beyond
-    the border, as repeating the border would) is computed once and kept for three layers."""
+    neighbourhood: the 3 x 3 dilation (erosion) of the largest (smallest) of three layers,
+    by OpenCV, which ignores samples beyond the border, as repeating the border would."""
     square = np.ones((3, 3), np.uint8)
     peak = np.zeros(dog.shape, dtype=bool)
-    high = [cv2.dilate(layer, square) for layer in dog[:2]]
-    low = [cv2.erode(layer, square) for layer in dog[:2]]
     for i in range(1, dog.shape[0] - 1):
-        high.append(cv2.dilate(dog[i + 1], square))
-        low.append(cv2.erode(dog[i + 1], square))
-        top = np.maximum(np.maximum(high[0], high[1]), high[2])
-        bottom = np.minimum(np.minimum(low[0], low[1]), low[2])
-        peak[i] = (((dog[i] >= floor) & (dog[i] == top))
-                   | ((dog[i] <= -floor) & (dog[i] == bottom)))
-        del high[0], low[0]
+        below, here, above = dog[i - 1], dog[i], dog[i + 1]
+        top = cv2.dilate(np.maximum(np.maximum(below, here), above), square)
+        peak[i] = (here >= floor) & (here == top)
+        del top
+        bottom = cv2.erode(np.minimum(np.minimum(below, here), above), square)
+        peak[i] |= (here <= -floor) & (here == bottom)
     return peak
 
 

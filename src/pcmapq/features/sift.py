@@ -114,9 +114,18 @@ def entropy(image: np.ndarray, window_px: float) -> np.ndarray:
     -------
     (rows, cols) float32 entropy in [0, 1] bits.
     """
-    p = np.clip(gaussian(image, window_px), 1e-7, 1 - 1e-7)
-    h = -p * np.log2(p) - (1 - p) * np.log2(1 - p)
-    return np.where((p <= 1e-7) | (p >= 1 - 1e-7), 0.0, h).astype(np.float32)
+    p = gaussian(image, window_px).astype(np.float32, copy=window_px <= 0)  # never the input
+    np.clip(p, 1e-7, 1 - 1e-7, out=p)
+    q = 1 - p
+    h = np.log2(p)
+    h *= p
+    rest = np.log2(q)
+    rest *= q
+    h += rest  # in place, one image at a time: -(p log p + q log q), as written out
+    np.negative(h, out=h)
+    del rest, q
+    h[(p <= 1e-7) | (p >= 1 - 1e-7)] = 0.0
+    return h
 
 
 def detect(walls: WallImage, params: Params) -> Features:
