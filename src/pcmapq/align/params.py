@@ -23,7 +23,8 @@ class AlignParams:
         ICP stages).
     finest: rigid search: a sweep coarser than this is refined through rasters of half the cell
         each down to at most this cell, metres (:func:`pcmapq.align.pyramid.descend`); maps up
-        to 40 m from their centroid are swept at this cell or finer and not refined.
+        to 80 m from their centroid are swept at this cell or finer and not refined (every
+        real map of docs/validation.md; a 400 m campus descends from 7 m to 1.75 m cells).
     beam: poses kept per level of that descent.
     top_k: candidate poses of the global search, each refined by a rough ICP stage.
     finalists: how many of those, by fitness, go through the fine stages and the point-to-line
@@ -36,7 +37,7 @@ class AlignParams:
     voxel: float = 0.05
     max_points: int = 200_000
     resolution: float | None = None
-    finest: float = 1.0
+    finest: float = 2.0
     beam: int = 48
     top_k: int = 6
     finalists: int | None = None
