@@ -189,5 +189,5 @@ def test_memory_guard_stops_before_the_work(tmp_path):
                "0.1", "--json", str(out))
     assert proc.returncode == 2 and not out.exists()
     line, = proc.stderr.strip().splitlines()
-    assert "needs about 0.4 GB of memory, more than the limit of 0.1 GB" in line
+    assert "needs about 0.5 GB of memory, more than the limit of 0.1 GB" in line
     assert "--truth-resolution" in line and "Traceback" not in proc.stderr

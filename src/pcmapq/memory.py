@@ -15,7 +15,7 @@ import os
 from pcmapq.errors import InputError
 
 #: Resident memory of the imported libraries, bytes.
-BASE = 400e6
+BASE = 450e6
 #: Bytes per input image cell, per truth grid cell, per working cell and per cloud point.
 PER_IMAGE_CELL, PER_GRID_CELL, PER_WORKING_CELL, PER_POINT = 10, 17, 75, 100
 #: The detectors' working cell, metres (:func:`pcmapq.features.walls.wall_image`).
