@@ -121,11 +121,16 @@ def disk(radius_px: float) -> np.ndarray:
     return (u * u + v * v <= radius_px * radius_px + 0.5).astype(np.uint8)
 
 
+def gaussian_reach(sigma_px: float) -> int:
+    """How many pixels away :func:`gaussian` looks: its kernel's half-width, 4 sigma."""
+    return int(np.ceil(4 * sigma_px))
+
+
 def gaussian(image: np.ndarray, sigma_px: float) -> np.ndarray:
     """Gaussian blur with ``sigma_px`` pixels, kernel to 4 sigma, reflected borders."""
     if sigma_px <= 0:
         return image
-    k = 2 * int(np.ceil(4 * sigma_px)) + 1
+    k = 2 * gaussian_reach(sigma_px) + 1
     return cv2.GaussianBlur(image, (k, k), sigma_px, borderType=cv2.BORDER_REFLECT)
 
 

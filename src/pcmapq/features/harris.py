@@ -22,6 +22,7 @@ from pcmapq.features.base import (
     by_strips,
     disk,
     gaussian,
+    gaussian_reach,
     point_candidates,
     sorted_features,
     suppress,
@@ -99,9 +100,9 @@ def detect(walls: WallImage, params: Params) -> Features:
     :func:`pcmapq.features.walls.wall_image`), in the metric frame of its grid; ``strength`` is
     the response."""
     work = walls.grid
-    # the blurs reach 4 sigma each, the derivatives one pixel more
-    reach = int(np.ceil(4 * params.sigma / work.resolution)) + int(
-        np.ceil(4 * params.integration / work.resolution)) + 2
+    # the two blurs' reaches, the derivatives' pixel and one more
+    reach = (gaussian_reach(params.sigma / work.resolution)
+             + gaussian_reach(params.integration / work.resolution) + 2)
     resp, = by_strips(walls.image, reach, lambda strip: (response(
         strip, work.resolution, params.sigma, params.integration, params.k),))
     uv, value = peaks(resp, params.radius / work.resolution, params.support * params.threshold)

@@ -49,6 +49,7 @@ from pcmapq.features.base import (
     by_strips,
     empty_features,
     gaussian,
+    gaussian_reach,
     no_candidates,
     sorted_features,
 )
@@ -101,8 +102,8 @@ def detect(walls: WallImage, params: Params) -> Features:
     p, image, work = params, walls.image, walls.grid
     resolution = work.resolution
     sigma_px = p.sigma / resolution
-    # the blur reaches 4 sigma, its derivatives one pixel more
-    mask, direction = by_strips(image, int(np.ceil(4 * sigma_px)) + 2,
+    # the blur's reach, its derivatives' pixel and one more
+    mask, direction = by_strips(image, gaussian_reach(sigma_px) + 2,
                                 lambda strip: ridges(strip, sigma_px, p.ridge))
     smooth = gaussian(image, sigma_px)
     shortest = p.support * p.min_length
