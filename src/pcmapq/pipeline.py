@@ -56,15 +56,23 @@ def min_hits(cloud: PointMap, settings: Settings) -> int:
     return 2 if cloud.is_3d else 1
 
 
+def truth_grid(truth: OccupancyMap | PointMap, truth_xy: np.ndarray,
+               settings: Settings) -> MetricGrid:
+    """The grid everything is drawn on: an image's own; for a cloud, an axis-aligned grid
+    around its plan points ``truth_xy`` at the truth's resolution (or the raster's
+    ``cloud_resolution``). Nothing is allocated."""
+    if isinstance(truth, OccupancyMap):
+        return truth.grid
+    return MetricGrid.covering(truth_xy,
+                               settings.truth.resolution or settings.raster.cloud_resolution)
+
+
 def truth_raster(truth: OccupancyMap | PointMap, truth_xy: np.ndarray,
                  settings: Settings) -> tuple[MetricGrid, np.ndarray]:
-    """The truth's grid and its occupied cells. An image keeps its own grid; a cloud gets an
-    axis-aligned grid around its points at the truth's resolution (or the raster's
-    ``cloud_resolution``)."""
+    """The truth's grid (:func:`truth_grid`) and its occupied cells."""
+    grid = truth_grid(truth, truth_xy, settings)
     if isinstance(truth, OccupancyMap):
-        return truth.grid, truth.state == OCCUPIED
-    grid = MetricGrid.covering(truth_xy,
-                               settings.truth.resolution or settings.raster.cloud_resolution)
+        return grid, truth.state == OCCUPIED
     return grid, points_to_grid(truth_xy, grid, min_hits(truth, settings))
 
 
@@ -221,11 +229,7 @@ def needed_memory(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMa
     images = sum(int(np.prod(s.grid.shape)) for s in (source, truth)
                  if isinstance(s, OccupancyMap))
     points = sum(len(s.points) for s in (source, truth) if isinstance(s, PointMap))
-    if isinstance(truth, OccupancyMap):
-        grid = truth.grid
-    else:
-        grid = MetricGrid.covering(truth_xy, settings.truth.resolution
-                                   or settings.raster.cloud_resolution)
+    grid = truth_grid(truth, truth_xy, settings)
     cells = int(np.prod(grid.shape))
     return memory.needed_bytes(images, cells, cells * grid.resolution**2, points)
 
