@@ -46,11 +46,12 @@ def needed_bytes(image_cells: int, grid_cells: int, extent_m2: float, points: in
 def guard(need: int, limit: int | None, what: str) -> None:
     """Raise InputError (exit 2, one line) when ``need`` bytes exceed ``limit`` (None: the
     default limit); ``what`` names the inputs."""
-    limit = default_limit() if limit is None else limit
+    default = ""
+    if limit is None:
+        limit = default_limit()
+        default = f", {DEFAULT_SHARE:.0%} of this machine's {machine_bytes() / 1e9:.1f} GB"
     if need <= limit:
         return
-    default = ("" if limit != default_limit() else
-               f", {DEFAULT_SHARE:.0%} of this machine's {machine_bytes() / 1e9:.1f} GB")
     raise InputError(
         f"{what}: needs about {need / 1e9:.1f} GB of memory, more than the limit of "
         f"{limit / 1e9:.1f} GB (--max-memory{default}); a coarser --truth-resolution, a larger "
