@@ -75,7 +75,7 @@ def _band_by_chunks(points: np.ndarray, rotation: np.ndarray, low: float,
     :func:`floor_height` finds it), then the heights in the floor's three bins (their median is
     the floor) and the points that may lie in the band whatever the floor within those bins.
     Levelled coordinates are sums of products (one thread, no BLAS), the same in both passes."""
-    bins, counts = _merged([_histogram(_turned(rows, rotation[2]))
+    bins, counts = _merged([_histogram(_bins(_turned(rows, rotation[2])))
                             for rows in _finite_chunks(points)])
     if len(bins) == 0:
         raise ValueError("no points")
@@ -85,7 +85,7 @@ def _band_by_chunks(points: np.ndarray, rotation: np.ndarray, low: float,
     near, heights, plans = [], [], []  # per chunk: the floor bins' z; the candidates' z, x y
     for rows in _finite_chunks(points):
         z = _turned(rows, rotation[2])
-        near.append(z[np.abs(np.floor(z / FLOOR_BIN).astype(np.int64) - peak) <= 1])
+        near.append(z[np.abs(_bins(z) - peak) <= 1])
         keep = (z >= lo) & (z <= hi)
         kept = rows[keep]
         heights.append(z[keep])
@@ -156,15 +156,18 @@ def floor_height(points: np.ndarray) -> float:
     higher peaks; sparse points below the floor (noise, reflections) are not strong peaks.
     """
     z = _finite_points(points)[:, 2]
-    idx = np.floor(z / FLOOR_BIN).astype(np.int64)
-    peak = _floor_bin(*_histogram(z))
-    return float(np.median(z[np.abs(idx - peak) <= 1]))
+    idx = _bins(z)
+    return float(np.median(z[np.abs(idx - _floor_bin(*_histogram(idx))) <= 1]))
 
 
-def _histogram(z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The sparse height histogram of heights z (n,), metres: the FLOOR_BIN bins' indices
-    (sorted, int64) that hold points, and their counts."""
-    idx = np.floor(z / FLOOR_BIN).astype(np.int64)
+def _bins(z: np.ndarray) -> np.ndarray:
+    """The FLOOR_BIN bin (int64 index) of each height z (n,), metres."""
+    return np.floor(z / FLOOR_BIN).astype(np.int64)
+
+
+def _histogram(idx: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The sparse height histogram of bin indices (n,) of :func:`_bins`: the bins (sorted,
+    int64) that hold points, and their counts."""
     if len(idx) == 0:
         return idx, idx
     lo = int(idx.min())
