@@ -113,3 +113,48 @@ def test_assign_components():
 def test_unknown_detector():
     with pytest.raises(InputError):
         match("nope", points([[0, 0]]), points([[0, 0]]))
+
+
+@pytest.mark.unit
+def test_hough_candidates_all_pairs_the_rule_allows():
+    """The segment pairs tested are prefiltered by distance; none the rule allows is lost: the
+    candidates equal the rule applied to every pair (short and long segments, turned up to
+    15 degrees, offsets up to twice the threshold)."""
+    from pcmapq.features import hough
+    from pcmapq.features.segments import directions
+
+    rng = np.random.default_rng(3)
+
+    def segments(n: int) -> np.ndarray:
+        mid = rng.uniform(0, 20, (n, 2))
+        angle = rng.choice([0.0, np.pi / 2], n) + np.radians(rng.uniform(-15, 15, n))
+        half = rng.choice([0.2, 1.0, 6.0], n)[:, None] * np.column_stack([np.cos(angle),
+                                                                          np.sin(angle)])
+        return np.hstack([mid - half, mid + half])
+
+    truth_seg = segments(300)
+    map_seg = np.vstack([truth_seg + rng.uniform(-1.0, 1.0, (300, 4)), segments(300)])
+
+    def features(seg: np.ndarray) -> Features:
+        length = directions(seg)[1]
+        return Features(0.5 * (seg[:, :2] + seg[:, 2:]), length, length > 1.0, segments=seg)
+
+    params, threshold = hough.Params(), 0.5
+    truth_f, map_f = features(truth_seg), features(map_seg)
+    i, j, cost, disp = hough.candidates(truth_f, map_f, threshold, params)
+    # the rule on every pair
+    dt, lt = directions(truth_seg)
+    dm, _ = directions(map_seg)
+    ii, jj = np.nonzero(np.abs(dt @ dm.T) >= np.cos(np.radians(params.max_angle)))
+    ii, jj = ii[truth_f.strong[ii] | map_f.strong[jj]], jj[truth_f.strong[ii] | map_f.strong[jj]]
+    mt, mm = truth_f.xy[ii], map_f.xy[jj]
+    nt, nm = np.column_stack([-dt[ii, 1], dt[ii, 0]]), np.column_stack([-dm[jj, 1], dm[jj, 0]])
+    off = np.maximum(np.abs(np.sum((mm - mt) * nm, 1)), np.abs(np.sum((mm - mt) * nt, 1)))
+    a = np.sum((map_seg[jj, :2] - mt) * dt[ii], 1)
+    b = np.sum((map_seg[jj, 2:] - mt) * dt[ii], 1)
+    overlap = np.minimum(np.maximum(a, b), 0.5 * lt[ii]) - np.maximum(np.minimum(a, b),
+                                                                      -0.5 * lt[ii])
+    keep = (overlap > 0) & (off <= threshold)
+    assert keep.sum() > 100
+    assert np.array_equal(i, ii[keep]) and np.array_equal(j, jj[keep])
+    assert np.allclose(cost, off[keep] / threshold)

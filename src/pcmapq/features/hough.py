@@ -54,7 +54,14 @@ from pcmapq.features.base import (
     sorted_features,
 )
 from pcmapq.features.ridges import pieces, ridges
-from pcmapq.features.segments import away, directions, inside_runs, merge, wall_test
+from pcmapq.features.segments import (
+    away,
+    directions,
+    inside_runs,
+    merge,
+    near_pairs,
+    wall_test,
+)
 from pcmapq.features.walls import WallImage
 
 
@@ -142,7 +149,13 @@ def candidates(truth: Features, map_: Features, threshold: float, params: Params
         return no_candidates()
     dt, lt = directions(truth.segments)
     dm, _ = directions(map_.segments)
-    i, j = np.nonzero(np.abs(dt @ dm.T) >= np.cos(np.radians(params.max_angle)))
+    # a candidate pair comes within threshold / cos(max_angle) of each other (the map segment
+    # where it meets the end of the truth segment's extent, or its midpoint), so only such
+    # pairs are tested
+    cos_max = np.cos(np.radians(params.max_angle))
+    i, j = near_pairs(truth.segments, map_.segments, threshold / max(cos_max, 1e-3))
+    parallel = np.abs(np.einsum("ij,ij->i", dt[i], dm[j])) >= cos_max
+    i, j = i[parallel], j[parallel]
     either = truth.strong[i] | map_.strong[j]
     i, j = i[either], j[either]
     mt, mm = truth.xy[i], map_.xy[j]

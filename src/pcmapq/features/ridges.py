@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import cv2
 import numpy as np
+from scipy import sparse
+from scipy.sparse.csgraph import connected_components
 
 from pcmapq.features.base import gaussian
 
@@ -59,19 +61,27 @@ def ridges(image: np.ndarray, sigma_px: float, floor: float) -> tuple[np.ndarray
 _BINS = 6
 
 
-def _label(mask: np.ndarray, direction: np.ndarray, offset: float) -> tuple[np.ndarray, int]:
-    """Connected pieces (8-connected) of ridge pixels whose directions fall in the same bin of
-    ``_BINS`` bins over [0, pi), the bins shifted by ``offset`` of a bin: (rows, cols) int32
-    labels (0 off the pieces) and the number of pieces."""
-    bins = np.floor(np.mod(direction * (_BINS / np.pi) + offset, _BINS)).astype(np.int32)
-    labels = np.zeros(mask.shape, dtype=np.int32)
-    count = 0
-    for k in range(_BINS):
-        n, lab = cv2.connectedComponents((mask & (bins == k)).astype(np.uint8), connectivity=8)
-        on = lab > 0
-        labels[on] = lab[on] + count
-        count += n - 1
-    return labels, count
+def _label(index: np.ndarray, bins: np.ndarray, cols: int) -> tuple[np.ndarray, int]:
+    """Connected pieces (8-connected) of ridge pixels of the same direction bin: the pixels are
+    given by their flat indices ``index`` (sorted, ``v * cols + u``) and bins; returns each
+    pixel's piece, numbered from 0 by bin, then in raster order of the piece's first pixel,
+    and the number of pieces. Only the ridge pixels are visited, never the whole image."""
+    u = index % cols
+    ends = []
+    # the four neighbours after a pixel in raster order; the others see it as theirs
+    for step, ok in ((1, u < cols - 1), (cols - 1, u > 0), (cols, True), (cols + 1, u < cols - 1)):
+        at = np.minimum(np.searchsorted(index, index + step), len(index) - 1)
+        hit = ok & (index[at] == index + step) & (bins[at] == bins)
+        ends.append((np.flatnonzero(hit), at[hit]))
+    a, b = (np.concatenate(e) for e in zip(*ends, strict=True))
+    graph = sparse.coo_array((np.ones(len(a), np.int8), (a, b)), shape=(len(index),) * 2)
+    count, label = connected_components(graph, directed=False)
+    # components are numbered by their first pixel; number them by bin first
+    first_bin = np.zeros(count, np.int64)
+    first_bin[label] = bins
+    rank = np.empty(count, np.int64)
+    rank[np.lexsort((np.arange(count), first_bin))] = np.arange(count)
+    return rank[label], count
 
 
 def pieces(mask: np.ndarray, direction: np.ndarray) -> np.ndarray:
@@ -85,26 +95,26 @@ def pieces(mask: np.ndarray, direction: np.ndarray) -> np.ndarray:
     neither jumps between parallel walls nor cuts across a curve, and a wall wavy by a pixel
     stays one piece as long as its direction stays within the bin.
     """
+    v, u = np.nonzero(mask)
+    index = v.astype(np.int64) * mask.shape[1] + u
+    theta = direction[v, u]
     out = []
     for offset in (0.0, 0.5):
-        labels, n = _label(mask, direction, offset)
-        v, u = np.nonzero(labels)
-        lab = labels[v, u]
-        count = np.bincount(lab, minlength=n + 1).astype(np.float64)
-        count[0] = 1.0
-        cu = np.bincount(lab, u, n + 1) / count
-        cv = np.bincount(lab, v, n + 1) / count
+        bins = np.floor(np.mod(theta * (_BINS / np.pi) + offset, _BINS)).astype(np.int32)
+        lab, n = _label(index, bins, mask.shape[1])
+        count = np.bincount(lab, minlength=n).astype(np.float64)
+        cu = np.bincount(lab, u, n) / count
+        cv = np.bincount(lab, v, n) / count
         du, dv = u - cu[lab], v - cv[lab]
-        suu = np.bincount(lab, du * du, n + 1)
-        svv = np.bincount(lab, dv * dv, n + 1)
-        suv = np.bincount(lab, du * dv, n + 1)
+        suu = np.bincount(lab, du * du, n)
+        svv = np.bincount(lab, dv * dv, n)
+        suv = np.bincount(lab, du * dv, n)
         angle = 0.5 * np.arctan2(2 * suv, suu - svv)  # principal axis of each piece
         eu, ev = np.cos(angle), np.sin(angle)
         t = du * eu[lab] + dv * ev[lab]
-        lo, hi = np.full(n + 1, np.inf), np.full(n + 1, -np.inf)
+        lo, hi = np.full(n, np.inf), np.full(n, -np.inf)
         np.minimum.at(lo, lab, t)
         np.maximum.at(hi, lab, t)
-        lo, hi = lo[1:] - 0.5, hi[1:] + 0.5  # pixel centres to pixel edges
-        cu, cv, eu, ev = cu[1:], cv[1:], eu[1:], ev[1:]
+        lo, hi = lo - 0.5, hi + 0.5  # pixel centres to pixel edges
         out.append(np.column_stack([cu + lo * eu, cv + lo * ev, cu + hi * eu, cv + hi * ev]))
     return np.concatenate(out).reshape(-1, 4)

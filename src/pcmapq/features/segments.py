@@ -145,7 +145,7 @@ def merge(seg: np.ndarray, max_angle: float, max_offset: float, max_gap: float,
         near = near[left[near] & (np.abs(d[near] @ u) >= cos_near) & (off <= 2 * max_offset)]
         e, dn, ln = ends[near], d[near], length[near]
         group = near == seed
-        for _ in range(_REFITS):
+        for _ in range(_REFITS if len(near) > 1 else 0):  # a lone seed is its own group
             centre, u = _line(e[group], ln[group])
 
             def bridged(start: np.ndarray, end: np.ndarray, centre=centre, u=u) -> np.ndarray:
@@ -177,9 +177,12 @@ def wall_test(image: np.ndarray, work: MetricGrid,
     """``solid(xy)``: whether points (..., 2), metres, fall on cells of ``image`` (on grid
     ``work``) of at least ``level``; points outside the image are not solid."""
 
+    to_pixels = work.xy_to_pixel_matrix()
+    rows, cols = image.shape
+
     def solid(xy: np.ndarray) -> np.ndarray:
-        uv = np.floor(work.xy_to_pixels(xy.reshape(-1, 2)) + 0.5).astype(np.int64)
-        rows, cols = image.shape
+        uv = np.floor(xy.reshape(-1, 2) @ to_pixels[:2, :2].T + to_pixels[:2, 2] + 0.5)
+        uv = uv.astype(np.int64)
         inside = (uv[:, 0] >= 0) & (uv[:, 0] < cols) & (uv[:, 1] >= 0) & (uv[:, 1] < rows)
         out = np.zeros(len(uv), dtype=bool)
         out[inside] = image[uv[inside, 1], uv[inside, 0]] >= level
@@ -188,13 +191,28 @@ def wall_test(image: np.ndarray, work: MetricGrid,
     return solid
 
 
-def _points(seg: np.ndarray, step: float) -> np.ndarray:
-    """Points (M, 2) every ``step`` along segments (N, 4), both ends included."""
+def _points(seg: np.ndarray, step: float) -> tuple[np.ndarray, np.ndarray]:
+    """Points (M, 2) every ``step`` along segments (N, 4), both ends included, and the index of
+    the segment of each (M,)."""
     d, length = directions(seg)
     n = np.floor(length / step).astype(np.int64) + 2
     which = np.repeat(np.arange(len(seg)), n)
     t = np.minimum((np.arange(n.sum()) - (np.cumsum(n) - n)[which]) * step, length[which])
-    return seg[which, :2] + t[:, None] * d[which]
+    return seg[which, :2] + t[:, None] * d[which], which
+
+
+def near_pairs(a: np.ndarray, b: np.ndarray, distance: float) -> tuple[np.ndarray, np.ndarray]:
+    """Every pair of segments of ``a`` (N, 4) and ``b`` (M, 4) that come within ``distance`` of
+    each other, and some up to twice as far (they are sampled every ``distance``): indices
+    (i, j) into ``a`` and ``b``, sorted by i, then j. Metres."""
+    if len(a) == 0 or len(b) == 0:
+        return np.zeros(0, np.int64), np.zeros(0, np.int64)
+    (pa, owner_a), (pb, owner_b) = _points(a, distance), _points(b, distance)
+    # every point of a segment is within half a step of one of its samples
+    near = cKDTree(pa).sparse_distance_matrix(cKDTree(pb), 2 * distance,
+                                              output_type="coo_matrix")
+    pair = np.unique(owner_a[near.row] * len(b) + owner_b[near.col])
+    return pair // len(b), pair % len(b)
 
 
 def away(xy: np.ndarray, seg: np.ndarray, distance: float, step: float) -> np.ndarray:
@@ -202,7 +220,7 @@ def away(xy: np.ndarray, seg: np.ndarray, distance: float, step: float) -> np.nd
     (M, 4) (tested at points every ``step`` along them). Metres."""
     if len(seg) == 0 or len(xy) == 0:
         return np.ones(len(xy), dtype=bool)
-    dist, _ = cKDTree(_points(seg, step)).query(xy, distance_upper_bound=distance)
+    dist, _ = cKDTree(_points(seg, step)[0]).query(xy, distance_upper_bound=distance)
     return ~np.isfinite(dist)
 
 
