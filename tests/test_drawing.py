@@ -3,6 +3,7 @@ at 0.05 m and 0.025 m cells, score like the usual drawing, whichever side is the
 
 from __future__ import annotations
 
+import cv2
 import numpy as np
 import pytest
 
@@ -99,3 +100,26 @@ def test_ridges_by_strips_equal_the_whole():
     assert whole[0].sum() > 5000
     for a, b in zip(whole, strips, strict=True):
         np.testing.assert_array_equal(a, b)
+
+
+@pytest.mark.unit
+def test_cores_on_the_rows_and_columns_of_objects_equal_the_whole_image():
+    """cores() drops the rows and columns without objects: every object's depth and core are
+    those of the whole image (objects at the border, next to each other, far apart)."""
+    from pcmapq.features.walls import cores, fill_holes
+    from pcmapq.morphology import distance_to
+
+    rng = np.random.default_rng(5)
+    image = np.zeros((150, 150), np.uint8)
+    for _ in range(25):
+        c, r = rng.integers(0, 150, 2), int(rng.integers(1, 12))
+        cv2.circle(image, (int(c[0]), int(c[1])), r, 1, int(rng.choice([-1, 1, 2])))
+    cv2.rectangle(image, (0, 60), (9, 75), 1, -1)
+    objects = fill_holes(image.astype(bool))
+    _, label = cv2.connectedComponents(objects.astype(np.uint8), connectivity=8)
+    depth = distance_to(np.pad(~objects, 1, constant_values=True))[1:-1, 1:-1]
+    deepest = np.zeros(label.max() + 1, np.float32)
+    np.maximum.at(deepest, label[objects], depth[objects])
+    for width in (3.0, 6.0):
+        want = objects & (depth >= deepest[label] - 0.5 * width)
+        assert np.array_equal(cores(objects, width), want)

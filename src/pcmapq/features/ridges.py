@@ -10,10 +10,10 @@ from __future__ import annotations
 
 import cv2
 import numpy as np
-from scipy import sparse
-from scipy.sparse.csgraph import connected_components
 
 from pcmapq.features.base import gaussian
+from pcmapq.features.pixels import flat_index, neighbour_pairs
+from pcmapq.features.pixels import pieces as connected
 
 
 def ridges(image: np.ndarray, sigma_px: float, floor: float) -> tuple[np.ndarray, np.ndarray]:
@@ -61,22 +61,15 @@ def ridges(image: np.ndarray, sigma_px: float, floor: float) -> tuple[np.ndarray
 _BINS = 6
 
 
-def _label(index: np.ndarray, bins: np.ndarray, cols: int) -> tuple[np.ndarray, int]:
-    """Connected pieces (8-connected) of ridge pixels of the same direction bin: the pixels are
-    given by their flat indices ``index`` (sorted, ``v * cols + u``) and bins; returns each
-    pixel's piece, numbered from 0 by bin, then in raster order of the piece's first pixel,
-    and the number of pieces. Only the ridge pixels are visited, never the whole image."""
-    u = index % cols
-    ends = []
-    # the four neighbours after a pixel in raster order; the others see it as theirs
-    for step, ok in ((1, u < cols - 1), (cols - 1, u > 0), (cols, True), (cols + 1, u < cols - 1)):
-        at = np.minimum(np.searchsorted(index, index + step), len(index) - 1)
-        hit = ok & (index[at] == index + step) & (bins[at] == bins)
-        ends.append((np.flatnonzero(hit), at[hit]))
-    a, b = (np.concatenate(e) for e in zip(*ends, strict=True))
-    graph = sparse.coo_array((np.ones(len(a), np.int8), (a, b)), shape=(len(index),) * 2)
-    count, label = connected_components(graph, directed=False)
-    # components are numbered by their first pixel; number them by bin first
+def _label(bins: np.ndarray, pairs: tuple[np.ndarray, np.ndarray]) -> tuple[np.ndarray, int]:
+    """Connected pieces (8-connected) of ridge pixels of the same direction bin: the pixels, in
+    raster order, are given by their bins and their 8-neighbour ``pairs`` (see
+    :func:`pcmapq.features.pixels.neighbour_pairs`); returns each pixel's piece, numbered from 0
+    by bin, then in raster order of the piece's first pixel, and the number of pieces."""
+    a, b = pairs
+    same = bins[a] == bins[b]
+    count, label = connected(len(bins), a[same], b[same])
+    # pieces are numbered by their first pixel; number them by bin first
     first_bin = np.zeros(count, np.int64)
     first_bin[label] = bins
     rank = np.empty(count, np.int64)
@@ -95,13 +88,13 @@ def pieces(mask: np.ndarray, direction: np.ndarray) -> np.ndarray:
     neither jumps between parallel walls nor cuts across a curve, and a wall wavy by a pixel
     stays one piece as long as its direction stays within the bin.
     """
-    v, u = np.nonzero(mask)
-    index = v.astype(np.int64) * mask.shape[1] + u
+    v, u, index = flat_index(mask)
+    pairs = neighbour_pairs(index, mask.shape[1])
     theta = direction[v, u]
     out = []
     for offset in (0.0, 0.5):
         bins = np.floor(np.mod(theta * (_BINS / np.pi) + offset, _BINS)).astype(np.int32)
-        lab, n = _label(index, bins, mask.shape[1])
+        lab, n = _label(bins, pairs)
         count = np.bincount(lab, minlength=n).astype(np.float64)
         cu = np.bincount(lab, u, n) / count
         cv = np.bincount(lab, v, n) / count

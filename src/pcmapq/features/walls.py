@@ -40,6 +40,8 @@ import numpy as np
 from scipy import sparse
 from skimage.morphology import skeletonize
 
+from pcmapq.features.pixels import flat_index, neighbour_pairs
+from pcmapq.features.pixels import pieces as connected
 from pcmapq.grid import MetricGrid
 from pcmapq.morphology import disc, distance_to
 
@@ -48,10 +50,6 @@ from pcmapq.morphology import disc, distance_to
 TILE, HALO = 2048, 4.0
 #: Threads drawing tiles, at most.
 THREADS = 4
-
-#: 8-neighbourhood of a pixel (the centre excluded).
-_NEIGHBOURS = np.array([[1, 1, 1], [1, 0, 1], [1, 1, 1]], dtype=np.float32)
-
 
 def _overlap_matrix(n_out: int, out_size: float, n_in: int, in_size: float) -> sparse.csr_array:
     """(n_out, n_in) weights of 1D area averaging: the fraction of output cell ``i`` (length
@@ -65,6 +63,12 @@ def _overlap_matrix(n_out: int, out_size: float, n_in: int, in_size: float) -> s
     return sparse.csr_array((length / out_size, (i, j)), shape=(n_out, n_in))
 
 
+def _whole(ratio: float) -> int:
+    """``ratio`` as a whole number of at least 2, or 0 when it is not one."""
+    k = int(round(ratio))
+    return k if k >= 2 and abs(ratio - k) < 1e-9 * ratio else 0
+
+
 def resample(image: np.ndarray, grid: MetricGrid,
              resolution: float) -> tuple[np.ndarray, MetricGrid]:
     """Resample ``image`` (rows, cols, on ``grid``) to cells of ``resolution`` metres by exact
@@ -76,6 +80,14 @@ def resample(image: np.ndarray, grid: MetricGrid,
     if abs(grid.resolution - resolution) < 1e-9 * resolution:
         return image, grid
     work = grid.resampled(resolution)
+    up, down = _whole(grid.resolution / resolution), _whole(resolution / grid.resolution)
+    if up:  # each new cell lies in one old cell
+        return cv2.resize(image, (work.shape[1], work.shape[0]),
+                          interpolation=cv2.INTER_NEAREST_EXACT), work
+    if down:  # each new cell is a block of old cells; blocks start at the lower-left corner
+        rows, cols = work.shape[0] * down, work.shape[1] * down
+        padded = np.pad(image, ((rows - image.shape[0], 0), (0, cols - image.shape[1])))
+        return cv2.resize(padded, work.shape[::-1], interpolation=cv2.INTER_AREA), work
     ax = _overlap_matrix(work.shape[1], resolution, grid.shape[1], grid.resolution)
     # rows count from the top, the origin is at the bottom: average the flipped rows
     ay = _overlap_matrix(work.shape[0], resolution, grid.shape[0], grid.resolution)
@@ -84,28 +96,27 @@ def resample(image: np.ndarray, grid: MetricGrid,
     return np.ascontiguousarray(out, dtype=np.float32), work
 
 
-def _neighbours(mask: np.ndarray) -> np.ndarray:
-    """Number of 8-neighbours of each pixel that are in ``mask``, (rows, cols) int."""
-    count = cv2.filter2D(mask.astype(np.float32), -1, _NEIGHBOURS,
-                         borderType=cv2.BORDER_CONSTANT)
-    return np.rint(count).astype(np.int32)
-
-
 def prune(skeleton: np.ndarray, shortest_px: float) -> np.ndarray:
     """The skeleton (bool) without its spurs: branches that end free and meet the rest at a
     junction, shorter than ``shortest_px`` pixels. Branches are the connected runs left when
-    the junction pixels (three or more neighbours) are taken out."""
-    count = _neighbours(skeleton)
-    junction = skeleton & (count >= 3)
-    end = skeleton & (count <= 1)
-    n, label = cv2.connectedComponents((skeleton & ~junction).astype(np.uint8), connectivity=8)
-    length = np.bincount(label.ravel(), minlength=n)
-    free_end = np.bincount(label[end], minlength=n) > 0
-    near_junction = cv2.dilate(junction.astype(np.uint8), np.ones((3, 3), np.uint8)) > 0
-    at_junction = np.bincount(label[near_junction & skeleton & ~junction], minlength=n) > 0
+    the junction pixels (three or more neighbours) are taken out. Only the skeleton's pixels
+    are visited (:mod:`pcmapq.features.pixels`)."""
+    v, u, index = flat_index(skeleton)
+    a, b = neighbour_pairs(index, skeleton.shape[1])
+    count = np.bincount(a, minlength=len(index)) + np.bincount(b, minlength=len(index))
+    junction = count >= 3
+    branch = ~junction
+    n, label = connected(len(index), a[branch[a] & branch[b]], b[branch[a] & branch[b]])
+    length = np.bincount(label[branch], minlength=n)
+    free_end = np.bincount(label[count <= 1], minlength=n) > 0
+    touch = junction[a] != junction[b]  # a branch pixel next to a junction
+    at_junction = np.zeros(n, dtype=bool)
+    at_junction[label[np.where(junction[a[touch]], b[touch], a[touch])]] = True
     spur = free_end & at_junction & (length < shortest_px)
-    spur[0] = False
-    return skeleton & ~spur[label]
+    drop = branch & spur[label]
+    pruned = skeleton.copy()
+    pruned[v[drop], u[drop]] = False
+    return pruned
 
 
 def centreline(occupied: np.ndarray, grid: MetricGrid, resolution: float, closing: float,
@@ -129,36 +140,48 @@ def centreline(occupied: np.ndarray, grid: MetricGrid, resolution: float, closin
     size = np.maximum(stats[:, cv2.CC_STAT_WIDTH], stats[:, cv2.CC_STAT_HEIGHT]) * resolution
     is_small = size <= small
     is_small[0] = False
-    objects = fill_holes(is_small[label], small / resolution)
+    objects = fill_holes(is_small[label])
     line = prune(skeletonize(wall.astype(bool) & ~objects), spur / resolution)
     return line, cores(objects, width / resolution), fine
 
 
-def fill_holes(mask: np.ndarray, largest_px: float) -> np.ndarray:
+def fill_holes(mask: np.ndarray) -> np.ndarray:
     """``mask`` (bool) with its holes filled: the 4-connected pieces of its complement that do
-    not touch the border, at most ``largest_px`` pixels wide and high."""
-    n, label, stats, _ = cv2.connectedComponentsWithStats((~mask).astype(np.uint8),
-                                                          connectivity=4)
-    x, y = stats[:, cv2.CC_STAT_LEFT], stats[:, cv2.CC_STAT_TOP]
-    w, h = stats[:, cv2.CC_STAT_WIDTH], stats[:, cv2.CC_STAT_HEIGHT]
-    rows, cols = mask.shape
-    inside = (x > 0) & (y > 0) & (x + w < cols) & (y + h < rows)
-    hole = inside & (np.maximum(w, h) <= largest_px)
-    hole[0] = False  # label 0: the mask itself
-    return mask | hole[label]
+    not reach the border (one flood fill from around the border). The holes of small objects
+    lie within them, so they are small too."""
+    outside = np.pad(~mask, 1, constant_values=True).view(np.uint8)
+    cv2.floodFill(outside, None, (0, 0), 2)  # 4-connected
+    return mask | (outside[1:-1, 1:-1] == 1)
 
 
 def cores(objects: np.ndarray, width_px: float) -> np.ndarray:
     """The core of each object (bool): its cells within ``width_px / 2`` pixels of its deepest
     depth (Euclidean distance to its outside). A solid block and a ring of thin walls around
-    the same spot, filled, have the same core, about ``width_px`` across."""
+    the same spot, filled, have the same core, about ``width_px`` across.
+
+    Computed on the rows and columns that hold object cells or touch one: the others hold
+    outside cells only, and an all-outside row or column is kept between any two objects, so
+    dropping the rest changes no cell's depth and joins no two objects."""
     if not objects.any():
         return objects
-    _, label = cv2.connectedComponents(objects.astype(np.uint8), connectivity=8)
-    depth = distance_to(np.pad(~objects, 1, constant_values=True))[1:-1, 1:-1]
+    rows, cols = _touched(objects.any(axis=1)), _touched(objects.any(axis=0))
+    crop = objects[np.ix_(rows, cols)]
+    _, label = cv2.connectedComponents(crop.astype(np.uint8), connectivity=8)
+    depth = distance_to(np.pad(~crop, 1, constant_values=True))[1:-1, 1:-1]
     deepest = np.zeros(label.max() + 1, dtype=np.float32)
-    np.maximum.at(deepest, label[objects], depth[objects])
-    return objects & (depth >= deepest[label] - 0.5 * width_px)
+    np.maximum.at(deepest, label[crop], depth[crop])
+    core = np.zeros_like(objects)
+    core[np.ix_(rows, cols)] = crop & (depth >= deepest[label] - 0.5 * width_px)
+    return core
+
+
+def _touched(held: np.ndarray) -> np.ndarray:
+    """Indices of the lines (rows or columns) that hold cells of interest (``held``, bool per
+    line) or lie next to one."""
+    near = held.copy()
+    near[1:] |= held[:-1]
+    near[:-1] |= held[1:]
+    return np.flatnonzero(near)
 
 
 @dataclass(frozen=True)
