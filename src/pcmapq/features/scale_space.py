@@ -106,20 +106,30 @@ def _dog(stack: np.ndarray) -> np.ndarray:
     return stack[:-1]
 
 
+#: Cells of a strip of :func:`_peaks`: a few strips of this size stay in the CPU's cache,
+#: which makes the test several times faster on a large image than whole-image passes.
+STRIP_CELLS = 1 << 18
+
+
 def _peaks(dog: np.ndarray, floor: float) -> np.ndarray:
     """(layers, rows, cols) bool: samples of layers 1 to n - 2 of the DoG stack that equal the
     maximum (at least ``floor``) or the minimum (at most ``-floor``) of their 3 x 3 x 3
     neighbourhood: the 3 x 3 dilation (erosion) of the largest (smallest) of three layers,
-    by OpenCV, which ignores samples beyond the border, as repeating the border would."""
+    by OpenCV, which ignores samples beyond the border, as repeating the border would.
+    Computed in strips of rows (each with one row of the next strips around it)."""
     square = np.ones((3, 3), np.uint8)
+    layers, rows, cols = dog.shape
+    strip = max(1, STRIP_CELLS // cols)
     peak = np.zeros(dog.shape, dtype=bool)
-    for i in range(1, dog.shape[0] - 1):
-        below, here, above = dog[i - 1], dog[i], dog[i + 1]
-        top = cv2.dilate(np.maximum(np.maximum(below, here), above), square)
-        peak[i] = (here >= floor) & (here == top)
-        del top
-        bottom = cv2.erode(np.minimum(np.minimum(below, here), above), square)
-        peak[i] |= (here <= -floor) & (here == bottom)
+    for top in range(0, rows, strip):
+        lo, hi = max(0, top - 1), min(rows, top + strip + 1)
+        first, last = top - lo, top - lo + min(strip, rows - top)
+        for i in range(1, layers - 1):
+            below, here, above = dog[i - 1, lo:hi], dog[i, lo:hi], dog[i + 1, lo:hi]
+            high = cv2.dilate(np.maximum(np.maximum(below, here), above), square)
+            low = cv2.erode(np.minimum(np.minimum(below, here), above), square)
+            found = ((here >= floor) & (here == high)) | ((here <= -floor) & (here == low))
+            peak[i, top:top + last - first] = found[first:last]
     return peak
 
 
