@@ -13,7 +13,7 @@ from pcmapq.align import Alignment, align
 from pcmapq.align.rigid3d import Registration3D, align_3d, apply
 from pcmapq.config import Settings
 from pcmapq.errors import EvaluationError, InputError
-from pcmapq.features import Features, detect_in, walls_of
+from pcmapq.features import Features, detect_both, walls_of
 from pcmapq.frames import Frames, Levelling
 from pcmapq.grid import MetricGrid
 from pcmapq.io import OccupancyMap, PointMap, load_map
@@ -267,16 +267,18 @@ def score(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap, setti
 
     progress("drawing the walls' centre lines")
     truth_walls, map_walls = walls_of(truth_occ, grid), walls_of(map_occ, grid)
+    names, params = settings.matching.detectors, settings.matching.params
+    progress(f"detecting {', '.join(names)}")
+    truth_found, map_found = detect_both(truth_walls, map_walls, names, params)
     detectors = {}
     full, threshold = settings.footprint.full, settings.matching.threshold
-    for name in settings.matching.detectors:
-        progress(f"detecting {name}")
-        params = settings.matching.params.get(name)
-        truth_f, map_f = detect_in(name, truth_walls, params), detect_in(name, map_walls, params)
+    for name in names:
+        truth_f, map_f = truth_found[name], map_found[name]
         if not full:  # truth features the map never saw are not missing
             truth_f = truth_f.counted_where(inside(truth_f, footprint, grid))
         detectors[name] = DetectorResult(truth_f, map_f,
-                                         match(name, truth_f, map_f, threshold, params))
+                                         match(name, truth_f, map_f, threshold,
+                                               params.get(name)))
     cloud_distances = None
     if registration is not None:
         progress("distances in 3D")

@@ -9,6 +9,9 @@ from __future__ import annotations
 
 import importlib
 import pkgutil
+from collections.abc import Mapping, Sequence
+from concurrent.futures import ThreadPoolExecutor
+from threading import Lock
 from typing import Any
 
 import numpy as np
@@ -19,7 +22,7 @@ from pcmapq.features.walls import WallImage, wall_image
 from pcmapq.grid import MetricGrid
 
 __all__ = ["DETECTORS", "Candidates", "Detector", "Features", "WallImage", "default_params",
-           "detect", "detect_in", "detector", "walls_of"]
+           "detect", "detect_both", "detect_in", "detector", "walls_of"]
 
 
 def _discover() -> dict[str, Detector]:
@@ -67,6 +70,32 @@ def detect_in(name: str, walls: WallImage, params: Any = None) -> Features:
     its defaults when None."""
     found = detector(name)
     return found.detect(walls, found.checked(params))
+
+
+def detect_both(truth: WallImage, map_: WallImage, names: Sequence[str],
+                params: Mapping[str, Any]) -> tuple[dict[str, Features], dict[str, Features]]:
+    """:func:`detect_in` of every detector of ``names`` (with ``params.get(name)``) in the truth's
+    and the map's walls: the two sides side by side on two threads, the map's detectors in the
+    reverse order and one side at a time per detector. So the two sides' largest temporaries
+    (SIFT's scale space) never coincide, and one side's Python-bound steps (Hough's merging)
+    overlap the other's OpenCV and NumPy work, which runs without the interpreter lock. Each
+    detection depends on its own input only: the features are those of one thread."""
+    names = list(names)
+    for name in names:
+        detector(name)  # unknown names fail here, before any work
+    busy = {name: Lock() for name in names}
+
+    def side(walls: WallImage, order: list[str]) -> dict[str, Features]:
+        found = {}
+        for name in order:
+            with busy[name]:
+                found[name] = detect_in(name, walls, params.get(name))
+        return found
+
+    with ThreadPoolExecutor(2) as pool:
+        truth_found = pool.submit(side, truth, names)
+        map_found = pool.submit(side, map_, names[::-1])
+        return truth_found.result(), map_found.result()
 
 
 def detect(name: str, occupied: np.ndarray, grid: MetricGrid, params: Any = None) -> Features:

@@ -111,16 +111,17 @@ def _dog(stack: np.ndarray) -> np.ndarray:
 STRIP_CELLS = 1 << 18
 
 
-def _peaks(dog: np.ndarray, floor: float) -> np.ndarray:
-    """(layers, rows, cols) bool: samples of layers 1 to n - 2 of the DoG stack that equal the
-    maximum (at least ``floor``) or the minimum (at most ``-floor``) of their 3 x 3 x 3
-    neighbourhood: the 3 x 3 dilation (erosion) of the largest (smallest) of three layers,
-    by OpenCV, which ignores samples beyond the border, as repeating the border would.
-    Computed in strips of rows (each with one row of the next strips around it)."""
+def _peaks(dog: np.ndarray, floor: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(layer, row, column) of every sample of layers 1 to n - 2 of the DoG stack, at least
+    :data:`BORDER` from the image's edges, that equals the maximum (at least ``floor``) or the
+    minimum (at most ``-floor``) of its 3 x 3 x 3 neighbourhood: the 3 x 3 dilation (erosion)
+    of the largest (smallest) of three layers, by OpenCV, which ignores samples beyond the
+    border, as repeating the border would. Computed in strips of rows (each with one row of
+    the next strips around it); sorted by layer, row, column."""
     square = np.ones((3, 3), np.uint8)
     layers, rows, cols = dog.shape
     strip = max(1, STRIP_CELLS // cols)
-    peak = np.zeros(dog.shape, dtype=bool)
+    found: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
     for top in range(0, rows, strip):
         lo, hi = max(0, top - 1), min(rows, top + strip + 1)
         first, last = top - lo, top - lo + min(strip, rows - top)
@@ -128,18 +129,20 @@ def _peaks(dog: np.ndarray, floor: float) -> np.ndarray:
             below, here, above = dog[i - 1, lo:hi], dog[i, lo:hi], dog[i + 1, lo:hi]
             high = cv2.dilate(np.maximum(np.maximum(below, here), above), square)
             low = cv2.erode(np.minimum(np.minimum(below, here), above), square)
-            found = ((here >= floor) & (here == high)) | ((here <= -floor) & (here == low))
-            peak[i, top:top + last - first] = found[first:last]
-    return peak
+            peak = ((here >= floor) & (here == high)) | ((here <= -floor) & (here == low))
+            r, c = np.nonzero(peak[first:last])
+            r += top
+            inner = (r >= BORDER) & (r < rows - BORDER) & (c >= BORDER) & (c < cols - BORDER)
+            found.append((np.full(inner.sum(), i), r[inner], c[inner]))
+    lay, r, c = (np.concatenate(f) for f in zip(*found, strict=True))
+    order = np.lexsort((c, r, lay))
+    return lay[order], r[order], c[order]
 
 
 def _octave_extrema(dog: np.ndarray, octave: int, sigma: float, floor: float) -> Extrema:
     """:func:`extrema` in one octave's DoG stack (layers + 3, rows, cols)."""
     layers = dog.shape[0] - 3
-    peak = _peaks(dog, floor)
-    peak[:, :BORDER], peak[:, peak.shape[1] - BORDER :] = False, False
-    peak[:, :, :BORDER], peak[:, :, peak.shape[2] - BORDER :] = False, False
-    lay, r, c = np.nonzero(peak)
+    lay, r, c = _peaks(dog, floor)
 
     def at(dl: int, dr: int, dc: int) -> np.ndarray:
         return dog[lay + dl, r + dr, c + dc].astype(np.float64)
