@@ -38,13 +38,15 @@ def _line(ends: np.ndarray, weight: np.ndarray) -> tuple[np.ndarray, np.ndarray]
 
 
 def _grow(t: np.ndarray, fits: np.ndarray, group: np.ndarray, max_gap: float,
-          bridged: Callable[[np.ndarray, np.ndarray], np.ndarray]) -> np.ndarray:
+          max_bridge: float, bridged: Callable[[np.ndarray, np.ndarray], np.ndarray]
+          ) -> np.ndarray:
     """The group extended by every fitting segment near its extent along the line, repeatedly,
     as the extent grows.
 
     ``t`` (N, 2) are the endpoint positions along the line, metres. A segment is near when the
-    gap between it and the group is at most ``max_gap``, or when ``bridged(start, end)`` says
-    the wall is solid over the gap (positions along the line, metres, one pair per segment).
+    gap between it and the group is at most ``max_gap``, or at most ``max_bridge`` when
+    ``bridged(start, end)`` says the wall is solid over the gap (positions along the line,
+    metres, one pair per segment).
     """
     a, b = t.min(axis=1), t.max(axis=1)
     while True:
@@ -53,7 +55,7 @@ def _grow(t: np.ndarray, fits: np.ndarray, group: np.ndarray, max_gap: float,
         start, end = np.where(above, hi, b), np.where(above, a, lo)
         gap = np.where(above | (b < lo), end - start, 0.0)
         near = fits & ~group & (gap <= max_gap)
-        far = np.flatnonzero(fits & ~group & ~near)
+        far = np.flatnonzero(fits & ~group & ~near & (gap <= max_bridge))
         if len(far):
             near[far] = bridged(start[far], end[far])
         if not near.any():
@@ -129,6 +131,7 @@ def merge(seg: np.ndarray, max_angle: float, max_offset: float, max_gap: float,
     cos_max = np.cos(np.radians(max_angle))
     cos_near = np.cos(np.radians(min(2 * max_angle, 90.0)))
     steps = np.linspace(0.0, 1.0, _BRIDGE_SAMPLES)
+    bridge = max_bridge if solid is not None else -np.inf  # no gap is bridged without solid
     left = np.ones(len(seg), dtype=bool)
     index = _Index(seg) if len(seg) else None
     out = []
@@ -149,15 +152,13 @@ def merge(seg: np.ndarray, max_angle: float, max_offset: float, max_gap: float,
             centre, u = _line(e[group], ln[group])
 
             def bridged(start: np.ndarray, end: np.ndarray, centre=centre, u=u) -> np.ndarray:
-                if solid is None:
-                    return np.zeros(len(start), dtype=bool)
                 pos = start[:, None] + (end - start)[:, None] * steps  # (K, S) along the line
-                return (end - start <= max_bridge) & solid(centre + pos[..., None] * u).all(1)
+                return solid(centre + pos[..., None] * u).all(1)
 
             t = (e - centre) @ u  # (K, 2) along the line
             off = np.abs((e - centre) @ np.array([-u[1], u[0]])).max(axis=1)
             fits = (np.abs(dn @ u) >= cos_max) & (off <= max_offset)
-            grown = _grow(t, fits, group, max_gap, bridged)
+            grown = _grow(t, fits, group, max_gap, bridge, bridged)
             if np.array_equal(grown, group):
                 break
             group = grown
