@@ -98,13 +98,13 @@ def load_occupancy(path: Path, resolution: float | None = None,
         meta = replace(meta, resolution=_resolution(path, resolution))
     if thresholds is not None:
         meta = thresholds.apply(meta)
-    grey, transparent = read_grey(image)
+    levels, channels, scale, transparent = read_levels(image)
     if meta.resolution is None and fallback is not None:
         meta = replace(meta, resolution=_resolution(path, fallback))
     if meta.resolution is None:
         raise InputError(f"{path}: no resolution: give --map-resolution/--truth-resolution "
                          "or a YAML beside it")
-    state = classify(grey, transparent, meta)
+    state = classify(levels, channels, scale, transparent, meta)
     return OccupancyMap(path, MetricGrid(meta.resolution, meta.origin, state.shape), state)
 
 
@@ -136,9 +136,11 @@ def read_yaml(path: Path) -> tuple[MapMeta, Path]:
     return meta, path.parent / doc["image"]
 
 
-def read_grey(path: Path) -> tuple[np.ndarray, np.ndarray]:
-    """An image as grey values on the 0..255 scale, float64 (rows, cols), and a bool mask of
-    transparent (alpha 0) pixels."""
+def read_levels(path: Path) -> tuple[np.ndarray, int, float, np.ndarray]:
+    """An image's pixels as integer levels (rows, cols): the sum of its colour channels; the
+    number of those channels, the grey value (0..255 scale) of one level of one channel, and
+    a bool mask of transparent (alpha 0) pixels. A pixel's grey value is
+    ``level / channels * scale``."""
     try:
         img = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
     except cv2.error:
@@ -149,29 +151,33 @@ def read_grey(path: Path) -> tuple[np.ndarray, np.ndarray]:
         raise InputError(f"{path}: unsupported pixel type {img.dtype} (expected 8 or 16 bit)")
     scale = 255.0 / np.iinfo(img.dtype).max
     if img.ndim == 2:
-        return img * scale, np.zeros(img.shape, dtype=bool)
+        return img, 1, scale, np.zeros(img.shape, dtype=bool)
     channels = img.shape[2]
     has_alpha = channels in (2, 4)
     colour = img[:, :, : channels - 1] if has_alpha else img
     transparent = img[:, :, -1] == 0 if has_alpha else np.zeros(img.shape[:2], dtype=bool)
-    return colour.mean(axis=2) * scale, transparent
+    return colour.sum(axis=2, dtype=np.int32), colour.shape[2], scale, transparent
 
 
-def classify(value: np.ndarray, transparent: np.ndarray, meta: MapMeta) -> np.ndarray:
-    """Cell states (int8 OCCUPIED/FREE/UNKNOWN) from grey values (0..255) and a transparency
-    mask, by map_server's rule. ``raw`` mode reads the value itself as occupancy in percent
-    (above 100: unknown) and ignores ``negate``."""
+def classify(levels: np.ndarray, channels: int, scale: float, transparent: np.ndarray,
+             meta: MapMeta) -> np.ndarray:
+    """Cell states (int8 OCCUPIED/FREE/UNKNOWN) of :func:`read_levels`' pixels by map_server's
+    rule, on their grey values ``level / channels * scale`` (0..255). ``raw`` mode reads the
+    value itself as occupancy in percent (above 100: unknown) and ignores ``negate``. The rule
+    is applied once per possible level, and the pixels look their state up."""
+    value = np.arange(int(levels.max(initial=0)) + 1) / channels * scale
     if meta.mode == "raw":
         p = value / 100.0
-        transparent = transparent | (value > 100.0)
     else:
         p = value / 255.0 if meta.negate else (255.0 - value) / 255.0
     state = np.full(value.shape, UNKNOWN, dtype=np.int8)
     state[p < meta.free_thresh] = FREE
     state[p > meta.occupied_thresh] = OCCUPIED
+    if meta.mode == "raw":
+        state[value > 100.0] = UNKNOWN
+    state = state[levels]
     state[transparent] = UNKNOWN
     return state
-
 
 
 def _yaml_problem(exc: Exception) -> str:
