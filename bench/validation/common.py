@@ -16,7 +16,7 @@ import numpy as np
 
 from pcmapq.config import Settings
 from pcmapq.io import PointMap
-from pcmapq.io.occupancy import MapMeta, read_grey
+from pcmapq.io.occupancy import MapMeta, read_levels
 from pcmapq.pipeline import evaluate
 from pcmapq.report.text import score
 from pcmapq.result import Result
@@ -126,7 +126,8 @@ def with_yaml(image: Path, folder: Path, resolution: float, **thresholds: float)
 def commonest_greys(image: Path, count: int = 3) -> list[int]:
     """The ``count`` most frequent grey values of an image as pcmapq's loader reads it (0..255),
     darkest first."""
-    grey, _ = read_grey(image)
+    levels, channels, scale, _ = read_levels(image)
+    grey = levels / channels * scale
     values, counts = np.unique(np.rint(grey), return_counts=True)
     return sorted(int(v) for v in values[np.argsort(-counts, kind="stable")[:count]])
 

@@ -13,7 +13,7 @@ import numpy as np
 from bench import bench_scale
 from pcmapq.config import AlignmentConfig, Settings, SourceConfig
 from pcmapq.io import OccupancyMap, load_map
-from pcmapq.io.occupancy import classify, read_grey
+from pcmapq.io.occupancy import classify, read_levels
 from pcmapq.raster.draw import OCCUPIED
 from pcmapq.report.text import number
 from pcmapq.result import Result
@@ -48,8 +48,9 @@ DARK = 50
 def walls_read_occupied(image: Path, dark: float = DARK) -> float:
     """Share of an image's dark pixels (grey < ``dark``, opaque) that pcmapq's loader, with
     ROS's default thresholds, reads as occupied."""
-    grey, transparent = read_grey(image)
-    state = classify(grey, transparent, ROS)
+    levels, channels, scale, transparent = read_levels(image)
+    state = classify(levels, channels, scale, transparent, ROS)
+    grey = levels / channels * scale
     walls = (grey < dark) & ~transparent
     return float((state[walls] == OCCUPIED).mean()) if walls.any() else 0.0
 
@@ -152,8 +153,8 @@ def pipeline_row(data: Path, name: str, run: Run) -> str:
 def section(data: Path, record: Record) -> Section:
     """The Halmstad maps against their layouts."""
     bench, *runs = (case.run(record) for case in cases(data))
-    greys = np.arange(256.0)
-    occupied = greys[classify(greys, np.zeros(256, bool), ROS) == OCCUPIED]
+    greys = np.arange(256)
+    occupied = greys[classify(greys, 1, 1.0, np.zeros(256, bool), ROS) == OCCUPIED]
     first_map, first_layout = paths(data, MAPS[0])
     occ, unknown, free = commonest_greys(first_map)
     wall, outside, inside = commonest_greys(first_layout)

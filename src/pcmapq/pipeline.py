@@ -13,7 +13,7 @@ from pcmapq.align import Alignment, align
 from pcmapq.align.rigid3d import Registration3D, align_3d, apply
 from pcmapq.config import Settings
 from pcmapq.errors import EvaluationError, InputError
-from pcmapq.features import Features, detect_both, walls_of
+from pcmapq.features import Features, detect_both
 from pcmapq.frames import Frames, Levelling
 from pcmapq.grid import MetricGrid
 from pcmapq.io import OccupancyMap, PointMap, load_map
@@ -265,11 +265,8 @@ def score(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap, setti
         raise EvaluationError(refusal(map_path, truth_path, alignment, cover, settings, map_xy,
                                       truth_xy))
 
-    progress("drawing the walls' centre lines")
-    truth_walls, map_walls = walls_of(truth_occ, grid), walls_of(map_occ, grid)
     names, params = settings.matching.detectors, settings.matching.params
-    progress(f"detecting {', '.join(names)}")
-    truth_found, map_found = detect_both(truth_walls, map_walls, names, params)
+    truth_found, map_found = detect_both(truth_occ, map_occ, grid, names, params, progress)
     detectors = {}
     full, threshold = settings.footprint.full, settings.matching.threshold
     for name in names:

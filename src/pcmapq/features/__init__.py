@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import importlib
 import pkgutil
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from threading import Lock
 from typing import Any
@@ -72,14 +72,17 @@ def detect_in(name: str, walls: WallImage, params: Any = None) -> Features:
     return found.detect(walls, found.checked(params))
 
 
-def detect_both(truth: WallImage, map_: WallImage, names: Sequence[str],
-                params: Mapping[str, Any]) -> tuple[dict[str, Features], dict[str, Features]]:
-    """:func:`detect_in` of every detector of ``names`` (with ``params.get(name)``) in the truth's
-    and the map's walls: the two sides side by side on two threads, the map's detectors in the
+def detect_both(truth: np.ndarray, map_: np.ndarray, grid: MetricGrid, names: Sequence[str],
+                params: Mapping[str, Any], progress: Callable[[str], None] = lambda step: None
+                ) -> tuple[dict[str, Features], dict[str, Features]]:
+    """:func:`detect` of every detector of ``names`` (with ``params.get(name)``) on the truth's
+    and the map's occupied cells (bool, both on ``grid``), the two sides side by side on two
+    threads: first both sides' walls (:func:`walls_of`), then the detectors, the map's in the
     reverse order and one side at a time per detector. So the two sides' largest temporaries
     (SIFT's scale space) never coincide, and one side's Python-bound steps (Hough's merging)
     overlap the other's OpenCV and NumPy work, which runs without the interpreter lock. Each
-    detection depends on its own input only: the features are those of one thread."""
+    result depends on its own input only, whichever thread computes it. ``progress`` hears
+    each stage's name as it starts."""
     names = list(names)
     for name in names:
         detector(name)  # unknown names fail here, before any work
@@ -93,8 +96,11 @@ def detect_both(truth: WallImage, map_: WallImage, names: Sequence[str],
         return found
 
     with ThreadPoolExecutor(2) as pool:
-        truth_found = pool.submit(side, truth, names)
-        map_found = pool.submit(side, map_, names[::-1])
+        progress("drawing the walls' centre lines")
+        truth_walls, map_walls = pool.map(walls_of, (truth, map_), (grid, grid))
+        progress(f"detecting {', '.join(names)}")
+        truth_found = pool.submit(side, truth_walls, names)
+        map_found = pool.submit(side, map_walls, names[::-1])
         return truth_found.result(), map_found.result()
 
 
