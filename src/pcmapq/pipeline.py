@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import replace
 from pathlib import Path
 
@@ -13,7 +14,7 @@ from pcmapq.align import Alignment, align
 from pcmapq.align.rigid3d import Registration3D, align_3d, apply
 from pcmapq.config import Settings
 from pcmapq.errors import EvaluationError, InputError
-from pcmapq.features import Features, detect_both
+from pcmapq.features import Features, SideBySide
 from pcmapq.frames import Frames, Levelling
 from pcmapq.grid import MetricGrid
 from pcmapq.io import OccupancyMap, PointMap, load_map
@@ -203,6 +204,19 @@ def align_clouds_3d(source: OccupancyMap | PointMap, truth: OccupancyMap | Point
     return replace(source, points=apply(reg.transform, source.points)), reg
 
 
+def align_plan(map_xy: np.ndarray, truth_xy: np.ndarray, registration: Registration3D | None,
+               settings: Settings) -> Alignment:
+    """The 2D alignment of the map's plan points to the truth's (both (N, 2) metres, in their
+    own frames): the search and ICP of :func:`pcmapq.align.align`, or, after a 3D registration,
+    the plan scored as it is."""
+    option = settings.alignment
+    if registration is None:
+        return align(map_xy, truth_xy, option.params, init=option.init, refine=option.enabled,
+                     scale=option.scale)
+    return replace(align(map_xy, truth_xy, option.params, init=Similarity2D(), refine=False),
+                   method="3d")
+
+
 def evaluate(map_path: str | Path | PointMap, truth_path: str | Path,
              settings: Settings | None = None, progress: Progress = lambda step: None,
              memory_limit: int | None = None) -> Result:
@@ -237,45 +251,50 @@ def needed_memory(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMa
 def score(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap, settings: Settings,
           progress: Progress = lambda step: None, memory_limit: int | None = None) -> Result:
     """Score a loaded map against a loaded truth: align, raster, detect, match; stop first
-    (InputError) when that would need more than ``memory_limit`` bytes (None: the default)."""
+    (InputError) when that would need more than ``memory_limit`` bytes (None: the default).
+    The truth's features do not depend on the map: they are found on a second thread while
+    the map is aligned and drawn (see :class:`~pcmapq.features.SideBySide`)."""
     map_path, truth_path = source.path, truth.path
     rule = map_footprint_rule(source, settings)
     truth_xy, truth_level = plan_points(truth, settings)
     memory.guard(needed_memory(source, truth, truth_xy, settings), memory_limit,
                  f"{map_path} against {truth_path}")
-    progress("aligning")
-    source, registration = align_clouds_3d(source, truth, settings)
-    map_xy, map_level = plan_points(source, settings)
-    option = settings.alignment
-    if registration is None:
-        alignment = align(map_xy, truth_xy, option.params, init=option.init,
-                          refine=option.enabled, scale=option.scale)
-    else:  # already aligned in 3D: score its plan in 2D as it is
-        alignment = replace(align(map_xy, truth_xy, option.params, init=Similarity2D(),
-                                  refine=False), method="3d")
+    grid, truth_occ = truth_raster(truth, truth_xy, settings)
+    sides = SideBySide(settings.matching.detectors, settings.matching.params)
+    with ThreadPoolExecutor(1) as background:
+        truth_side = background.submit(sides.features, truth_occ, grid)
+        try:
+            progress("aligning")
+            source, registration = align_clouds_3d(source, truth, settings)
+            map_xy, map_level = plan_points(source, settings)
+            alignment = align_plan(map_xy, truth_xy, registration, settings)
+
+            progress("rasterising")
+            map_occ, footprint = map_raster(source, map_xy, alignment.transform, grid, settings,
+                                            rule)
+            to_map = nearest_distance(map_occ, grid)
+            cover = overlap(truth_occ, to_map, footprint, alignment)
+            option = settings.alignment
+            if cover.confidence < option.min_confidence and not option.force:
+                raise EvaluationError(refusal(map_path, truth_path, alignment, cover, settings,
+                                              map_xy, truth_xy))
+            progress("drawing the walls' centre lines and detecting features")
+            map_found = sides.features(map_occ, grid, reverse=True)
+            truth_found = truth_side.result()
+        except BaseException:
+            sides.cancel()
+            raise
     frames = Frames(alignment.transform, map_level, truth_level,
                     None if registration is None else registration.transform)
-
-    progress("rasterising")
-    grid, truth_occ = truth_raster(truth, truth_xy, settings)
-    map_occ, footprint = map_raster(source, map_xy, alignment.transform, grid, settings, rule)
-    to_map = nearest_distance(map_occ, grid)
-    cover = overlap(truth_occ, to_map, footprint, alignment)
-    if cover.confidence < option.min_confidence and not option.force:
-        raise EvaluationError(refusal(map_path, truth_path, alignment, cover, settings, map_xy,
-                                      truth_xy))
-
-    names, params = settings.matching.detectors, settings.matching.params
-    truth_found, map_found = detect_both(truth_occ, map_occ, grid, names, params, progress)
     detectors = {}
     full, threshold = settings.footprint.full, settings.matching.threshold
-    for name in names:
+    for name in sides.names:
         truth_f, map_f = truth_found[name], map_found[name]
         if not full:  # truth features the map never saw are not missing
             truth_f = truth_f.counted_where(inside(truth_f, footprint, grid))
         detectors[name] = DetectorResult(truth_f, map_f,
                                          match(name, truth_f, map_f, threshold,
-                                               params.get(name)))
+                                               settings.matching.params.get(name)))
     cloud_distances = None
     if registration is not None:
         progress("distances in 3D")

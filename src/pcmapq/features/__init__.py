@@ -9,9 +9,8 @@ from __future__ import annotations
 
 import importlib
 import pkgutil
-from collections.abc import Callable, Mapping, Sequence
-from concurrent.futures import ThreadPoolExecutor
-from threading import Lock
+from collections.abc import Mapping, Sequence
+from threading import Event, Lock
 from typing import Any
 
 import numpy as np
@@ -21,8 +20,8 @@ from pcmapq.features.base import Candidates, Detector, Features
 from pcmapq.features.walls import WallImage, wall_image
 from pcmapq.grid import MetricGrid
 
-__all__ = ["DETECTORS", "Candidates", "Detector", "Features", "WallImage", "default_params",
-           "detect", "detect_both", "detect_in", "detector", "walls_of"]
+__all__ = ["DETECTORS", "Candidates", "Detector", "Features", "SideBySide", "WallImage",
+           "default_params", "detect", "detect_in", "detector", "walls_of"]
 
 
 def _discover() -> dict[str, Detector]:
@@ -72,36 +71,42 @@ def detect_in(name: str, walls: WallImage, params: Any = None) -> Features:
     return found.detect(walls, found.checked(params))
 
 
-def detect_both(truth: np.ndarray, map_: np.ndarray, grid: MetricGrid, names: Sequence[str],
-                params: Mapping[str, Any], progress: Callable[[str], None] = lambda step: None
-                ) -> tuple[dict[str, Features], dict[str, Features]]:
-    """:func:`detect` of every detector of ``names`` (with ``params.get(name)``) on the truth's
-    and the map's occupied cells (bool, both on ``grid``), the two sides side by side on two
-    threads: first both sides' walls (:func:`walls_of`), then the detectors, the map's in the
-    reverse order and one side at a time per detector. So the two sides' largest temporaries
-    (SIFT's scale space) never coincide, and one side's Python-bound steps (Hough's merging)
-    overlap the other's OpenCV and NumPy work, which runs without the interpreter lock. Each
-    result depends on its own input only, whichever thread computes it. ``progress`` hears
-    each stage's name as it starts."""
-    names = list(names)
-    for name in names:
-        detector(name)  # unknown names fail here, before any work
-    busy = {name: Lock() for name in names}
+class SideBySide:
+    """The truth's and the map's features, each side on its own thread (:meth:`features`):
+    the truth's start as soon as its raster exists, while the map is still being aligned.
 
-    def side(walls: WallImage, order: list[str]) -> dict[str, Features]:
+    The two sides take turns per detector (one side at a time runs a given detector) and the
+    map runs its detectors in the reverse order, so the two sides' largest temporaries (SIFT's
+    scale space) never coincide and one side's Python-bound steps (Hough's merging) overlap the
+    other's OpenCV and NumPy work, which runs without the interpreter lock. Each result depends
+    on its own input only, whichever thread computes it. :meth:`cancel` stops a side at its next
+    detector (a refused map needs no truth features)."""
+
+    def __init__(self, names: Sequence[str], params: Mapping[str, Any]) -> None:
+        """names: the detectors (keys of :data:`DETECTORS`, unknown ones fail here); params:
+        their parameters by name (missing: the defaults)."""
+        self.names, self.params = list(names), params
+        for name in self.names:
+            detector(name)
+        self._busy = {name: Lock() for name in self.names}
+        self._stop = Event()
+
+    def features(self, occupied: np.ndarray, grid: MetricGrid,
+                 reverse: bool = False) -> dict[str, Features]:
+        """Every detector's features on one side's occupied cells (bool on ``grid``), in the
+        detectors' order or its ``reverse``; empty when cancelled before any."""
+        walls = walls_of(occupied, grid)
         found = {}
-        for name in order:
-            with busy[name]:
-                found[name] = detect_in(name, walls, params.get(name))
+        for name in self.names[::-1] if reverse else self.names:
+            if self._stop.is_set():
+                break
+            with self._busy[name]:
+                found[name] = detect_in(name, walls, self.params.get(name))
         return found
 
-    with ThreadPoolExecutor(2) as pool:
-        progress("drawing the walls' centre lines")
-        truth_walls, map_walls = pool.map(walls_of, (truth, map_), (grid, grid))
-        progress(f"detecting {', '.join(names)}")
-        truth_found = pool.submit(side, truth_walls, names)
-        map_found = pool.submit(side, map_walls, names[::-1])
-        return truth_found.result(), map_found.result()
+    def cancel(self) -> None:
+        """Stop every side at its next detector."""
+        self._stop.set()
 
 
 def detect(name: str, occupied: np.ndarray, grid: MetricGrid, params: Any = None) -> Features:
