@@ -134,7 +134,8 @@ def _align_rigid(map_xy: np.ndarray, truth_xy: np.ndarray, params: AlignParams,
                        params.finalists_for(scale=False))
     # Point-to-line on the winner only: finishing both finalists (as with the scale free) moved
     # no bench_align pose by over 1e-7 m and took 18 % more CPU time there.
-    tf = refine_point_to_line(map_ds, LineTarget(truth_ds), best.transform, fine_stages[-1][0])
+    tf = refine_point_to_line(map_ds, LineTarget(truth_ds, tree), best.transform,
+                              fine_stages[-1][0])
     return _labelled(scored(tf), search, "coarse+icp")
 
 
@@ -175,7 +176,7 @@ def align_similarity(map_xy: np.ndarray, truth_xy: np.ndarray,
                                    resolution=resolution, top_k=params.top_k)
     first, *rest = similarity_schedule(resolution, tolerance, voxel)
     rough, fine = SimilarityTarget(truth_ds, (first,)), SimilarityTarget(truth_ds, tuple(rest))
-    lines = LineTarget(truth_ds)
+    lines = LineTarget(truth_ds, tree)
 
     def finish(tf: Similarity2D) -> Similarity2D:
         tf = refine_similarity(map_xy, fine, tf)
