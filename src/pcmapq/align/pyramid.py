@@ -31,7 +31,7 @@ import numpy as np
 
 from pcmapq.align.coarse import Candidate, Search, _pose, _suppress, likelihood_field
 from pcmapq.grid import MetricGrid
-from pcmapq.voxels import voxel_centroids
+from pcmapq.voxels import evenly, voxel_centroids
 
 #: Distinct poses searched per level, in beams: the bound prunes all but a few of them.
 PARENTS = 4
@@ -60,10 +60,7 @@ class _Level:
                                        value=0.0)
         size = 2 * BOUND + 1
         self.bound = cv2.dilate(self.field, np.ones((size, size), np.uint8))
-        points = voxel_centroids(centred, 0.5 * cell)
-        if len(points) > max_points:
-            points = points[np.linspace(0, len(points) - 1, max_points).astype(np.int64)]
-        self.points = points
+        self.points = evenly(voxel_centroids(centred, 0.5 * cell), max_points)
 
     def pixels(self, yaws: np.ndarray, xy: np.ndarray) -> np.ndarray:
         """Padded-field pixels (len(yaws), N, 2) int64 of the points turned by each yaw
