@@ -29,7 +29,7 @@ from pcmapq.align.point_to_point import DEFAULT_SCHEDULE, IcpTarget, refine_poin
 from pcmapq.align.pyramid import descend
 from pcmapq.align.similarity_icp import SimilarityTarget, refine_similarity, similarity_schedule
 from pcmapq.transform import Similarity2D
-from pcmapq.voxels import evenly, voxel_centroids
+from pcmapq.voxels import evenly, voxel_centroids, voxel_count
 
 #: The truth keeps this many times the map's ``max_points``: a sparse target would put map points
 #: on its walls farther than the tolerance from its nearest point.
@@ -244,12 +244,12 @@ def _scored(map_xy: np.ndarray, tree: cKDTree, tf: Similarity2D, tolerance: floa
 def _thinned(xy: np.ndarray, voxel: float, max_points: int) -> tuple[np.ndarray, float]:
     """Voxel centroids of ``xy`` (N, 2, metres) at ``voxel`` metres; when more than
     ``max_points``, at the voxel grown by the ratio (about ``max_points`` remain on walls).
-    Returns them and the voxel used, metres."""
-    ds = voxel_centroids(xy, voxel)
-    if len(ds) <= max_points:
-        return ds, voxel
-    grown = voxel * len(ds) / max_points
-    return voxel_centroids(xy, grown), grown
+    Returns them and the voxel used, metres. Beyond ``max_points`` points the voxels are counted
+    first, so a cloud to be thinned is grouped once, at the grown voxel."""
+    if len(xy) > max_points and (count := voxel_count(xy, voxel)) > max_points:
+        grown = voxel * count / max_points
+        return voxel_centroids(xy, grown), grown
+    return voxel_centroids(xy, voxel), voxel
 
 
 def _map_at_scale(map_xy: np.ndarray, tf: Similarity2D, voxel: float) -> np.ndarray:
