@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from pcmapq import voxels
-from pcmapq.voxels import VoxelMap, voxel_centroids, voxel_index, voxel_keys
+from pcmapq.voxels import VoxelMap, evenly, voxel_centroids, voxel_count, voxel_index, voxel_keys
 
 
 def by_sorting(points: np.ndarray, voxel: float) -> np.ndarray:
@@ -45,3 +45,18 @@ def test_voxel_map_counts_its_first_merge_and_sorts_the_next() -> None:
     np.testing.assert_allclose(grid.points(), by_sorting(np.vstack([first, second]), 0.5),
                                rtol=0, atol=1e-12)
     assert len(grid) == len(by_sorting(np.vstack([first, second]), 0.5))
+
+
+@pytest.mark.parametrize("dims", [2, 3])
+def test_voxel_count_is_the_number_of_centroids(dims: int) -> None:
+    rng = np.random.default_rng(10 + dims)
+    dense = rng.normal(0, 0.3, (50_000, dims))  # counted by voxel_centroids
+    sparse = rng.uniform(-500, 500, (20_000, dims))  # sorted by voxel_centroids
+    for points in (dense, sparse, np.vstack([sparse, sparse[:100]]), np.empty((0, dims))):
+        assert voxel_count(points, 0.05) == len(voxel_centroids(points, 0.05))
+
+
+def test_evenly_spreads_over_the_order() -> None:
+    points = np.arange(20.0).reshape(10, 2)
+    np.testing.assert_array_equal(evenly(points, 4), points[[0, 3, 6, 9]])
+    assert evenly(points, 10) is points and evenly(points, 50) is points

@@ -17,7 +17,8 @@ class AlignParams:
     max_points: rigid alignment: a map with more voxels than this is downsampled again with
         the voxel grown in proportion (walls are lines: about this many points remain), so
         the search and ICP on a large map cost about what they cost on one of this size; the
-        truth likewise beyond ten times as many.
+        truth likewise beyond ten times as many. A thinned map's point-to-point ICP stages run
+        on a few thousand of its points (:data:`pcmapq.align.planar.ICP_POINTS`).
     resolution: raster cell of the global search's sweep, metres; None: the map's radius / 40,
         at least 0.25 m (rigid), or the truth's radius / 20 (scale free, where it also sets the
         ICP stages).

@@ -9,24 +9,37 @@ from scipy.spatial import cKDTree
 from pcmapq.transform import Similarity2D
 
 
-def line_normals(xy: np.ndarray, tree: cKDTree, neighbours: int = 8) -> np.ndarray:
-    """Unit normal (N, 2) of the local line through each point (N >= 2, 2, metres): the
-    direction of least spread of its nearest neighbours (PCA); ``tree`` holds the points."""
-    _, idx = tree.query(xy, k=min(neighbours, len(xy)))
-    near = xy[idx] - xy[idx].mean(axis=1, keepdims=True)
+def line_normals(tree: cKDTree, index: np.ndarray, neighbours: int = 8) -> np.ndarray:
+    """Unit normal (K, 2) of the local line through each of the tree's points ``index`` (K,):
+    the direction of least spread of the point's nearest neighbours among the tree's points
+    (N >= 2, 2, metres; PCA). Each normal depends on its point alone, not on the others asked
+    for with it."""
+    points = tree.data
+    _, idx = tree.query(points[index], k=min(neighbours, len(points)))
+    near = points[idx] - points[idx].mean(axis=1, keepdims=True)
     _, vectors = np.linalg.eigh(np.einsum("nki,nkj->nij", near, near))
     return vectors[:, :, 0]
 
 
 class LineTarget:
     """The truth prepared once for point-to-line ICP from many starts: its points (M, 2, metres,
-    truth frame), their KD-tree and line normals (none under 3 points: nothing to refine on)."""
+    truth frame), their KD-tree, and their line normals, each computed the first time a map
+    point pairs with its truth point (a map of part of a large truth touches few of them)."""
 
-    def __init__(self, truth_xy: np.ndarray) -> None:
+    def __init__(self, truth_xy: np.ndarray, tree: cKDTree | None = None) -> None:
+        """truth_xy: (M, 2) metres, truth frame; tree: a KD-tree of exactly these points, to
+        share one already built (default: one is built)."""
         self.points = np.asarray(truth_xy, dtype=np.float64).reshape(-1, 2)
-        self.tree = cKDTree(self.points)
-        self.normals = (line_normals(self.points, self.tree) if len(self.points) >= 3
-                        else np.empty((0, 2)))
+        self.tree = cKDTree(self.points) if tree is None else tree
+        self._normals = np.full((len(self.points), 2), np.nan)
+
+    def normals(self, index: np.ndarray) -> np.ndarray:
+        """Unit line normals (K, 2) of the truth points ``index`` (K,), as
+        :func:`line_normals`; none is computed twice. Needs at least 3 truth points."""
+        missing = np.unique(index[np.isnan(self._normals[index, 0])])
+        if len(missing):
+            self._normals[missing] = line_normals(self.tree, missing)
+        return self._normals[index]
 
 
 def refine_point_to_line(map_xy: np.ndarray, target: LineTarget, init: Similarity2D,
@@ -36,17 +49,17 @@ def refine_point_to_line(map_xy: np.ndarray, target: LineTarget, init: Similarit
     frame) onto the truth (``target``), from ``init``; pairs farther apart than
     ``max_distance`` metres are ignored. Returns the map -> truth transform: scale 1, or with
     ``with_scale`` the scale refined too (the map then in any unit, starting at ``init``'s)."""
-    if len(target.normals) == 0:
+    if len(target.points) < 3:  # no lines to refine on
         return init
-    truth_xy, normals, tree = target.points, target.normals, target.tree
+    truth_xy, tree = target.points, target.tree
     tf = init if with_scale else Similarity2D(init.tx, init.ty, init.yaw)
     for _ in range(iterations):
         p = tf.apply(map_xy)
-        dist, j = tree.query(p, distance_upper_bound=max_distance)
+        dist, j = tree.query(p, distance_upper_bound=max_distance, workers=-1)
         ok = np.isfinite(dist)
         if ok.sum() < 3:
             break
-        p, n = p[ok], normals[j[ok]]
+        p, n = p[ok], target.normals(j[ok])
         r = np.einsum("ni,ni->n", p - truth_xy[j[ok]], n)
         # residual change for a step (dx, dy, dyaw[, ds]) about the origin:
         # n . (d + dyaw * perp(p) [+ ds * p])

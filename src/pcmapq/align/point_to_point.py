@@ -44,21 +44,25 @@ def _to_se2(m: np.ndarray) -> Similarity2D:
 
 
 class IcpTarget:
-    """The truth cloud prepared once for every stage of a schedule, so many starts can share it."""
+    """The truth cloud prepared once for every stage of a schedule, so many starts can share it:
+    one downsampled cloud per distinct voxel of the schedule."""
 
     def __init__(self, truth_xy: np.ndarray,
                  schedule: tuple[tuple[float, float], ...] = DEFAULT_SCHEDULE) -> None:
         """truth_xy: (N, 2) metres, truth frame; schedule: (max distance, voxel) pairs, metres."""
         self.schedule = schedule
-        self.clouds = [_cloud(voxel_centroids(truth_xy, voxel)) for _, voxel in schedule]
+        clouds = {voxel: _cloud(voxel_centroids(truth_xy, voxel))
+                  for voxel in dict.fromkeys(voxel for _, voxel in schedule)}
+        self.clouds = [clouds[voxel] for _, voxel in schedule]
 
 
 def refine_point_to_point(map_xy: np.ndarray, target: IcpTarget, init: Similarity2D,
-                          max_iterations: int = 30) -> Similarity2D:
+                          max_iterations: int = 30, stages: slice = slice(None)) -> Similarity2D:
     """Point-to-point ICP of the map (N, 2, metres, map frame) onto the truth from ``init``.
 
-    Runs the target's schedule of shrinking correspondence distances and voxel sizes, projecting
-    to SE(2) after every stage. Returns the map -> truth transform (scale 1).
+    Runs the target's schedule (its ``stages`` part) of shrinking correspondence distances and
+    voxel sizes, projecting to SE(2) after every stage. Returns the map -> truth transform
+    (scale 1).
     """
     import open3d as o3d  # heavy: loaded when ICP runs
 
@@ -66,7 +70,8 @@ def refine_point_to_point(map_xy: np.ndarray, target: IcpTarget, init: Similarit
     criteria = o3d.pipelines.registration.ICPConvergenceCriteria(
         relative_fitness=1e-6, relative_rmse=1e-6, max_iteration=max_iterations)
     method = o3d.pipelines.registration.TransformationEstimationPointToPoint()
-    for (max_dist, voxel), truth in zip(target.schedule, target.clouds, strict=True):
+    for (max_dist, voxel), truth in zip(target.schedule[stages], target.clouds[stages],
+                                        strict=True):
         source = _cloud(voxel_centroids(map_xy, voxel))
         result = o3d.pipelines.registration.registration_icp(
             source, truth, max_dist, _matrix4(tf), method, criteria)

@@ -31,7 +31,7 @@ import numpy as np
 
 from pcmapq.align.coarse import Candidate, Search, _pose, _suppress, likelihood_field
 from pcmapq.grid import MetricGrid
-from pcmapq.voxels import voxel_centroids
+from pcmapq.voxels import evenly, voxel_centroids
 
 #: Distinct poses searched per level, in beams: the bound prunes all but a few of them.
 PARENTS = 4
@@ -40,11 +40,15 @@ SHIFT = 2
 #: Max-pooling half-width of the bound, cells: a turn of one step moves a point one cell, the
 #: shift SHIFT cells, the rounding of points to cells one more.
 BOUND = 1 + SHIFT + 1
+#: Zero cells around the field that children read: a point clipped into this border reads only
+#: zeros at every shift, as a point outside the field does.
+WIDE = 2 * SHIFT + 1
 
 
 class _Level:
     """One level of the descent: the likelihood field at ``cell`` metres (padded by one zero
-    cell), its max-pooled bound, and the map's points (N, 2, metres, about its centroid)."""
+    cell; and by WIDE, for the children's shifted reads), its max-pooled bound, and the map's
+    points (N, 2, metres, about its centroid)."""
 
     def __init__(self, centred: np.ndarray, truth_xy: np.ndarray, cell: float, margin: float,
                  max_points: int) -> None:
@@ -52,12 +56,11 @@ class _Level:
         self.grid = MetricGrid.covering(truth_xy, cell, margin=margin)
         field = likelihood_field(truth_xy, self.grid, cell)
         self.field = cv2.copyMakeBorder(field, 1, 1, 1, 1, cv2.BORDER_CONSTANT, value=0.0)
+        self.wide = cv2.copyMakeBorder(field, WIDE, WIDE, WIDE, WIDE, cv2.BORDER_CONSTANT,
+                                       value=0.0)
         size = 2 * BOUND + 1
         self.bound = cv2.dilate(self.field, np.ones((size, size), np.uint8))
-        points = voxel_centroids(centred, 0.5 * cell)
-        if len(points) > max_points:
-            points = points[np.linspace(0, len(points) - 1, max_points).astype(np.int64)]
-        self.points = points
+        self.points = evenly(voxel_centroids(centred, 0.5 * cell), max_points)
 
     def pixels(self, yaws: np.ndarray, xy: np.ndarray) -> np.ndarray:
         """Padded-field pixels (len(yaws), N, 2) int64 of the points turned by each yaw
@@ -76,13 +79,18 @@ class _Level:
         return image[v, u].mean(axis=-1)
 
     def children(self, yaw: float, xy: np.ndarray, step: float) -> np.ndarray:
-        """The best child of the region of (yaw, xy): one row (score, yaw, x, y)."""
+        """The best child of the region of (yaw, xy): one row (score, yaw, x, y). Each child's
+        score is :meth:`mean` of the padded field under its shifted pixels, read in the wide
+        field at flat indices: a pixel outside reads 0 either way."""
         yaws = yaw + step * np.arange(-1, 2)
-        uv = self.pixels(yaws, xy)  # (3, N, 2)
+        uv = self.pixels(yaws, xy)  # (3, N, 2), in the field padded by one cell
+        rows, cols = self.wide.shape
+        u = np.clip(uv[..., 0] + (WIDE - 1), SHIFT, cols - 1 - SHIFT)
+        v = np.clip(uv[..., 1] + (WIDE - 1), SHIFT, rows - 1 - SHIFT)
         d = np.arange(-SHIFT, SHIFT + 1)
         du, dv = (a.ravel() for a in np.meshgrid(d, d))
-        shifted = uv[:, None, :, :] + np.stack([du, dv], axis=-1)[None, :, None, :]
-        scores = self.mean(self.field, shifted)  # (3, 25)
+        flat = (v * cols + u)[:, None, :] + (dv * cols + du)[None, :, None]  # (3, 25, N)
+        scores = self.wide.ravel()[flat].mean(axis=-1)  # (3, 25)
         i, j = np.unravel_index(int(np.argmax(scores)), scores.shape)
         best = xy + self.cell * np.array([du[j], -dv[j]])
         return np.array([scores[i, j], yaws[i], best[0], best[1]])
