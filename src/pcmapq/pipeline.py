@@ -225,14 +225,20 @@ def evaluate(map_path: str | Path | PointMap, truth_path: str | Path,
     ``memory_limit`` bytes (None: :func:`pcmapq.memory.default_limit`)."""
     settings = Settings() if settings is None else settings
     progress("loading")
-    truth = load_map(truth_path, settings.truth.resolution,
-                     thresholds=settings.truth.thresholds)
-    guess = settings.truth.resolution or settings.raster.cloud_resolution
-    if isinstance(truth, OccupancyMap):
-        guess = truth.grid.resolution
-    source = map_path if isinstance(map_path, PointMap) else load_map(
-        map_path, settings.map.resolution, guess if settings.alignment.scale else None,
-        settings.map.thresholds)
+    scaled = settings.alignment.scale
+    with ThreadPoolExecutor(1) as background:  # the two files at once
+        truth_job = background.submit(load_map, truth_path, settings.truth.resolution,
+                                      thresholds=settings.truth.thresholds)
+        try:
+            source = map_path if isinstance(map_path, PointMap) or scaled else load_map(
+                map_path, settings.map.resolution, None, settings.map.thresholds)
+        finally:
+            truth = truth_job.result()  # the truth's error first, as one after the other
+    if scaled and not isinstance(map_path, PointMap):
+        # a map of unknown unit starts from the truth's resolution
+        guess = truth.grid.resolution if isinstance(truth, OccupancyMap) else (
+            settings.truth.resolution or settings.raster.cloud_resolution)
+        source = load_map(map_path, settings.map.resolution, guess, settings.map.thresholds)
     return score(source, truth, settings, progress, memory_limit)
 
 
