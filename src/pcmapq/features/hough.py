@@ -48,7 +48,6 @@ from pcmapq.features.base import (
     Features,
     by_strips,
     empty_features,
-    gaussian,
     gaussian_reach,
     no_candidates,
     sorted_features,
@@ -110,9 +109,8 @@ def detect(walls: WallImage, params: Params) -> Features:
     resolution = work.resolution
     sigma_px = p.sigma / resolution
     # the blur's reach, its derivatives' pixel and one more
-    mask, direction = by_strips(image, gaussian_reach(sigma_px) + 2,
-                                lambda strip: ridges(strip, sigma_px, p.ridge))
-    smooth = gaussian(image, sigma_px)
+    mask, direction, smooth = by_strips(image, gaussian_reach(sigma_px) + 2,
+                                        lambda strip: ridges(strip, sigma_px, p.ridge))
     shortest = p.support * p.min_length
     px = pieces(mask, direction)
     _, size = directions(px)

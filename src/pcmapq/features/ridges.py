@@ -16,7 +16,8 @@ from pcmapq.features.pixels import flat_index, neighbour_pairs
 from pcmapq.features.pixels import pieces as connected
 
 
-def ridges(image: np.ndarray, sigma_px: float, floor: float) -> tuple[np.ndarray, np.ndarray]:
+def ridges(image: np.ndarray, sigma_px: float,
+           floor: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """One-pixel centre lines of the bright ridges of ``image`` (Steger's detector), and their
     local direction.
 
@@ -38,6 +39,7 @@ def ridges(image: np.ndarray, sigma_px: float, floor: float) -> tuple[np.ndarray
     mask : (rows, cols) bool mask of ridge pixels.
     direction : (rows, cols) float32 direction along the ridge, radians in [0, pi) measured
         from the pixel u axis towards v (meaningful on the mask only).
+    smooth : (rows, cols) float32, the image smoothed with ``sigma_px``.
     """
     s = gaussian(image, sigma_px)
 
@@ -54,7 +56,7 @@ def ridges(image: np.ndarray, sigma_px: float, floor: float) -> tuple[np.ndarray
     inside = (np.abs(t * nu) <= 0.5) & (np.abs(t * nv) <= 0.5)
     line_like = np.abs(along) <= 0.5 * np.abs(lam)  # not a blob (a wall end)
     mask = inside & line_like & (-lam * sigma_px**2 >= floor)
-    return mask, np.mod(theta + 0.5 * np.pi, np.pi).astype(np.float32)
+    return mask, np.mod(theta + 0.5 * np.pi, np.pi).astype(np.float32), s
 
 
 #: Direction bins of one partition of the ridge pixels (30 degrees each).
