@@ -38,7 +38,7 @@ def ridges(image: np.ndarray, sigma_px: float,
     -------
     mask : (rows, cols) bool mask of ridge pixels.
     direction : (rows, cols) float32 direction along the ridge, radians in [0, pi) measured
-        from the pixel u axis towards v (meaningful on the mask only).
+        from the pixel u axis towards v (on strong line-like pixels, 0 elsewhere).
     smooth : (rows, cols) float32, the image smoothed with ``sigma_px``.
     """
     s = gaussian(image, sigma_px)
@@ -46,17 +46,23 @@ def ridges(image: np.ndarray, sigma_px: float,
     def diff(du: int, dv: int, scale: float) -> np.ndarray:
         return cv2.Sobel(s, cv2.CV_32F, du, dv, ksize=3, borderType=cv2.BORDER_REFLECT) / scale
 
-    gu, gv = diff(1, 0, 8.0), diff(0, 1, 8.0)
     a, c, b = diff(2, 0, 4.0), diff(0, 2, 4.0), diff(1, 1, 4.0)
     root = np.sqrt(0.25 * (a - c) ** 2 + b * b)
     lam, along = 0.5 * (a + c) - root, 0.5 * (a + c) + root  # across and along the ridge
+    line_like = np.abs(along) <= 0.5 * np.abs(lam)  # not a blob (a wall end)
+    # the rest only where the ridge is strong and line-like (a few percent of the pixels)
+    at = np.flatnonzero(line_like & (-lam * sigma_px**2 >= floor))
+    a, c, b, lam = a.ravel()[at], c.ravel()[at], b.ravel()[at], lam.ravel()[at]
+    gu, gv = diff(1, 0, 8.0).ravel()[at], diff(0, 1, 8.0).ravel()[at]
     theta = 0.5 * np.arctan2(2 * b, a - c) + 0.5 * np.pi  # eigenvector of lam: across
     nu, nv = np.cos(theta), np.sin(theta)
     t = -(gu * nu + gv * nv) / np.minimum(lam, -1e-12)  # distance to the maximum, pixels
     inside = (np.abs(t * nu) <= 0.5) & (np.abs(t * nv) <= 0.5)
-    line_like = np.abs(along) <= 0.5 * np.abs(lam)  # not a blob (a wall end)
-    mask = inside & line_like & (-lam * sigma_px**2 >= floor)
-    return mask, np.mod(theta + 0.5 * np.pi, np.pi).astype(np.float32), s
+    mask = np.zeros(s.shape, dtype=bool)
+    mask.ravel()[at[inside]] = True
+    direction = np.zeros(s.shape, dtype=np.float32)
+    direction.ravel()[at] = np.mod(theta + 0.5 * np.pi, np.pi)
+    return mask, direction, s
 
 
 #: Direction bins of one partition of the ridge pixels (30 degrees each).
