@@ -82,14 +82,16 @@ def peaks(resp: np.ndarray, radius_px: float, floor: float) -> tuple[np.ndarray,
 
     Returns sub-pixel (N, 2) pixel coordinates (u, v) and the (N,) peak values.
     """
-    padded = np.pad(resp, 1, mode="edge")
+    rows, cols = resp.shape
     # OpenCV's dilation ignores pixels beyond the border, as repeating the border would
-    is_max = (resp >= floor) & (cv2.dilate(resp, disk(radius_px)) <= resp)
-    v, u = np.nonzero(is_max)
+    top = cv2.dilate(resp, disk(radius_px)).ravel()
+    at = np.flatnonzero(resp >= floor)  # a few percent of the cells: test those only
+    at = at[top[at] <= resp.ravel()[at]]
+    v, u = np.divmod(at, cols)
     c = resp[v, u]
-    # a parabola through the 3 values along each axis (padded indices are +1)
-    left, right = padded[v + 1, u], padded[v + 1, u + 2]
-    up, down = padded[v, u + 1], padded[v + 2, u + 1]
+    # a parabola through the 3 values along each axis (the border repeated beyond it)
+    left, right = resp[v, np.maximum(u - 1, 0)], resp[v, np.minimum(u + 1, cols - 1)]
+    up, down = resp[np.maximum(v - 1, 0), u], resp[np.minimum(v + 1, rows - 1), u]
     du = 0.5 * (left - right) / np.minimum(left - 2 * c + right, -1e-12)
     dv = 0.5 * (up - down) / np.minimum(up - 2 * c + down, -1e-12)
     return np.column_stack([u + np.clip(du, -0.5, 0.5), v + np.clip(dv, -0.5, 0.5)]), c
