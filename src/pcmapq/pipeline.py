@@ -285,7 +285,7 @@ def score(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap, setti
                 raise EvaluationError(refusal(map_path, truth_path, alignment, cover, settings,
                                               map_xy, truth_xy))
             progress("drawing the walls' centre lines and detecting features")
-            map_found = sides.features(map_occ, grid, reverse=True)
+            map_found = sides.features(map_occ, grid, threads=2)
             truth_found = truth_side.result()
         except BaseException:
             sides.cancel()

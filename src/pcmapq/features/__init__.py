@@ -10,6 +10,7 @@ from __future__ import annotations
 import importlib
 import pkgutil
 from collections.abc import Mapping, Sequence
+from concurrent.futures import ThreadPoolExecutor
 from threading import Event, Lock
 from typing import Any
 
@@ -75,12 +76,13 @@ class SideBySide:
     """The truth's and the map's features, each side on its own thread (:meth:`features`):
     the truth's start as soon as its raster exists, while the map is still being aligned.
 
-    The two sides take turns per detector (one side at a time runs a given detector) and the
-    map runs its detectors in the reverse order, so the two sides' largest temporaries (SIFT's
-    scale space) never coincide and one side's Python-bound steps (Hough's merging) overlap the
-    other's OpenCV and NumPy work, which runs without the interpreter lock. Each result depends
-    on its own input only, whichever thread computes it. :meth:`cancel` stops a side at its next
-    detector (a refused map needs no truth features)."""
+    One side at a time runs a given detector, and a side takes the next of its detectors that
+    the other side is not running (waiting only when all that are left are busy): the two
+    sides' largest temporaries (SIFT's scale space) never coincide, neither side idles while
+    there is work the other does not hold, and one side's Python-bound steps (Hough's merging)
+    overlap the other's OpenCV and NumPy work, which runs without the interpreter lock. Each
+    result depends on its own input only, whichever thread computes it and in whatever order.
+    :meth:`cancel` stops a side at its next detector (a refused map needs no truth features)."""
 
     def __init__(self, names: Sequence[str], params: Mapping[str, Any]) -> None:
         """names: the detectors (keys of :data:`DETECTORS`, unknown ones fail here); params:
@@ -92,16 +94,35 @@ class SideBySide:
         self._stop = Event()
 
     def features(self, occupied: np.ndarray, grid: MetricGrid,
-                 reverse: bool = False) -> dict[str, Features]:
-        """Every detector's features on one side's occupied cells (bool on ``grid``), in the
-        detectors' order or its ``reverse``; empty when cancelled before any."""
+                 threads: int = 1) -> dict[str, Features]:
+        """Every detector's features on one side's occupied cells (bool on ``grid``), on up to
+        ``threads`` threads of this side (this one included); only those found before a
+        :meth:`cancel`."""
         walls = walls_of(occupied, grid)
-        found = {}
-        for name in self.names[::-1] if reverse else self.names:
-            if self._stop.is_set():
-                break
-            with self._busy[name]:
-                found[name] = detect_in(name, walls, self.params.get(name))
+        found: dict[str, Features] = {}
+        left, taking = list(self.names), Lock()
+
+        def work() -> None:
+            while not self._stop.is_set():
+                with taking:  # the first detector left that is free, else the first left
+                    if not left:
+                        return
+                    free = next((n for n in left if self._busy[n].acquire(blocking=False)),
+                                None)
+                    name = left[0] if free is None else free
+                    left.remove(name)
+                if free is None:
+                    self._busy[name].acquire()
+                try:
+                    found[name] = detect_in(name, walls, self.params.get(name))
+                finally:
+                    self._busy[name].release()
+
+        with ThreadPoolExecutor(max(threads - 1, 1)) as more:
+            others = [more.submit(work) for _ in range(threads - 1)]
+            work()
+            for other in others:
+                other.result()
         return found
 
     def cancel(self) -> None:
