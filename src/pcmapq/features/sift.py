@@ -114,17 +114,12 @@ def entropy(image: np.ndarray, window_px: float) -> np.ndarray:
     -------
     (rows, cols) float32 entropy in [0, 1] bits.
     """
-    p = gaussian(image, window_px).astype(np.float32, copy=window_px <= 0)  # never the input
-    np.clip(p, 1e-7, 1 - 1e-7, out=p)
-    q = 1 - p
-    h = np.log2(p)
-    h *= p
-    rest = np.log2(q)
-    rest *= q
-    h += rest  # in place, one image at a time: -(p log p + q log q), as written out
-    np.negative(h, out=h)
-    del rest, q
-    h[(p <= 1e-7) | (p >= 1 - 1e-7)] = 0.0
+    p = np.asarray(gaussian(image, window_px), dtype=np.float32)
+    at = np.flatnonzero((p > 1e-7) & (p < 1 - 1e-7))  # 0 bits where the window is one state
+    pa = p.ravel()[at]
+    qa = 1 - pa
+    h = np.zeros(p.shape, dtype=np.float32)
+    h.ravel()[at] = -(np.log2(pa) * pa + np.log2(qa) * qa)
     return h
 
 

@@ -266,6 +266,8 @@ def _band(occupied: np.ndarray, grid: MetricGrid, resolution: float, closing: fl
     line, core, fine = centreline(occupied, grid, fine_res, closing, spur, small, width)
     band = core.astype(np.float32)
     if line.any():
-        dist = distance_to(line)
-        band = np.maximum(band, np.clip(0.5 + (0.5 * width / fine_res - dist), 0.0, 1.0))
+        shade = distance_to(line)  # in place: 0.5 + (half width - distance), clipped to [0, 1]
+        np.subtract(0.5 * width / fine_res, shade, out=shade)
+        np.add(0.5, shade, out=shade)
+        np.maximum(band, np.clip(shade, 0.0, 1.0, out=shade), out=band)
     return resample(band, fine, resolution)[0]
