@@ -73,8 +73,10 @@ def test_round_room_json_table_report_plot(round_result):
     buf = io.StringIO()
     print_table(round_result, Console(file=buf, width=200))
     table = buf.getvalue()
-    rows = {line.split()[1]: line for line in table.splitlines()
-            if line.split()[1:2] in (["harris"], ["hough"], ["sift"])}
+    rows: dict[str, str] = {}  # the score table's rows, the first of each detector's
+    for line in table.splitlines():
+        if line.split()[:1] in (["harris"], ["hough"], ["sift"]):
+            rows.setdefault(line.split()[0], line)
     assert rows["harris"].count("n/a") == 3 and rows["sift"].count("n/a") == 3
     assert "n/a" not in rows["hough"]
     assert "harris: n/a: no strong truth feature" in table

@@ -13,8 +13,8 @@ import typer
 from rich.console import Console
 from rich.progress import Progress
 
-from pcmapq import options
-from pcmapq.config import DistancesConfig, MatchingConfig, Settings, SourceConfig
+from pcmapq import __version__, options
+from pcmapq.config import DETECTOR_NAMES, DistancesConfig, MatchingConfig, Settings, SourceConfig
 from pcmapq.errors import EvaluationError, InputError
 from pcmapq.io import PointMap
 from pcmapq.io.writers import write_atomic, write_cloud
@@ -28,19 +28,37 @@ from pcmapq.mapping import (
     write_tum_poses,
 )
 from pcmapq.pipeline import evaluate
+from pcmapq.raster.footprint import FOOTPRINT_RULES
 from pcmapq.report.table import print_table
 
 #: The documented defaults, read from the one place that defines them.
 DEFAULTS = Settings()
 
+#: Help at the terminal's width (click caps it at 80 columns unless told otherwise), as plain
+#: text: rich's markup would eat "[default: ...]" and squeeze the help into a narrow column.
+HELP_WIDTH = 200
+
 app = typer.Typer(add_completion=False, no_args_is_help=True, pretty_exceptions_enable=False,
+                  rich_markup_mode=None, context_settings={"max_content_width": HELP_WIDTH},
                   help="Map quality against a ground-truth map, in metres.")
 
 
+def _print_version(value: bool) -> None:
+    """--version: print pcmapq's version and stop."""
+    if value:
+        print(f"pcmapq {__version__}")
+        raise typer.Exit()
+
+
 @app.callback()
-def main() -> None:
+def main(
+    version: Annotated[bool, typer.Option(
+        "--version", help="Print pcmapq's version and exit.", callback=_print_version,
+        is_eager=True)] = False,
+) -> None:
     """pcmapq: score a robot-made map against a ground-truth map (frame convention:
-    p_truth = s * R(yaw) * p_map + t; metres and degrees)."""
+    p_truth = s * R(yaw) * p_map + t; metres and degrees). The scores are defined in
+    docs/metrics.md."""
 
 
 @app.command("map")
@@ -66,11 +84,13 @@ def map_command(
                          ] = None,
     voxel: Annotated[float, typer.Option(help="Cell of the output map, metres.", min=1e-4)
                      ] = 0.1,
+    quiet: Annotated[bool, typer.Option(
+        "--quiet", "-q", help="Print nothing but errors.")] = False,
 ) -> None:
     """Build a map from LiDAR scans with KISS-ICP (or with given poses) and save it."""
     err = Console(stderr=True)
     with _errors(err):
-        with _bar(err) as tick:
+        with _bar(err, enabled=not quiet) as tick:
             if poses is None:
                 points, trajectory = build_map_kiss(source, max_scans=max_scans, voxel=voxel,
                                                     progress=tick)
@@ -82,11 +102,16 @@ def map_command(
                     trajectory = trajectory[:max_scans]
                 points = build_map_from_poses(source, trajectory, voxel=voxel, progress=tick)
         write_cloud(out, points)
+        wrote = [f"wrote {out}: {len(points)} points from {len(trajectory)} scans"]
         if poses_out is not None:
             write_kitti_poses(poses_out, trajectory)
+            wrote.append(f"wrote {poses_out}: {len(trajectory)} poses (KITTI)")
         if tum_out is not None:
             write_tum_poses(tum_out, trajectory)
-    err.print(f"{out}: {len(points)} points from {len(trajectory)} scans", highlight=False)
+            wrote.append(f"wrote {tum_out}: {len(trajectory)} poses (TUM)")
+    if not quiet:
+        for line in wrote:
+            err.print(line, markup=False, highlight=False, soft_wrap=True)
 
 
 @contextmanager
@@ -100,9 +125,9 @@ def _errors(console: Console) -> Iterator[None]:
 
 
 @contextmanager
-def _bar(console: Console) -> Iterator[Callable[[int, int], None]]:
+def _bar(console: Console, enabled: bool) -> Iterator[Callable[[int, int], None]]:
     """A progress bar over scans on the terminal; nothing when not a terminal."""
-    if not console.is_terminal:
+    if not (enabled and console.is_terminal):
         yield lambda done, total: None
         return
     with Progress(console=console, transient=True) as bar:
@@ -133,9 +158,11 @@ def eval_command(
     max_scans: Annotated[int | None, typer.Option(
         help="With --scans: use only the first N scans.", min=1)] = None,
     map_resolution: Annotated[str | None, typer.Option(
+        metavar="<metres|auto>",
         help="Metres per pixel of a map image without YAML (overrides its YAML); 'auto' "
         "estimates the map's scale (same as --scale auto).")] = None,
     scale: Annotated[str, typer.Option(
+        metavar="<fixed|auto>",
         help="'fixed': the map's metres are metres; 'auto': estimate its scale too (a "
         "similarity), for maps whose resolution is unknown.")] = "fixed",
     truth_resolution: Annotated[float | None, typer.Option(
@@ -175,14 +202,18 @@ def eval_command(
         help="Wall band of a 3D cloud: upper bound, metres above the floor.")
     ] = DEFAULTS.raster.band_high,
     min_hits: Annotated[int | None, typer.Option(
-        help="Points needed to mark a cloud's cell occupied [default: 2 for a 3D cloud, 1 for "
-        "a 2D one].", min=1, show_default=False)] = None,
+        help="Points needed to mark a cloud's cell occupied (default: 2 for a 3D cloud, 1 for "
+        "a 2D one).", min=1, show_default=False)] = None,
     detectors: Annotated[str, typer.Option(
-        help="Comma-separated detectors to run.")] = ",".join(DEFAULTS.matching.detectors),
+        metavar="<" + ",".join(DEFAULTS.matching.detectors) + ">",
+        help="Comma-separated detectors to run, any of "
+        f"{', '.join(DETECTOR_NAMES)}.")] = ",".join(DEFAULTS.matching.detectors),
     json_path: Annotated[str | None, typer.Option(
         "--json", help="Write the result as JSON to this path ('-' for stdout only).")] = None,
     vectors: Annotated[Path | None, typer.Option(
-        help="Write the matched displacements (the vectorial map) as CSV.")] = None,
+        help="Write the vectorial map as CSV: one row per matched pair of features (truth and "
+        "map position, displacement, metres) and which of its two features are counted "
+        "(truth_counted, map_counted: 1 or 0).")] = None,
     plot: Annotated[Path | None, typer.Option(
         help="Draw the vectorial map, one panel per detector, as PNG.")] = None,
     report: Annotated[Path | None, typer.Option(
@@ -194,6 +225,7 @@ def eval_command(
         help="Distance thresholds of the F-score, metres, comma-separated.")
     ] = ",".join(f"{t:g}" for t in DEFAULTS.distances.taus),
     footprint: Annotated[str, typer.Option(
+        metavar="<" + "|".join(FOOTPRINT_RULES) + ">",
         help="The area the map observed: 'known' cells of an image, the area its 'walls' "
         "enclose, 'all' of its rectangle; 'auto': known cells for an image with unknown "
         "regions, walls for a binary image or a cloud.")] = DEFAULTS.footprint.rule,
@@ -203,6 +235,8 @@ def eval_command(
     max_memory: Annotated[float | None, typer.Option(
         help="Stop (exit 2) before a run estimated to need more than this many GB "
         "(default: 75 % of this machine's memory).", min=0.0, show_default=False)] = None,
+    quiet: Annotated[bool, typer.Option(
+        "--quiet", "-q", help="Print nothing but errors (and the JSON of --json -).")] = False,
 ) -> None:
     """Align MAP to TRUTH, then score it with Harris, Hough and SIFT features."""
     if len(paths) != (1 if scans else 2):
@@ -223,10 +257,9 @@ def eval_command(
         footprint=replace(DEFAULTS.footprint, rule=options.parse_footprint(footprint), full=full),
         matching=MatchingConfig(options.parse_detectors(detectors), threshold),
         distances=DistancesConfig(options.parse_taus(tau)))
-    quiet = json_path == "-"
     err = Console(stderr=True)
-    out = Console(quiet=quiet, width=None if err.is_terminal else 132)
-    with _errors(err), _progress(err, enabled=not quiet) as progress:
+    out = Console(quiet=quiet or json_path == "-")  # not a terminal: COLUMNS or 80 wide
+    with _errors(err), _progress(err, enabled=not quiet and json_path != "-") as progress:
         if scans is None:
             map_path: Path | PointMap = paths[0]
         else:
@@ -240,14 +273,22 @@ def eval_command(
         if json_path == "-":
             sys.stdout.write(result.to_json())
         elif json_path is not None:
-            write_atomic(Path(json_path), result.to_json())
+            _save(err, quiet, Path(json_path), result.to_json())
         if vectors is not None:
-            write_atomic(vectors, result.vectors_csv())
+            _save(err, quiet, vectors, result.vectors_csv())
         if plot is not None or report is not None:
             from pcmapq.report.html import report_html
             from pcmapq.report.plot import png_bytes, vectorial_figure
         if plot is not None:
-            write_atomic(plot, png_bytes(vectorial_figure(result)))
+            _save(err, quiet, plot, png_bytes(vectorial_figure(result)))
         if report is not None:
-            write_atomic(report, report_html(result))
+            _save(err, quiet, report, report_html(result))
     print_table(result, out)
+
+
+def _save(console: Console, quiet: bool, path: Path, data: str | bytes) -> None:
+    """Write an output file whole (:func:`write_atomic`) and say so: 'wrote PATH' on stderr,
+    unless ``quiet``."""
+    write_atomic(path, data)
+    if not quiet:
+        console.print(f"wrote {path}", markup=False, highlight=False, soft_wrap=True)

@@ -191,13 +191,21 @@ class Result:
         return _from_dict(json.loads(text))
 
     def vectors_csv(self) -> str:
-        """One row per matched feature: truth and map position and displacement, metres."""
+        """One row per matched pair (the JSON's ``matches``): its truth and map features'
+        positions and the displacement between them, metres (truth frame), then which of its
+        two features are counted (1) or support-level (0). A pair counts towards ``matched``
+        when its truth feature is counted and towards ``matched_map`` when its map feature
+        is, so the rows outnumber either count when some pairs have one side uncounted."""
         out = io.StringIO()
-        out.write("detector,truth_x_m,truth_y_m,map_x_m,map_y_m,dx_m,dy_m,displacement_m\n")
+        out.write("detector,truth_x_m,truth_y_m,map_x_m,map_y_m,dx_m,dy_m,displacement_m,"
+                  "truth_counted,map_counted\n")
         for name, det in self.detectors.items():
-            rows = np.column_stack([det.truth_xy, det.map_xy, det.matching.displacement,
-                                    det.distances])
-            np.savetxt(out, rows + 0.0, fmt=",".join([name] + [f"%.{DECIMALS}f"] * 7))
+            m = det.matching
+            rows = np.column_stack([det.truth_xy, det.map_xy, m.displacement, det.distances])
+            counted = np.column_stack([det.truth.strong[m.truth_idx], det.map.strong[m.map_idx]])
+            for row, flags in zip(rows + 0.0, counted.astype(int), strict=True):
+                out.write(",".join([name, *(f"{v:.{DECIMALS}f}" for v in row),
+                                    *(str(f) for f in flags)]) + "\n")
         return out.getvalue()
 
 

@@ -1,45 +1,176 @@
-"""The terminal view of a Result: the alignment and one row per detector."""
+"""The terminal view of a Result: a verdict in words, the alignment, one row per detector (its
+scores and counts, then its displacements), the distances and a legend. Fits the console's
+width with no value cut: lines break only between whole values, and a table too wide for the
+console is printed as one stacked block per detector instead."""
 
 from __future__ import annotations
 
+from rich import box
 from rich.console import Console
 from rich.table import Table
 
-from pcmapq.report.text import number, score
-from pcmapq.result import Result
+from pcmapq.report.text import LEGEND, metres, number, score, verdict, words, wrap
+from pcmapq.result import DetectorResult, Result
+from pcmapq.stats import FIELDS, Stats
+
+#: Width of the labels of the key-value lines, characters.
+LABEL = 12
+#: The score table's columns: header, and the figure of a detector.
+SCORE_COLUMNS = ("quality", "precision", "f1", "truth\nfeatures", "matched\ntruth",
+                 "map\nfeatures", "matched\nmap")
+#: The displacement table's columns (the Stats fields; count is the number of pairs).
+DISPLACEMENT_COLUMNS = ("pairs", *FIELDS[1:])
 
 
 def print_table(result: Result, console: Console) -> None:
-    """Print the alignment and the per-detector qualities (metres, degrees)."""
-    a = result.alignment
-    tf = result.transform
-    console.print(
-        f"[bold]{result.map_path}[/] -> [bold]{result.truth_path}[/]  "
-        f"x {tf.tx:.3f} m  y {tf.ty:.3f} m  yaw {tf.yaw_deg:.2f} deg  scale {tf.scale:.4f}  "
-        f"fitness {a.fitness:.3f} (within {a.tolerance_m} m)  rmse {a.rmse_m:.3f} m  "
-        f"coverage {result.overlap.coverage:.3f} (footprint: {result.footprint_rule})  "
-        f"confidence {result.overlap.confidence:.2f}"
-        + ("  (scored against the whole truth)" if result.full else ""))
-    table = Table(title=f"feature matching within {result.threshold} m")
-    for col in ("detector", "quality", "precision", "f1", "truth", "map", "matched"):
-        table.add_column(col, justify="right")
-    for col in ("mean m", "median m", "rmse m", "max m"):
-        table.add_column(f"disp. {col}", justify="right")
-    for name, det in result.detectors.items():
-        m = det.matching
-        stats = det.displacement_stats()
-        table.add_row(name, score(m.quality), score(m.precision), score(m.f1),
-                      str(m.truth_features), str(m.map_features), str(m.matched),
-                      *(number(getattr(stats, k)) for k in ("mean", "median", "rmse", "max")))
-    console.print(table)
-    for line in result.notes():
-        console.print(line, highlight=False)
-    if result.registration_3d is not None and result.distances_3d is not None:
-        reg, d3 = result.registration_3d, result.distances_3d
-        console.print(f"3D registration: fitness {reg.fitness:.3f}, rmse {reg.rmse_m:.3f} m; "
-                      f"3D accuracy mean {number(d3.accuracy.mean)} m, completeness mean "
-                      f"{number(d3.completeness.mean)} m, Chamfer {number(d3.chamfer_m)} m")
+    """Print the verdict, the alignment, the per-detector scores and displacements, the
+    distances and the legend on ``console`` (metres, degrees), within its width."""
+    width = console.width
+    _lines(console, words(verdict(result), width))
+    console.print()
+    for label, parts in _summary(result):
+        _field(console, label, _values(console, parts))
+    if result.detectors:
+        console.print()
+        _scores(console, result)
+        console.print()
+        _displacements(console, result)
+    console.print()
+    for label, parts in _distances(result):
+        _field(console, label, _values(console, parts))
+    for i, note in enumerate(result.notes()):
+        _field(console, "notes" if i == 0 else "", words(note, width - LABEL - 1))
+    console.print()
+    _lines(console, words(LEGEND, width))
+
+
+def score_row(det: DetectorResult) -> tuple[str, ...]:
+    """A detector's figures in :data:`SCORE_COLUMNS` order: quality, precision and f1 ('n/a'
+    when undefined), then the counts of strong features (quality = matched truth / truth
+    features, precision = matched map / map features)."""
+    m = det.matching
+    return (score(m.quality), score(m.precision), score(m.f1), str(m.truth_features),
+            str(m.matched), str(m.map_features), str(m.matched_map))
+
+
+def displacement_row(stats: Stats) -> tuple[str, ...]:
+    """A detector's displacement statistics in :data:`DISPLACEMENT_COLUMNS` order, metres."""
+    return (str(stats.count), *(number(getattr(stats, k)) for k in FIELDS[1:]))
+
+
+def _summary(result: Result) -> list[tuple[str, list[str]]]:
+    """The inputs, the alignment and the footprint as (label, values) lines."""
+    a, tf = result.alignment, result.transform
+    lines = [
+        ("map", [str(result.map_path), result.map_kind]),
+        ("truth", [str(result.truth_path), result.truth_kind,
+                   f"{result.grid.resolution:g} m cells"]),
+        ("alignment", [f"x {tf.tx:.3f} m", f"y {tf.ty:.3f} m", f"yaw {tf.yaw_deg:.2f} deg",
+                       f"scale {tf.scale:.4f}", f"map -> truth by {a.method}",
+                       f"fitness {a.fitness:.3f} within {a.tolerance_m:g} m",
+                       f"rmse {a.rmse_m:.3f} m",
+                       f"confidence {result.overlap.confidence:.2f}"]),
+        ("footprint", [f"{result.footprint_rule}",
+                       f"coverage {result.overlap.coverage:.3f}",
+                       "scored against the whole truth" if result.full
+                       else "truth features outside it not counted"]),
+    ]
+    if result.registration_3d is not None:
+        reg = result.registration_3d
+        lines.append(("3D", [f"registration fitness {reg.fitness:.3f}",
+                             f"rmse {reg.rmse_m:.3f} m"]))
+    return lines
+
+
+def _distances(result: Result) -> list[tuple[str, list[str]]]:
+    """The wall distances (and the 3D ones when both inputs are 3D clouds) as lines."""
     d = result.distances
-    f = "  ".join(f"F@{s.tau_m:g} m {s.f:.3f}" for s in d.fscores)
-    console.print(f"distances: accuracy mean {number(d.accuracy.mean)} m, completeness mean "
-                  f"{number(d.completeness.mean)} m, Chamfer {number(d.chamfer_m)} m  {f}")
+    lines = [("accuracy", _stats_parts(d.accuracy, "map -> truth")),
+             ("completeness", _stats_parts(d.completeness, "truth -> map")),
+             ("F-score", [f"F@{s.tau_m:g} m {s.f:.3f}" for s in d.fscores]
+              + [f"Chamfer {metres(d.chamfer_m)}"])]
+    if result.distances_3d is not None:
+        d3 = result.distances_3d
+        lines += [("3D accuracy", _stats_parts(d3.accuracy, "map -> truth, 3D")),
+                  ("3D complete", _stats_parts(d3.completeness, "truth -> map, 3D")),
+                  ("3D", [f"Chamfer {metres(d3.chamfer_m)}"])]
+    return lines
+
+
+def _stats_parts(stats: Stats, direction: str) -> list[str]:
+    """A distance's statistics as 'mean 0.127 m' pieces, with its direction."""
+    return [f"{direction}: mean {metres(stats.mean)}",
+            *(f"{k} {metres(getattr(stats, k))}" for k in ("median", "rmse", "std", "p95",
+                                                           "max"))]
+
+
+def _scores(console: Console, result: Result) -> None:
+    """Quality, precision, f1 and the four counts per detector."""
+    rows = {name: score_row(det) for name, det in result.detectors.items()}
+    title = (f"features matched within {result.threshold:g} m (counts of strong features; "
+             "quality = matched truth / truth features, precision = matched map / map "
+             "features)")
+    table = _table(SCORE_COLUMNS, rows)
+    if _fits(console, table):
+        _lines(console, words(title, console.width))
+        console.print(table)
+        return
+    _lines(console, words(f"features matched within {result.threshold:g} m", console.width))
+    for name, (q, p, f1, truth, matched, map_, matched_map) in rows.items():
+        _field(console, name, _values(console, [f"quality {q} ({matched}/{truth} truth)",
+                                                f"precision {p} ({matched_map}/{map_} map)",
+                                                f"f1 {f1}"]))
+
+
+def _displacements(console: Console, result: Result) -> None:
+    """The displacement statistics of each detector's matched pairs, metres."""
+    rows = {name: displacement_row(det.displacement_stats())
+            for name, det in result.detectors.items()}
+    title = ("displacement from truth feature to map feature over the matched pairs "
+             "(every pair, whichever of its features are counted), metres")
+    table = _table(DISPLACEMENT_COLUMNS, rows)
+    if _fits(console, table):
+        _lines(console, words(title, console.width))
+        console.print(table)
+        return
+    _lines(console, words("displacement of the matched pairs", console.width))
+    for name, (pairs, *values) in rows.items():
+        _field(console, name, _values(console, [f"{pairs} pairs"] + [
+            f"{k} {v}" + (" m" if v != "-" else "") for k, v in zip(FIELDS[1:], values,
+                                                                   strict=True)]))
+
+
+def _table(columns: tuple[str, ...], rows: dict[str, tuple[str, ...]]) -> Table:
+    """A right-aligned table, one row per detector, no vertical rules, no cell wrapped."""
+    table = Table(box=box.SIMPLE_HEAD, show_edge=False, pad_edge=False,
+                  padding=(0, 0, 0, 1))
+    table.add_column("detector", no_wrap=True)
+    for col in columns:
+        table.add_column(col, justify="right", no_wrap=True)
+    for name, row in rows.items():
+        table.add_row(name, *row)
+    return table
+
+
+def _fits(console: Console, table: Table) -> bool:
+    """Whether ``table`` shows whole on ``console``, every cell on one line."""
+    unbounded = console.options.update_width(10_000)
+    return console.measure(table, options=unbounded).maximum <= console.width
+
+
+def _field(console: Console, label: str, lines: list[str]) -> None:
+    """Lines of values under a label: the label's column, then the lines one under another
+    (each at most ``console.width - LABEL - 1`` wide, see :func:`_values`)."""
+    first, *rest = lines
+    _lines(console, [f"{label:<{LABEL}} {first}", *(" " * (LABEL + 1) + line for line in rest)])
+
+
+def _values(console: Console, parts: list[str]) -> list[str]:
+    """Values joined by commas in lines that fit beside the labels, broken between values."""
+    return wrap(parts, console.width - LABEL - 1)
+
+
+def _lines(console: Console, lines: list[str]) -> None:
+    """Print lines as they are: no markup, no highlighting, no rewrapping."""
+    for line in lines:
+        console.print(line, markup=False, highlight=False, soft_wrap=True)

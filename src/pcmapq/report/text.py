@@ -1,7 +1,22 @@
 """How a figure reads wherever it is shown: a number, `n/a` for an undefined score, `-` for
-nothing measured."""
+nothing measured; the one-line verdict on a Result; lines wrapped between whole values."""
 
 from __future__ import annotations
+
+import re
+from collections.abc import Sequence
+
+from pcmapq.result import Result
+
+#: What the terms of the table mean, in one short paragraph (their definitions:
+#: docs/metrics.md).
+LEGEND = ("quality: share of the truth's features the map has (the paper's q = matched truth / "
+          "truth); precision: share of the map's features that are in the truth (matched map / "
+          "map); f1: their harmonic mean; n/a: nothing to count; pair: a matched truth feature "
+          "and map feature; displacement: the length from a pair's truth feature to its map "
+          "feature; accuracy: distance from the map's walls to the truth's; completeness: from "
+          "the truth's walls to the map's; F@tau: F-score of the walls within tau; definitions "
+          "in docs/metrics.md")
 
 
 def score(value: float | None, digits: int = 3) -> str:
@@ -13,3 +28,74 @@ def score(value: float | None, digits: int = 3) -> str:
 def number(value: float | None, digits: int = 3) -> str:
     """A figure with ``digits`` decimals; '-' when there is none (nothing measured)."""
     return "-" if value is None else f"{value:.{digits}f}"
+
+
+def metres(value: float | None, digits: int = 3) -> str:
+    """A length in metres, 'x.xxx m'; '-' when there is none (nothing measured)."""
+    return "-" if value is None else f"{value:.{digits}f} m"
+
+
+def alignment_words(result: Result) -> str:
+    """How the map was placed on the truth, in words: the method and the confidence that it
+    shows the truth's place."""
+    method = result.alignment.method
+    confidence = result.overlap.confidence
+    if method == "none":
+        return "not aligned (--no-align: the map's frame taken as the truth's)"
+    if method == "init":
+        placed = "placed at --init"
+    elif method == "init+icp":
+        placed = "aligned from --init"
+    else:
+        placed = "aligned"
+    if confidence < 0.5:
+        return (f"{placed}, but it may show another place (confidence {confidence:.2f} < 0.5, "
+                "scored because of --force)")
+    return f"{placed} with confidence {confidence:.2f}"
+
+
+def verdict(result: Result) -> str:
+    """How good the map is and why, in one sentence built from the result only: how it was
+    aligned, how much of the truth it covers, each detector's quality (or why it is
+    undefined), and how far its walls are from the truth's, metres."""
+    covered = f"{100 * result.overlap.coverage:.0f} % of the truth's walls covered"
+    if result.full:
+        covered += " (scored against the whole truth)"
+    features = []
+    for name, det in result.detectors.items():
+        note = result.note(name)
+        quality = det.matching.quality
+        features.append(f"{name} {score(quality, 2)}" if quality is not None
+                        else f"{name} n/a ({note})")
+    d = result.distances
+    walls = (f"map walls {metres(d.accuracy.mean)} from the truth's on average, "
+             f"truth walls {metres(d.completeness.mean)} from the map's")
+    if d.accuracy.mean is None or d.completeness.mean is None:
+        walls += " ('-': nothing to measure)"
+    parts = [alignment_words(result), covered]
+    if features:
+        parts.append("feature quality " + ", ".join(features))
+    return f"{result.map_path.name}: " + "; ".join(parts + [walls]) + "."
+
+
+def wrap(parts: Sequence[str], width: int, sep: str = ", ", indent: str = "") -> list[str]:
+    """``parts`` joined by ``sep`` in lines of at most ``width`` characters, broken only between
+    parts (a part longer than a line stands alone on its line); every line after the first
+    starts with ``indent``."""
+    lines: list[str] = []
+    line = ""
+    for i, part in enumerate(parts):
+        piece = part + (sep.rstrip() if i < len(parts) - 1 else "")
+        if line and len(line) + 1 + len(piece) > width:
+            lines.append(line)
+            line = indent + piece
+        else:
+            line = f"{line} {piece}" if line else piece
+    return lines + ([line] if line else [])
+
+
+def words(text: str, width: int, indent: str = "") -> list[str]:
+    """``text`` wrapped at spaces in lines of at most ``width`` characters, a number never
+    parted from its unit ('0.127 m', '97 %', '36.99 deg')."""
+    glued = re.sub(r"(\d) (m|%|deg)(?!\w)", "\\1\u00a0\\2", text)
+    return [line.replace("\u00a0", " ") for line in wrap(glued.split(" "), width, " ", indent)]
