@@ -46,6 +46,8 @@ def alignment_words(result: Result) -> str:
         placed = "placed at --init"
     elif method == "init+icp":
         placed = "aligned from --init"
+    elif method.startswith("similarity"):
+        placed = f"aligned at an estimated scale of {result.transform.scale:.4f}"
     else:
         placed = "aligned"
     if confidence < 0.5:
