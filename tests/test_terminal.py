@@ -13,6 +13,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 from rich.console import Console
 from typer.testing import CliRunner
@@ -192,3 +193,24 @@ def test_quiet_prints_nothing_and_every_output_file_is_announced(tmp_path):
     quiet = CliRunner().invoke(app, [*args, *files, "--quiet"])
     assert quiet.exit_code == 0 and quiet.stdout == "" and quiet.stderr == ""
     assert all(path.exists() for path in out.values())
+
+
+def test_map_says_what_it_wrote_unless_quiet(tmp_path):
+    """`pcmapq map` with given poses on two small scans: one 'wrote PATH' line per file."""
+    scans = tmp_path / "scans"
+    scans.mkdir()
+    rng = np.random.default_rng(0)
+    for k in range(2):
+        np.save(scans / f"{k:06d}.npy", rng.uniform(-5, 5, (500, 3)))
+    poses = tmp_path / "poses.txt"
+    poses.write_text("1 0 0 0 0 1 0 0 0 0 1 0\n1 0 0 1 0 1 0 0 0 0 1 0\n")
+    out = [tmp_path / "m.ply", tmp_path / "kitti.txt", tmp_path / "tum.txt"]
+    args = ["map", str(scans), "--poses", str(poses), "--out", str(out[0]), "--poses-out",
+            str(out[1]), "--tum-out", str(out[2])]
+    loud = CliRunner().invoke(app, args)
+    assert loud.exit_code == 0, loud.stderr
+    lines = loud.stderr.splitlines()
+    assert [line.split(":")[0] for line in lines] == [f"wrote {path}" for path in out]
+    assert lines[1].endswith(": 2 poses (KITTI)") and lines[2].endswith(": 2 poses (TUM)")
+    quiet = CliRunner().invoke(app, [*args, "-q"])
+    assert quiet.exit_code == 0 and quiet.stdout == "" and quiet.stderr == ""
