@@ -28,6 +28,7 @@ from pcmapq.mapping import (
     write_tum_poses,
 )
 from pcmapq.pipeline import evaluate
+from pcmapq.report.style import ARROW_SCALE
 from pcmapq.report.table import print_table
 
 #: The documented defaults, read from the one place that defines them.
@@ -187,6 +188,9 @@ def eval_command(
         help="Draw the vectorial map, one panel per detector, as PNG.")] = None,
     report: Annotated[Path | None, typer.Option(
         help="Write a self-contained HTML report (figures embedded).")] = None,
+    arrow_scale: Annotated[float, typer.Option(
+        help="Displacement arrows of --plot and --report are drawn this many times their "
+        "length, in every panel of every run.", min=1e-6)] = ARROW_SCALE,
     voxel_3d: Annotated[float, typer.Option(
         "--voxel-3d", help="Working voxel of the 3D registration of two 3D clouds, metres "
         "(0.5-1 for outdoor maps).", min=0.01)] = DEFAULTS.alignment.voxel_3d,
@@ -247,7 +251,7 @@ def eval_command(
             from pcmapq.report.html import report_html
             from pcmapq.report.plot import png_bytes, vectorial_figure
         if plot is not None:
-            write_atomic(plot, png_bytes(vectorial_figure(result)))
+            write_atomic(plot, png_bytes(vectorial_figure(result, arrow_scale)))
         if report is not None:
-            write_atomic(report, report_html(result))
+            write_atomic(report, report_html(result, arrow_scale))
     print_table(result, out)
