@@ -22,9 +22,13 @@ from pcmapq.io.writers import write_atomic, write_cloud
 from pcmapq.mapping import (
     build_map_from_poses,
     build_map_kiss,
+    describe_scans,
     lidar_poses_from_camera,
+    moves_along_z,
+    open_scans,
     read_calib,
     read_poses,
+    scans_for_poses,
     write_kitti_poses,
     write_tum_poses,
 )
@@ -71,7 +75,12 @@ def map_command(
 ) -> None:
     """Build a map from LiDAR scans with KISS-ICP (or with given poses) and save it."""
     err = Console(stderr=True)
-    with _errors(err):
+    with _errors(err), _warnings(err):
+        if calib is not None and poses is None:
+            raise InputError(f"{calib}: --calib places scans with --poses only (KISS-ICP's "
+                             "map is in the first scanner's frame already)")
+        options.check_outputs({"--out": out, "--poses-out": poses_out, "--tum-out": tum_out},
+                              None)
         with _bar(err) as tick:
             if poses is None:
                 points, trajectory = build_map_kiss(source, max_scans=max_scans, voxel=voxel,
@@ -80,9 +89,19 @@ def map_command(
                 trajectory = read_poses(poses)
                 if calib is not None:
                     trajectory = lidar_poses_from_camera(trajectory, read_calib(calib))
+                elif moves_along_z(trajectory):
+                    warnings.warn(f"{poses}: these poses move along their z axis, as a camera's "
+                                  "do (KITTI's are the left camera's); without --calib (KITTI's "
+                                  "Tr) the scans are placed as if they were the scanner's, and "
+                                  "the map smears", stacklevel=1)
+                every = open_scans(source)
+                scans = scans_for_poses(every, len(trajectory), max_scans=max_scans,
+                                        poses_path=poses)
                 if max_scans is not None:
-                    trajectory = trajectory[:max_scans]
-                points = build_map_from_poses(source, trajectory, voxel=voxel, progress=tick)
+                    err.print(f"mapping {describe_scans(scans, len(every))}", markup=False,
+                              highlight=False, soft_wrap=True)
+                trajectory = trajectory[:len(scans)]
+                points = build_map_from_poses(scans, trajectory, voxel=voxel, progress=tick)
         write_cloud(out, points)
         if poses_out is not None:
             write_kitti_poses(poses_out, trajectory)
@@ -279,5 +298,5 @@ def eval_command(
             write_atomic(report, report_html(result))
         for path in export.write_exports(result, map_path, settings, aligned=aligned,
                                          transform=transform, distances=distances):
-            err.print(f"wrote {path}", markup=False, highlight=False)
+            err.print(f"wrote {path}", markup=False, highlight=False, soft_wrap=True)
     print_table(result, out)

@@ -103,7 +103,9 @@ def parse_footprint(text: str) -> str:
 #: What each output option writes, by extension (``--aligned``: see :func:`output_suffixes`).
 OUTPUT_SUFFIXES = {"--json": (".json",), "--vectors": (".csv",),
                    "--plot": (".png", ".svg", ".pdf"), "--report": (".html", ".htm"),
-                   "--transform": (".txt",), "--distances": (".ply",)}
+                   "--transform": (".txt",), "--distances": (".ply",),
+                   "--out": (".ply", ".pcd"), "--poses-out": (".txt", ".kitti"),
+                   "--tum-out": (".txt", ".tum")}
 #: ``--aligned`` of an image map (a map_server image, its YAML beside it) and of a cloud.
 ALIGNED_IMAGE, ALIGNED_CLOUD = (".png", ".pgm"), (".ply", ".pcd")
 
