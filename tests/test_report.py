@@ -18,17 +18,22 @@ from pcmapq.grid import MetricGrid
 from pcmapq.pipeline import evaluate
 from pcmapq.report.html import report_html
 from pcmapq.report.plot import (
-    DPI,
-    MAP_BLUE,
-    TRUTH_GREY,
     distance_heatmap,
     extent,
+    overlay,
     png_bytes,
+    shade,
+    thinned,
     vectorial_figure,
     wall_distances,
 )
+from pcmapq.report.style import ARROW_SCALE, DPI, FIGURE_WIDTH_PX, MAP_LIGHT
+from pcmapq.report.text import number
 
 from .conftest import write_image_map
+
+#: The colour of the truth's walls where no map wall is under them.
+TRUTH_ON_WHITE = tuple(overlay(np.ones((1, 1)), np.zeros((1, 1)))[0, 0])
 
 
 @pytest.fixture(scope="module")
@@ -61,12 +66,15 @@ def region(fig, ax, box: tuple[float, float, float, float], dpi: int = 130):
 
 
 def test_vectorial_figure_draws_the_displacements(moved_result, perfect_result):
-    """Black arrows where the wall moved, none there when nothing moved (Hough panel: the
-    arm's displacement is drawn at its midpoint)."""
+    """Black arrows where the wall moved, ARROW_SCALE times its 0.5 m long, none there when
+    nothing moved (Hough panel: the arm's displacement is drawn at its midpoint; the truth's
+    dark walls are lighter than the arrows)."""
+    arrows = (MOVED_ARM[0], MOVED_ARM[0] + 0.5 * ARROW_SCALE, *MOVED_ARM[2:])
+
     def black(result) -> int:
         fig = vectorial_figure(result)
         ax = fig.axes[list(result.detectors).index("hough")]
-        return int(np.count_nonzero(region(fig, ax, MOVED_ARM).max(axis=2) < 60))
+        return int(np.count_nonzero(region(fig, ax, arrows).max(axis=2) < 25))
 
     assert black(moved_result) > 20
     assert black(perfect_result) == 0
@@ -88,6 +96,7 @@ def test_report_is_self_contained(moved_result):
     page = report_html(moved_result)
     assert not re.search(r'(src|href)="(https?:)?//', page)  # nothing fetched from a network
     assert page.count("data:image/png;base64,") == 2
+    assert f"displacement x{ARROW_SCALE:g}" not in page  # the legend is in the figure
     q = moved_result.detectors["harris"].matching.quality
     assert f"{q:.3f}" in page and "coverage" in page
 
@@ -161,7 +170,7 @@ def test_large_grids_are_pooled_and_one_cell_walls_drawn_in_place(fine_result, m
     assert factor > 1 and shown == tuple(-(-np.array(fine_result.grid.shape) // factor))
     assert shown[0] <= bb.height * DPI / fig.dpi and shown[1] <= bb.width * DPI / fig.dpi
     tol = factor * FINE + (box[1] - box[0]) / img.shape[1]
-    grey, blue = coloured(img, TRUTH_GREY), coloured(img, MAP_BLUE)
+    grey, blue = coloured(img, TRUTH_ON_WHITE), coloured(img, MAP_LIGHT)
     np.testing.assert_allclose(runs(grey.mean(axis=0) > 0.5, box, 0), TRUTH_X, atol=tol)
     np.testing.assert_allclose(runs(grey.mean(axis=1) > 0.5, box, 1), [TRUTH_Y], atol=tol)
     np.testing.assert_allclose(runs(blue.mean(axis=0) > 0.5, box, 0),
@@ -190,3 +199,137 @@ def test_wall_distances_keep_the_nearest_cell_of_each_block():
     walls[2, 3] = walls[5, 7] = walls[15, 12] = True
     np.testing.assert_allclose(wall_distances(truth, walls, 0.01, 10),
                                [[0.03, np.nan], [np.nan, 0.12]], rtol=1e-6)
+
+
+def test_truth_shows_where_the_map_lies_on_it(perfect_result):
+    """The truth scored against itself: every map wall lies on a truth wall, yet the truth's
+    dark walls show (over the map's light ones, which show at their edges)."""
+    fig = vectorial_figure(perfect_result)
+    img = region(fig, fig.axes[0], extent(perfect_result))
+    walls = int(np.count_nonzero(perfect_result.truth_occupied))
+    dark = np.count_nonzero(img.max(axis=2) < 80)
+    assert dark > 0.5 * walls
+    assert np.count_nonzero(coloured(img, MAP_LIGHT)) > 0.5 * walls
+
+
+def _inside(inner, outer) -> bool:
+    return (inner.x0 >= outer.x0 - 0.5 and inner.y0 >= outer.y0 - 0.5
+            and inner.x1 <= outer.x1 + 0.5 and inner.y1 <= outer.y1 + 0.5)
+
+
+@pytest.mark.parametrize("names", [("harris",), ("harris", "hough"), ("harris", "hough", "sift")])
+def test_legend_and_scale_bars_inside_the_canvas_and_off_the_data(moved_result, names):
+    """With one, two or three detectors: the legend and every scale bar lie whole inside the
+    figure and overlap no panel's data area; no two texts overlap."""
+    result = replace(moved_result, detectors={n: moved_result.detectors[n] for n in names})
+    fig = vectorial_figure(result)
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    panels = [ax for ax in fig.axes if ax.images]
+    assert len(panels) == len(names)
+    legends = fig.legends + [ax.get_legend() for ax in fig.axes if ax.get_legend()]
+    bars = [a for ax in panels for a in ax.artists]
+    assert len(legends) == 1 and len(bars) == len(names)
+    for artist in legends + bars:
+        box = artist.get_window_extent(renderer)
+        assert _inside(box, fig.bbox), (artist, box, fig.bbox)
+        assert not any(box.overlaps(ax.get_window_extent(renderer)) for ax in panels)
+    texts = [t for ax in panels for t in (ax.title, ax.xaxis.label)]
+    boxes = [t.get_window_extent(renderer) for t in texts] + \
+            [a.get_window_extent(renderer) for a in bars + legends]
+    for i, a in enumerate(boxes):
+        assert _inside(a, fig.bbox)
+        assert not any(a.overlaps(b) for b in boxes[i + 1:]), a
+
+
+def test_arrow_scale_is_one_for_every_panel_and_run(moved_result, fine_result):
+    """Two maps of different grids: every panel's arrows are ARROW_SCALE times their
+    displacement in metres, and the legend says so; --arrow-scale changes every one."""
+    for result in (moved_result, fine_result):
+        for gain in (ARROW_SCALE, 3.0):
+            fig = vectorial_figure(result, gain)
+            quivers = [c for ax in fig.axes for c in ax.collections if hasattr(c, "scale_units")]
+            assert quivers and {(q.scale_units, q.scale) for q in quivers} == {("xy", 1 / gain)}
+            legend = (fig.legends or [ax.get_legend() for ax in fig.axes if ax.get_legend()])[0]
+            assert f"displacement x{gain:g} (0.1 m drawn {0.1 * gain:g} m)" in \
+                [t.get_text() for t in legend.get_texts()]
+
+
+def test_fonts_read_at_the_reports_width(moved_result):
+    """The figures are no wider than the report shows them, so none is scaled down there, and
+    every text in them is at least 12 pixels high."""
+    page = report_html(moved_result)
+    assert f"max-width: {FIGURE_WIDTH_PX + 50}px" in page
+    for fig in (vectorial_figure(moved_result), distance_heatmap(moved_result)):
+        assert fig.get_figwidth() * DPI <= FIGURE_WIDTH_PX
+        sizes = [t.get_fontsize() for t in fig.findobj(matplotlib.text.Text)
+                 if t.get_visible() and t.get_text()]
+        assert sizes and min(sizes) * DPI / 72 >= 12, min(sizes)
+
+
+def test_completeness_heatmap_colours_the_truth_wall_the_map_left(moved_result,
+                                                                  perfect_result):
+    """Right panel: the truth's arm, 0.5 m west of where the map has it, in viridis' yellow
+    (0.5 m); none there when nothing moved."""
+    truth_arm = (MOVED_ARM[0] - 0.5, MOVED_ARM[1] - 0.5, *MOVED_ARM[2:])
+
+    def yellow(result) -> int:
+        fig = distance_heatmap(result)
+        img = region(fig, fig.axes[1], truth_arm).astype(int)
+        b, g, r = img[..., 0], img[..., 1], img[..., 2]
+        return int(np.count_nonzero((r > 200) & (g > 200) & (b < 80)))
+
+    assert yellow(moved_result) > 10
+    assert yellow(perfect_result) == 0
+
+
+def test_report_lists_every_missing_and_extra_feature(moved_result):
+    """Matched within 0.2 m, the features of the wall moved by 0.5 m are missing and extra:
+    the report lists each, with its position."""
+    strict = evaluate(moved_result.map_path, moved_result.truth_path,
+                      Settings(matching=MatchingConfig(threshold=0.2)))
+    page = report_html(strict)
+    for name, det in strict.detectors.items():
+        m = det.matching
+        assert f"{name}: {len(m.missing)} missing" in page
+        assert f"{name}: {len(m.extra)} extra" in page
+        for x, y in np.vstack([det.truth.xy[m.missing], det.map.xy[m.extra]]):
+            assert f"<td>{number(x)}</td><td>{number(y)}</td>" in page
+    assert sum(len(d.matching.missing) for d in strict.detectors.values()) > 0
+    assert sum(len(d.matching.extra) for d in strict.detectors.values()) > 0
+
+
+def test_thinned_keeps_one_point_a_square():
+    """Points 0.1 m apart in 1 m squares: one a square, the first of each, in order."""
+    xy = np.array([[0.1, 0.1], [0.2, 0.1], [1.5, 0.2], [0.3, 0.9], [1.1, 1.1], [-0.5, 0.0]])
+    np.testing.assert_array_equal(thinned(xy, 1.0), [0, 2, 4, 5])
+    assert thinned(np.zeros((0, 2)), 1.0).shape == (0,)
+
+
+def test_density_shades_by_occupied_share():
+    """A 4 x 4 block with 1 and with 16 occupied cells: the lone cell shows (at least the floor),
+    the full block is solid; walls mode shows both solid."""
+    mask = np.zeros((4, 8), bool)
+    mask[0, 0] = True
+    mask[:, 4:] = True
+    dens, walls = shade(mask, 4, True), shade(mask, 4, False)
+    assert 0.3 <= dens[0, 0] < 0.6 and dens[0, 1] == 1.0
+    np.testing.assert_array_equal(walls, [[1.0, 1.0]])
+
+
+def test_lidar_pair_is_drawn_as_density_with_fewer_markers(moved_result):
+    """Marked as two 3D clouds, the same result is drawn as a density (shades between the
+    map's and the truth's full colours) with markers thinned to wider squares."""
+    from pcmapq.align.rigid3d import Registration3D
+
+    lidar = replace(moved_result, registration_3d=Registration3D(np.eye(4), 1.0, 0.0))
+    fine = replace(lidar, grid=MetricGrid(0.01, lidar.grid.origin, lidar.grid.shape))
+
+    def markers(result) -> int:
+        fig = vectorial_figure(result)
+        return sum(len(c.get_offsets()) for ax in fig.axes for c in ax.collections
+                   if type(c).__name__ == "PathCollection")
+
+    assert markers(fine) < markers(replace(fine, registration_3d=None))
+    fig = vectorial_figure(lidar)
+    assert "occupied share" in " ".join(t.get_text() for t in fig.findobj(matplotlib.text.Text))

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import sys
+import warnings
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import replace
@@ -21,14 +22,20 @@ from pcmapq.io.writers import write_atomic, write_cloud
 from pcmapq.mapping import (
     build_map_from_poses,
     build_map_kiss,
+    describe_scans,
     lidar_poses_from_camera,
+    moves_along_z,
+    open_scans,
     read_calib,
     read_poses,
+    scans_for_poses,
     write_kitti_poses,
     write_tum_poses,
 )
 from pcmapq.pipeline import evaluate
 from pcmapq.raster.footprint import FOOTPRINT_RULES
+from pcmapq.report import export
+from pcmapq.report.style import ARROW_SCALE
 from pcmapq.report.table import print_table
 
 #: The documented defaults, read from the one place that defines them.
@@ -85,11 +92,16 @@ def map_command(
     voxel: Annotated[float, typer.Option(help="Cell of the output map, metres.", min=1e-4)
                      ] = 0.1,
     quiet: Annotated[bool, typer.Option(
-        "--quiet", "-q", help="Print nothing but errors.")] = False,
+        "--quiet", "-q", help="Print nothing but warnings and errors.")] = False,
 ) -> None:
     """Build a map from LiDAR scans with KISS-ICP (or with given poses) and save it."""
     err = Console(stderr=True)
-    with _errors(err):
+    with _errors(err), _warnings(err):
+        if calib is not None and poses is None:
+            raise InputError(f"{calib}: --calib places scans with --poses only (KISS-ICP's "
+                             "map is in the first scanner's frame already)")
+        options.check_outputs({"--out": out, "--poses-out": poses_out, "--tum-out": tum_out},
+                              None)
         with _bar(err, enabled=not quiet) as tick:
             if poses is None:
                 points, trajectory = build_map_kiss(source, max_scans=max_scans, voxel=voxel,
@@ -98,9 +110,19 @@ def map_command(
                 trajectory = read_poses(poses)
                 if calib is not None:
                     trajectory = lidar_poses_from_camera(trajectory, read_calib(calib))
-                if max_scans is not None:
-                    trajectory = trajectory[:max_scans]
-                points = build_map_from_poses(source, trajectory, voxel=voxel, progress=tick)
+                elif moves_along_z(trajectory):
+                    warnings.warn(f"{poses}: these poses move along their z axis, as a camera's "
+                                  "do (KITTI's are the left camera's); without --calib (KITTI's "
+                                  "Tr) the scans are placed as if they were the scanner's, and "
+                                  "the map smears", stacklevel=1)
+                every = open_scans(source)
+                scans = scans_for_poses(every, len(trajectory), max_scans=max_scans,
+                                        poses_path=poses)
+                if max_scans is not None and not quiet:
+                    err.print(f"mapping {describe_scans(scans, len(every))}", markup=False,
+                              highlight=False, soft_wrap=True)
+                trajectory = trajectory[:len(scans)]
+                points = build_map_from_poses(scans, trajectory, voxel=voxel, progress=tick)
         write_cloud(out, points)
         wrote = [f"wrote {out}: {len(points)} points from {len(trajectory)} scans"]
         if poses_out is not None:
@@ -122,6 +144,16 @@ def _errors(console: Console) -> Iterator[None]:
     except (InputError, EvaluationError) as error:
         console.print(f"pcmapq: error: {error}", markup=False, highlight=False, soft_wrap=True)
         raise typer.Exit(error.exit_code) from None
+
+
+@contextmanager
+def _warnings(console: Console) -> Iterator[None]:
+    """pcmapq's warnings: one line each on stderr, as they come, every time."""
+    with warnings.catch_warnings():
+        warnings.filterwarnings("always", module=r"pcmapq\.")
+        warnings.showwarning = lambda message, *_: console.print(
+            f"pcmapq: warning: {message}", markup=False, highlight=False, soft_wrap=True)
+        yield
 
 
 @contextmanager
@@ -218,6 +250,9 @@ def eval_command(
         help="Draw the vectorial map, one panel per detector, as PNG.")] = None,
     report: Annotated[Path | None, typer.Option(
         help="Write a self-contained HTML report (figures embedded).")] = None,
+    arrow_scale: Annotated[float, typer.Option(
+        help="Displacement arrows of --plot and --report are drawn this many times their "
+        "length, in every panel of every run.", min=1e-6)] = ARROW_SCALE,
     voxel_3d: Annotated[float, typer.Option(
         "--voxel-3d", help="Working voxel of the 3D registration of two 3D clouds, metres "
         "(0.5-1 for outdoor maps).", min=0.01)] = DEFAULTS.alignment.voxel_3d,
@@ -235,8 +270,19 @@ def eval_command(
     max_memory: Annotated[float | None, typer.Option(
         help="Stop (exit 2) before a run estimated to need more than this many GB "
         "(default: 75 % of this machine's memory).", min=0.0, show_default=False)] = None,
+    aligned: Annotated[Path | None, typer.Option(
+        help="Write the map moved into the truth's frame: .ply/.pcd for a cloud map (a 3D "
+        "cloud keeps its heights), .png/.pgm with its map_server YAML for an image map.")
+    ] = None,
+    transform: Annotated[Path | None, typer.Option(
+        help="Write the map -> truth matrix as plain text (.txt): 4x4 for a 3D cloud map, 3x3 "
+        "for a 2D map (np.loadtxt, CloudCompare).")] = None,
+    distances: Annotated[Path | None, typer.Option(
+        help="Write the map's points in the truth's frame with their distance to the truth "
+        "(.ply: scalar field scalar_distance_m, metres, and a colour).")] = None,
     quiet: Annotated[bool, typer.Option(
-        "--quiet", "-q", help="Print nothing but errors (and the JSON of --json -).")] = False,
+        "--quiet", "-q", help="Print nothing but warnings and errors (and the JSON of "
+        "--json -).")] = False,
 ) -> None:
     """Align MAP to TRUTH, then score it with Harris, Hough and SIFT features."""
     if len(paths) != (1 if scans else 2):
@@ -257,9 +303,15 @@ def eval_command(
         footprint=replace(DEFAULTS.footprint, rule=options.parse_footprint(footprint), full=full),
         matching=MatchingConfig(options.parse_detectors(detectors), threshold),
         distances=DistancesConfig(options.parse_taus(tau)))
+    exports = {"--aligned": aligned, "--transform": transform, "--distances": distances}
     err = Console(stderr=True)
     out = Console(quiet=quiet or json_path == "-")  # not a terminal: COLUMNS or 80 wide
-    with _errors(err), _progress(err, enabled=not quiet and json_path != "-") as progress:
+    with _errors(err), _warnings(err), \
+            _progress(err, enabled=not quiet and json_path != "-") as progress:
+        options.check_eval_options(scans=scans, max_scans=max_scans, no_align=no_align,
+                                   auto_scale=auto)
+        options.check_outputs({"--json": json_path, "--vectors": vectors, "--plot": plot,
+                               "--report": report, **exports}, None if scans else paths[0])
         if scans is None:
             map_path: Path | PointMap = paths[0]
         else:
@@ -278,11 +330,16 @@ def eval_command(
             _save(err, quiet, vectors, result.vectors_csv())
         if plot is not None or report is not None:
             from pcmapq.report.html import report_html
-            from pcmapq.report.plot import png_bytes, vectorial_figure
+            from pcmapq.report.plot import DPI, vectorial_figure
         if plot is not None:
-            _save(err, quiet, plot, png_bytes(vectorial_figure(result)))
+            _save(err, quiet, plot, export.figure_bytes(vectorial_figure(result, arrow_scale),
+                                                        plot, DPI))
         if report is not None:
-            _save(err, quiet, report, report_html(result))
+            _save(err, quiet, report, report_html(result, arrow_scale))
+        for path in export.write_exports(result, map_path, settings, aligned=aligned,
+                                         transform=transform, distances=distances):
+            if not quiet:
+                err.print(f"wrote {path}", markup=False, highlight=False, soft_wrap=True)
     print_table(result, out)
 
 

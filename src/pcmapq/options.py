@@ -1,15 +1,20 @@
 """The command line's option text turned into typed values (typer.BadParameter on bad text),
-and the command line rebuilt from its parsed options."""
+the command line rebuilt from its parsed options, and the checks that refuse, before any work,
+outputs that cannot be written and options that cannot work together (InputError, exit 2)."""
 
 from __future__ import annotations
 
+import os
 import shlex
+from pathlib import Path
 
 import numpy as np
 import typer
 
 from pcmapq.config import DETECTOR_NAMES
+from pcmapq.errors import InputError
 from pcmapq.io import Thresholds
+from pcmapq.io.occupancy import IMAGE_SUFFIXES, YAML_SUFFIXES
 from pcmapq.raster.footprint import FOOTPRINT_RULES
 from pcmapq.transform import Similarity2D
 
@@ -93,3 +98,67 @@ def parse_footprint(text: str) -> str:
         raise typer.BadParameter(f"expected one of {', '.join(FOOTPRINT_RULES)}, got {text!r}",
                                  param_hint="--footprint")
     return text
+
+
+#: What each output option writes, by extension (``--aligned``: see :func:`output_suffixes`).
+OUTPUT_SUFFIXES = {"--json": (".json",), "--vectors": (".csv",),
+                   "--plot": (".png", ".svg", ".pdf"), "--report": (".html", ".htm"),
+                   "--transform": (".txt",), "--distances": (".ply",),
+                   "--out": (".ply", ".pcd"), "--poses-out": (".txt", ".kitti"),
+                   "--tum-out": (".txt", ".tum")}
+#: ``--aligned`` of an image map (a map_server image, its YAML beside it) and of a cloud.
+ALIGNED_IMAGE, ALIGNED_CLOUD = (".png", ".pgm"), (".ply", ".pcd")
+
+
+def output_suffixes(option: str, map_path: Path | None) -> tuple[str, ...]:
+    """The extensions ``option`` may write; ``--aligned`` writes the map's kind (an image for
+    an image or YAML map, a cloud otherwise, or for a map built from scans: ``map_path`` None)."""
+    if option != "--aligned":
+        return OUTPUT_SUFFIXES[option]
+    image = map_path is not None and map_path.suffix.lower() in IMAGE_SUFFIXES + YAML_SUFFIXES
+    return ALIGNED_IMAGE if image else ALIGNED_CLOUD
+
+
+def check_outputs(outputs: dict[str, str | Path | None], map_path: Path | None) -> None:
+    """Refuse, before any work, an output that could not be written: ``outputs`` maps each
+    option (``--json`` ...) to its path or None (``--json -`` is stdout). Each path needs a
+    known extension, an existing writable folder, no folder in its place, and no other output
+    on it (an ``--aligned`` image's YAML included)."""
+    taken: dict[Path, str] = {}
+    for option, given in outputs.items():
+        if given is None or str(given) == "-":
+            continue
+        path = Path(given)
+        suffixes = output_suffixes(option, map_path)
+        if path.suffix.lower() not in suffixes:
+            raise InputError(f"{path}: {option} writes {_alternatives(suffixes)}, not "
+                             f"'{path.suffix or path.name}'")
+        folder = path.parent
+        if not folder.is_dir():
+            raise InputError(f"{path}: {option}: folder '{folder}' does not exist")
+        if not os.access(folder, os.W_OK | os.X_OK):
+            raise InputError(f"{path}: {option}: folder '{folder}' is not writable")
+        if path.is_dir():
+            raise InputError(f"{path}: {option}: is a folder")
+        written = [path] + ([path.with_suffix(".yaml")] if suffixes == ALIGNED_IMAGE else [])
+        for target in written:
+            key = target.resolve()
+            if key in taken:
+                raise InputError(f"{target}: written by both {taken[key]} and {option}")
+            taken[key] = option
+
+
+def check_eval_options(*, scans: Path | None, max_scans: int | None, no_align: bool,
+                       auto_scale: bool) -> None:
+    """Refuse options of ``pcmapq eval`` that cannot work together."""
+    if max_scans is not None and scans is None:
+        raise InputError("--max-scans N: only with --scans DIR (the scans to map)")
+    if no_align and auto_scale:
+        raise InputError("--no-align and --scale auto (or --map-resolution auto) cannot go "
+                         "together: estimating the scale is part of the alignment")
+
+
+def _alternatives(suffixes: tuple[str, ...]) -> str:
+    """``.png, .svg or .pdf``."""
+    return suffixes[0] if len(suffixes) == 1 else \
+        f"{', '.join(suffixes[:-1])} or {suffixes[-1]}"

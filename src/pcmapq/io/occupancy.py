@@ -10,6 +10,7 @@ image's lower-left corner (see :mod:`pcmapq.grid`).
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TypeVar
@@ -92,8 +93,7 @@ def load_occupancy(path: Path, resolution: float | None = None,
             raise InputError(f"{path}: image '{image.name}' not found")
     else:
         image = path
-        beside = [path.with_suffix(s) for s in YAML_SUFFIXES if path.with_suffix(s).is_file()]
-        meta = read_yaml(beside[0])[0] if beside else MapMeta(resolution=None)
+        meta = _meta_beside(path, resolution)
     if resolution is not None:
         meta = replace(meta, resolution=_resolution(path, resolution))
     if thresholds is not None:
@@ -106,6 +106,38 @@ def load_occupancy(path: Path, resolution: float | None = None,
                          "or a YAML beside it")
     state = classify(levels, channels, scale, transparent, meta)
     return OccupancyMap(path, MetricGrid(meta.resolution, meta.origin, state.shape), state)
+
+
+def _meta_beside(image: Path, resolution: float | None) -> MapMeta:
+    """The map_server metadata of the YAML beside an image (same stem), or none. A YAML there
+    that is not a map_server file (no ``image`` key, or not YAML at all: a results file) is
+    ignored with a warning when a ``resolution`` is given, and an error otherwise."""
+    beside = [image.with_suffix(s) for s in YAML_SUFFIXES if image.with_suffix(s).is_file()]
+    if not beside:
+        return MapMeta(resolution=None)
+    try:
+        return read_yaml(beside[0])[0]
+    except InputError as error:
+        if resolution is None or _is_map_yaml(beside[0]):
+            raise
+        warnings.warn(f"{beside[0]}: ignored, not a map_server YAML ({_after_path(error)}); "
+                      f"{image.name} read with the resolution given, {resolution:g} m",
+                      stacklevel=2)
+        return MapMeta(resolution=None)
+
+
+def _is_map_yaml(path: Path) -> bool:
+    """Whether ``path`` is YAML naming an image, as every map_server YAML does."""
+    try:
+        doc = yaml.safe_load(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, yaml.YAMLError):
+        return False
+    return isinstance(doc, dict) and "image" in doc
+
+
+def _after_path(error: InputError) -> str:
+    """An InputError's message without its leading ``path: ``."""
+    return str(error).split(": ", 1)[-1]
 
 
 def read_yaml(path: Path) -> tuple[MapMeta, Path]:

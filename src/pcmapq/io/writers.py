@@ -5,7 +5,9 @@ from __future__ import annotations
 import contextlib
 import os
 import tempfile
+from collections.abc import Iterator
 from pathlib import Path
+from typing import BinaryIO
 
 import cv2
 import numpy as np
@@ -14,26 +16,35 @@ from pcmapq.errors import InputError
 
 
 def write_atomic(path: Path, data: str | bytes) -> None:
-    """Write ``data`` (str as UTF-8) to ``path`` atomically: into a temporary file in the same
-    directory, then ``os.replace``. On failure the temporary file is removed, any old ``path``
-    is left as it was, and InputError is raised. The new file gets the usual mode (0o666 less
-    the umask), or the old file's mode when replacing one."""
+    """Write ``data`` (str as UTF-8) to ``path`` atomically (see :func:`atomic_file`)."""
+    with atomic_file(path) as f:
+        f.write(data.encode("utf-8") if isinstance(data, str) else data)
+
+
+@contextlib.contextmanager
+def atomic_file(path: Path) -> Iterator[BinaryIO]:
+    """A binary file to write ``path`` through, whole or not at all: the bytes go into a
+    temporary file in the same directory, which replaces ``path`` (``os.replace``) when the
+    block ends without an error. On failure the temporary file is removed, any old ``path`` is
+    left as it was, and an OSError becomes InputError. The new file gets the usual mode (0o666
+    less the umask), or the old file's mode when replacing one."""
     path = Path(path)
-    payload = data.encode("utf-8") if isinstance(data, str) else data
     tmp: str | None = None
     try:
         fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
         with os.fdopen(fd, "wb") as f:
-            f.write(payload)
+            yield f
             f.flush()
             os.fsync(f.fileno())
         os.chmod(tmp, _target_mode(path))
         os.replace(tmp, path)
+        tmp = None
     except OSError as exc:
+        raise InputError(f"{path}: cannot write: {one_line(exc)}") from None
+    finally:
         if tmp is not None:
             with contextlib.suppress(OSError):
                 os.unlink(tmp)
-        raise InputError(f"{path}: cannot write: {one_line(exc)}") from None
 
 
 def write_ros_map(path: Path, image: np.ndarray, resolution: float,

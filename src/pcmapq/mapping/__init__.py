@@ -12,6 +12,7 @@ from __future__ import annotations
 from pcmapq.mapping.kiss import build_map_kiss, kiss_config
 from pcmapq.mapping.poses import (
     lidar_poses_from_camera,
+    moves_along_z,
     read_calib,
     read_kitti_poses,
     read_poses,
@@ -19,7 +20,7 @@ from pcmapq.mapping.poses import (
     write_kitti_poses,
     write_tum_poses,
 )
-from pcmapq.mapping.reference import build_map_from_poses
+from pcmapq.mapping.reference import build_map_from_poses, describe_scans, scans_for_poses
 from pcmapq.mapping.scans import ScanSequence, open_scans
 from pcmapq.voxels import VoxelMap, voxel_centroids
 
@@ -28,13 +29,16 @@ __all__ = [
     "VoxelMap",
     "build_map_from_poses",
     "build_map_kiss",
+    "describe_scans",
     "kiss_config",
     "lidar_poses_from_camera",
+    "moves_along_z",
     "open_scans",
     "read_calib",
     "read_kitti_poses",
     "read_poses",
     "read_tum_poses",
+    "scans_for_poses",
     "voxel_centroids",
     "write_kitti_poses",
     "write_tum_poses",

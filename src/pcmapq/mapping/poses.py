@@ -33,6 +33,7 @@ from pcmapq.io.writers import one_line, write_atomic
 
 __all__ = [
     "lidar_poses_from_camera",
+    "moves_along_z",
     "read_calib",
     "read_kitti_poses",
     "read_tum_poses",
@@ -149,6 +150,18 @@ def lidar_poses_from_camera(camera_poses: np.ndarray, tr: np.ndarray) -> np.ndar
     """
     tr = np.asarray(tr, dtype=np.float64).reshape(4, 4)
     return np.linalg.inv(tr) @ np.asarray(camera_poses, dtype=np.float64) @ tr
+
+
+def moves_along_z(poses: np.ndarray, min_travel: float = 0.5) -> bool:
+    """Whether a trajectory (K, 4, 4) moves mostly along its first pose's z axis, by more than
+    ``min_travel`` metres: a camera's forward axis (KITTI's reference poses are the left
+    camera's: x right, y down, z forward), not a scanner's or a robot's up axis (REP 103: x
+    forward, z up). The test is on the pose furthest from the first: |dz| > |d| / sqrt(2)."""
+    poses = np.asarray(poses, dtype=np.float64)
+    steps = (poses[:, :3, 3] - poses[0, :3, 3]) @ poses[0, :3, :3]  # in the first pose's frame
+    far = steps[int(np.argmax(np.linalg.norm(steps, axis=1)))]
+    travel = float(np.linalg.norm(far))
+    return travel > min_travel and abs(far[2]) > travel / np.sqrt(2.0)
 
 
 # ---------------------------------------------------------------------------------------------

@@ -12,38 +12,67 @@ scanner like KISS-ICP's input.
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
 from pcmapq.errors import InputError
-from pcmapq.mapping.scans import open_scans
+from pcmapq.mapping.scans import ScanSequence, open_scans
 from pcmapq.voxels import VoxelMap
 
-__all__ = ["build_map_from_poses"]
+__all__ = ["build_map_from_poses", "describe_scans", "scans_for_poses"]
 
 
-def build_map_from_poses(source: str | Path, poses: np.ndarray, calib: np.ndarray | None = None,
-                         *, max_scans: int | None = None, voxel: float = 0.1,
-                         progress: Callable[[int, int], None] | None = None,
+def scans_for_poses(source: str | Path | ScanSequence, pose_count: int, *,
+                    max_scans: int | None = None, topic: str | None = None,
+                    poses_path: Path | None = None) -> ScanSequence:
+    """The scans ``pose_count`` poses place: every scan of the sequence, which must have one
+    pose each, or its first ``max_scans`` (the poses must cover them). Otherwise InputError,
+    one line naming the poses file (``poses_path``) and the counts."""
+    scans = source if isinstance(source, ScanSequence) else open_scans(source, topic=topic)
+    name = "poses" if poses_path is None else str(poses_path)
+    if max_scans is None:
+        if pose_count != len(scans):
+            raise InputError(f"{name}: {pose_count} poses for {len(scans)} scans in "
+                             f"{scans.path} (one pose per scan); --max-scans "
+                             f"{min(pose_count, len(scans))} maps the first "
+                             f"{min(pose_count, len(scans))}")
+        return scans
+    wanted = min(max_scans, len(scans))
+    if pose_count < wanted:
+        raise InputError(f"{name}: {pose_count} poses for the first {wanted} scans of "
+                         f"{scans.path}")
+    return replace(scans, count=wanted, files=scans.files[:wanted])
+
+
+def describe_scans(scans: ScanSequence, total: int) -> str:
+    """Which scans a sequence holds, in words: ``scans 000000.bin to 000004.bin (the first 5
+    of 20) of DIR``; messages of a bag count from 0."""
+    first, last = (scans.files[0].name, scans.files[-1].name) if scans.files else (
+        "0", str(len(scans) - 1))
+    return (f"scans {first} to {last} (the first {len(scans)} of {total}) of {scans.path}")
+
+
+def build_map_from_poses(source: str | Path | ScanSequence, poses: np.ndarray,
+                         calib: np.ndarray | None = None, *, max_scans: int | None = None,
+                         voxel: float = 0.1, progress: Callable[[int, int], None] | None = None,
                          min_range: float = 0.0, max_range: float = 100.0,
                          topic: str | None = None) -> np.ndarray:
     """Accumulate scan k placed by ``poses[k] @ calib`` into one map.
 
-    source: a scan folder, ROS bag or MCAP file. poses: (K, 4, 4), one per scan in order; the
-    scans used are the first ``min(K, max_scans)``, and a sequence with fewer scans than that is
-    an error. calib: 4x4 scanner -> pose frame, or None. voxel: output cell, metres.
-    progress: ``progress(done, total)`` after each scan.
+    source: a scan folder, ROS bag or MCAP file, or a sequence opened already. poses: (K, 4,
+    4), one per scan in order; the scans used are all of them (K must equal their number) or
+    the first ``max_scans`` (K at least that; see :func:`scans_for_poses`). calib: 4x4
+    scanner -> pose frame, or None. voxel: output cell, metres. progress: ``progress(done,
+    total)`` after each scan.
 
     Returns the map (N, 3) float64, metres, in the poses' world frame. Deterministic.
     """
     poses = np.asarray(poses, dtype=np.float64)
     if poses.ndim != 3 or poses.shape[1:] != (4, 4) or len(poses) == 0:
         raise InputError(f"poses: expected K x 4 x 4, got shape {poses.shape}")
-    limit = len(poses) if max_scans is None else min(len(poses), max_scans)
-    scans = open_scans(source, max_scans=limit, topic=topic)
-    if len(scans) < limit:
-        raise InputError(f"{scans.path}: {len(scans)} scans for {limit} poses")
+    scans = scans_for_poses(source, len(poses), max_scans=max_scans, topic=topic)
     mount = np.eye(4) if calib is None else np.asarray(calib, dtype=np.float64).reshape(4, 4)
     grid = VoxelMap(voxel)
     for index, (points, _) in enumerate(scans):
@@ -52,5 +81,5 @@ def build_map_from_poses(source: str | Path, poses: np.ndarray, calib: np.ndarra
         place = poses[index] @ mount
         grid.add(points @ place[:3, :3].T + place[:3, 3])
         if progress is not None:
-            progress(index + 1, limit)
+            progress(index + 1, len(scans))
     return grid.points()

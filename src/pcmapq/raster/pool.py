@@ -48,3 +48,12 @@ def min_pool(values: np.ndarray, factor: int) -> np.ndarray:
     stays NaN): (rows, cols) float32 or uint8 -> (ceil(rows / factor), ceil(cols / factor)),
     same dtype. ``values`` itself when ``factor`` is 1."""
     return _pool(values, factor, np.fmin)
+
+
+def mean_pool(mask: np.ndarray, factor: int) -> np.ndarray:
+    """The share of true cells in each ``factor`` x ``factor`` block of a bool mask (partial
+    blocks over their own cells): (rows, cols) bool -> (ceil(rows / factor),
+    ceil(cols / factor)) float64 in [0, 1]."""
+    counts = _pool(mask, factor, np.add).astype(np.float64)
+    rows, cols = (np.minimum(factor, n - np.arange(0, n, factor)) for n in mask.shape)
+    return counts / np.outer(rows, cols)

@@ -1,19 +1,24 @@
-"""A self-contained HTML report of a Result: inputs, alignment, scores, figures (embedded)."""
+"""A self-contained HTML report of a Result: inputs, alignment, scores, figures (embedded, shown
+at their own width so their fonts read as drawn), the lists of missing and extra features."""
 
 from __future__ import annotations
 
 import base64
 import html
 
+import numpy as np
+from scipy.spatial import cKDTree
+
 from pcmapq import __version__
 from pcmapq.report.plot import distance_heatmap, png_bytes, vectorial_figure
+from pcmapq.report.style import ARROW_SCALE, FIGURE_WIDTH_PX
 from pcmapq.report.text import number, score
-from pcmapq.result import Result
+from pcmapq.result import DetectorResult, Result
 from pcmapq.stats import Stats
 
 STYLE = """
 body { font-family: -apple-system, 'Segoe UI', Helvetica, Arial, sans-serif; margin: 2em auto;
-       max-width: 1500px; color: #222; padding: 0 1em; }
+       color: #222; padding: 0 1em; }
 h1 { font-size: 1.5em; margin-bottom: 0.2em; } h2 { font-size: 1.15em; margin-top: 1.6em;
      border-bottom: 1px solid #ddd; padding-bottom: 0.2em; }
 .sub { color: #666; margin-top: 0; }
@@ -22,7 +27,11 @@ th, td { padding: 0.3em 0.8em; text-align: right; border-bottom: 1px solid #e4e4
 th { background: #f5f5f5; } td:first-child, th:first-child { text-align: left; }
 img { max-width: 100%; border: 1px solid #eee; }
 .note { color: #555; font-size: 0.9em; max-width: 70em; }
-"""
+.lists { display: flex; flex-wrap: wrap; gap: 0 2em; }
+.list { max-height: 16em; overflow-y: auto; border: 1px solid #eee; margin-bottom: 0.8em; }
+.list table { margin: 0; }
+h3 { font-size: 1em; margin: 0.8em 0 0.3em; }
+""" + f"body {{ max-width: {FIGURE_WIDTH_PX + 50}px; }}\n"  # a figure shown at its own width
 
 
 #: How each footprint rule reads in the report.
@@ -33,6 +42,34 @@ FOOTPRINT_WORDS = {"known": "known cells", "walls": "enclosed by its walls",
 def _img(png: bytes, alt: str) -> str:
     return f'<img alt="{html.escape(alt)}" src="data:image/png;base64,' \
            f'{base64.b64encode(png).decode("ascii")}">'
+
+
+def _nearest(points: np.ndarray, others: np.ndarray) -> list[str]:
+    """Distance, metres, from each of ``points`` (N, 2) to the nearest of ``others`` (M, 2);
+    '-' for every point when there is none."""
+    if len(others) == 0:
+        return ["-"] * len(points)
+    return [number(d) for d in cKDTree(others).query(points)[0]] if len(points) else []
+
+
+def _feature_list(label: str, xy: np.ndarray, others: np.ndarray, other_side: str) -> str:
+    """One scrollable table of features: number, x, y, distance to the nearest feature of the
+    other side."""
+    rows = [[str(i + 1), number(x), number(y), d]
+            for i, ((x, y), d) in enumerate(zip(xy.tolist(), _nearest(xy, others),
+                                                strict=True))]
+    table = _table(["#", "x [m]", "y [m]", f"nearest {other_side} feature [m]"], rows)
+    return f'<div><h3>{html.escape(label)}</h3><div class="list">{table}</div></div>'
+
+
+def _lists(name: str, det: DetectorResult) -> str:
+    """The missing truth features and the extra map features of one detector, truth frame."""
+    m = det.matching
+    return '<div class="lists">' + _feature_list(
+        f"{name}: {len(m.missing)} missing (truth features with no map partner)",
+        det.truth.xy[m.missing], det.map.xy, "map") + _feature_list(
+        f"{name}: {len(m.extra)} extra (map features with no truth partner)",
+        det.map.xy[m.extra], det.truth.xy, "truth") + "</div>"
 
 
 def _table(header: list[str], rows: list[list[str]]) -> str:
@@ -58,8 +95,9 @@ def _stats_table(counted: str, rows: list[tuple[str, Stats]]) -> str:
                   [[label, *_stats_cells(s), str(s.count)] for label, s in rows])
 
 
-def report_html(result: Result) -> str:
-    """The whole report as one HTML document (figures as embedded PNGs, no network needed)."""
+def report_html(result: Result, arrow_scale: float = ARROW_SCALE) -> str:
+    """The whole report as one HTML document (figures as embedded PNGs, no network needed);
+    displacement arrows ``arrow_scale`` times their length."""
     a, tf, o = result.alignment, result.transform, result.overlap
     inputs = _table(["", "path", "kind"], [
         ["map", str(result.map_path), result.map_kind],
@@ -98,8 +136,10 @@ def report_html(result: Result) -> str:
                 "clouds:</p>"
         dist += _stats_table("points", [("3D accuracy (map to truth)", d3.accuracy),
                                         ("3D completeness (truth to map)", d3.completeness)])
-    vectors = _img(png_bytes(vectorial_figure(result)), "vectorial map per detector")
-    heat = _img(png_bytes(distance_heatmap(result)), "map-to-truth distance heatmap")
+    vectors = _img(png_bytes(vectorial_figure(result, arrow_scale)), "vectorial map per detector")
+    heat = _img(png_bytes(distance_heatmap(result)),
+                "distance heatmaps: accuracy (map to truth) and completeness (truth to map)")
+    lists = "".join(_lists(name, det) for name, det in result.detectors.items())
     title = f"pcmapq: {html.escape(result.map_path.name)} against " \
             f"{html.escape(result.truth_path.name)}"
     return f"""<!DOCTYPE html>
@@ -124,6 +164,12 @@ map feature.</p>
 <p class="note">Chamfer distance {number(d.chamfer_m)} m (mean of the two means). Definitions in
 docs/metrics.md.</p>{fscore}
 <h2>Vectorial map</h2>{vectors}
-<h2>Distance heatmap</h2>{heat}
+<h2>Distance heatmaps</h2>{heat}
+<p class="note">Left, accuracy: each wall cell of the aligned map coloured by its distance to
+the nearest truth wall. Right, completeness: each truth wall cell the scores count coloured by
+its distance to the nearest map wall.</p>
+<h2>Missing and extra features</h2>
+<p class="note">Truth frame, metres. A feature with a partner within {result.threshold:g} m
+is still listed when the one-to-one assignment gave that partner to another feature.</p>{lists}
 </body></html>
 """

@@ -1,24 +1,34 @@
-"""Pictures of a Result: the vectorial map per detector, and the map-to-truth distance heatmap.
+"""Pictures of a Result: the vectorial map per detector, and the distance heatmaps (accuracy:
+map -> truth, completeness: truth -> map).
 
-Everything is drawn in the truth frame, axes in metres (matplotlib, headless Agg backend).
+Everything is drawn in the truth frame, axes in metres (matplotlib, headless Agg backend). The
+truth's walls are drawn dark over the aligned map's, light and one pixel wider, so both show
+where they meet; displacement arrows are :data:`~pcmapq.report.style.ARROW_SCALE` times their
+length (``--arrow-scale``) in every panel of every run; legends and scale bars stand outside the
+axes, never over data; a figure is at most as wide as the HTML report shows it (style.py).
 
 Rasters are drawn at display resolution: a grid with more cells across or down than its panel
-has pixels at :data:`DPI` is max-pooled (:mod:`pcmapq.raster.pool`) to fit, so a map of any
-size costs a picture of the same size (at most about 0.7 MP a vectorial panel, 1 MP the
-heatmap), and a wall one cell thin still shows, which matplotlib's nearest resampling of a
-larger image would skip (on a 2000-pixel raster of one-cell walls drawn into 600 pixels it
-showed 4 walls of 50). A grid that fits is drawn cell for cell, as before.
+has pixels at :data:`DPI` is pooled (:mod:`pcmapq.raster.pool`) to fit, so a map of any size
+costs a picture of the same size, and a wall one cell thin still shows, which matplotlib's
+nearest resampling of a larger image would skip (on a 2000-pixel raster of one-cell walls drawn
+into 600 pixels it showed 4 walls of 50). A grid that fits is drawn cell for cell. Two 3D
+clouds (LiDAR maps, outdoors as a rule: a scatter of points, not walls) are drawn as a bird's-eye
+density instead: each pixel's shade is the share of its cells that are occupied. Feature
+markers of one kind are thinned to one per :data:`~pcmapq.report.style.THIN_PX` pixels square
+(:data:`~pcmapq.report.style.THIN_PX_DENSITY` on a density).
 """
 
 from __future__ import annotations
 
 import io
 import math
+import textwrap
 from collections.abc import Sequence
 
 import matplotlib
 
 matplotlib.use("Agg")
+import cv2  # noqa: E402
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.axes import Axes  # noqa: E402
@@ -26,20 +36,38 @@ from matplotlib.cm import ScalarMappable  # noqa: E402
 from matplotlib.collections import LineCollection  # noqa: E402
 from matplotlib.colors import Normalize  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
+from matplotlib.legend import Legend  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
 from mpl_toolkits.axes_grid1.anchored_artists import AnchoredSizeBar  # noqa: E402
 
 from pcmapq.morphology import distance_to  # noqa: E402
-from pcmapq.raster.pool import max_pool, min_pool  # noqa: E402
+from pcmapq.raster.pool import max_pool, mean_pool, min_pool  # noqa: E402
+from pcmapq.report.style import (  # noqa: E402
+    ARROW_SCALE,
+    DPI,
+    EXTRA,
+    FIGURE_WIDTH_PX,
+    FOOTPRINT,
+    MAP_LIGHT,
+    MATCHED,
+    MISSING,
+    TEXT_PT,
+    THIN_PX,
+    THIN_PX_DENSITY,
+    TITLE_PT,
+    TRUTH_DARK,
+)
 from pcmapq.report.text import score  # noqa: E402
 from pcmapq.result import DetectorResult, Result  # noqa: E402
 
-TRUTH_GREY, MAP_BLUE = (0.62, 0.62, 0.62), (0.25, 0.55, 0.95)
-MATCHED, MISSING, EXTRA, FOOTPRINT = "#1a9850", "#d73027", "#f28e2b", "#7b3294"
 NICE = (1, 2, 5)
-#: Dots per inch of the PNGs (:func:`png_bytes`' default); rasters are pooled to the pixels their
-#: panel has at this resolution (saved at fewer dpi, matplotlib skips some of their rows again).
-DPI = 130
+#: Figure width, inches: the report's figure width at DPI.
+WIDTH_IN = FIGURE_WIDTH_PX / DPI
+#: Shade of a pixel with any occupied cell in a density picture (so a lone hit shows), and
+#: of the truth over the map.
+DENSITY_FLOOR, TRUTH_ALPHA = 0.3, 0.9
+#: Grey of the walls under a heatmap's coloured cells.
+UNDER_GREY = (0.8, 0.8, 0.8)
 
 
 def _nice(value: float) -> float:
@@ -59,25 +87,27 @@ def extent(result: Result, factor: int = 1) -> tuple[float, float, float, float]
     return x0, x0 + blocks_across * res, y0 + (rows - blocks_down) * res, y0 + rows * res
 
 
-def pooling(fig: Figure, axes: Sequence[Axes], shape: tuple[int, int]) -> int:
+def pooling(fig: Figure, axes: Sequence[Axes], shape: tuple[int, int]) -> tuple[int, float]:
     """The smallest pooling factor that leaves a raster of ``shape`` (rows, cols) no more cells
     across and down than each of ``axes`` has pixels at :data:`DPI`, once ``fig`` is laid out
-    (its titles, labels, legend and colour bar placed, the axes' aspect ratio applied). The
-    axes are then put back where they were: the layout is run again when the figure is saved,
-    and from where it starts depends where it ends, to a fraction of a pixel."""
+    (its titles, labels, legend and colour bar placed, the axes' aspect ratio applied), and the
+    metres a pixel spans in the smallest of them. The axes are then put back where they were:
+    the layout is run again when the figure is saved, and from where it starts depends where
+    it ends, to a fraction of a pixel."""
     before = [(ax, ax.get_position(original=True), ax.get_in_layout()) for ax in fig.axes]
     fig.get_layout_engine().execute(fig)
-    factor = 1
+    factor, pixel_m = 1, 0.0
     for ax in axes:
         ax.apply_aspect()
         box = ax.get_position()
         across = box.width * fig.get_figwidth() * DPI
         down = box.height * fig.get_figheight() * DPI
         factor = max(factor, math.ceil(shape[0] / down), math.ceil(shape[1] / across))
+        pixel_m = max(pixel_m, abs(np.diff(ax.get_xlim())[0]) / across)
     for ax, position, in_layout in before:
         ax.set_position(position)
         ax.set_in_layout(in_layout)  # which set_position turns off
-    return factor
+    return factor, pixel_m
 
 
 def _frame(ax: Axes, result: Result) -> None:
@@ -85,40 +115,78 @@ def _frame(ax: Axes, result: Result) -> None:
     left, right, bottom, top = extent(result)
     ax.set_xlim(left, right)
     ax.set_ylim(bottom, top)
-    ax.set_xlabel("x [m]")
-    ax.set_ylabel("y [m]")
+    ax.set_xlabel("x [m]", fontsize=TEXT_PT)
+    ax.set_ylabel("y [m]", fontsize=TEXT_PT)
+    ax.tick_params(labelsize=TEXT_PT)
     ax.set_aspect("equal")
 
 
-def overlay(truth: np.ndarray, map_: np.ndarray) -> np.ndarray:
-    """RGB image (float) of two wall masks of one shape: white, the truth's walls grey, the
-    aligned map's walls blue over them."""
-    img = np.ones((*truth.shape, 3))
-    img[truth] = TRUTH_GREY
-    img[map_] = MAP_BLUE
+def density(result: Result) -> bool:
+    """Whether ``result``'s pictures show densities (both inputs 3D clouds: LiDAR maps) rather
+    than walls."""
+    return result.registration_3d is not None
+
+
+def shade(mask: np.ndarray, factor: int, as_density: bool) -> np.ndarray:
+    """Opacity per display pixel of a (rows, cols) bool mask pooled ``factor``-fold, [0, 1]:
+    1 where a block holds a true cell (walls), or the blocks' occupied share, square-rooted and
+    lifted to at least DENSITY_FLOOR where not 0 (density)."""
+    if not as_density:
+        return max_pool(mask, factor).astype(np.float64)
+    share = mean_pool(mask, factor)
+    return np.where(share > 0, DENSITY_FLOOR + (1 - DENSITY_FLOOR) * np.sqrt(share), 0.0)
+
+
+def grown(alpha: np.ndarray) -> np.ndarray:
+    """``alpha`` (rows, cols) float with each pixel taking its 3 x 3 neighbourhood's largest
+    value: drawn one pixel wider on every side."""
+    return cv2.dilate(alpha.astype(np.float32), np.ones((3, 3), np.uint8),
+                      borderType=cv2.BORDER_REPLICATE).astype(np.float64)
+
+
+def overlay(truth_alpha: np.ndarray, map_alpha: np.ndarray) -> np.ndarray:
+    """RGB image (float) of two opacities of one shape on white: the aligned map light
+    (MAP_LIGHT), the truth dark (TRUTH_DARK) over it at TRUTH_ALPHA of its opacity."""
+    img = np.ones((*truth_alpha.shape, 3))
+    for colour, alpha in ((MAP_LIGHT, map_alpha), (TRUTH_DARK, TRUTH_ALPHA * truth_alpha)):
+        img += alpha[..., None] * (np.asarray(colour) - img)
     return img
 
 
-def arrow_gain(result: Result) -> float:
-    """How much displacement arrows are lengthened: a 1, 2 or 5 step chosen so that the
-    largest displacement draws about 4 % of the map's width."""
-    d = np.concatenate([det.distances for det in result.detectors.values()] + [np.zeros(1)])
-    if d.max() <= 0:
-        return 1.0
-    return max(1.0, _nice(0.04 * result.grid.size_m[0] / d.max()))
+def thinned(xy: np.ndarray, cell_m: float) -> np.ndarray:
+    """Indices (sorted) of the first of ``xy`` (N, 2) metres in each square of ``cell_m``
+    metres: at most one point a square."""
+    if len(xy) == 0:
+        return np.zeros(0, dtype=np.intp)
+    _, first = np.unique(np.floor(xy / cell_m).astype(np.int64), axis=0, return_index=True)
+    return np.sort(first)
 
 
 def _title(ax: Axes, result: Result, name: str) -> None:
     m = result.detectors[name].matching
+    note = result.note(name)
     ax.set_title(f"{name}: quality {score(m.quality, 2)}, precision {score(m.precision, 2)}, "
-                 f"f1 {score(m.f1, 2)}"
-                 + (f"\n{note}" if (note := result.note(name)) else ""), fontsize=10)
+                 f"f1 {score(m.f1, 2)}" + (f"\n{textwrap.fill(note, 60)}" if note else ""),
+                 fontsize=TITLE_PT)
+
+
+def _scale_bar(ax: Axes, result: Result) -> None:
+    """A bar of a round length, right-aligned under the axes at the x label's height."""
+    width = result.grid.size_m[0]
+    bar = _nice(width / 5)
+    ax.add_artist(AnchoredSizeBar(ax.transData, bar, f"{bar:g} m", "upper right",
+                                  bbox_to_anchor=(1.0, 0.0), bbox_transform=ax.transAxes,
+                                  borderpad=1.9, pad=0, sep=2, frameon=False,
+                                  size_vertical=0, fontproperties={"size": TEXT_PT}))
+    ax.artists[-1].size_bar.get_children()[0].set_linewidth(2.5)
 
 
 def _panel(ax: Axes, result: Result, factor: int, image: np.ndarray,
-           footprint: np.ndarray | None, det: DetectorResult, gain: float) -> None:
+           footprint: np.ndarray | None, det: DetectorResult, gain: float,
+           cell_m: float) -> None:
     """One detector's panel over ``image`` and ``footprint``, the rasters pooled
-    ``factor``-fold."""
+    ``factor``-fold; markers thinned to one per ``cell_m`` metres square, arrows ``gain``
+    times their displacement."""
     ax.imshow(image, extent=extent(result, factor), origin="upper", interpolation="nearest")
     if footprint is not None:
         ax.contour(footprint, levels=[0.5], colors=FOOTPRINT, linewidths=0.8,
@@ -128,95 +196,151 @@ def _panel(ax: Axes, result: Result, factor: int, image: np.ndarray,
         for idx, feats, colour in ((m.truth_idx, det.truth, MATCHED),
                                    (m.missing, det.truth, MISSING), (m.extra, det.map, EXTRA)):
             ax.add_collection(LineCollection(feats.segments[idx].reshape(-1, 2, 2),
-                                             colors=colour, linewidths=1.6))
-    ax.scatter(*det.truth_xy.T, s=9, c=MATCHED, zorder=3)
-    ax.scatter(*det.truth.xy[m.missing].T, s=28, c=MISSING, marker="x", zorder=3)
-    ax.scatter(*det.map.xy[m.extra].T, s=28, c=EXTRA, marker="+", zorder=3)
-    if len(m.displacement):
-        q = ax.quiver(*det.truth_xy.T, *m.displacement.T, angles="xy", scale_units="xy",
-                      scale=1.0 / gain, color="black", width=0.003, zorder=4)
-        ref = _nice(max(float(det.distances.max()), 1e-3))
-        ax.quiverkey(q, 0.04, 0.04, ref, f"{ref:g} m (x{gain:g})", labelpos="E",
-                     coordinates="axes", fontproperties={"size": 8})
-    width = result.grid.size_m[0]
-    bar = _nice(width / 5)
-    ax.add_artist(AnchoredSizeBar(ax.transData, bar, f"{bar:g} m", "lower right", pad=0.4,
-                                  frameon=True, size_vertical=width / 300))
+                                             colors=colour, linewidths=1.2))
+    matched = thinned(det.truth_xy, cell_m)
+    missing = det.truth.xy[m.missing][thinned(det.truth.xy[m.missing], cell_m)]
+    extra = det.map.xy[m.extra][thinned(det.map.xy[m.extra], cell_m)]
+    ax.scatter(*det.truth_xy[matched].T, s=9, c=MATCHED, zorder=3)
+    ax.scatter(*missing.T, s=28, c=MISSING, marker="x", zorder=3)
+    ax.scatter(*extra.T, s=28, c=EXTRA, marker="+", zorder=3)
+    if len(matched):
+        ax.quiver(*det.truth_xy[matched].T, *m.displacement[matched].T, angles="xy",
+                  scale_units="xy", scale=1.0 / gain, color="black", width=0.003, zorder=4)
+    _scale_bar(ax, result)
 
 
-def vectorial_figure(result: Result) -> Figure:
-    """One panel per detector: truth grey, aligned map blue, matched features with their
-    displacement arrows, missing truth features and extra map features, the footprint outline."""
-    names = list(result.detectors)
-    width, height = result.grid.size_m
-    cols = len(names)
-    panel_w = 6.0
-    panel_h = float(np.clip(panel_w * height / max(width, 1e-9), 3.0, 9.0))
-    fig, axes = plt.subplots(1, cols, figsize=(panel_w * cols, panel_h + 1.2), squeeze=False,
-                             layout="constrained")
-    gain = arrow_gain(result)
-    handles = [Line2D([], [], color=TRUTH_GREY, lw=4, label="truth walls"),
-               Line2D([], [], color=MAP_BLUE, lw=4, label="aligned map walls"),
+def _legend_handles(result: Result, gain: float, as_density: bool) -> list[Line2D]:
+    what = "occupied share" if as_density else "walls"
+    handles = [Line2D([], [], color=TRUTH_DARK, lw=4, label=f"truth {what}"),
+               Line2D([], [], color=MAP_LIGHT, lw=4, label=f"aligned map {what}"),
                Line2D([], [], color=MATCHED, marker="o", ls="", label="matched (truth)"),
                Line2D([], [], color="black", marker=r"$\rightarrow$", ls="", ms=12,
-                      label=f"displacement to the map (x{gain:g})"),
+                      label=f"displacement x{gain:g} ({0.1:g} m drawn {0.1 * gain:g} m)"),
                Line2D([], [], color=MISSING, marker="x", ls="", label="missing in the map"),
                Line2D([], [], color=EXTRA, marker="+", ls="", label="extra in the map")]
     if not result.full:
         handles.append(Line2D([], [], color=FOOTPRINT, lw=1, label="map footprint"))
-    fig.legend(handles=handles, loc="outside lower center", ncols=len(handles), fontsize=8,
-               frameon=False)
-    for ax, name in zip(axes[0], names, strict=True):
+    return handles
+
+
+def fitted_legend(fig: Figure, handles: list[Line2D], note: str,
+                  spare: Axes | None = None) -> Legend:
+    """A legend titled ``note``: centred in the ``spare`` axes (an empty panel cell, its frame
+    hidden) when there is one, else below the panels in as many columns as fit the figure's
+    width (one a row at worst)."""
+    options = {"handles": handles, "fontsize": TEXT_PT, "title_fontsize": TEXT_PT,
+               "frameon": False}
+    if spare is not None:
+        spare.set_axis_off()
+        return spare.legend(loc="center", title=textwrap.fill(note, 40), **options)
+    renderer = fig.canvas.get_renderer()
+    for ncols in range(len(handles), 0, -1):
+        legend = fig.legend(loc="outside lower center", ncols=ncols, title=note, **options)
+        if ncols == 1 or legend.get_window_extent(renderer).width <= 0.98 * fig.bbox.width:
+            return legend
+        legend.remove()
+    raise AssertionError("unreachable")
+
+
+def _grid_shape(n: int) -> tuple[int, int]:
+    """(rows, cols) of the panels of ``n`` detectors: one column for one, else two."""
+    cols = 1 if n == 1 else 2
+    return -(-n // cols), cols
+
+
+def vectorial_figure(result: Result, arrow_scale: float = ARROW_SCALE) -> Figure:
+    """One panel per detector: the truth dark over the aligned map light, matched features with
+    their displacement arrows (``arrow_scale`` times their length), missing truth features and
+    extra map features (thinned where crowded), the footprint outline."""
+    names = list(result.detectors)
+    width, height = result.grid.size_m
+    rows, cols = _grid_shape(len(names))
+    panel_w = WIDTH_IN / cols
+    spare = rows * cols > len(names)
+    panel_h = float(np.clip(panel_w * height / max(width, 1e-9), 2.5, 9.0)) + 0.6
+    fig, grid = plt.subplots(rows, cols, figsize=(WIDTH_IN, rows * panel_h + (0 if spare else 1)),
+                             squeeze=False, layout="constrained")
+    axes = list(grid.flat[:len(names)])
+    as_density = density(result)
+    thin_px = THIN_PX_DENSITY if as_density else THIN_PX
+    fitted_legend(fig, _legend_handles(result, arrow_scale, as_density),
+                  f"markers thinned to one per {thin_px} px square where crowded; "
+                  f"{'shade: share of occupied cells per pixel; ' if as_density else ''}"
+                  "axes and arrows in metres", grid.flat[-1] if spare else None)
+    for ax, name in zip(axes, names, strict=True):
         _title(ax, result, name)
         _frame(ax, result)
-    factor = pooling(fig, axes[0], result.grid.shape)
-    image = overlay(max_pool(result.truth_occupied, factor), max_pool(result.map_occupied, factor))
+    factor, pixel_m = pooling(fig, axes, result.grid.shape)
+    image = overlay(shade(result.truth_occupied, factor, as_density),
+                    grown(shade(result.map_occupied, factor, as_density)))
     footprint = None if result.full else max_pool(result.overlap.footprint, factor)
-    for ax, name in zip(axes[0], names, strict=True):
-        _panel(ax, result, factor, image, footprint, result.detectors[name], gain)
+    for ax, name in zip(axes, names, strict=True):
+        _panel(ax, result, factor, image, footprint, result.detectors[name], arrow_scale,
+               thin_px * pixel_m)
     return fig
 
 
-def wall_distances(truth: np.ndarray, map_: np.ndarray, resolution: float,
+def wall_distances(target: np.ndarray, source: np.ndarray, resolution: float,
                    factor: int) -> np.ndarray:
-    """Per block of ``factor`` x ``factor`` cells, the smallest distance, metres, from the map's
-    wall cells in it to the nearest truth wall cell: truth, map_ (rows, cols) bool wall masks
-    of cells of ``resolution`` metres -> (ceil(rows / factor), ceil(cols / factor)) float64,
-    NaN where the block holds no map wall.
+    """Per block of ``factor`` x ``factor`` cells, the smallest distance, metres, from the
+    ``source`` wall cells in it to the nearest ``target`` wall cell: target, source (rows, cols)
+    bool wall masks of cells of ``resolution`` metres -> (ceil(rows / factor),
+    ceil(cols / factor)) float64, NaN where the block holds no source wall. Accuracy: the
+    map's walls to the truth's; completeness: the truth's to the map's.
 
     The distances are the full grid's (a float32 transform, 4 bytes a cell), so each shown value
-    is one the accuracy statistics count; a transform on the pooled truth would be cheaper but
-    off by up to a pooled cell's diagonal (24 mm on the Gazebo truth, pooled 9-fold; 1 to 1.5 s
-    and 0.3 GB saved there). The smallest, because a block's
-    distance to the truth is that of its nearest wall cell, as a cell's is; the block's other
-    wall cells are at most its diagonal farther.
+    is one the statistics count; a transform on the pooled target would be cheaper but off by
+    up to a pooled cell's diagonal (24 mm on the Gazebo truth, pooled 9-fold; 1 to 1.5 s and
+    0.3 GB saved there). The smallest, because a block's distance to the target is that of its
+    nearest wall cell, as a cell's is; the block's other wall cells are at most its diagonal
+    farther.
     """
-    cells = distance_to(truth)
-    np.copyto(cells, np.float32(np.nan), where=~map_)
+    cells = distance_to(target)
+    np.copyto(cells, np.float32(np.nan), where=~source)
     return np.multiply(min_pool(cells, factor), resolution, dtype=np.float64)
 
 
-def distance_heatmap(result: Result, clip: float = 0.5) -> Figure:
-    """Each occupied cell of the aligned map coloured by its distance to the nearest truth wall,
-    metres (clipped at ``clip``); the truth's walls in grey beneath. Pooled to display
-    resolution (:func:`wall_distances`)."""
-    width, height = result.grid.size_m
-    fig, ax = plt.subplots(figsize=(8.0, float(np.clip(8.0 * height / width, 3.0, 10.0))),
-                           layout="constrained")
-    colours = ScalarMappable(Normalize(0, clip), "viridis")
-    fig.colorbar(colours, ax=ax, label=f"map-to-truth distance [m] (clipped at {clip:g})",
-                 shrink=0.8)
-    ax.set_title("distance from each map wall cell to the nearest truth wall", fontsize=10)
-    _frame(ax, result)
-    factor = pooling(fig, [ax], result.grid.shape)
-    truth = max_pool(result.truth_occupied, factor)
-    base = np.ones((*truth.shape, 3))
-    base[truth] = (0.82, 0.82, 0.82)
+def _heat_panel(ax: Axes, result: Result, factor: int, under: np.ndarray, shown: np.ndarray,
+                colours: ScalarMappable, title: str) -> None:
+    """``under`` (pooled bool) in grey, then ``shown`` (pooled distances, NaN where none)
+    coloured by ``colours``, each coloured pixel grown by one pixel so lone cells show."""
+    base = np.ones((*under.shape, 3))
+    base[under] = UNDER_GREY
     ax.imshow(base, extent=extent(result, factor), origin="upper", interpolation="nearest")
-    shown = wall_distances(result.truth_occupied, result.map_occupied, result.grid.resolution,
-                           factor)
-    ax.imshow(np.minimum(shown, clip), extent=extent(result, factor), origin="upper",
-              cmap=colours.cmap, norm=colours.norm, interpolation="nearest")
+    near = -cv2.dilate(np.nan_to_num(-shown, nan=-np.inf).astype(np.float32),
+                       np.ones((3, 3), np.uint8), borderType=cv2.BORDER_REPLICATE)
+    ax.imshow(np.where(np.isfinite(near), np.minimum(near, colours.norm.vmax), np.nan),
+              extent=extent(result, factor), origin="upper", cmap=colours.cmap,
+              norm=colours.norm, interpolation="nearest")
+    ax.set_title(title, fontsize=TITLE_PT)
+
+
+def distance_heatmap(result: Result, clip: float = 0.5) -> Figure:
+    """Two panels: accuracy (each occupied cell of the aligned map coloured by its distance to
+    the nearest truth wall, the truth's walls grey beneath) and completeness (each truth wall
+    cell the scores count, inside the footprint unless scored against the whole truth,
+    coloured by its distance to the nearest map wall, the map's walls grey beneath); metres,
+    clipped at ``clip``. Pooled to display resolution (:func:`wall_distances`)."""
+    width, height = result.grid.size_m
+    panel_w = WIDTH_IN / 2
+    fig, axes = plt.subplots(1, 2, figsize=(WIDTH_IN, float(np.clip(
+        panel_w * height / width, 2.5, 9.0)) + 1.4), layout="constrained")
+    colours = ScalarMappable(Normalize(0, clip), "viridis")
+    bar = fig.colorbar(colours, ax=list(axes), location="bottom", shrink=0.6, aspect=40)
+    bar.set_label(f"distance to the nearest wall of the other side [m] (clipped at {clip:g})",
+                  fontsize=TEXT_PT)
+    bar.ax.tick_params(labelsize=TEXT_PT)
+    for ax in axes:
+        _frame(ax, result)
+    factor, _ = pooling(fig, list(axes), result.grid.shape)
+    truth, walls, res = result.truth_occupied, result.map_occupied, result.grid.resolution
+    counted = truth if result.full else truth & result.overlap.footprint
+    _heat_panel(axes[0], result, factor, max_pool(truth, factor),
+                wall_distances(truth, walls, res, factor), colours,
+                "accuracy: map walls to the truth")
+    _heat_panel(axes[1], result, factor, max_pool(walls, factor),
+                wall_distances(walls, counted, res, factor), colours,
+                "completeness: truth walls to the map")
     return fig
 
 

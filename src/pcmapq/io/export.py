@@ -1,0 +1,98 @@
+"""File formats other tools read: point clouds with a scalar field and colours (binary PLY, as
+CloudCompare, Open3D and MeshLab read it; binary PCD, as PCL and Open3D read it) and transform
+matrices as plain text (``np.loadtxt``, CloudCompare's "Apply transformation" file).
+
+Clouds are written from chunks of records, so a cloud of any size needs one chunk of memory;
+every file is written whole or not at all (:func:`pcmapq.io.writers.atomic_file`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from pathlib import Path
+
+import numpy as np
+
+from pcmapq.errors import InputError
+from pcmapq.io.writers import atomic_file
+
+#: The scalar field of a distance cloud: metres. CloudCompare reads a PLY property named
+#: ``scalar_<name>`` as the scalar field ``<name>``.
+DISTANCE_FIELD = "scalar_distance_m"
+#: Extensions :func:`write_records` writes.
+CLOUD_SUFFIXES = (".ply", ".pcd")
+
+_PLY_TYPES = {"f4": "float", "u1": "uchar"}
+
+
+def record_dtype(scalar: str | None = None, colour: bool = False) -> np.dtype:
+    """Little-endian records: float32 x, y, z (metres), then float32 ``scalar`` and uchar red,
+    green, blue when asked."""
+    fields = [("x", "<f4"), ("y", "<f4"), ("z", "<f4")]
+    if scalar is not None:
+        fields.append((scalar, "<f4"))
+    if colour:
+        fields += [("red", "u1"), ("green", "u1"), ("blue", "u1")]
+    return np.dtype(fields)
+
+
+def records(xyz: np.ndarray, dtype: np.dtype, scalar: np.ndarray | None = None,
+            rgb: np.ndarray | None = None) -> np.ndarray:
+    """Points (n, 3) metres, with a scalar (n,) and colours (n, 3) uint8 when ``dtype`` has
+    them, as records of ``dtype`` (:func:`record_dtype`)."""
+    out = np.empty(len(xyz), dtype=dtype)
+    for axis, name in enumerate("xyz"):
+        out[name] = xyz[:, axis]
+    if scalar is not None:
+        out[dtype.names[3]] = scalar
+    if rgb is not None:
+        for axis, name in enumerate(("red", "green", "blue")):
+            out[name] = rgb[:, axis]
+    return out
+
+
+def write_records(path: Path, count: int, chunks: Iterable[np.ndarray], dtype: np.dtype,
+                  comment: str = "") -> None:
+    """Write ``count`` records of ``dtype`` (:func:`record_dtype`), given as chunks, as a binary
+    PLY (every field a vertex property) or a binary PCD (x, y, z only), by ``path``'s
+    extension; ``comment`` (one line) goes into the header."""
+    suffix = path.suffix.lower()
+    if suffix not in CLOUD_SUFFIXES:
+        raise InputError(f"{path}: a cloud is written as .ply or .pcd")
+    if suffix == ".pcd" and dtype.names != ("x", "y", "z"):
+        raise InputError(f"{path}: a cloud with a scalar field is written as .ply")
+    header = _ply_header(count, dtype, comment) if suffix == ".ply" else _pcd_header(count)
+    written = 0
+    with atomic_file(path) as f:
+        f.write(header.encode("ascii"))
+        for chunk in chunks:
+            f.write(np.ascontiguousarray(chunk, dtype=dtype).tobytes())
+            written += len(chunk)
+        if written != count:
+            raise InputError(f"{path}: {written} points written, {count} announced")
+
+
+def write_matrix(path: Path, matrix: np.ndarray) -> None:
+    """A 3x3 or 4x4 homogeneous transform as plain text: one row a line, numbers separated by
+    one space, shortest exact form (reading it back gives the same floats)."""
+    rows = np.asarray(matrix, dtype=np.float64)
+    with atomic_file(path) as f:
+        f.write("".join(" ".join(repr(float(v) + 0.0) for v in row) + "\n"
+                        for row in rows).encode("ascii"))
+
+
+def _ply_header(count: int, dtype: np.dtype, comment: str) -> str:
+    """The header of a binary little-endian PLY of ``count`` vertices of ``dtype``."""
+    lines = ["ply", "format binary_little_endian 1.0"]
+    lines += [f"comment {comment}"] if comment else []
+    lines.append(f"element vertex {count}")
+    lines += [f"property {_PLY_TYPES[dtype[name].str[1:]]} {name}" for name in dtype.names]
+    return "\n".join([*lines, "end_header"]) + "\n"
+
+
+def _pcd_header(count: int) -> str:
+    """The header of a binary PCD (v0.7) of ``count`` float32 x, y, z points."""
+    return ("# .PCD v0.7 - Point Cloud Data file format\nVERSION 0.7\nFIELDS x y z\n"
+            "SIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\n"
+            f"WIDTH {count}\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS {count}\n"
+            "DATA binary\n")
