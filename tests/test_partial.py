@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 
 import cv2
 import numpy as np
@@ -171,7 +172,7 @@ def test_cli_footprint_option(plan, truth_png, tmp_path):
     res = runner.invoke(app, ["eval", path, str(truth_png), "--detectors", "harris",
                               "--json", str(tmp_path / "r.json")])
     assert res.exit_code == 0, res.output
-    assert "(footprint: walls)" in res.output
+    assert re.search(r"^footprint +walls, coverage", res.output, flags=re.M), res.output
     assert json.loads((tmp_path / "r.json").read_text())["footprint"] == "walls"
     res = runner.invoke(app, ["eval", path, str(truth_png), "--footprint", "everything"])
     assert res.exit_code == 2 and "--footprint" in res.output
