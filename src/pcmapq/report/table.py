@@ -107,37 +107,41 @@ def _stats_parts(stats: Stats, direction: str) -> list[str]:
 def _scores(console: Console, result: Result) -> None:
     """Quality, precision, f1 and the four counts per detector."""
     rows = {name: score_row(det) for name, det in result.detectors.items()}
-    title = (f"features matched within {result.threshold:g} m (counts of strong features; "
-             "quality = matched truth / truth features, precision = matched map / map "
-             "features)")
-    table = _table(SCORE_COLUMNS, rows)
-    if _fits(console, table):
-        _lines(console, words(title, console.width))
-        console.print(table)
-        return
-    _lines(console, words(f"features matched within {result.threshold:g} m", console.width))
-    for name, (q, p, f1, truth, matched, map_, matched_map) in rows.items():
-        _field(console, name, _values(console, [f"quality {q} ({matched}/{truth} truth)",
-                                                f"precision {p} ({matched_map}/{map_} map)",
-                                                f"f1 {f1}"]))
+    _table_or_blocks(
+        console, _table(SCORE_COLUMNS, rows),
+        f"features matched within {result.threshold:g} m (counts of strong features; "
+        "quality = matched truth / truth features, precision = matched map / map features)",
+        f"features matched within {result.threshold:g} m",
+        {name: [f"quality {q} ({matched}/{truth} truth)",
+                f"precision {p} ({matched_map}/{map_} map)", f"f1 {f1}"]
+         for name, (q, p, f1, truth, matched, map_, matched_map) in rows.items()})
 
 
 def _displacements(console: Console, result: Result) -> None:
     """The displacement statistics of each detector's matched pairs, metres."""
     rows = {name: displacement_row(det.displacement_stats())
             for name, det in result.detectors.items()}
-    title = ("displacement from truth feature to map feature over the matched pairs "
-             "(every pair, whichever of its features are counted), metres")
-    table = _table(DISPLACEMENT_COLUMNS, rows)
+    _table_or_blocks(
+        console, _table(DISPLACEMENT_COLUMNS, rows),
+        "displacement from truth feature to map feature over the matched pairs (every pair, "
+        "whichever of its features are counted), metres",
+        "displacement of the matched pairs",
+        {name: [f"{pairs} pairs"] + [f"{k} {v}" + (" m" if v != "-" else "")
+                                     for k, v in zip(FIELDS[1:], values, strict=True)]
+         for name, (pairs, *values) in rows.items()})
+
+
+def _table_or_blocks(console: Console, table: Table, title: str, short_title: str,
+                     blocks: dict[str, list[str]]) -> None:
+    """``table`` under ``title`` when it fits the console's width; else ``short_title`` and
+    one block of ``blocks``' values per row name, broken between values."""
     if _fits(console, table):
         _lines(console, words(title, console.width))
         console.print(table)
         return
-    _lines(console, words("displacement of the matched pairs", console.width))
-    for name, (pairs, *values) in rows.items():
-        _field(console, name, _values(console, [f"{pairs} pairs"] + [
-            f"{k} {v}" + (" m" if v != "-" else "") for k, v in zip(FIELDS[1:], values,
-                                                                   strict=True)]))
+    _lines(console, words(short_title, console.width))
+    for name, parts in blocks.items():
+        _field(console, name, _values(console, parts))
 
 
 def _table(columns: tuple[str, ...], rows: dict[str, tuple[str, ...]]) -> Table:
