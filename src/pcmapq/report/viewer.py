@@ -86,6 +86,7 @@ SCRIPT = """
   let dragged = false;
   svg.addEventListener('pointerdown', function (e) {
     drag = {x: e.clientX, y: e.clientY, box: box.slice(), px: svg.getScreenCTM().a, moved: 0};
+    dragged = false;
     svg.classList.add('dragging');
   });
   svg.addEventListener('pointermove', function (e) {
