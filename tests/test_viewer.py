@@ -115,7 +115,7 @@ def test_viewer_pools_large_grids_and_is_deterministic():
     page = viewer_html(result, 10.0)
     assert page == viewer_html(small_result(grid), 10.0)
     factor = -(-5000 // VIEWER_PX)
-    assert f"here {factor} x {factor} cells a pixel" in page
+    assert f"(here {factor} x {factor}\ncells a pixel)" in page
     sizes = re.findall(r'<image x="-0.5" y="-0.5" width="(\d+)" height="(\d+)"', page)
     assert sizes == [(str(-(-5000 // factor) * factor), str(-(-3000 // factor) * factor))] * 2
     for uri in re.findall(r'href="data:image/png;base64,([^"]+)"', page):

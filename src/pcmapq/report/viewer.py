@@ -282,8 +282,8 @@ def viewer_html(result: Result, arrow_scale: float) -> str:
 {images}{groups}</svg>
 <div id="viewer-tip"></div></div>
 <p class="note">Wheel: zoom; drag: pan; hover or click a feature: its detector, match, position
-and displacement (truth frame, metres). Arrows: displacement x{arrow_scale:g}, truth feature to
-map feature; rings: missing truth features (red) and extra map features (orange). Walls shown
-at up to {VIEWER_PX} pixels across (here {factor} x {factor} cells a pixel); every feature is
-shown.</p>
+and displacement (truth frame, metres). Arrows: {arrow_scale:g} times the displacement, from
+the truth feature towards the map feature; rings: missing truth features (red) and extra map
+features (orange). Walls shown at up to {VIEWER_PX} pixels across (here {factor} x {factor}
+cells a pixel); every feature is shown.</p>
 <script>{SCRIPT}</script>"""
