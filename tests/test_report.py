@@ -95,7 +95,7 @@ def test_heatmap_colours_the_moved_wall(moved_result, perfect_result):
 def test_report_is_self_contained(moved_result):
     page = report_html(moved_result)
     assert not re.search(r'(src|href)="(https?:)?//', page)  # nothing fetched from a network
-    assert page.count("data:image/png;base64,") == 2
+    assert page.count("data:image/png;base64,") == 4  # two figures, the viewer's two walls
     assert f"displacement x{ARROW_SCALE:g}" not in page  # the legend is in the figure
     q = moved_result.detectors["harris"].matching.quality
     assert f"{q:.3f}" in page and "coverage" in page

@@ -7,12 +7,13 @@ import base64
 import html
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from pcmapq import __version__
 from pcmapq.report.plot import distance_heatmap, png_bytes, vectorial_figure
 from pcmapq.report.style import ARROW_SCALE, FIGURE_WIDTH_PX
 from pcmapq.report.text import number, score
+from pcmapq.report.viewer import STYLE as VIEWER_STYLE
+from pcmapq.report.viewer import nearest_distances, viewer_html
 from pcmapq.result import DetectorResult, Result
 from pcmapq.stats import Stats
 
@@ -47,9 +48,7 @@ def _img(png: bytes, alt: str) -> str:
 def _nearest(points: np.ndarray, others: np.ndarray) -> list[str]:
     """Distance, metres, from each of ``points`` (N, 2) to the nearest of ``others`` (M, 2);
     '-' for every point when there is none."""
-    if len(others) == 0:
-        return ["-"] * len(points)
-    return [number(d) for d in cKDTree(others).query(points)[0]] if len(points) else []
+    return [number(None if np.isnan(d) else d) for d in nearest_distances(points, others)]
 
 
 def _feature_list(label: str, xy: np.ndarray, others: np.ndarray, other_side: str) -> str:
@@ -136,6 +135,7 @@ def report_html(result: Result, arrow_scale: float = ARROW_SCALE) -> str:
                 "clouds:</p>"
         dist += _stats_table("points", [("3D accuracy (map to truth)", d3.accuracy),
                                         ("3D completeness (truth to map)", d3.completeness)])
+    viewer = viewer_html(result, arrow_scale)
     vectors = _img(png_bytes(vectorial_figure(result, arrow_scale)), "vectorial map per detector")
     heat = _img(png_bytes(distance_heatmap(result)),
                 "distance heatmaps: accuracy (map to truth) and completeness (truth to map)")
@@ -144,7 +144,7 @@ def report_html(result: Result, arrow_scale: float = ARROW_SCALE) -> str:
             f"{html.escape(result.truth_path.name)}"
     return f"""<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8"><title>{title}</title>
-<style>{STYLE}</style></head><body>
+<style>{STYLE}{VIEWER_STYLE}</style></head><body>
 <h1>{title}</h1>
 <p class="sub">pcmapq {__version__}. Frame convention: p_truth = s R(yaw) p_map + t; all
 coordinates in the truth frame, metres and degrees.</p>
@@ -163,6 +163,7 @@ map feature.</p>
 <h2>Distances</h2>{dist}
 <p class="note">Chamfer distance {number(d.chamfer_m)} m (mean of the two means). Definitions in
 docs/metrics.md.</p>{fscore}
+<h2>Interactive map</h2>{viewer}
 <h2>Vectorial map</h2>{vectors}
 <h2>Distance heatmaps</h2>{heat}
 <p class="note">Left, accuracy: each wall cell of the aligned map coloured by its distance to

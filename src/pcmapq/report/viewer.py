@@ -1,0 +1,289 @@
+"""The report's interactive map: truth and aligned map overlaid in an inline SVG that zooms
+(wheel) and pans (drag), every feature a circle that tells, hovered or clicked, its detector,
+whether it is matched, missing or extra, where it stands and its displacement, metres.
+
+The SVG's user unit is one cell of the truth grid (cell centres at integers, as
+:meth:`~pcmapq.grid.MetricGrid.xy_to_pixels` gives them), so the walls, drawn in the grid's own
+rows and columns, and the features, placed from their metric (truth frame) coordinates, stand
+where the grid puts them for any grid origin and yaw. The walls are two embedded PNGs (the
+truth dark over the aligned map light, as in the figures), pooled to at most
+:data:`VIEWER_PX` pixels across and down (:mod:`pcmapq.raster.pool`), so a map of any size
+costs pictures of bounded size; every feature is kept, none thinned. One ``<g>`` per detector
+and status holds its circles (Hough: its segments too; matched: the displacement arrows), and a
+checkbox shows or hides it. No network: the script is inline and plain JavaScript.
+"""
+
+from __future__ import annotations
+
+import base64
+import html
+import json
+
+import cv2
+import numpy as np
+from scipy.spatial import cKDTree
+
+from pcmapq.report.plot import density, grown, shade
+from pcmapq.report.style import EXTRA, MAP_LIGHT, MATCHED, MISSING, TRUTH_DARK
+from pcmapq.result import DetectorResult, Result
+
+#: Longest side, pixels, of the embedded wall pictures: sharp on a 1350-pixel-wide viewer
+#: zoomed in 1.5-fold, and a few hundred kB on the largest maps.
+VIEWER_PX = 2048
+#: Opacity of the truth's walls over the map's (plot.TRUTH_ALPHA).
+TRUTH_OPACITY = 0.9
+#: What each status means, in the tooltip and beside its checkbox.
+STATUSES = {"matched": "matched", "missing": "missing (truth, no map partner)",
+            "extra": "extra (map, no truth partner)"}
+COLOURS = {"matched": MATCHED, "missing": MISSING, "extra": EXTRA}
+
+STYLE = """
+.viewer { position: relative; border: 1px solid #ddd; }
+.viewer svg { display: block; width: 100%; height: auto; max-height: 80vh; background: #fff;
+              cursor: grab; touch-action: none; user-select: none; }
+.viewer svg.dragging { cursor: grabbing; }
+.viewer circle { r: var(--r, 3px); vector-effect: non-scaling-stroke; pointer-events: all;
+                 stroke-width: 2; }
+.viewer circle:hover, .viewer circle.pinned { stroke: #000; stroke-width: 3; }
+.viewer line { vector-effect: non-scaling-stroke; pointer-events: none; }
+.viewer .arrow { stroke: #000; stroke-width: 1.5; }
+.viewer image { image-rendering: pixelated; }
+#viewer-tip { position: absolute; pointer-events: none; background: rgba(255,255,255,0.95);
+              border: 1px solid #888; padding: 0.3em 0.5em; font-size: 0.85em;
+              white-space: pre; display: none; }
+.controls { font-size: 0.9em; margin: 0.5em 0; } .controls td { text-align: left; }
+.controls label { white-space: nowrap; }
+""" + "".join(
+    f'.viewer g[id$="-{status}"] circle {{ fill: {colour}; stroke: {colour}; }}\n'
+    f'.viewer g[id$="-{status}"] .segment {{ stroke: {colour}; stroke-width: 2; }}\n'
+    for status, colour in COLOURS.items()) + \
+    '.viewer g[id$="-missing"] circle, .viewer g[id$="-extra"] circle { fill-opacity: 0.25; }\n'
+
+SCRIPT = """
+(function () {
+  const svg = document.getElementById('viewer-svg');
+  const tip = document.getElementById('viewer-tip');
+  const home = svg.getAttribute('viewBox');
+  let box = home.split(' ').map(Number);
+  const R_PX = 4;
+  function show() {
+    svg.setAttribute('viewBox', box.join(' '));
+    const ctm = svg.getScreenCTM();
+    if (ctm && ctm.a > 0) svg.style.setProperty('--r', (R_PX / ctm.a) + 'px');
+  }
+  function toUser(x, y) {
+    const p = new DOMPoint(x, y).matrixTransform(svg.getScreenCTM().inverse());
+    return [p.x, p.y];
+  }
+  svg.addEventListener('wheel', function (e) {
+    e.preventDefault();
+    const [ux, uy] = toUser(e.clientX, e.clientY);
+    const k = Math.pow(1.0015, e.deltaY);
+    box = [ux - (ux - box[0]) * k, uy - (uy - box[1]) * k, box[2] * k, box[3] * k];
+    show();
+  }, {passive: false});
+  let drag = null;
+  let dragged = false;
+  svg.addEventListener('pointerdown', function (e) {
+    drag = {x: e.clientX, y: e.clientY, box: box.slice(), px: svg.getScreenCTM().a, moved: 0};
+    dragged = false;
+    svg.classList.add('dragging');
+  });
+  svg.addEventListener('pointermove', function (e) {
+    if (!drag) return;
+    const dx = e.clientX - drag.x, dy = e.clientY - drag.y;
+    drag.moved = Math.max(drag.moved, Math.abs(dx) + Math.abs(dy));
+    box = [drag.box[0] - dx / drag.px, drag.box[1] - dy / drag.px, box[2], box[3]];
+    show();
+  });
+  function release(moved) {
+    dragged = moved && drag !== null && drag.moved > 3;
+    drag = null;
+    svg.classList.remove('dragging');
+  }
+  svg.addEventListener('pointerup', function () { release(true); });
+  svg.addEventListener('pointerleave', function () { release(false); });
+  const labels = JSON.parse(svg.dataset.labels);
+  const m = function (v) { return v + ' m'; };
+  function describe(c) {
+    const d = c.dataset;
+    const lines = [d.detector + ': ' + labels[d.status], 'x ' + m(d.x) + ', y ' + m(d.y)];
+    if (d.status === 'matched') {
+      lines.push('map feature: x ' + m(d.mapX) + ', y ' + m(d.mapY));
+      lines.push('displacement ' + m(d.displacement) + ' (dx ' + d.dx + ', dy ' + d.dy + ' m)');
+    } else {
+      lines.push('displacement: none (unmatched); nearest ' +
+                 (d.status === 'missing' ? 'map' : 'truth') + ' feature: ' +
+                 (d.nearest ? m(d.nearest) : 'none'));
+    }
+    return lines.join('\\n');
+  }
+  let pinned = null;
+  function place(c, e) {
+    tip.textContent = describe(c);
+    tip.style.display = 'block';
+    const frame = svg.parentNode.getBoundingClientRect();
+    tip.style.left = (e.clientX - frame.left + 12) + 'px';
+    tip.style.top = (e.clientY - frame.top + 12) + 'px';
+  }
+  svg.addEventListener('mouseover', function (e) {
+    if (!pinned && e.target.tagName === 'circle') place(e.target, e);
+  });
+  svg.addEventListener('mouseout', function (e) {
+    if (!pinned && e.target.tagName === 'circle') tip.style.display = 'none';
+  });
+  svg.addEventListener('click', function (e) {
+    if (dragged) { dragged = false; return; }
+    if (pinned) pinned.classList.remove('pinned');
+    pinned = e.target.tagName === 'circle' ? e.target : null;
+    if (pinned) { pinned.classList.add('pinned'); place(pinned, e); }
+    else tip.style.display = 'none';
+  });
+  document.querySelectorAll('.controls input[data-layer]').forEach(function (input) {
+    input.addEventListener('change', function () {
+      document.getElementById(input.dataset.layer)
+        .setAttribute('display', input.checked ? 'inline' : 'none');
+    });
+  });
+  document.getElementById('viewer-reset').addEventListener('click', function () {
+    box = home.split(' ').map(Number); show();
+  });
+  window.addEventListener('resize', show);
+  show();
+})();
+"""
+
+
+def _png(alpha: np.ndarray, rgb: tuple[float, float, float], opacity: float) -> str:
+    """A data URI of an RGBA PNG: ``rgb`` (0-1) at ``opacity`` times ``alpha`` (rows, cols,
+    [0, 1]) per pixel."""
+    rgba = np.empty((*alpha.shape, 4), np.uint8)
+    rgba[..., :3] = np.round(np.asarray(rgb[::-1]) * 255)  # OpenCV writes BGR(A)
+    rgba[..., 3] = np.round(np.clip(alpha, 0.0, 1.0) * opacity * 255)
+    ok, buf = cv2.imencode(".png", rgba)
+    if not ok:
+        raise ValueError("PNG encoding failed")
+    return "data:image/png;base64," + base64.b64encode(buf.tobytes()).decode("ascii")
+
+
+def nearest_distances(points: np.ndarray, others: np.ndarray) -> np.ndarray:
+    """Distance, metres, from each of ``points`` (N, 2) to the nearest of ``others`` (M, 2):
+    (N,) float, NaN when there is no other."""
+    if len(others) == 0 or len(points) == 0:
+        return np.full(len(points), np.nan)
+    return cKDTree(others).query(points)[0]
+
+
+def _mm(value: float) -> str:
+    return f"{value + 0.0:.3f}"
+
+
+def _uv(result: Result, xy: np.ndarray) -> np.ndarray:
+    """Metric (N, 2) -> the SVG's user units (grid cells), (N, 2)."""
+    return result.grid.xy_to_pixels(xy) if len(xy) else np.zeros((0, 2))
+
+
+def _circles(result: Result, name: str, status: str, xy: np.ndarray,
+             extra: list[dict[str, str]]) -> str:
+    """One circle per feature at ``xy`` (N, 2, metres) with its data attributes, and the
+    per-feature ``extra`` ones."""
+    out = []
+    for (u, v), (x, y), attrs in zip(_uv(result, xy).tolist(), xy.tolist(), extra, strict=True):
+        more = "".join(f' data-{k}="{val}"' for k, val in attrs.items())
+        out.append(f'<circle cx="{u:.2f}" cy="{v:.2f}" data-detector="{name}" '
+                   f'data-status="{status}" data-x="{_mm(x)}" '
+                   f'data-y="{_mm(y)}"{more}/>')
+    return "".join(out)
+
+
+def _lines(result: Result, starts: np.ndarray, ends: np.ndarray, cls: str) -> str:
+    """Lines from ``starts`` to ``ends`` (N, 2, metres) of class ``cls``."""
+    if len(starts) == 0:
+        return ""
+    return "".join(f'<line class="{cls}" x1="{a:.2f}" y1="{b:.2f}" x2="{c:.2f}" y2="{d:.2f}"/>'
+                   for (a, b), (c, d) in zip(_uv(result, starts).tolist(),
+                                             _uv(result, ends).tolist(), strict=True))
+
+
+def _segments(result: Result, segments: np.ndarray | None, idx: np.ndarray) -> str:
+    """Hough's segments ``idx`` (x0, y0, x1, y1 metres), none for a point detector."""
+    if segments is None:
+        return ""
+    picked = segments[idx].reshape(-1, 4)
+    return _lines(result, picked[:, :2], picked[:, 2:], "segment")
+
+
+def _groups(result: Result, name: str, det: DetectorResult, gain: float) -> dict[str, str]:
+    """The SVG of each status of one detector: its segments, arrows and circles."""
+    m = det.matching
+    disp = m.displacement
+    matched = [{"map-x": _mm(px), "map-y": _mm(py), "dx": _mm(dx), "dy": _mm(dy),
+                "displacement": _mm(d)}
+               for (px, py), (dx, dy), d in zip(det.map_xy.tolist(), disp.tolist(),
+                                                 det.distances.tolist(), strict=True)]
+    missing, extra = det.truth.xy[m.missing], det.map.xy[m.extra]
+
+    def near(d: float) -> dict[str, str]:
+        return {"nearest": "" if np.isnan(d) else _mm(d)}
+
+    return {
+        "matched": _segments(result, det.truth.segments, m.truth_idx)
+        + _lines(result, det.truth_xy, det.truth_xy + gain * disp, "arrow")
+        + _circles(result, name, "matched", det.truth_xy, matched),
+        "missing": _segments(result, det.truth.segments, m.missing)
+        + _circles(result, name, "missing", missing,
+                   [near(d) for d in nearest_distances(missing, det.map.xy)]),
+        "extra": _segments(result, det.map.segments, m.extra)
+        + _circles(result, name, "extra", extra,
+                   [near(d) for d in nearest_distances(extra, det.truth.xy)]),
+    }
+
+
+def _controls(result: Result) -> str:
+    """Checkboxes: the two wall layers, and each detector's matched, missing, extra groups
+    (with their counts)."""
+    rows = []
+    for name, det in result.detectors.items():
+        m = det.matching
+        counts = {"matched": len(m.truth_idx), "missing": len(m.missing),
+                  "extra": len(m.extra)}
+        cells = "".join(
+            f'<td><label><input type="checkbox" checked data-layer="f-{name}-{status}"> '
+            f'<span style="color:{COLOURS[status]}">&#9679;</span> {html.escape(label)}: '
+            f'{counts[status]}</label></td>' for status, label in STATUSES.items())
+        rows.append(f"<tr><th>{html.escape(name)}</th>{cells}</tr>")
+    walls = "".join(f'<label><input type="checkbox" checked data-layer="{layer}"> {label}'
+                    '</label> ' for layer, label in (("walls-truth", "truth walls (dark)"),
+                                                     ("walls-map", "aligned map walls (light)")))
+    return f'<div class="controls">{walls}<button id="viewer-reset" type="button">' \
+           f'reset view</button><table>{"".join(rows)}</table></div>'
+
+
+def viewer_html(result: Result, arrow_scale: float) -> str:
+    """The interactive map as an HTML fragment (its style, controls, SVG and script inline);
+    matched features' arrows ``arrow_scale`` times their displacement."""
+    rows, cols = result.grid.shape
+    factor = max(1, -(-max(rows, cols) // VIEWER_PX))
+    as_density = density(result)
+    truth = shade(result.truth_occupied, factor, as_density)
+    walls = grown(shade(result.map_occupied, factor, as_density))
+    w, h = walls.shape[1] * factor, walls.shape[0] * factor
+    images = "".join(
+        f'<g id="{layer}"><image x="-0.5" y="-0.5" width="{w}" height="{h}" '
+        f'preserveAspectRatio="none" href="{_png(alpha, rgb, opacity)}"/></g>'
+        for layer, alpha, rgb, opacity in (("walls-map", walls, MAP_LIGHT, 1.0),
+                                           ("walls-truth", truth, TRUTH_DARK, TRUTH_OPACITY)))
+    groups = "".join(f'<g id="f-{name}-{status}">{svg}</g>'
+                     for name, det in result.detectors.items()
+                     for status, svg in _groups(result, name, det, arrow_scale).items())
+    return f"""{_controls(result)}
+<div class="viewer"><svg id="viewer-svg" viewBox="-0.5 -0.5 {cols} {rows}"
+ style="aspect-ratio: {cols} / {rows}" data-labels="{html.escape(json.dumps(STATUSES))}">
+{images}{groups}</svg>
+<div id="viewer-tip"></div></div>
+<p class="note">Wheel: zoom; drag: pan; hover or click a feature: its detector, match, position
+and displacement (truth frame, metres). Arrows: {arrow_scale:g} times the displacement, from
+the truth feature towards the map feature; rings: missing truth features (red) and extra map
+features (orange). Walls shown at up to {VIEWER_PX} pixels across (here {factor} x {factor}
+cells a pixel); every feature is shown.</p>
+<script>{SCRIPT}</script>"""

@@ -1,0 +1,286 @@
+"""The report's interactive map: every feature in it with its data, placed where the grid puts
+it, and, in headless Chromium, zoom, pan, tooltip and toggles working."""
+
+from __future__ import annotations
+
+import base64
+import html
+import json
+import re
+import shutil
+import subprocess
+
+import cv2
+import numpy as np
+import pytest
+
+from pcmapq import synth
+from pcmapq.config import MatchingConfig, Settings
+from pcmapq.features import Features
+from pcmapq.grid import MetricGrid
+from pcmapq.match import Matching
+from pcmapq.pipeline import evaluate
+from pcmapq.report.html import report_html
+from pcmapq.report.viewer import STYLE, VIEWER_PX, viewer_html
+from pcmapq.result import DetectorResult, Result
+
+from .conftest import write_image_map
+
+
+@pytest.fixture(scope="module")
+def moved_result(plan, truth_png, tmp_path_factory):
+    """test_report's map whose L-shaped wall stands 0.5 m east of the truth's."""
+    moved = synth.move_wall(synth.move_wall(plan, 20, (0.5, 0.0)), 21, (0.5, 0.0))
+    path = write_image_map(moved, tmp_path_factory.mktemp("moved") / "moved.png")
+    return evaluate(path, truth_png, Settings(matching=MatchingConfig(threshold=1.0)))
+
+
+CIRCLE = re.compile(r"<circle ([^>]*)/>")
+ATTR = re.compile(r'([\w-]+)="([^"]*)"')
+
+
+def circles(page: str) -> list[dict[str, str]]:
+    """The attributes of every circle of ``page``."""
+    return [dict(ATTR.findall(c)) for c in CIRCLE.findall(page)]
+
+
+def _detector(truth_xy, map_xy, pairs, displacement, missing, extra, segments=None):
+    n, k = len(truth_xy), len(map_xy)
+    m = Matching(np.array(pairs[0], dtype=np.intp), np.array(pairs[1], dtype=np.intp),
+                 np.array(displacement, dtype=float).reshape(-1, 2), np.zeros(len(pairs[0])),
+                 None, None, None, n, k, len(pairs[0]), len(pairs[0]),
+                 np.array(missing, dtype=np.intp), np.array(extra, dtype=np.intp))
+    return DetectorResult(
+        Features(np.array(truth_xy, float).reshape(-1, 2), np.ones(n), np.ones(n, bool),
+                 segments=segments),
+        Features(np.array(map_xy, float).reshape(-1, 2), np.ones(k), np.ones(k, bool)), m)
+
+
+def small_result(grid: MetricGrid) -> Result:
+    """A hand-made result on ``grid``: harris with 1 matched (0.3, -0.4 m: 0.5 m), 2 missing,
+    1 extra; hough with one matched segment; sift with no feature. Only what the viewer reads
+    is set."""
+    harris = _detector([[2.0, 3.0], [4.0, 5.0], [6.0, 2.5]], [[2.3, 2.6], [5.0, 3.0]],
+                       ([0], [0]), [[0.3, -0.4]], [1, 2], [1])
+    hough = _detector([[3.0, 4.0]], [[3.0, 4.1]], ([0], [0]), [[0.0, 0.1]], [], [],
+                      segments=np.array([[2.0, 4.0, 4.0, 4.0]]))
+    sift = _detector(np.zeros((0, 2)), np.zeros((0, 2)), ([], []), [], [], [])
+    walls = np.zeros(grid.shape, bool)
+    walls[5, :] = True
+    return Result(map_path=None, map_kind="", truth_path=None, truth_kind="", grid=grid,
+                  alignment=None, overlap=None, distances=None, registration_3d=None,
+                  distances_3d=None, threshold=0.5, full=True,
+                  detectors={"harris": harris, "hough": hough, "sift": sift},
+                  truth_occupied=walls, map_occupied=np.roll(walls, 2, axis=0), frames=None)
+
+
+#: A grid turned by 30 degrees, off the origin: the features must follow the grid.
+TURNED = MetricGrid(0.1, (1.0, 2.0, float(np.radians(30.0))), (60, 80))
+
+
+def test_viewer_places_each_feature_where_the_grid_puts_it():
+    """One circle per feature, at its grid cell (u, v), with its metric x, y, detector, status
+    and displacement; nearest other-side feature for the unmatched."""
+    page = viewer_html(small_result(TURNED), 10.0)
+    got = circles(page)
+    assert len(got) == 5
+    for c in got:
+        uv = TURNED.xy_to_pixels([[float(c["data-x"]), float(c["data-y"])]])[0]
+        np.testing.assert_allclose([float(c["cx"]), float(c["cy"])], uv, atol=0.006)
+    by = {(c["data-detector"], c["data-status"], c["data-x"], c["data-y"]): c for c in got}
+    matched = by[("harris", "matched", "2.000", "3.000")]
+    assert (matched["data-displacement"], matched["data-dx"], matched["data-dy"],
+            matched["data-map-x"], matched["data-map-y"]) == ("0.500", "0.300", "-0.400",
+                                                              "2.300", "2.600")
+    assert by[("harris", "missing", "4.000", "5.000")]["data-nearest"] == f"{np.hypot(1, 2):.3f}"
+    assert by[("harris", "extra", "5.000", "3.000")]["data-nearest"] == f"{np.hypot(1, 0.5):.3f}"
+    assert "data-displacement" not in by[("harris", "missing", "6.000", "2.500")]
+    assert ("hough", "matched", "3.000", "4.000") in by
+    # the matched arrow runs 10 times the displacement from the truth feature
+    u, v = TURNED.xy_to_pixels([[2.0, 3.0], [2.0 + 3.0, 3.0 - 4.0]])
+    assert f'<line class="arrow" x1="{u[0]:.2f}" y1="{u[1]:.2f}" x2="{v[0]:.2f}" ' \
+           f'y2="{v[1]:.2f}"/>' in page
+    assert page.count('class="segment"') == 1
+    for name in ("harris", "hough", "sift"):
+        for status in ("matched", "missing", "extra"):
+            assert f'<g id="f-{name}-{status}">' in page
+            assert f'data-layer="f-{name}-{status}"' in page
+
+
+def test_viewer_pools_large_grids_and_is_deterministic():
+    """A grid larger than VIEWER_PX is pooled to at most VIEWER_PX pixels a side, drawn over
+    the grid's whole extent; the same result gives the same bytes."""
+    grid = MetricGrid(0.01, (0.0, 0.0, 0.0), (3000, 5000))
+    result = small_result(grid)
+    page = viewer_html(result, 10.0)
+    assert page == viewer_html(small_result(grid), 10.0)
+    factor = -(-5000 // VIEWER_PX)
+    assert f"(here {factor} x {factor}\ncells a pixel)" in page
+    sizes = re.findall(r'<image x="-0.5" y="-0.5" width="(\d+)" height="(\d+)"', page)
+    assert sizes == [(str(-(-5000 // factor) * factor), str(-(-3000 // factor) * factor))] * 2
+    for uri in re.findall(r'href="data:image/png;base64,([^"]+)"', page):
+        img = cv2.imdecode(np.frombuffer(base64.b64decode(uri), np.uint8), cv2.IMREAD_UNCHANGED)
+        assert img.shape == (-(-3000 // factor), -(-5000 // factor), 4)
+        assert max(img.shape[:2]) <= VIEWER_PX and img[..., 3].any()
+
+
+def test_report_holds_one_element_per_feature_and_nothing_from_a_network(moved_result):
+    """The report's viewer: no script, style or picture fetched (no http(s) src or href), and
+    one circle per matched, missing and extra feature of each detector."""
+    page = report_html(moved_result)
+    assert not re.search(r'(src|href)\s*=\s*["\']?(https?:)?//', page, re.I)
+    assert "<script>" in page and "<script src" not in page
+    got = circles(page)
+    for name, det in moved_result.detectors.items():
+        m = det.matching
+        for status, n in (("matched", len(m.truth_idx)), ("missing", len(m.missing)),
+                          ("extra", len(m.extra))):
+            mine = [c for c in got if (c["data-detector"], c["data-status"]) == (name, status)]
+            assert len(mine) == n, (name, status)
+        shown = sorted(float(c["data-displacement"]) for c in got
+                       if (c["data-detector"], c["data-status"]) == (name, "matched"))
+        np.testing.assert_allclose(shown, np.sort(det.distances), atol=5e-4)
+    assert len(got) == sum(len(d.matching.truth_idx) + len(d.matching.missing)
+                           + len(d.matching.extra) for d in moved_result.detectors.values())
+
+
+#: Run in the page after the viewer's script: zoom, pan, hover, click and toggle as a user
+#: would (dispatched DOM events), and write what the page shows into <pre id="probe">.
+PROBE = """
+<script>
+(function () {
+  const svg = document.getElementById('viewer-svg');
+  const tip = document.getElementById('viewer-tip');
+  const out = {};
+  const box = () => svg.getAttribute('viewBox').split(' ').map(Number);
+  const user = (x, y) => {
+    const p = new DOMPoint(x, y).matrixTransform(svg.getScreenCTM().inverse());
+    return [p.x, p.y];
+  };
+  const r = svg.getBoundingClientRect();
+  const cx = r.left + r.width * 0.3, cy = r.top + r.height * 0.6;
+  out.before = box();
+  out.under = user(cx, cy);
+  svg.dispatchEvent(new WheelEvent('wheel', {deltaY: -500, clientX: cx, clientY: cy,
+                                             bubbles: true, cancelable: true}));
+  out.zoomed = box();
+  out.underAfter = user(cx, cy);
+  const px = svg.getScreenCTM().a;
+  const ev = (type, x, y) => svg.dispatchEvent(new PointerEvent(type, {clientX: x, clientY: y,
+                                                                       bubbles: true}));
+  ev('pointerdown', cx, cy); ev('pointermove', cx + 40, cy + 20); ev('pointerup', cx + 40, cy + 20);
+  svg.dispatchEvent(new MouseEvent('click', {clientX: cx + 40, clientY: cy + 20, bubbles: true}));
+  out.afterPan = getComputedStyle(tip).display;  // the click that ends a drag pins nothing
+  out.panned = box();
+  out.pxPerUnit = px;
+  document.getElementById('viewer-reset').click();
+  out.reset = box();
+  const f = document.querySelector(FEATURE);
+  f.scrollIntoView({block: 'center'});
+  const fr = f.getBoundingClientRect();
+  const fx = fr.left + fr.width / 2, fy = fr.top + fr.height / 2;
+  out.hit = document.elementFromPoint(fx, fy) === f;
+  out.radiusPx = fr.width / 2;
+  f.dispatchEvent(new MouseEvent('mouseover', {clientX: fx, clientY: fy, bubbles: true}));
+  out.hover = tip.textContent;
+  out.hoverShown = getComputedStyle(tip).display;
+  f.dispatchEvent(new MouseEvent('mouseout', {clientX: fx, clientY: fy, bubbles: true}));
+  out.afterOut = getComputedStyle(tip).display;
+  f.dispatchEvent(new MouseEvent('click', {clientX: fx, clientY: fy, bubbles: true}));
+  out.clicked = tip.textContent;
+  out.pinnedShown = getComputedStyle(tip).display;
+  const visible = (sel) => Array.from(document.querySelectorAll(sel))
+    .map((c) => c.getBoundingClientRect().width > 0);  // 0 when not rendered
+  const [name, status] = TOGGLE;
+  const group = `circle[data-detector="${name}"][data-status="${status}"]`;
+  out.toggledBefore = visible(group);
+  document.querySelector(`input[data-layer="f-${name}-${status}"]`).click();
+  out.toggledAfter = visible(group);
+  out.othersAfter = visible(`circle:not([data-detector="${name}"]), ` +
+                            `circle[data-detector="${name}"]:not([data-status="${status}"])`);
+  const pre = document.createElement('pre');
+  pre.id = 'probe';
+  pre.textContent = JSON.stringify(out);
+  document.body.appendChild(pre);
+})();
+</script>
+"""
+
+
+def probed(page: str, feature: str, toggle: tuple[str, str], tmp_path) -> dict:
+    """What PROBE found in ``page`` (HTML) in headless Chromium, hovering and clicking the
+    circle ``feature`` (a CSS selector) and unticking the ``toggle`` (detector, status)."""
+    path = tmp_path / "page.html"
+    path.write_text(page.replace("</body>", PROBE.replace("FEATURE", json.dumps(feature))
+                                 .replace("TOGGLE", json.dumps(toggle)) + "</body>"))
+    run = subprocess.run(["chromium", "--headless", "--no-sandbox", "--disable-gpu",
+                          "--disable-quic", "--no-first-run", "--disable-background-networking",
+                          "--disable-component-update", "--disable-sync",
+                          f"--user-data-dir={tmp_path / 'profile'}", "--window-size=1400,1000",
+                          "--dump-dom", path.as_uri()],
+                         capture_output=True, timeout=120, check=True, text=True)
+    probe = re.search(r'<pre id="probe">(.*?)</pre>', run.stdout, re.S)
+    assert probe, run.stderr[-2000:]
+    return json.loads(html.unescape(probe.group(1)))
+
+
+def check_view(out: dict, grid: MetricGrid) -> None:
+    """The view before (the whole grid), zoomed 2.1-fold about the cursor, then panned by the
+    pointer's 40, 20 pixels, reset; the feature on top where it is drawn, 4 pixels in radius."""
+    before, zoomed, panned = (np.array(out[k]) for k in ("before", "zoomed", "panned"))
+    rows, cols = grid.shape
+    np.testing.assert_allclose(before, [-0.5, -0.5, cols, rows])
+    np.testing.assert_allclose(zoomed[2:], before[2:] * 1.0015 ** -500, rtol=1e-6)
+    step = 1 / out["pxPerUnit"]  # one screen pixel, grid cells
+    np.testing.assert_allclose(out["underAfter"], out["under"], atol=step)
+    np.testing.assert_allclose(panned, zoomed - [40 * step, 20 * step, 0, 0], atol=1e-6)
+    np.testing.assert_allclose(out["reset"], before)
+    assert out["hit"] and 3.5 <= out["radiusPx"] <= 4.5
+    assert (out["afterPan"], out["hoverShown"], out["afterOut"], out["pinnedShown"]) == \
+        ("none", "block", "none", "block")
+
+
+def selector(name: str, status: str, x: float, y: float) -> str:
+    return f'circle[data-detector="{name}"][data-status="{status}"][data-x="{x + 0.0:.3f}"]' \
+           f'[data-y="{y + 0.0:.3f}"]'
+
+
+CHROMIUM = pytest.mark.skipif(shutil.which("chromium") is None,
+                              reason="Debian's chromium is not installed")
+
+
+@CHROMIUM
+def test_viewer_zooms_pans_tells_and_toggles_in_chromium(tmp_path):
+    """The hand-made result on the turned grid: zoom about the cursor, pan, the matched harris
+    feature's tooltip (detector, status, both positions, displacement) on hover and click,
+    unticking harris' missing hides its two features and nothing else."""
+    page = f"<!DOCTYPE html><html><head><style>{STYLE}</style></head><body>" \
+           f"{viewer_html(small_result(TURNED), 10.0)}</body></html>"
+    out = probed(page, selector("harris", "matched", 2.0, 3.0), ("harris", "missing"), tmp_path)
+    check_view(out, TURNED)
+    for text in (out["hover"], out["clicked"]):
+        assert text == "harris: matched\nx 2.000 m, y 3.000 m\nmap feature: x 2.300 m, " \
+                       "y 2.600 m\ndisplacement 0.500 m (dx 0.300, dy -0.400 m)"
+    assert (out["toggledBefore"], out["toggledAfter"]) == ([True] * 2, [False] * 2)
+    assert out["othersAfter"] == [True] * 3
+
+
+@CHROMIUM
+def test_report_viewer_tells_the_moved_walls_displacement_in_chromium(moved_result, tmp_path):
+    """The whole report: the moved wall's Hough feature tells its 0.5 m displacement; unticking
+    hough's matched hides all 22 of them and no other feature."""
+    det = moved_result.detectors["hough"]
+    i = int(np.argmax(det.distances))
+    (x, y), d = det.truth_xy[i], det.distances[i]
+    assert d > 0.49  # the wall moved by 0.5 m
+    out = probed(report_html(moved_result), selector("hough", "matched", x, y),
+                 ("hough", "matched"), tmp_path)
+    check_view(out, moved_result.grid)
+    for text in (out["hover"], out["clicked"]):
+        assert text.startswith(f"hough: matched\nx {x + 0.0:.3f} m, y {y + 0.0:.3f} m\n")
+        assert f"displacement {d:.3f} m" in text
+    n = len(det.matching.truth_idx)
+    assert (out["toggledBefore"], out["toggledAfter"]) == ([True] * n, [False] * n)
+    others = sum(len(v.matching.truth_idx) + len(v.matching.missing) + len(v.matching.extra)
+                 for v in moved_result.detectors.values()) - n
+    assert out["othersAfter"] == [True] * others
