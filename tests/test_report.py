@@ -333,3 +333,20 @@ def test_lidar_pair_is_drawn_as_density_with_fewer_markers(moved_result):
     assert markers(fine) < markers(replace(fine, registration_3d=None))
     fig = vectorial_figure(lidar)
     assert "occupied share" in " ".join(t.get_text() for t in fig.findobj(matplotlib.text.Text))
+
+
+@pytest.mark.unit
+def test_report_says_how_it_was_made(moved_result):
+    """The report holds pcmapq's version, the command line and every setting, as the JSON
+    does."""
+    import html as html_module
+    import json as json_module
+
+    from pcmapq import __version__
+
+    result = replace(moved_result, command="pcmapq eval moved.png truth.png --threshold 0.5")
+    page = report_html(result)
+    assert f"pcmapq {__version__}; command: <code>pcmapq eval moved.png truth.png" in page
+    settings = json_module.loads(html_module.unescape(
+        page.split("<summary>settings</summary><pre>")[1].split("</pre>")[0]))
+    assert settings == json_module.loads(result.to_json())["settings"]

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import base64
 import html
+import json
 
 import numpy as np
 
@@ -94,6 +95,16 @@ def _stats_table(counted: str, rows: list[tuple[str, Stats]]) -> str:
                   [[label, *_stats_cells(s), str(s.count)] for label, s in rows])
 
 
+def _run(result: Result) -> str:
+    """How the result was made: pcmapq's version, the command line (when it came from one) and
+    every setting it ran with (metres and degrees), as the JSON's ``pcmapq`` and ``settings``
+    hold them."""
+    command = html.escape(result.command) if result.command else "(called from Python)"
+    settings = html.escape(json.dumps(result.settings or {}, indent=1, sort_keys=True))
+    return (f"<p>pcmapq {__version__}; command: <code>{command}</code></p>"
+            f"<details><summary>settings</summary><pre>{settings}</pre></details>")
+
+
 def report_html(result: Result, arrow_scale: float = ARROW_SCALE) -> str:
     """The whole report as one HTML document (figures as embedded PNGs, no network needed);
     displacement arrows ``arrow_scale`` times their length."""
@@ -172,5 +183,6 @@ its distance to the nearest map wall.</p>
 <h2>Missing and extra features</h2>
 <p class="note">Truth frame, metres. A feature with a partner within {result.threshold:g} m
 is still listed when the one-to-one assignment gave that partner to another feature.</p>{lists}
+<h2>Run</h2>{_run(result)}
 </body></html>
 """
