@@ -96,7 +96,7 @@ def test_non_finite_vertices_are_dropped(tmp_path: Path) -> None:
 BAD = {
     "truncated.ply": (lambda p: write_ply(p, [("float", "x"), ("float", "y"), ("float", "z")],
                                           XYZ.astype("<f4")).write_bytes(p.read_bytes()[:-5]),
-                      "truncated: its header promises 4 vertices"),
+                      "truncated: header declares 4 points, the file holds 3"),
     "noz.ply": (lambda p: write_ply(p, [("float", "x"), ("float", "y")],
                                     XYZ[:, :2].astype("<f4")),
                 "the PLY's vertices have no z"),

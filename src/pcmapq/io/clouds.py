@@ -18,8 +18,11 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from numpy.lib import format as npy
 
+from pcmapq import memory
 from pcmapq.errors import InputError
+from pcmapq.io import pcd, ply
 from pcmapq.io.ply import CHUNK, VertexBlock, vertex_block
 from pcmapq.io.writers import one_line
 
@@ -106,13 +109,15 @@ def with_z(path: Path, table: np.ndarray) -> np.ndarray:
 
 
 def read_open3d(path: Path) -> np.ndarray:
-    """PLY or PCD via Open3D. Open3D reports unreadable files by returning no points."""
+    """PLY or PCD via Open3D, once its header is checked against the data the file holds
+    (InputError for a truncated file). Open3D reports unreadable files by returning no
+    points."""
     import open3d as o3d  # heavy: loaded when a PLY or PCD is read
 
-    with path.open("rb") as f:
-        head = f.read(3)
-    if path.suffix.lower() == ".ply" and head != b"ply":
-        raise InputError(f"{path}: not a PLY file")
+    if path.suffix.lower() == ".ply":
+        ply.check_size(path)  # Open3D pads a short file with zeros, printing RPly errors
+    else:
+        pcd.check_size(path)
     with o3d.utility.VerbosityContextManager(o3d.utility.VerbosityLevel.Error):
         cloud = o3d.io.read_point_cloud(str(path))
     if not cloud.has_points():
@@ -133,13 +138,32 @@ def read_text(path: Path) -> np.ndarray:
 
 def read_npy(path: Path) -> np.ndarray:
     """A NumPy array N x 2 or N x 3+ of numbers (no pickles)."""
-    with path.open("rb") as f:
-        if f.read(6) != b"\x93NUMPY":
-            raise InputError(f"{path}: not a .npy file")
+    check_npy(path)
     try:
         return np.load(path, allow_pickle=False)
     except (ValueError, EOFError) as exc:
         raise InputError(f"{path}: cannot be read as .npy: {one_line(exc)}") from None
+
+
+def check_npy(path: Path) -> None:
+    """InputError, before anything is allocated, when the header of the .npy ``path`` declares
+    more bytes than the file holds (truncated, or an absurd shape) or an array the memory guard
+    (:mod:`pcmapq.memory`, the default limit) refuses as a cloud."""
+    with path.open("rb") as f:
+        try:
+            version = npy.read_magic(f)
+            read = npy.read_array_header_1_0 if version == (1, 0) else npy.read_array_header_2_0
+            shape, _, dtype = read(f, max_header_size=10_000)
+        except ValueError as exc:
+            raise InputError(f"{path}: not a .npy file: {one_line(exc)}") from None
+        offset = f.tell()
+    rows = shape[0] if shape else 1
+    declared = int(np.prod(shape, dtype=object)) * dtype.itemsize
+    held = path.stat().st_size - offset
+    if declared > held:
+        raise InputError(f"{path}: truncated or corrupt: header declares shape "
+                         f"{tuple(shape)} ({declared} bytes), the file holds {held} bytes")
+    memory.guard(memory.needed_bytes(0, 0, 0.0, int(rows)), None, str(path))
 
 
 def read_kitti_bin(path: Path) -> np.ndarray:

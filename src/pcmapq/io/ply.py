@@ -20,7 +20,7 @@ import numpy as np
 
 from pcmapq.errors import InputError
 
-__all__ = ["VertexBlock", "vertex_block"]
+__all__ = ["VertexBlock", "check_size", "count_lines", "vertex_block"]
 
 #: PLY scalar type names (both spellings) -> NumPy type codes, without byte order.
 SCALARS = {"char": "i1", "int8": "i1", "uchar": "u1", "uint8": "u1", "short": "i2",
@@ -82,22 +82,12 @@ def vertex_block(path: Path) -> VertexBlock | None:
     its vertices cannot be located without reading every record (see the module's docstring).
     InputError for a header that is not PLY or is malformed, for missing x, y, z, and for a
     file shorter than its header promises (a truncated file)."""
-    with path.open("rb") as f:
-        head = f.read(MAX_HEADER)
-    if not head.startswith(b"ply"):
-        raise InputError(f"{path}: not a PLY file")
-    end = head.find(b"end_header")
-    newline = head.find(b"\n", end) if end >= 0 else -1
-    if newline < 0:
-        raise InputError(f"{path}: PLY header without end_header")
-    lines = head[:end].decode("ascii", errors="replace").splitlines()
-    fmt, elements = _parse(path, lines)
+    fmt, elements, offset = _header(path)
     if fmt == "ascii":
         return None
     order = "<" if fmt == "binary_little_endian" else ">"
-    offset = newline + 1
     for name, count, props in elements:
-        if any(kind is None for _, kind in props):  # a list property: records vary in size
+        if any(kind.startswith("list") for _, kind in props):  # records vary in size
             return None
         try:
             dtype = np.dtype([(prop, order + kind) for prop, kind in props])
@@ -110,16 +100,74 @@ def vertex_block(path: Path) -> VertexBlock | None:
             size = path.stat().st_size
             need = offset + count * dtype.itemsize
             if size < need:
-                raise InputError(f"{path}: truncated: its header promises {count} vertices "
-                                 f"({need} bytes), the file has {size} bytes")
+                raise InputError(f"{path}: truncated: header declares {count} points, the file "
+                                 f"holds {max(size - offset, 0) // dtype.itemsize}")
             return VertexBlock(path, count, offset, dtype)
         offset += count * dtype.itemsize
     raise InputError(f"{path}: no vertex element in the PLY header")
 
 
+def check_size(path: Path) -> None:
+    """InputError when ``path`` (a PLY) holds fewer records than its header declares: for a
+    binary PLY, fewer bytes than its elements need (a list property counted at its smallest,
+    an empty list), for an ASCII PLY fewer data lines than records. Open3D would pad the
+    missing points with zeros."""
+    fmt, elements, offset = _header(path)
+    points = sum(count for name, count, _ in elements if name == "vertex")
+    before = 0  # records (ASCII) or bytes (binary) of the elements before the vertices
+    for name, count, props in elements:
+        if name == "vertex":
+            break
+        before += count if fmt == "ascii" else count * _smallest_record(props)
+    if fmt == "ascii":
+        held = count_lines(path, offset)
+        need = sum(count for _, count, _ in elements)
+    else:
+        held = path.stat().st_size - offset
+        need = sum(count * _smallest_record(props) for _, count, props in elements)
+    if held < need:
+        vertex = [props for name, _, props in elements if name == "vertex"]
+        per_point = 1 if fmt == "ascii" or not vertex else _smallest_record(vertex[0])
+        present = min(max(held - before, 0) // per_point, points)
+        raise InputError(f"{path}: truncated: header declares {points} points, "
+                         f"the file holds {present}")
+
+
+def _header(path: Path) -> tuple[str, list[tuple[str, int, list]], int]:
+    """The format and elements of a PLY's header (see :func:`_parse`) and the offset of its
+    data, bytes."""
+    with path.open("rb") as f:
+        head = f.read(MAX_HEADER)
+    if not head.startswith(b"ply"):
+        raise InputError(f"{path}: not a PLY file")
+    end = head.find(b"end_header")
+    newline = head.find(b"\n", end) if end >= 0 else -1
+    if newline < 0:
+        raise InputError(f"{path}: PLY header without end_header")
+    fmt, elements = _parse(path, head[:end].decode("ascii", errors="replace").splitlines())
+    return fmt, elements, newline + 1
+
+
+def _smallest_record(props: list[tuple[str, str]]) -> int:
+    """The fewest bytes a binary record of these properties takes (a list: its count)."""
+    return sum(np.dtype(kind.removeprefix("list")).itemsize for _, kind in props)
+
+
+def count_lines(path: Path, offset: int, chunk: int = 1 << 24) -> int:
+    """The lines of ``path`` from byte ``offset`` on (the last one counted without its newline
+    too), read ``chunk`` bytes at a time. Blank lines count too, so none makes a file short."""
+    lines, last = 0, b"\n"
+    with path.open("rb") as f:
+        f.seek(offset)
+        while block := f.read(chunk):
+            lines += block.count(b"\n")
+            last = block[-1:]
+    return lines + (last != b"\n")
+
+
 def _parse(path: Path, lines: list[str]) -> tuple[str, list[tuple[str, int, list]]]:
-    """The format and the elements (name, count, [(property, type code or None for a list)])
-    of a PLY header's lines (without end_header)."""
+    """The format and the elements (name, count, [(property, type code)]) of a PLY header's
+    lines (without end_header); a list property's type is ``list`` and its count's code."""
     fmt, elements = "", []
     for number, line in enumerate(lines[1:], start=2):
         words = line.split()
@@ -136,8 +184,10 @@ def _parse(path: Path, lines: list[str]) -> tuple[str, list[tuple[str, int, list
                     raise ValueError(f"negative count {count}")
                 elements.append((words[1], count, []))
             elif words[0] == "property" and elements:
-                if words[1] == "list":
-                    elements[-1][2].append((words[4], None))
+                if words[1] == "list":  # "list" and the type of its count
+                    if words[2] not in SCALARS:
+                        raise ValueError(f"unknown type {words[2]}")
+                    elements[-1][2].append((words[4], "list" + SCALARS[words[2]]))
                 elif words[1] in SCALARS:
                     elements[-1][2].append((words[2], SCALARS[words[1]]))
                 else:
