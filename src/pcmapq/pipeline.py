@@ -28,6 +28,10 @@ from pcmapq.transform import Similarity2D
 
 Progress = Callable[[str], None]
 
+#: The fewest distinct occupied cells (of memory.WORKING_CELL, 0.05 m) a map or truth needs to
+#: be scored: fewer (one point, a few identical points, a 1x1 image) is refused, exit 1.
+MIN_CELLS = 10
+
 
 def plan_points(source: OccupancyMap | PointMap,
                 settings: Settings) -> tuple[np.ndarray, Levelling | None]:
@@ -47,7 +51,19 @@ def plan_points(source: OccupancyMap | PointMap,
         xy = source.points[:, :2]
     if len(xy) == 0:
         raise InputError(f"{source.path}: no occupied cells or wall points")
+    cells = distinct_cells(xy[:100_000])  # a large map shows its structure in its first rows
+    if cells < MIN_CELLS and len(xy) > 100_000:
+        cells = distinct_cells(xy)
+    if cells < MIN_CELLS:
+        raise EvaluationError(f"{source.path}: degenerate map: its walls fill {cells} distinct "
+                              f"{memory.WORKING_CELL:g} m cells, fewer than {MIN_CELLS}: "
+                              "nothing to align or score")
     return xy, levelling
+
+
+def distinct_cells(xy: np.ndarray) -> int:
+    """How many distinct cells of memory.WORKING_CELL (metres) the points ``xy`` (metres) fill."""
+    return len(np.unique(np.floor(np.asarray(xy[:, :2]) / memory.WORKING_CELL), axis=0))
 
 
 def min_hits(cloud: PointMap, settings: Settings) -> int:

@@ -86,15 +86,18 @@ def read_flaser(path: str | Path) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     path = Path(path)
     numbers, lines = flaser_lines(path)
     counts = _beam_counts(path, numbers, lines)
+    rows = np.asarray(lines, dtype=object)
+    # every line's values parsed (its beam count checked against them) before the padded
+    # tables of the largest count are allocated: "FLASER 100000000 1 2 3" allocates nothing
+    groups = {int(n): np.flatnonzero(counts == n) for n in np.unique(counts)}
+    tables = {n: _parse_group(path, numbers[which], rows[which].tolist(), n)
+              for n, which in groups.items()}
     width = int(counts.max())
     poses = np.empty((len(lines), 3), dtype=np.float64)
     ranges = np.full((len(lines), width), np.nan)
     angles = np.full((len(lines), width), np.nan)
-    rows = np.asarray(lines, dtype=object)
-    for n in np.unique(counts):
-        n = int(n)
-        which = np.flatnonzero(counts == n)
-        table = _parse_group(path, numbers[which], rows[which].tolist(), n)
+    for n, which in groups.items():
+        table = tables[n]
         ranges[which, :n] = table[:, 1:n + 1]
         poses[which] = table[:, n + 1:n + 4]
         angles[which, :n] = beam_angles(n)

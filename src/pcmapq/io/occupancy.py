@@ -22,6 +22,7 @@ import yaml
 from pcmapq.cells import FREE, OCCUPIED, UNKNOWN
 from pcmapq.errors import InputError
 from pcmapq.grid import MetricGrid
+from pcmapq.io.image_header import check_image_size
 from pcmapq.io.writers import one_line
 
 IMAGE_SUFFIXES = (".png", ".pgm", ".jpg", ".jpeg", ".bmp")
@@ -172,7 +173,8 @@ def read_levels(path: Path) -> tuple[np.ndarray, int, float, np.ndarray]:
     """An image's pixels as integer levels (rows, cols): the sum of its colour channels; the
     number of those channels, the grey value (0..255 scale) of one level of one channel, and
     a bool mask of transparent (alpha 0) pixels. A pixel's grey value is
-    ``level / channels * scale``."""
+    ``level / channels * scale``. The size its header declares is checked first."""
+    check_image_size(path)
     try:
         img = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
     except cv2.error:
