@@ -89,8 +89,8 @@ def map_command(
         "inv(T) P_k T.")] = None,
     max_scans: Annotated[int | None, typer.Option(help="Use only the first N scans.", min=1)
                          ] = None,
-    voxel: Annotated[float, typer.Option(help="Cell of the output map, metres.", min=1e-4)
-                     ] = 0.1,
+    voxel: Annotated[float, typer.Option(help="Cell of the output map, metres.", min=1e-4,
+                                         callback=options.finite)] = 0.1,
     quiet: Annotated[bool, typer.Option(
         "--quiet", "-q", help="Print nothing but warnings and errors.")] = False,
 ) -> None:
@@ -199,21 +199,23 @@ def eval_command(
         "similarity), for maps whose resolution is unknown.")] = "fixed",
     truth_resolution: Annotated[float | None, typer.Option(
         help="Metres per pixel of a truth image without YAML; cell size for a cloud truth "
-        "(default 0.05).", min=1e-6)] = None,
+        "(default 0.05).", min=1e-6, callback=options.finite)] = None,
     map_occupied_thresh: Annotated[float | None, typer.Option(
         help="Map image: occupied if p > this (map_server's occupied_thresh; overrides the "
-        "YAML's, default 0.65).", min=0.0, max=1.0, show_default=False)] = None,
+        "YAML's, default 0.65).", min=0.0, max=1.0, show_default=False,
+        callback=options.finite)] = None,
     map_free_thresh: Annotated[float | None, typer.Option(
         help="Map image: free if p < this (map_server's free_thresh; overrides the YAML's, "
-        "default 0.196).", min=0.0, max=1.0, show_default=False)] = None,
+        "default 0.196).", min=0.0, max=1.0, show_default=False, callback=options.finite)] = None,
     map_negate: Annotated[bool | None, typer.Option(
         "--map-negate/--map-no-negate", help="Map image: p = v / 255 instead of (255 - v) / 255 "
         "(map_server's negate; overrides the YAML's).", show_default=False)] = None,
     truth_occupied_thresh: Annotated[float | None, typer.Option(
         help="Truth image: as --map-occupied-thresh.", min=0.0, max=1.0,
-        show_default=False)] = None,
+        show_default=False, callback=options.finite)] = None,
     truth_free_thresh: Annotated[float | None, typer.Option(
-        help="Truth image: as --map-free-thresh.", min=0.0, max=1.0, show_default=False)
+        help="Truth image: as --map-free-thresh.", min=0.0, max=1.0, show_default=False,
+        callback=options.finite)
     ] = None,
     truth_negate: Annotated[bool | None, typer.Option(
         "--truth-negate/--truth-no-negate", help="Truth image: as --map-negate.",
@@ -225,13 +227,16 @@ def eval_command(
     force: Annotated[bool, typer.Option(
         help="Evaluate even when the map does not seem to show the truth's place.")] = False,
     threshold: Annotated[float, typer.Option(
-        help="Largest distance between matched features, metres.", min=1e-6)
+        help="Largest distance between matched features, metres.", min=1e-6,
+        callback=options.finite)
     ] = DEFAULTS.matching.threshold,
     band_low: Annotated[float, typer.Option(
-        help="Wall band of a 3D cloud: lower bound, metres above the floor.")
+        help="Wall band of a 3D cloud: lower bound, metres above the floor.",
+        callback=options.finite)
     ] = DEFAULTS.raster.band_low,
     band_high: Annotated[float, typer.Option(
-        help="Wall band of a 3D cloud: upper bound, metres above the floor.")
+        help="Wall band of a 3D cloud: upper bound, metres above the floor.",
+        callback=options.finite)
     ] = DEFAULTS.raster.band_high,
     min_hits: Annotated[int | None, typer.Option(
         help="Points needed to mark a cloud's cell occupied (default: 2 for a 3D cloud, 1 for "
@@ -252,10 +257,11 @@ def eval_command(
         help="Write a self-contained HTML report (figures embedded).")] = None,
     arrow_scale: Annotated[float, typer.Option(
         help="Displacement arrows of --plot and --report are drawn this many times their "
-        "length, in every panel of every run.", min=1e-6)] = ARROW_SCALE,
+        "length, in every panel of every run.", min=1e-6, callback=options.finite)] = ARROW_SCALE,
     voxel_3d: Annotated[float, typer.Option(
         "--voxel-3d", help="Working voxel of the 3D registration of two 3D clouds, metres "
-        "(0.5-1 for outdoor maps).", min=0.01)] = DEFAULTS.alignment.voxel_3d,
+        "(0.5-1 for outdoor maps).", min=0.01,
+        callback=options.finite)] = DEFAULTS.alignment.voxel_3d,
     tau: Annotated[str, typer.Option(
         help="Distance thresholds of the F-score, metres, comma-separated.")
     ] = ",".join(f"{t:g}" for t in DEFAULTS.distances.taus),
@@ -269,7 +275,8 @@ def eval_command(
     ] = False,
     max_memory: Annotated[float | None, typer.Option(
         help="Stop (exit 2) before a run estimated to need more than this many GB "
-        "(default: 75 % of this machine's memory).", min=0.0, show_default=False)] = None,
+        "(default: 75 % of this machine's memory).", min=0.0, show_default=False,
+        callback=options.finite)] = None,
     aligned: Annotated[Path | None, typer.Option(
         help="Write the map moved into the truth's frame: .ply/.pcd for a cloud map (a 3D "
         "cloud keeps its heights), .png/.pgm with its map_server YAML for an image map.")

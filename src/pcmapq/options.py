@@ -4,6 +4,7 @@ outputs that cannot be written and options that cannot work together (InputError
 
 from __future__ import annotations
 
+import math
 import os
 import shlex
 from pathlib import Path
@@ -38,14 +39,25 @@ def command_line(ctx: typer.Context) -> str:
     return shlex.join(words)
 
 
+def finite(param: typer.CallbackParam, value: float | None) -> float | None:
+    """A float option's callback: refuse 'inf' and 'nan', which click's FLOAT reads."""
+    if value is not None and not math.isfinite(value):
+        raise typer.BadParameter(f"expected a finite number, got {value}",
+                                 param_hint=param.opts[0] if param.opts else None)
+    return value
+
+
 def parse_init(text: str | None) -> Similarity2D | None:
+    """--init ``x,y,yaw`` (metres, metres, degrees; finite) as a map -> truth guess."""
     if text is None:
         return None
     try:
         x, y, yaw = (float(v) for v in text.split(","))
+        if not all(math.isfinite(v) for v in (x, y, yaw)):
+            raise ValueError(text)
     except ValueError:
-        raise typer.BadParameter(f"expected x,y,yaw (metres, metres, degrees), got {text!r}",
-                                 param_hint="--init") from None
+        raise typer.BadParameter(f"expected finite x,y,yaw (metres, metres, degrees), got "
+                                 f"{text!r}", param_hint="--init") from None
     return Similarity2D(x, y, float(np.radians(yaw)))
 
 
@@ -59,7 +71,7 @@ def parse_resolution(text: str | None, scale: str) -> tuple[float | None, bool]:
         value = float(text)
     except ValueError:
         value = -1.0
-    if not value > 0:
+    if not 0 < value < math.inf:
         raise typer.BadParameter(f"expected metres per pixel or 'auto', got {text!r}",
                                  param_hint="--map-resolution")
     return value, scale == "auto"
@@ -74,12 +86,13 @@ def thresholds(occupied: float | None, free: float | None,
 
 
 def parse_taus(text: str) -> tuple[float, ...]:
+    """--tau ``M,M,...``: positive finite distances, metres."""
     try:
         taus = tuple(float(v) for v in text.split(","))
     except ValueError:
         taus = ()
-    if not taus or min(taus) <= 0:
-        raise typer.BadParameter(f"expected positive distances in metres, got {text!r}",
+    if not taus or not all(0 < t < math.inf for t in taus):
+        raise typer.BadParameter(f"expected positive finite distances in metres, got {text!r}",
                                  param_hint="--tau")
     return taus
 
