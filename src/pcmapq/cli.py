@@ -18,7 +18,7 @@ from pcmapq import __version__, options
 from pcmapq.config import DETECTOR_NAMES, DistancesConfig, MatchingConfig, Settings, SourceConfig
 from pcmapq.errors import EvaluationError, InputError
 from pcmapq.io import PointMap
-from pcmapq.io.writers import write_atomic, write_cloud
+from pcmapq.io.writers import OutputSet, write_atomic, write_cloud
 from pcmapq.mapping import (
     build_map_from_poses,
     build_map_kiss,
@@ -37,6 +37,7 @@ from pcmapq.raster.footprint import FOOTPRINT_RULES
 from pcmapq.report import export
 from pcmapq.report.style import ARROW_SCALE
 from pcmapq.report.table import print_table
+from pcmapq.result import Result
 
 #: The documented defaults, read from the one place that defines them.
 DEFAULTS = Settings()
@@ -101,7 +102,7 @@ def map_command(
             raise InputError(f"{calib}: --calib places scans with --poses only (KISS-ICP's "
                              "map is in the first scanner's frame already)")
         options.check_outputs({"--out": out, "--poses-out": poses_out, "--tum-out": tum_out},
-                              None)
+                              None, inputs=(source, poses, calib))
         with _bar(err, enabled=not quiet) as tick:
             if poses is None:
                 points, trajectory = build_map_kiss(source, max_scans=max_scans, voxel=voxel,
@@ -318,7 +319,8 @@ def eval_command(
         options.check_eval_options(scans=scans, max_scans=max_scans, no_align=no_align,
                                    auto_scale=auto)
         options.check_outputs({"--json": json_path, "--vectors": vectors, "--plot": plot,
-                               "--report": report, **exports}, None if scans else paths[0])
+                               "--report": report, **exports}, None if scans else paths[0],
+                              inputs=paths)
         if scans is None:
             map_path: Path | PointMap = paths[0]
         else:
@@ -329,30 +331,43 @@ def eval_command(
         result = replace(evaluate(map_path, truth_path, settings, progress, limit),
                          command=options.command_line(ctx))
         progress("writing outputs")
+        wrote = _write_outputs(result, map_path, settings, arrow_scale, json_path=json_path,
+                               vectors=vectors, plot=plot, report=report, exports=exports)
         if json_path == "-":
             sys.stdout.write(result.to_json())
-        elif json_path is not None:
-            _save(err, quiet, Path(json_path), result.to_json())
+    if not quiet:
+        for path in wrote:
+            err.print(f"wrote {path}", markup=False, highlight=False, soft_wrap=True)
+    print_table(result, out)
+
+
+def _write_outputs(result: Result, map_path: Path | PointMap, settings: Settings,
+                   arrow_scale: float, *, json_path: str | None, vectors: Path | None,
+                   plot: Path | None, report: Path | None,
+                   exports: dict[str, Path | None]) -> list[Path]:
+    """Write the run's output files, all or nothing: each is produced into a temporary file
+    beside its target, and all are renamed into place only once every one is produced
+    (:class:`OutputSet`). The files written (an ``--aligned`` image's YAML too)."""
+    with OutputSet() as outputs:
+        wrote: list[Path] = []
+        if json_path not in (None, "-"):
+            write_atomic(Path(json_path), result.to_json(), outputs)
+            wrote.append(Path(json_path))
         if vectors is not None:
-            _save(err, quiet, vectors, result.vectors_csv())
+            write_atomic(vectors, result.vectors_csv(), outputs)
+            wrote.append(vectors)
         if plot is not None or report is not None:
             from pcmapq.report.html import report_html
             from pcmapq.report.plot import DPI, vectorial_figure
         if plot is not None:
-            _save(err, quiet, plot, export.figure_bytes(vectorial_figure(result, arrow_scale),
-                                                        plot, DPI))
+            write_atomic(plot, export.figure_bytes(vectorial_figure(result, arrow_scale), plot,
+                                                   DPI), outputs)
+            wrote.append(plot)
         if report is not None:
-            _save(err, quiet, report, report_html(result, arrow_scale))
-        for path in export.write_exports(result, map_path, settings, aligned=aligned,
-                                         transform=transform, distances=distances):
-            if not quiet:
-                err.print(f"wrote {path}", markup=False, highlight=False, soft_wrap=True)
-    print_table(result, out)
-
-
-def _save(console: Console, quiet: bool, path: Path, data: str | bytes) -> None:
-    """Write an output file whole (:func:`write_atomic`) and say so: 'wrote PATH' on stderr,
-    unless ``quiet``."""
-    write_atomic(path, data)
-    if not quiet:
-        console.print(f"wrote {path}", markup=False, highlight=False, soft_wrap=True)
+            write_atomic(report, report_html(result, arrow_scale), outputs)
+            wrote.append(report)
+        wrote += export.write_exports(result, map_path, settings, aligned=exports["--aligned"],
+                                      transform=exports["--transform"],
+                                      distances=exports["--distances"], outputs=outputs)
+        outputs.commit()
+    return wrote
