@@ -8,6 +8,7 @@ import json
 import os
 from pathlib import Path
 
+import numpy as np
 import pytest
 from typer.testing import CliRunner
 
@@ -164,3 +165,42 @@ def test_every_output_written_and_a_symlink_written_through(tmp_path: Path):
     assert json.loads((tmp_path / "runs" / "r1.json").read_text())["map"]["kind"] == "image"
     assert sorted(p.name for p in tmp_path.iterdir()) == [
         "a.png", "a.yaml", "latest.json", "runs", "truth.png", "truth.yaml", "v.csv"]
+
+
+def _scans(folder: Path) -> tuple[Path, Path]:
+    """Three small .npy scans (a box of walls, metres) and their KITTI poses (1 m apart)."""
+    scans = folder / "scans"
+    scans.mkdir()
+    rng = np.random.default_rng(0)
+    for k in range(3):
+        np.save(scans / f"{k:06d}.npy", rng.uniform(-5, 5, (500, 3)).astype(np.float32))
+    poses = folder / "poses.txt"
+    poses.write_text("".join(f"1 0 0 {k} 0 1 0 0 0 0 1 0\n" for k in range(3)))
+    return scans, poses
+
+
+def test_map_outputs_all_or_none(tmp_path: Path, monkeypatch):
+    """`pcmapq map`: the poses failing after the map is produced leaves no map; a pose output
+    on the input poses is refused before any work, the poses byte for byte as they were."""
+    import pcmapq.cli
+
+    scans, poses = _scans(tmp_path)
+    before = _files(tmp_path)
+    code, _, err = _cli("map", scans, "--poses", poses, "--out", tmp_path / "m.ply",
+                        "--poses-out", poses)
+    assert code == 2 and err.strip().endswith(f"--poses-out would overwrite the input '{poses}'")
+    assert _files(tmp_path) == before
+
+    def broken(path: Path, *_: object, **__: object) -> None:
+        raise InputError(f"{path}: cannot write: No space left on device")
+
+    monkeypatch.setattr(pcmapq.cli, "write_tum_poses", broken)
+    code, _, err = _cli("map", scans, "--poses", poses, "--out", tmp_path / "m.ply",
+                        "--poses-out", tmp_path / "p.txt", "--tum-out", tmp_path / "t.tum")
+    assert code == 2 and err.strip().endswith("t.tum: cannot write: No space left on device")
+    assert _files(tmp_path) == before
+    monkeypatch.undo()
+    code, _, err = _cli("map", scans, "--poses", poses, "--out", tmp_path / "m.ply",
+                        "--poses-out", tmp_path / "p.txt", "--tum-out", tmp_path / "t.tum")
+    assert code == 0, err
+    assert {"m.ply", "p.txt", "t.tum"} <= set(_files(tmp_path))

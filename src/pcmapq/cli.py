@@ -124,14 +124,16 @@ def map_command(
                               highlight=False, soft_wrap=True)
                 trajectory = trajectory[:len(scans)]
                 points = build_map_from_poses(scans, trajectory, voxel=voxel, progress=tick)
-        write_cloud(out, points)
-        wrote = [f"wrote {out}: {len(points)} points from {len(trajectory)} scans"]
-        if poses_out is not None:
-            write_kitti_poses(poses_out, trajectory)
-            wrote.append(f"wrote {poses_out}: {len(trajectory)} poses (KITTI)")
-        if tum_out is not None:
-            write_tum_poses(tum_out, trajectory)
-            wrote.append(f"wrote {tum_out}: {len(trajectory)} poses (TUM)")
+        with OutputSet() as outputs:  # the map and its poses: all or none
+            write_cloud(out, points, outputs)
+            wrote = [f"wrote {out}: {len(points)} points from {len(trajectory)} scans"]
+            if poses_out is not None:
+                write_kitti_poses(poses_out, trajectory, outputs)
+                wrote.append(f"wrote {poses_out}: {len(trajectory)} poses (KITTI)")
+            if tum_out is not None:
+                write_tum_poses(tum_out, trajectory, outputs=outputs)
+                wrote.append(f"wrote {tum_out}: {len(trajectory)} poses (TUM)")
+            outputs.commit()
     if not quiet:
         for line in wrote:
             err.print(line, markup=False, highlight=False, soft_wrap=True)

@@ -133,19 +133,28 @@ def _target_mode(path: Path) -> int:
         return 0o666 & ~umask
 
 
-def write_cloud(path: Path, points: np.ndarray) -> None:
-    """Write points (N, 3, metres) as .ply or .pcd (binary float32), whole or not at all."""
+def write_cloud(path: Path, points: np.ndarray, outputs: OutputSet | None = None) -> None:
+    """Write points (N, 3, metres) as .ply or .pcd (binary float32), whole or not at all (with
+    ``outputs``: when that set is committed); a symlink is written through."""
     import open3d as o3d
 
     if path.suffix.lower() not in (".ply", ".pcd"):
         raise InputError(f"{path}: a map is written as .ply or .pcd")
     cloud = o3d.t.geometry.PointCloud(o3d.core.Tensor(np.asarray(points, dtype=np.float32)))
-    tmp = path.with_name(f".{path.stem}.{os.getpid()}.tmp{path.suffix}")
+    target = Path(os.path.realpath(path))
+    tmp = target.with_name(f".{target.stem}.{os.getpid()}.tmp{target.suffix}")
+    staged = False
     try:
         if not o3d.t.io.write_point_cloud(str(tmp), cloud):
             raise InputError(f"{path}: cannot write")
-        os.replace(tmp, path)
+        os.chmod(tmp, _target_mode(target))
+        if outputs is None:
+            os.replace(tmp, target)
+        else:
+            outputs.stage(str(tmp), target)
+            staged = True
     except OSError as err:
         raise InputError(f"{path}: cannot write: {err.strerror or err}") from None
     finally:
-        tmp.unlink(missing_ok=True)
+        if not staged:
+            tmp.unlink(missing_ok=True)
