@@ -18,7 +18,7 @@ from pcmapq import __version__, options
 from pcmapq.config import DETECTOR_NAMES, DistancesConfig, MatchingConfig, Settings, SourceConfig
 from pcmapq.errors import EvaluationError, InputError
 from pcmapq.io import PointMap
-from pcmapq.io.writers import write_atomic, write_cloud
+from pcmapq.io.writers import OutputSet, write_atomic, write_cloud
 from pcmapq.mapping import (
     build_map_from_poses,
     build_map_kiss,
@@ -37,6 +37,7 @@ from pcmapq.raster.footprint import FOOTPRINT_RULES
 from pcmapq.report import export
 from pcmapq.report.style import ARROW_SCALE
 from pcmapq.report.table import print_table
+from pcmapq.result import Result
 
 #: The documented defaults, read from the one place that defines them.
 DEFAULTS = Settings()
@@ -89,8 +90,8 @@ def map_command(
         "inv(T) P_k T.")] = None,
     max_scans: Annotated[int | None, typer.Option(help="Use only the first N scans.", min=1)
                          ] = None,
-    voxel: Annotated[float, typer.Option(help="Cell of the output map, metres.", min=1e-4)
-                     ] = 0.1,
+    voxel: Annotated[float, typer.Option(help="Cell of the output map, metres.", min=1e-4,
+                                         callback=options.finite)] = 0.1,
     quiet: Annotated[bool, typer.Option(
         "--quiet", "-q", help="Print nothing but warnings and errors.")] = False,
 ) -> None:
@@ -101,7 +102,7 @@ def map_command(
             raise InputError(f"{calib}: --calib places scans with --poses only (KISS-ICP's "
                              "map is in the first scanner's frame already)")
         options.check_outputs({"--out": out, "--poses-out": poses_out, "--tum-out": tum_out},
-                              None)
+                              None, inputs=(source, poses, calib))
         with _bar(err, enabled=not quiet) as tick:
             if poses is None:
                 points, trajectory = build_map_kiss(source, max_scans=max_scans, voxel=voxel,
@@ -123,14 +124,16 @@ def map_command(
                               highlight=False, soft_wrap=True)
                 trajectory = trajectory[:len(scans)]
                 points = build_map_from_poses(scans, trajectory, voxel=voxel, progress=tick)
-        write_cloud(out, points)
-        wrote = [f"wrote {out}: {len(points)} points from {len(trajectory)} scans"]
-        if poses_out is not None:
-            write_kitti_poses(poses_out, trajectory)
-            wrote.append(f"wrote {poses_out}: {len(trajectory)} poses (KITTI)")
-        if tum_out is not None:
-            write_tum_poses(tum_out, trajectory)
-            wrote.append(f"wrote {tum_out}: {len(trajectory)} poses (TUM)")
+        with OutputSet() as outputs:  # the map and its poses: all or none
+            write_cloud(out, points, outputs)
+            wrote = [f"wrote {out}: {len(points)} points from {len(trajectory)} scans"]
+            if poses_out is not None:
+                write_kitti_poses(poses_out, trajectory, outputs)
+                wrote.append(f"wrote {poses_out}: {len(trajectory)} poses (KITTI)")
+            if tum_out is not None:
+                write_tum_poses(tum_out, trajectory, outputs=outputs)
+                wrote.append(f"wrote {tum_out}: {len(trajectory)} poses (TUM)")
+            outputs.commit()
     if not quiet:
         for line in wrote:
             err.print(line, markup=False, highlight=False, soft_wrap=True)
@@ -199,21 +202,23 @@ def eval_command(
         "similarity), for maps whose resolution is unknown.")] = "fixed",
     truth_resolution: Annotated[float | None, typer.Option(
         help="Metres per pixel of a truth image without YAML; cell size for a cloud truth "
-        "(default 0.05).", min=1e-6)] = None,
+        "(default 0.05).", min=1e-6, callback=options.finite)] = None,
     map_occupied_thresh: Annotated[float | None, typer.Option(
         help="Map image: occupied if p > this (map_server's occupied_thresh; overrides the "
-        "YAML's, default 0.65).", min=0.0, max=1.0, show_default=False)] = None,
+        "YAML's, default 0.65).", min=0.0, max=1.0, show_default=False,
+        callback=options.finite)] = None,
     map_free_thresh: Annotated[float | None, typer.Option(
         help="Map image: free if p < this (map_server's free_thresh; overrides the YAML's, "
-        "default 0.196).", min=0.0, max=1.0, show_default=False)] = None,
+        "default 0.196).", min=0.0, max=1.0, show_default=False, callback=options.finite)] = None,
     map_negate: Annotated[bool | None, typer.Option(
         "--map-negate/--map-no-negate", help="Map image: p = v / 255 instead of (255 - v) / 255 "
         "(map_server's negate; overrides the YAML's).", show_default=False)] = None,
     truth_occupied_thresh: Annotated[float | None, typer.Option(
         help="Truth image: as --map-occupied-thresh.", min=0.0, max=1.0,
-        show_default=False)] = None,
+        show_default=False, callback=options.finite)] = None,
     truth_free_thresh: Annotated[float | None, typer.Option(
-        help="Truth image: as --map-free-thresh.", min=0.0, max=1.0, show_default=False)
+        help="Truth image: as --map-free-thresh.", min=0.0, max=1.0, show_default=False,
+        callback=options.finite)
     ] = None,
     truth_negate: Annotated[bool | None, typer.Option(
         "--truth-negate/--truth-no-negate", help="Truth image: as --map-negate.",
@@ -225,13 +230,16 @@ def eval_command(
     force: Annotated[bool, typer.Option(
         help="Evaluate even when the map does not seem to show the truth's place.")] = False,
     threshold: Annotated[float, typer.Option(
-        help="Largest distance between matched features, metres.", min=1e-6)
+        help="Largest distance between matched features, metres.", min=1e-6,
+        callback=options.finite)
     ] = DEFAULTS.matching.threshold,
     band_low: Annotated[float, typer.Option(
-        help="Wall band of a 3D cloud: lower bound, metres above the floor.")
+        help="Wall band of a 3D cloud: lower bound, metres above the floor.",
+        callback=options.finite)
     ] = DEFAULTS.raster.band_low,
     band_high: Annotated[float, typer.Option(
-        help="Wall band of a 3D cloud: upper bound, metres above the floor.")
+        help="Wall band of a 3D cloud: upper bound, metres above the floor.",
+        callback=options.finite)
     ] = DEFAULTS.raster.band_high,
     min_hits: Annotated[int | None, typer.Option(
         help="Points needed to mark a cloud's cell occupied (default: 2 for a 3D cloud, 1 for "
@@ -252,10 +260,11 @@ def eval_command(
         help="Write a self-contained HTML report (figures embedded).")] = None,
     arrow_scale: Annotated[float, typer.Option(
         help="Displacement arrows of --plot and --report are drawn this many times their "
-        "length, in every panel of every run.", min=1e-6)] = ARROW_SCALE,
+        "length, in every panel of every run.", min=1e-6, callback=options.finite)] = ARROW_SCALE,
     voxel_3d: Annotated[float, typer.Option(
         "--voxel-3d", help="Working voxel of the 3D registration of two 3D clouds, metres "
-        "(0.5-1 for outdoor maps).", min=0.01)] = DEFAULTS.alignment.voxel_3d,
+        "(0.5-1 for outdoor maps).", min=0.01,
+        callback=options.finite)] = DEFAULTS.alignment.voxel_3d,
     tau: Annotated[str, typer.Option(
         help="Distance thresholds of the F-score, metres, comma-separated.")
     ] = ",".join(f"{t:g}" for t in DEFAULTS.distances.taus),
@@ -269,7 +278,8 @@ def eval_command(
     ] = False,
     max_memory: Annotated[float | None, typer.Option(
         help="Stop (exit 2) before a run estimated to need more than this many GB "
-        "(default: 75 % of this machine's memory).", min=0.0, show_default=False)] = None,
+        "(default: 75 % of this machine's memory).", min=0.0, show_default=False,
+        callback=options.finite)] = None,
     aligned: Annotated[Path | None, typer.Option(
         help="Write the map moved into the truth's frame: .ply/.pcd for a cloud map (a 3D "
         "cloud keeps its heights), .png/.pgm with its map_server YAML for an image map.")
@@ -311,7 +321,8 @@ def eval_command(
         options.check_eval_options(scans=scans, max_scans=max_scans, no_align=no_align,
                                    auto_scale=auto)
         options.check_outputs({"--json": json_path, "--vectors": vectors, "--plot": plot,
-                               "--report": report, **exports}, None if scans else paths[0])
+                               "--report": report, **exports}, None if scans else paths[0],
+                              inputs=paths)
         if scans is None:
             map_path: Path | PointMap = paths[0]
         else:
@@ -322,30 +333,43 @@ def eval_command(
         result = replace(evaluate(map_path, truth_path, settings, progress, limit),
                          command=options.command_line(ctx))
         progress("writing outputs")
+        wrote = _write_outputs(result, map_path, settings, arrow_scale, json_path=json_path,
+                               vectors=vectors, plot=plot, report=report, exports=exports)
         if json_path == "-":
             sys.stdout.write(result.to_json())
-        elif json_path is not None:
-            _save(err, quiet, Path(json_path), result.to_json())
+    if not quiet:
+        for path in wrote:
+            err.print(f"wrote {path}", markup=False, highlight=False, soft_wrap=True)
+    print_table(result, out)
+
+
+def _write_outputs(result: Result, map_path: Path | PointMap, settings: Settings,
+                   arrow_scale: float, *, json_path: str | None, vectors: Path | None,
+                   plot: Path | None, report: Path | None,
+                   exports: dict[str, Path | None]) -> list[Path]:
+    """Write the run's output files, all or nothing: each is produced into a temporary file
+    beside its target, and all are renamed into place only once every one is produced
+    (:class:`OutputSet`). The files written (an ``--aligned`` image's YAML too)."""
+    with OutputSet() as outputs:
+        wrote: list[Path] = []
+        if json_path not in (None, "-"):
+            write_atomic(Path(json_path), result.to_json(), outputs)
+            wrote.append(Path(json_path))
         if vectors is not None:
-            _save(err, quiet, vectors, result.vectors_csv())
+            write_atomic(vectors, result.vectors_csv(), outputs)
+            wrote.append(vectors)
         if plot is not None or report is not None:
             from pcmapq.report.html import report_html
             from pcmapq.report.plot import DPI, vectorial_figure
         if plot is not None:
-            _save(err, quiet, plot, export.figure_bytes(vectorial_figure(result, arrow_scale),
-                                                        plot, DPI))
+            write_atomic(plot, export.figure_bytes(vectorial_figure(result, arrow_scale), plot,
+                                                   DPI), outputs)
+            wrote.append(plot)
         if report is not None:
-            _save(err, quiet, report, report_html(result, arrow_scale))
-        for path in export.write_exports(result, map_path, settings, aligned=aligned,
-                                         transform=transform, distances=distances):
-            if not quiet:
-                err.print(f"wrote {path}", markup=False, highlight=False, soft_wrap=True)
-    print_table(result, out)
-
-
-def _save(console: Console, quiet: bool, path: Path, data: str | bytes) -> None:
-    """Write an output file whole (:func:`write_atomic`) and say so: 'wrote PATH' on stderr,
-    unless ``quiet``."""
-    write_atomic(path, data)
-    if not quiet:
-        console.print(f"wrote {path}", markup=False, highlight=False, soft_wrap=True)
+            write_atomic(report, report_html(result, arrow_scale), outputs)
+            wrote.append(report)
+        wrote += export.write_exports(result, map_path, settings, aligned=exports["--aligned"],
+                                      transform=exports["--transform"],
+                                      distances=exports["--distances"], outputs=outputs)
+        outputs.commit()
+    return wrote

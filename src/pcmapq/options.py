@@ -4,8 +4,11 @@ outputs that cannot be written and options that cannot work together (InputError
 
 from __future__ import annotations
 
+import math
 import os
 import shlex
+import stat
+from collections.abc import Iterable
 from pathlib import Path
 
 import numpy as np
@@ -14,7 +17,7 @@ import typer
 from pcmapq.config import DETECTOR_NAMES
 from pcmapq.errors import InputError
 from pcmapq.io import Thresholds
-from pcmapq.io.occupancy import IMAGE_SUFFIXES, YAML_SUFFIXES
+from pcmapq.io.occupancy import IMAGE_SUFFIXES, YAML_SUFFIXES, read_yaml
 from pcmapq.raster.footprint import FOOTPRINT_RULES
 from pcmapq.transform import Similarity2D
 
@@ -38,14 +41,25 @@ def command_line(ctx: typer.Context) -> str:
     return shlex.join(words)
 
 
+def finite(param: typer.CallbackParam, value: float | None) -> float | None:
+    """A float option's callback: refuse 'inf' and 'nan', which click's FLOAT reads."""
+    if value is not None and not math.isfinite(value):
+        raise typer.BadParameter(f"expected a finite number, got {value}",
+                                 param_hint=param.opts[0] if param.opts else None)
+    return value
+
+
 def parse_init(text: str | None) -> Similarity2D | None:
+    """--init ``x,y,yaw`` (metres, metres, degrees; finite) as a map -> truth guess."""
     if text is None:
         return None
     try:
         x, y, yaw = (float(v) for v in text.split(","))
+        if not all(math.isfinite(v) for v in (x, y, yaw)):
+            raise ValueError(text)
     except ValueError:
-        raise typer.BadParameter(f"expected x,y,yaw (metres, metres, degrees), got {text!r}",
-                                 param_hint="--init") from None
+        raise typer.BadParameter(f"expected finite x,y,yaw (metres, metres, degrees), got "
+                                 f"{text!r}", param_hint="--init") from None
     return Similarity2D(x, y, float(np.radians(yaw)))
 
 
@@ -59,7 +73,7 @@ def parse_resolution(text: str | None, scale: str) -> tuple[float | None, bool]:
         value = float(text)
     except ValueError:
         value = -1.0
-    if not value > 0:
+    if not 0 < value < math.inf:
         raise typer.BadParameter(f"expected metres per pixel or 'auto', got {text!r}",
                                  param_hint="--map-resolution")
     return value, scale == "auto"
@@ -74,12 +88,13 @@ def thresholds(occupied: float | None, free: float | None,
 
 
 def parse_taus(text: str) -> tuple[float, ...]:
+    """--tau ``M,M,...``: positive finite distances, metres."""
     try:
         taus = tuple(float(v) for v in text.split(","))
     except ValueError:
         taus = ()
-    if not taus or min(taus) <= 0:
-        raise typer.BadParameter(f"expected positive distances in metres, got {text!r}",
+    if not taus or not all(0 < t < math.inf for t in taus):
+        raise typer.BadParameter(f"expected positive finite distances in metres, got {text!r}",
                                  param_hint="--tau")
     return taus
 
@@ -119,11 +134,20 @@ def output_suffixes(option: str, map_path: Path | None) -> tuple[str, ...]:
     return ALIGNED_IMAGE if image else ALIGNED_CLOUD
 
 
-def check_outputs(outputs: dict[str, str | Path | None], map_path: Path | None) -> None:
+#: Folders of device and process files (``/dev/stdout`` and its like): no output is written
+#: there (``--json -`` is stdout), except in the ordinary files of ``/dev/shm``.
+SPECIAL_FOLDERS, ORDINARY_FOLDER = (Path("/dev"), Path("/proc")), Path("/dev/shm")
+
+
+def check_outputs(outputs: dict[str, str | Path | None], map_path: Path | None,
+                  inputs: Iterable[Path | None] = ()) -> None:
     """Refuse, before any work, an output that could not be written: ``outputs`` maps each
     option (``--json`` ...) to its path or None (``--json -`` is stdout). Each path needs a
-    known extension, an existing writable folder, no folder in its place, and no other output
-    on it (an ``--aligned`` image's YAML included)."""
+    known extension, an existing writable folder (a symlink's: it is written through), no
+    folder, device, FIFO or socket in its place, no other output on it (an ``--aligned``
+    image's YAML included), and must not be one of the ``inputs`` (nor the YAML beside an input
+    image, nor the image an input YAML names)."""
+    read = [f for given in inputs if given is not None for f in input_files(Path(given))]
     taken: dict[Path, str] = {}
     for option, given in outputs.items():
         if given is None or str(given) == "-":
@@ -133,19 +157,67 @@ def check_outputs(outputs: dict[str, str | Path | None], map_path: Path | None) 
         if path.suffix.lower() not in suffixes:
             raise InputError(f"{path}: {option} writes {_alternatives(suffixes)}, not "
                              f"'{path.suffix or path.name}'")
-        folder = path.parent
-        if not folder.is_dir():
-            raise InputError(f"{path}: {option}: folder '{folder}' does not exist")
-        if not os.access(folder, os.W_OK | os.X_OK):
-            raise InputError(f"{path}: {option}: folder '{folder}' is not writable")
-        if path.is_dir():
-            raise InputError(f"{path}: {option}: is a folder")
+        _check_target(option, path)
         written = [path] + ([path.with_suffix(".yaml")] if suffixes == ALIGNED_IMAGE else [])
         for target in written:
+            if (source := next((f for f in read if same_file(target, f)), None)) is not None:
+                raise InputError(f"{target}: {option} would overwrite the input '{source}'")
             key = target.resolve()
             if key in taken:
                 raise InputError(f"{target}: written by both {taken[key]} and {option}")
             taken[key] = option
+
+
+def _check_target(option: str, path: Path) -> None:
+    """Refuse an output path that is a folder or a special file, or whose folder (through a
+    symlink: its target's) is missing or not writable."""
+    real = Path(os.path.realpath(path))
+    for place in [*_link_chain(path), real]:
+        if any(place.is_relative_to(folder) for folder in SPECIAL_FOLDERS) and \
+                not place.is_relative_to(ORDINARY_FOLDER):
+            raise InputError(f"{path}: {option}: a device or process file, not a regular file"
+                             + (" (--json - writes to stdout)" if option == "--json" else ""))
+    folder = real.parent
+    if not folder.is_dir():
+        raise InputError(f"{path}: {option}: folder '{folder}' does not exist")
+    if not os.access(folder, os.W_OK | os.X_OK):
+        raise InputError(f"{path}: {option}: folder '{folder}' is not writable")
+    if real.is_dir():
+        raise InputError(f"{path}: {option}: is a folder")
+    if real.exists() and not stat.S_ISREG(real.stat().st_mode):
+        raise InputError(f"{path}: {option}: not a regular file (a FIFO, device or socket)")
+
+
+def _link_chain(path: Path, hops: int = 40) -> list[Path]:
+    """``path`` and every path its symlinks lead through (absolute, normalised): a link to
+    ``/dev/stdout`` passes ``/dev`` even when its end is a regular file."""
+    chain = [Path(os.path.abspath(path))]
+    while chain[-1].is_symlink() and len(chain) <= hops:
+        chain.append(Path(os.path.abspath(chain[-1].parent / os.readlink(chain[-1]))))
+    return chain
+
+
+def input_files(path: Path) -> list[Path]:
+    """The files an input path reads: itself, the map_server YAML beside an image (same
+    stem), the image a YAML names (when it parses)."""
+    suffix = path.suffix.lower()
+    if suffix in IMAGE_SUFFIXES:
+        return [path] + [path.with_suffix(s) for s in YAML_SUFFIXES]
+    if suffix in YAML_SUFFIXES:
+        try:
+            return [path, read_yaml(path)[1]]
+        except InputError:
+            return [path]
+    return [path]
+
+
+def same_file(a: Path, b: Path) -> bool:
+    """Whether two paths name one file: ``os.path.samefile`` when both exist (links and hard
+    links included), else the same resolved path."""
+    try:
+        return os.path.samefile(a, b)
+    except OSError:
+        return a.resolve() == b.resolve()
 
 
 def check_eval_options(*, scans: Path | None, max_scans: int | None, no_align: bool,

@@ -181,7 +181,9 @@ class Result:
         return _rounded(doc)
 
     def to_json(self) -> str:
-        return json.dumps(self.to_dict(), indent=2) + "\n"
+        """The JSON document, strict: a NaN or infinity in it is a ValueError, never bare
+        ``NaN`` / ``Infinity`` (which JSON readers refuse)."""
+        return json.dumps(self.to_dict(), indent=2, allow_nan=False) + "\n"
 
     @classmethod
     def from_json(cls, text: str) -> Result:

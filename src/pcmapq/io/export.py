@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from pcmapq.errors import InputError
-from pcmapq.io.writers import atomic_file
+from pcmapq.io.writers import OutputSet, atomic_file
 
 #: The scalar field of a distance cloud: metres. CloudCompare reads a PLY property named
 #: ``scalar_<name>`` as the scalar field ``<name>``.
@@ -52,10 +52,11 @@ def records(xyz: np.ndarray, dtype: np.dtype, scalar: np.ndarray | None = None,
 
 
 def write_records(path: Path, count: int, chunks: Iterable[np.ndarray], dtype: np.dtype,
-                  comment: str = "") -> None:
+                  comment: str = "", outputs: OutputSet | None = None) -> None:
     """Write ``count`` records of ``dtype`` (:func:`record_dtype`), given as chunks, as a binary
     PLY (every field a vertex property) or a binary PCD (x, y, z only), by ``path``'s
-    extension; ``comment`` (one line) goes into the header."""
+    extension; ``comment`` (one line) goes into the header; with ``outputs``, the file appears
+    when that set is committed."""
     suffix = path.suffix.lower()
     if suffix not in CLOUD_SUFFIXES:
         raise InputError(f"{path}: a cloud is written as .ply or .pcd")
@@ -63,7 +64,7 @@ def write_records(path: Path, count: int, chunks: Iterable[np.ndarray], dtype: n
         raise InputError(f"{path}: a cloud with a scalar field is written as .ply")
     header = _ply_header(count, dtype, comment) if suffix == ".ply" else _pcd_header(count)
     written = 0
-    with atomic_file(path) as f:
+    with atomic_file(path, outputs) as f:
         f.write(header.encode("ascii"))
         for chunk in chunks:
             f.write(np.ascontiguousarray(chunk, dtype=dtype).tobytes())
@@ -72,11 +73,12 @@ def write_records(path: Path, count: int, chunks: Iterable[np.ndarray], dtype: n
             raise InputError(f"{path}: {written} points written, {count} announced")
 
 
-def write_matrix(path: Path, matrix: np.ndarray) -> None:
+def write_matrix(path: Path, matrix: np.ndarray, outputs: OutputSet | None = None) -> None:
     """A 3x3 or 4x4 homogeneous transform as plain text: one row a line, numbers separated by
-    one space, shortest exact form (reading it back gives the same floats)."""
+    one space, shortest exact form (reading it back gives the same floats); with ``outputs``,
+    the file appears when that set is committed."""
     rows = np.asarray(matrix, dtype=np.float64)
-    with atomic_file(path) as f:
+    with atomic_file(path, outputs) as f:
         f.write("".join(" ".join(repr(float(v) + 0.0) for v in row) + "\n"
                         for row in rows).encode("ascii"))
 

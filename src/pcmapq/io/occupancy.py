@@ -10,6 +10,7 @@ image's lower-left corner (see :mod:`pcmapq.grid`).
 from __future__ import annotations
 
 import math
+import re
 import warnings
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -29,6 +30,9 @@ IMAGE_SUFFIXES = (".png", ".pgm", ".jpg", ".jpeg", ".bmp")
 YAML_SUFFIXES = (".yaml", ".yml")
 MODES = ("trinary", "scale", "raw")
 _T = TypeVar("_T")
+#: A decimal number as text, exponent allowed: ``5e-2``, ``1.0e9``, ``-.5``. PyYAML (YAML 1.1)
+#: reads an exponent without a dot or a signed exponent as a string; map_server reads a number.
+_NUMBER_TEXT = re.compile(r"[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?")
 
 
 @dataclass(frozen=True)
@@ -222,7 +226,10 @@ def _yaml_problem(exc: Exception) -> str:
 
 
 def _number(path: Path, key: str, value: object) -> float:
-    """A YAML value that must be a finite number."""
+    """A YAML value that must be a finite number: a YAML number, or text that reads as one
+    (``5e-2``, ``1.0e9``), as map_server accepts."""
+    if isinstance(value, str) and _NUMBER_TEXT.fullmatch(value.strip()):
+        value = float(value)
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
         raise InputError(f"{path}: '{key}' must be a finite number, got {value!r}")
     return float(value)

@@ -15,29 +15,79 @@ import numpy as np
 from pcmapq.errors import InputError
 
 
-def write_atomic(path: Path, data: str | bytes) -> None:
+class OutputSet:
+    """The output files of one run, all or nothing. A file written with ``outputs=`` this set
+    (:func:`atomic_file`) waits, whole, in a temporary file beside its target; :meth:`commit`
+    renames them all into place once every output is produced, and :meth:`discard` (or leaving
+    a ``with`` block by an error) removes them, so none of the run's outputs appears."""
+
+    def __init__(self) -> None:
+        self._staged: list[tuple[str, Path]] = []
+
+    def __enter__(self) -> OutputSet:
+        return self
+
+    def __exit__(self, kind: type[BaseException] | None, *_: object) -> None:
+        if kind is not None:
+            self.discard()
+
+    def stage(self, tmp: str, target: Path) -> None:
+        """Hold the finished temporary file ``tmp`` until :meth:`commit` moves it to
+        ``target``."""
+        self._staged.append((tmp, target))
+
+    def commit(self) -> list[Path]:
+        """Rename every staged file into place (``os.replace``, in the order written); the
+        targets. A rename that fails (an OS fault) removes the files not yet renamed."""
+        done: list[Path] = []
+        try:
+            while self._staged:
+                tmp, target = self._staged[0]
+                os.replace(tmp, target)
+                self._staged.pop(0)
+                done.append(target)
+        except OSError as exc:
+            self.discard()
+            raise InputError(f"{target}: cannot write: {one_line(exc)}") from None
+        return done
+
+    def discard(self) -> None:
+        """Remove every staged temporary file: no output of the set is written."""
+        for tmp, _ in self._staged:
+            with contextlib.suppress(OSError):
+                os.unlink(tmp)
+        self._staged.clear()
+
+
+def write_atomic(path: Path, data: str | bytes, outputs: OutputSet | None = None) -> None:
     """Write ``data`` (str as UTF-8) to ``path`` atomically (see :func:`atomic_file`)."""
-    with atomic_file(path) as f:
+    with atomic_file(path, outputs) as f:
         f.write(data.encode("utf-8") if isinstance(data, str) else data)
 
 
 @contextlib.contextmanager
-def atomic_file(path: Path) -> Iterator[BinaryIO]:
+def atomic_file(path: Path, outputs: OutputSet | None = None) -> Iterator[BinaryIO]:
     """A binary file to write ``path`` through, whole or not at all: the bytes go into a
-    temporary file in the same directory, which replaces ``path`` (``os.replace``) when the
-    block ends without an error. On failure the temporary file is removed, any old ``path`` is
-    left as it was, and an OSError becomes InputError. The new file gets the usual mode (0o666
-    less the umask), or the old file's mode when replacing one."""
+    temporary file in the target's directory, which replaces the target (``os.replace``) when
+    the block ends without an error, or, with ``outputs``, when that set is committed. A
+    symlink is written through: its target is replaced, the link stays. On failure the
+    temporary file is removed, any old file is left as it was, and an OSError becomes
+    InputError. The new file gets the usual mode (0o666 less the umask), or the old file's
+    mode when replacing one."""
     path = Path(path)
+    target = Path(os.path.realpath(path))
     tmp: str | None = None
     try:
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+        fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
         with os.fdopen(fd, "wb") as f:
             yield f
             f.flush()
             os.fsync(f.fileno())
-        os.chmod(tmp, _target_mode(path))
-        os.replace(tmp, path)
+        os.chmod(tmp, _target_mode(target))
+        if outputs is None:
+            os.replace(tmp, target)
+        else:
+            outputs.stage(tmp, target)
         tmp = None
     except OSError as exc:
         raise InputError(f"{path}: cannot write: {one_line(exc)}") from None
@@ -48,20 +98,22 @@ def atomic_file(path: Path) -> Iterator[BinaryIO]:
 
 
 def write_ros_map(path: Path, image: np.ndarray, resolution: float,
-                  origin: tuple[float, float] = (0.0, 0.0)) -> Path:
+                  origin: tuple[float, float] = (0.0, 0.0),
+                  outputs: OutputSet | None = None) -> Path:
     """Save an occupancy image (uint8 grey values, ROS's 0 occupied, 254 free, 205 unknown) at
     ``path`` (.png or .pgm) with its map_server YAML beside it (same stem): ``resolution``
     metres per pixel, ``origin`` (x, y) metres of the image's lower-left corner, yaw 0, ROS's
-    default thresholds. Both are written whole (:func:`write_atomic`). Returns ``path``."""
+    default thresholds. Both are written whole (:func:`write_atomic`; with ``outputs``, when
+    that set is committed). Returns ``path``."""
     path = Path(path)
     ok, encoded = cv2.imencode(path.suffix or ".png", np.asarray(image, dtype=np.uint8))
     if not ok:
         raise InputError(f"{path}: cannot be written as an image")
-    write_atomic(path, encoded.tobytes())
+    write_atomic(path, encoded.tobytes(), outputs)
     write_atomic(path.with_suffix(".yaml"),
                  f"image: {path.name}\nresolution: {resolution}\n"
                  f"origin: [{origin[0]}, {origin[1]}, 0.0]\n"
-                 "negate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n")
+                 "negate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n", outputs)
     return path
 
 
@@ -81,19 +133,28 @@ def _target_mode(path: Path) -> int:
         return 0o666 & ~umask
 
 
-def write_cloud(path: Path, points: np.ndarray) -> None:
-    """Write points (N, 3, metres) as .ply or .pcd (binary float32), whole or not at all."""
+def write_cloud(path: Path, points: np.ndarray, outputs: OutputSet | None = None) -> None:
+    """Write points (N, 3, metres) as .ply or .pcd (binary float32), whole or not at all (with
+    ``outputs``: when that set is committed); a symlink is written through."""
     import open3d as o3d
 
     if path.suffix.lower() not in (".ply", ".pcd"):
         raise InputError(f"{path}: a map is written as .ply or .pcd")
     cloud = o3d.t.geometry.PointCloud(o3d.core.Tensor(np.asarray(points, dtype=np.float32)))
-    tmp = path.with_name(f".{path.stem}.{os.getpid()}.tmp{path.suffix}")
+    target = Path(os.path.realpath(path))
+    tmp = target.with_name(f".{target.stem}.{os.getpid()}.tmp{target.suffix}")
+    staged = False
     try:
         if not o3d.t.io.write_point_cloud(str(tmp), cloud):
             raise InputError(f"{path}: cannot write")
-        os.replace(tmp, path)
+        os.chmod(tmp, _target_mode(target))
+        if outputs is None:
+            os.replace(tmp, target)
+        else:
+            outputs.stage(str(tmp), target)
+            staged = True
     except OSError as err:
         raise InputError(f"{path}: cannot write: {err.strerror or err}") from None
     finally:
-        tmp.unlink(missing_ok=True)
+        if not staged:
+            tmp.unlink(missing_ok=True)

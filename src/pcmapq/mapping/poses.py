@@ -29,7 +29,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from pcmapq.errors import InputError
-from pcmapq.io.writers import one_line, write_atomic
+from pcmapq.io.writers import OutputSet, one_line, write_atomic
 
 __all__ = [
     "lidar_poses_from_camera",
@@ -55,14 +55,16 @@ def read_kitti_poses(path: str | Path) -> np.ndarray:
     return _homogeneous(table.reshape(-1, 3, 4))
 
 
-def write_kitti_poses(path: str | Path, poses: np.ndarray) -> None:
-    """Write poses (K, 4, 4), sensor -> world, metres, as a KITTI pose file (atomically).
+def write_kitti_poses(path: str | Path, poses: np.ndarray,
+                      outputs: OutputSet | None = None) -> None:
+    """Write poses (K, 4, 4), sensor -> world, metres, as a KITTI pose file (atomically; with
+    ``outputs``, when that set is committed).
 
     Numbers are written with ``repr`` precision, so reading the file back gives the same floats.
     """
     poses = _check_poses(np.asarray(poses, dtype=np.float64), Path(path))
     rows = poses[:, :3, :].reshape(-1, 12)
-    write_atomic(Path(path), _format_rows(rows))
+    write_atomic(Path(path), _format_rows(rows), outputs)
 
 
 def read_tum_poses(path: str | Path) -> tuple[np.ndarray, np.ndarray]:
@@ -84,8 +86,9 @@ def read_tum_poses(path: str | Path) -> tuple[np.ndarray, np.ndarray]:
 
 
 def write_tum_poses(path: str | Path, poses: np.ndarray, timestamps: np.ndarray | None = None,
-                    ) -> None:
-    """Write poses (K, 4, 4), sensor -> world, as a TUM trajectory (atomically).
+                    outputs: OutputSet | None = None) -> None:
+    """Write poses (K, 4, 4), sensor -> world, as a TUM trajectory (atomically; with
+    ``outputs``, when that set is committed).
 
     ``timestamps`` (K,) in seconds; default 0, 1, 2, ... (the scan index). The rotation written
     is the nearest rotation to ``poses[:, :3, :3]``, as a unit quaternion with ``qw >= 0``.
@@ -100,7 +103,7 @@ def write_tum_poses(path: str | Path, poses: np.ndarray, timestamps: np.ndarray 
     quats = Rotation.from_matrix(poses[:, :3, :3]).as_quat()  # x, y, z, w
     quats *= np.where(quats[:, 3:4] < 0, -1.0, 1.0)
     rows = np.column_stack([stamps, poses[:, :3, 3], quats])
-    write_atomic(path, _format_rows(rows))
+    write_atomic(path, _format_rows(rows), outputs)
 
 
 def read_poses(path: str | Path) -> np.ndarray:

@@ -34,7 +34,7 @@ from pcmapq.grid import MetricGrid
 from pcmapq.io import OccupancyMap, PointMap, load_map
 from pcmapq.io.export import DISTANCE_FIELD, record_dtype, records, write_matrix, write_records
 from pcmapq.io.ply import CHUNK
-from pcmapq.io.writers import write_ros_map
+from pcmapq.io.writers import OutputSet, write_ros_map
 from pcmapq.pipeline import plan_points
 from pcmapq.raster.draw import warp_state
 from pcmapq.result import Result
@@ -135,16 +135,18 @@ def aligned_grid(source: MetricGrid, tf: Similarity2D, truth: MetricGrid) -> Met
     return MetricGrid(res, (float(lo[0]), float(lo[1]), 0.0), (int(rows), int(cols)))
 
 
-def write_aligned(path: Path, result: Result, source: OccupancyMap | PointMap) -> list[Path]:
+def write_aligned(path: Path, result: Result, source: OccupancyMap | PointMap,
+                  outputs: OutputSet | None = None) -> list[Path]:
     """The map moved into the truth's frame: an image map as a map_server PNG/PGM + YAML on
-    :func:`aligned_grid`, a cloud as PLY/PCD. Returns the files written."""
+    :func:`aligned_grid`, a cloud as PLY/PCD. Returns the files written (with ``outputs``:
+    staged there, written when it is committed)."""
     if isinstance(source, OccupancyMap):
         tf = result.frames.planar
         grid = aligned_grid(source.grid, tf, result.grid)
         state = warp_state(source.state, source.grid, tf, grid)
         image = np.full(state.shape, ROS_UNKNOWN, dtype=np.uint8)
         image[state == FREE], image[state == OCCUPIED] = ROS_FREE, ROS_OCCUPIED
-        write_ros_map(path, image, grid.resolution, grid.origin[:2])
+        write_ros_map(path, image, grid.resolution, grid.origin[:2], outputs)
         return [path, path.with_suffix(".yaml")]
     dtype = record_dtype()
     if source.is_3d:
@@ -152,7 +154,7 @@ def write_aligned(path: Path, result: Result, source: OccupancyMap | PointMap) -
     else:
         chunks = iter([plan_cloud(result.frames.planar.apply(source.points[:, :2]))])
     write_records(path, len(source.points), (records(c, dtype) for c in chunks), dtype,
-                  f"pcmapq: {source.path} in the frame of {result.truth_path}, metres")
+                  f"pcmapq: {source.path} in the frame of {result.truth_path}, metres", outputs)
     return [path]
 
 
@@ -196,9 +198,10 @@ def colours(distance: np.ndarray, clip: float) -> np.ndarray:
 
 
 def write_distances(path: Path, result: Result, source: OccupancyMap | PointMap,
-                    settings: Settings) -> list[Path]:
+                    settings: Settings, outputs: OutputSet | None = None) -> list[Path]:
     """The map's points in the truth's frame with their distance to the truth (float
-    ``scalar_distance_m``) and a colour (0 m to the largest ``--tau``), as a binary PLY."""
+    ``scalar_distance_m``) and a colour (0 m to the largest ``--tau``), as a binary PLY (with
+    ``outputs``: staged there, written when it is committed)."""
     truth = load_map(result.truth_path, settings.truth.resolution,
                      thresholds=settings.truth.thresholds)
     count, chunks = distance_chunks(result, source, truth, settings)
@@ -206,27 +209,29 @@ def write_distances(path: Path, result: Result, source: OccupancyMap | PointMap,
     clip = max(settings.distances.taus)
     write_records(path, count, (records(xyz, dtype, d, colours(d, clip)) for xyz, d in chunks),
                   dtype, f"pcmapq: {source.path} against {result.truth_path}: {DISTANCE_FIELD}"
-                  f" in metres, colour {COLOURS} from 0 to {clip:g} m")
+                  f" in metres, colour {COLOURS} from 0 to {clip:g} m", outputs)
     return [path]
 
 
 def write_exports(result: Result, given: Path | PointMap, settings: Settings, *,
                   aligned: Path | None = None, transform: Path | None = None,
-                  distances: Path | None = None) -> list[Path]:
+                  distances: Path | None = None, outputs: OutputSet | None = None
+                  ) -> list[Path]:
     """Write the exports asked for (``--aligned``, ``--transform``, ``--distances``); the map
     (``given``: its file, or a map built from scans) is read again only when one is asked.
-    Returns the files written."""
+    Returns the files written (with ``outputs``: staged there, written when it is
+    committed)."""
     if aligned is None and transform is None and distances is None:
         return []
     source = load_source(result, given, settings)
     written = []
     if aligned is not None:
-        written += write_aligned(aligned, result, source)
+        written += write_aligned(aligned, result, source, outputs)
     if transform is not None:
-        write_matrix(transform, map_matrix(result, source))
+        write_matrix(transform, map_matrix(result, source), outputs)
         written.append(transform)
     if distances is not None:
-        written += write_distances(distances, result, source, settings)
+        written += write_distances(distances, result, source, settings, outputs)
     return written
 
 

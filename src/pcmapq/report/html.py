@@ -100,7 +100,8 @@ def _run(result: Result) -> str:
     every setting it ran with (metres and degrees), as the JSON's ``pcmapq`` and ``settings``
     hold them."""
     command = html.escape(result.command) if result.command else "(called from Python)"
-    settings = html.escape(json.dumps(result.settings or {}, indent=1, sort_keys=True))
+    settings = html.escape(json.dumps(result.settings or {}, indent=1, sort_keys=True,
+                                           allow_nan=False))
     return (f"<p>pcmapq {__version__}; command: <code>{command}</code></p>"
             f"<details><summary>settings</summary><pre>{settings}</pre></details>")
 
