@@ -360,10 +360,10 @@ def _write_outputs(result: Result, map_path: Path | PointMap, settings: Settings
             wrote.append(vectors)
         if plot is not None or report is not None:
             from pcmapq.report.html import report_html
-            from pcmapq.report.plot import DPI, vectorial_figure
+            from pcmapq.report.plot import figure_bytes, vectorial_figure
         if plot is not None:
-            write_atomic(plot, export.figure_bytes(vectorial_figure(result, arrow_scale), plot,
-                                                   DPI), outputs)
+            write_atomic(plot, figure_bytes(vectorial_figure(result, arrow_scale),
+                                            plot.suffix.lower()[1:]), outputs)
             wrote.append(plot)
         if report is not None:
             write_atomic(report, report_html(result, arrow_scale), outputs)

@@ -19,10 +19,8 @@ occupied cells, its points or its wall band).
 
 from __future__ import annotations
 
-import io
 from collections.abc import Iterator
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 import numpy as np
 from scipy.spatial import cKDTree
@@ -40,15 +38,10 @@ from pcmapq.raster.draw import warp_state
 from pcmapq.result import Result
 from pcmapq.transform import Similarity2D
 
-if TYPE_CHECKING:  # matplotlib loads when a figure is written
-    from matplotlib.figure import Figure
-
 #: map_server grey values of an occupied, a free and an unknown cell (negate 0).
 ROS_OCCUPIED, ROS_FREE, ROS_UNKNOWN = 0, 254, 205
 #: Colour map of the distance cloud, from 0 m to the largest F-score threshold.
 COLOURS = "viridis"
-#: Figure formats of ``--plot``, by extension.
-FIGURE_FORMATS = {".png": "png", ".svg": "svg", ".pdf": "pdf"}
 
 
 def lift(tf: Similarity2D) -> np.ndarray:
@@ -233,25 +226,3 @@ def write_exports(result: Result, given: Path | PointMap, settings: Settings, *,
     if distances is not None:
         written += write_distances(distances, result, source, settings, outputs)
     return written
-
-
-def figure_bytes(fig: Figure, path: Path, dpi: int) -> bytes:
-    """The figure in the format of ``path``'s extension (PNG, SVG or PDF), then closed."""
-    import matplotlib.pyplot as plt
-
-    buf = io.BytesIO()
-    with plt.rc_context({"svg.hashsalt": "pcmapq"}):  # SVG ids the same on every run
-        fig.savefig(buf, format=FIGURE_FORMATS[path.suffix.lower()], dpi=dpi,
-                    metadata=_fixed_metadata(path))
-    plt.close(fig)
-    return buf.getvalue()
-
-
-def _fixed_metadata(path: Path) -> dict:
-    """Figure metadata that makes the file the same on every run (no date, no random id)."""
-    suffix = path.suffix.lower()
-    if suffix == ".svg":
-        return {"Date": None}
-    if suffix == ".pdf":
-        return {"CreationDate": None, "ModDate": None}
-    return {}

@@ -344,9 +344,21 @@ def distance_heatmap(result: Result, clip: float = 0.5) -> Figure:
     return fig
 
 
-def png_bytes(fig: Figure, dpi: int = DPI) -> bytes:
-    """The figure as PNG bytes (then closed)."""
+#: Metadata that makes a figure file the same on every run (no date), by format.
+_FIXED_METADATA = {"png": {}, "svg": {"Date": None}, "pdf": {"CreationDate": None,
+                                                             "ModDate": None}}
+
+
+def figure_bytes(fig: Figure, fmt: str, dpi: int = DPI) -> bytes:
+    """The figure as a ``fmt`` file ("png", "svg" or "pdf"), the same bytes on every run
+    (then closed)."""
     buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=dpi)
+    with plt.rc_context({"svg.hashsalt": "pcmapq"}):  # SVG ids the same on every run
+        fig.savefig(buf, format=fmt, dpi=dpi, metadata=_FIXED_METADATA[fmt])
     plt.close(fig)
     return buf.getvalue()
+
+
+def png_bytes(fig: Figure, dpi: int = DPI) -> bytes:
+    """The figure as PNG bytes (then closed)."""
+    return figure_bytes(fig, "png", dpi)
