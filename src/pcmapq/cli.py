@@ -223,6 +223,12 @@ def eval_command(
     truth_negate: Annotated[bool | None, typer.Option(
         "--truth-negate/--truth-no-negate", help="Truth image: as --map-negate.",
         show_default=False)] = None,
+    map_crop: Annotated[str | None, typer.Option(
+        metavar="<x0,y0,x1,y1>", help="Keep only the map's part inside this box, metres, in "
+        "its own frame (outlier points far away).")] = None,
+    truth_crop: Annotated[str | None, typer.Option(
+        metavar="<x0,y0,x1,y1>", help="Keep only the truth's part inside this box, metres, in "
+        "its own frame.")] = None,
     init: Annotated[str | None, typer.Option(
         help="Initial guess x,y,yaw (m, m, deg), map -> truth; skips the global search.")] = None,
     no_align: Annotated[bool, typer.Option(
@@ -302,9 +308,11 @@ def eval_command(
     resolution, auto = options.parse_resolution(map_resolution, scale)
     settings = Settings(
         map=SourceConfig(resolution, options.thresholds(map_occupied_thresh, map_free_thresh,
-                                                        map_negate)),
+                                                        map_negate),
+                         options.parse_box(map_crop, "--map-crop")),
         truth=SourceConfig(truth_resolution, options.thresholds(
-            truth_occupied_thresh, truth_free_thresh, truth_negate)),
+            truth_occupied_thresh, truth_free_thresh, truth_negate),
+            options.parse_box(truth_crop, "--truth-crop")),
         raster=replace(DEFAULTS.raster, band_low=band_low, band_high=band_high,
                        min_hits=min_hits),
         alignment=replace(DEFAULTS.alignment, enabled=not no_align,

@@ -8,6 +8,7 @@ from typing import Any
 
 from pcmapq.align.params import AlignParams
 from pcmapq.features import DETECTORS, default_params
+from pcmapq.io.extent import Box
 from pcmapq.io.occupancy import Thresholds
 from pcmapq.metrics.distances import DEFAULT_TAUS
 from pcmapq.transform import Similarity2D
@@ -24,10 +25,13 @@ class SourceConfig:
         cloud truth, the cell size of its grid (default ``RasterConfig.cloud_resolution``).
     thresholds: map_server's occupied_thresh, free_thresh and negate for an image, overriding
         its YAML (``--map-occupied-thresh`` ...).
+    crop: keep only the part inside this box ``(x0, y0, x1, y1)``, metres, in the input's own
+        frame (``--map-crop``, ``--truth-crop``; see :mod:`pcmapq.io.extent`).
     """
 
     resolution: float | None = None
     thresholds: Thresholds | None = None
+    crop: Box | None = None
 
 
 @dataclass(frozen=True)
@@ -139,7 +143,9 @@ class Settings:
         """The inverse of :meth:`to_dict` (e.g. the ``settings`` of a saved result)."""
         def source(d: dict) -> SourceConfig:
             t = d["thresholds"]
-            return SourceConfig(d["resolution"], None if t is None else Thresholds(**t))
+            crop = d.get("crop")
+            return SourceConfig(d["resolution"], None if t is None else Thresholds(**t),
+                                None if crop is None else tuple(crop))
 
         a, m = doc["alignment"], doc["matching"]
         init = a["init"]

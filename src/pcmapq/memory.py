@@ -11,6 +11,7 @@ clouds. Each byte count below is the largest per-unit cost measured, so the esti
 from __future__ import annotations
 
 import os
+from collections.abc import Callable
 
 from pcmapq.errors import InputError
 
@@ -43,16 +44,18 @@ def needed_bytes(image_cells: int, grid_cells: int, extent_m2: float, points: in
                + PER_WORKING_CELL * working + PER_POINT * points)
 
 
-def guard(need: int, limit: int | None, what: str) -> None:
+def guard(need: int, limit: int | None, what: str,
+          advice: Callable[[], str] = lambda: "") -> None:
     """Raise InputError (exit 2, one line) when ``need`` bytes exceed ``limit`` (None: the
-    default limit); ``what`` names the inputs."""
+    default limit); ``what`` names the inputs, ``advice()`` says what looks wrong with them and
+    how to fix it (empty: the general advice)."""
     default = ""
     if limit is None:
         limit = default_limit()
         default = f", {DEFAULT_SHARE:.0%} of this machine's {machine_bytes() / 1e9:.1f} GB"
     if need <= limit:
         return
-    raise InputError(
-        f"{what}: needs about {need / 1e9:.1f} GB of memory, more than the limit of "
-        f"{limit / 1e9:.1f} GB (--max-memory{default}); a coarser --truth-resolution, a larger "
-        "--voxel-3d or inputs cropped to the region of interest need less")
+    fix = advice() or ("a coarser --truth-resolution, a larger --voxel-3d or inputs cropped to "
+                       "the region of interest (--map-crop, --truth-crop) need less")
+    raise InputError(f"{what}: needs about {need / 1e9:,.1f} GB of memory, more than the limit "
+                     f"of {limit / 1e9:.1f} GB (--max-memory{default}); {fix}")

@@ -63,6 +63,20 @@ def parse_init(text: str | None) -> Similarity2D | None:
     return Similarity2D(x, y, float(np.radians(yaw)))
 
 
+def parse_box(text: str | None, option: str) -> tuple[float, float, float, float] | None:
+    """--map-crop / --truth-crop ``x0,y0,x1,y1`` (metres, finite, x0 < x1, y0 < y1)."""
+    if text is None:
+        return None
+    try:
+        x0, y0, x1, y1 = (float(v) for v in text.split(","))
+        if not (all(math.isfinite(v) for v in (x0, y0, x1, y1)) and x0 < x1 and y0 < y1):
+            raise ValueError(text)
+    except ValueError:
+        raise typer.BadParameter(f"expected a box x0,y0,x1,y1 in metres with x0 < x1 and "
+                                 f"y0 < y1, got {text!r}", param_hint=option) from None
+    return x0, y0, x1, y1
+
+
 def parse_resolution(text: str | None, scale: str) -> tuple[float | None, bool]:
     """(--map-resolution as metres or None, whether to estimate the scale)."""
     if scale not in ("fixed", "auto"):

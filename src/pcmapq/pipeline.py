@@ -15,56 +15,19 @@ from pcmapq.align.rigid3d import Registration3D, align_3d, apply
 from pcmapq.config import Settings
 from pcmapq.errors import EvaluationError, InputError
 from pcmapq.features import Features, SideBySide
-from pcmapq.frames import Frames, Levelling
+from pcmapq.frames import Frames
 from pcmapq.grid import MetricGrid
-from pcmapq.io import OccupancyMap, PointMap, load_map
+from pcmapq.io import OccupancyMap, PointMap
+from pcmapq.io.extent import check_span, far_points, hint
 from pcmapq.match import match
 from pcmapq.metrics.distances import distances, distances_3d, nearest_distance
+from pcmapq.plan import MAP_CROP, TRUTH_CROP, cropped, load_input, plan_points
 from pcmapq.raster.draw import OCCUPIED, UNKNOWN, points_to_grid, warp_state
 from pcmapq.raster.footprint import footprint_rule, map_footprint
-from pcmapq.raster.slice import wall_band
 from pcmapq.result import DetectorResult, Overlap, Result
 from pcmapq.transform import Similarity2D
 
 Progress = Callable[[str], None]
-
-#: The fewest distinct occupied cells (of memory.WORKING_CELL, 0.05 m) a map or truth needs to
-#: be scored: fewer (one point, a few identical points, a 1x1 image) is refused, exit 1.
-MIN_CELLS = 10
-
-
-def plan_points(source: OccupancyMap | PointMap,
-                settings: Settings) -> tuple[np.ndarray, Levelling | None]:
-    """The 2D structure of an input, (N, 2) metres in its own plan frame: occupied cell centres
-    of an image, the wall band of a 3D cloud (with the levelling that made its plan), or a 2D
-    cloud as it is."""
-    levelling = None
-    if isinstance(source, OccupancyMap):
-        xy = source.grid.cell_centres(source.state == OCCUPIED)
-    elif source.is_3d:
-        try:
-            xy, levelling = wall_band(source.points, settings.raster.band_low,
-                                       settings.raster.band_high)
-        except ValueError as err:
-            raise InputError(f"{source.path}: {err}") from None
-    else:
-        xy = source.points[:, :2]
-    if len(xy) == 0:
-        raise InputError(f"{source.path}: no occupied cells or wall points")
-    cells = distinct_cells(xy[:100_000])  # a large map shows its structure in its first rows
-    if cells < MIN_CELLS and len(xy) > 100_000:
-        cells = distinct_cells(xy)
-    if cells < MIN_CELLS:
-        raise EvaluationError(f"{source.path}: degenerate map: its walls fill {cells} distinct "
-                              f"{memory.WORKING_CELL:g} m cells, fewer than {MIN_CELLS}: "
-                              "nothing to align or score")
-    return xy, levelling
-
-
-def distinct_cells(xy: np.ndarray) -> int:
-    """How many distinct cells of memory.WORKING_CELL (metres) the points ``xy`` (metres) fill."""
-    return len(np.unique(np.floor(np.asarray(xy[:, :2]) / memory.WORKING_CELL), axis=0))
-
 
 def min_hits(cloud: PointMap, settings: Settings) -> int:
     """Points needed to mark a cell of this cloud occupied (see RasterConfig.min_hits)."""
@@ -175,17 +138,21 @@ def _radius(xy: np.ndarray) -> float:
     return float(np.sqrt(((xy - xy.mean(axis=0)) ** 2).sum(axis=1).max()))
 
 
-def refusal(map_path: Path, truth_path: Path, alignment: Alignment, cover: Overlap,
-            settings: Settings, map_xy: np.ndarray, truth_xy: np.ndarray) -> str:
+def refusal(source: OccupancyMap | PointMap, truth_path: Path, alignment: Alignment,
+            cover: Overlap, settings: Settings, map_xy: np.ndarray, truth_xy: np.ndarray) -> str:
     """One line: why the map seems not to show the truth's place, and the likely cause with the
     option that addresses it."""
+    map_path = source.path
     distinct = alignment.distinctiveness
     why = (f"{cover.truth_recall:.0%} of the truth it covers lies near the map" +
            ("" if distinct is None else
             f", the best pose scores {distinct:.0%} above the best one elsewhere"))
     size = _radius(map_xy) / max(_radius(truth_xy), 1e-12)
     option = settings.alignment
-    if option.init is not None or not option.enabled:
+    far = far_points(source, MAP_CROP)
+    if far:
+        cause = far
+    elif option.init is not None or not option.enabled:
         cause = ("the given frame: a wrong --init guess or --no-align; drop them for a "
                  "global search")
     elif not option.scale and size > OVERSIZE:
@@ -220,13 +187,31 @@ def align_clouds_3d(source: OccupancyMap | PointMap, truth: OccupancyMap | Point
     return replace(source, points=apply(reg.transform, source.points)), reg
 
 
-def align_plan(map_xy: np.ndarray, truth_xy: np.ndarray, registration: Registration3D | None,
-               settings: Settings) -> Alignment:
+def check_scale_range(source: OccupancyMap | PointMap, map_xy: np.ndarray,
+                      truth_xy: np.ndarray, settings: Settings) -> None:
+    """EvaluationError (one line) when ``--scale auto`` searches for a map's scale that even its
+    lowest scale leaves :data:`OVERSIZE` times larger than the truth: another unit, or a much
+    larger place."""
+    option = settings.alignment
+    if not option.scale or option.init is not None or not option.enabled:
+        return
+    lowest = option.params.scale_range[0]
+    size = lowest * _radius(map_xy) / max(_radius(truth_xy), 1e-12)
+    if size > OVERSIZE:
+        why = hint(source, MAP_CROP) or "a map of a larger place, or in another unit"
+        raise EvaluationError(f"{source.path}: at the lowest scale --scale auto tries "
+                              f"({lowest:g}), the map is still {size:.0f} times the size of "
+                              f"the truth; {why}")
+
+
+def align_plan(source: OccupancyMap | PointMap, map_xy: np.ndarray, truth_xy: np.ndarray,
+               registration: Registration3D | None, settings: Settings) -> Alignment:
     """The 2D alignment of the map's plan points to the truth's (both (N, 2) metres, in their
     own frames): the search and ICP of :func:`pcmapq.align.align`, or, after a 3D registration,
     the plan scored as it is."""
     option = settings.alignment
     if registration is None:
+        check_scale_range(source, map_xy, truth_xy, settings)
         return align(map_xy, truth_xy, option.params, init=option.init, refine=option.enabled,
                      scale=option.scale)
     return replace(align(map_xy, truth_xy, option.params, init=Similarity2D(), refine=False),
@@ -243,18 +228,19 @@ def evaluate(map_path: str | Path | PointMap, truth_path: str | Path,
     progress("loading")
     scaled = settings.alignment.scale
     with ThreadPoolExecutor(1) as background:  # the two files at once
-        truth_job = background.submit(load_map, truth_path, settings.truth.resolution,
-                                      thresholds=settings.truth.thresholds)
+        truth_job = background.submit(load_input, truth_path, settings.truth, TRUTH_CROP,
+                                      memory_limit=memory_limit)
         try:
-            source = map_path if isinstance(map_path, PointMap) or scaled else load_map(
-                map_path, settings.map.resolution, None, settings.map.thresholds)
+            source = (cropped(map_path, settings.map, MAP_CROP)
+                      if isinstance(map_path, PointMap) else None if scaled else
+                      load_input(map_path, settings.map, MAP_CROP, memory_limit=memory_limit))
         finally:
             truth = truth_job.result()  # the truth's error first, as one after the other
     if scaled and not isinstance(map_path, PointMap):
         # a map of unknown unit starts from the truth's resolution
         guess = truth.grid.resolution if isinstance(truth, OccupancyMap) else (
             settings.truth.resolution or settings.raster.cloud_resolution)
-        source = load_map(map_path, settings.map.resolution, guess, settings.map.thresholds)
+        source = load_input(map_path, settings.map, MAP_CROP, guess, memory_limit)
     return score(source, truth, settings, progress, memory_limit)
 
 
@@ -277,10 +263,14 @@ def score(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap, setti
     The truth's features do not depend on the map: they are found on a second thread while
     the map is aligned and drawn (see :class:`~pcmapq.features.SideBySide`)."""
     map_path, truth_path = source.path, truth.path
+    check_span(truth, TRUTH_CROP)
+    check_span(source, MAP_CROP)
     rule = map_footprint_rule(source, settings)
     truth_xy, truth_level = plan_points(truth, settings)
+    cell = truth_grid(truth, truth_xy, settings).resolution
     memory.guard(needed_memory(source, truth, truth_xy, settings), memory_limit,
-                 f"{map_path} against {truth_path}")
+                 f"{map_path} against {truth_path}",
+                 lambda: hint(truth, TRUTH_CROP, cell) or hint(source, MAP_CROP))
     grid, truth_occ = truth_raster(truth, truth_xy, settings)
     sides = SideBySide(settings.matching.detectors, settings.matching.params)
     with ThreadPoolExecutor(1) as background:
@@ -289,7 +279,7 @@ def score(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap, setti
             progress("aligning")
             source, registration = align_clouds_3d(source, truth, settings)
             map_xy, map_level = plan_points(source, settings)
-            alignment = align_plan(map_xy, truth_xy, registration, settings)
+            alignment = align_plan(source, map_xy, truth_xy, registration, settings)
 
             progress("rasterising")
             map_occ, footprint = map_raster(source, map_xy, alignment.transform, grid, settings,
@@ -298,7 +288,7 @@ def score(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap, setti
             cover = overlap(truth_occ, to_map, footprint, alignment)
             option = settings.alignment
             if cover.confidence < option.min_confidence and not option.force:
-                raise EvaluationError(refusal(map_path, truth_path, alignment, cover, settings,
+                raise EvaluationError(refusal(source, truth_path, alignment, cover, settings,
                                               map_xy, truth_xy))
             progress("drawing the walls' centre lines and detecting features")
             map_found = sides.features(map_occ, grid, threads=2)

@@ -27,7 +27,8 @@ _ADVERTISED = (".png", ".pgm", ".yaml", ".ply", ".pcd", ".xyz", ".txt", ".npy", 
 
 def load_map(path: str | Path, resolution: float | None = None,
              fallback_resolution: float | None = None,
-             thresholds: Thresholds | None = None) -> OccupancyMap | PointMap:
+             thresholds: Thresholds | None = None,
+             memory_limit: int | None = None) -> OccupancyMap | PointMap:
     """Load a map file by its extension.
 
     Occupancy images (.png, .pgm, .jpg, .bmp) and ROS map_server YAML (.yaml, .yml) give an
@@ -36,7 +37,9 @@ def load_map(path: str | Path, resolution: float | None = None,
     (.ply, .pcd, .xyz, .txt, .npy, KITTI .bin) and CARMEN laser logs (.log, .log.gz: the beam
     endpoints at the logged poses) give a :class:`PointMap`; ``resolution`` is ignored for them.
     ``thresholds`` (map_server's occupied_thresh, free_thresh, negate) override an image's YAML;
-    clouds ignore them.
+    clouds ignore them. Sizes declared in headers (an image's pixels, a .npy's rows) are checked
+    against ``memory_limit`` bytes (None: :func:`pcmapq.memory.default_limit`) before anything
+    is allocated.
     """
     path = Path(path)
     if not path.exists():
@@ -47,7 +50,7 @@ def load_map(path: str | Path, resolution: float | None = None,
         return load_carmen(path)
     suffix = path.suffix.lower()
     if suffix in IMAGE_SUFFIXES or suffix in YAML_SUFFIXES:
-        return load_occupancy(path, resolution, fallback_resolution, thresholds)
+        return load_occupancy(path, resolution, fallback_resolution, thresholds, memory_limit)
     if suffix in CLOUD_SUFFIXES:
-        return load_cloud(path)
+        return load_cloud(path, memory_limit)
     raise InputError(f"{path}: unsupported format '{suffix}' (expected {', '.join(_ADVERTISED)})")

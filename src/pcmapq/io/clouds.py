@@ -51,11 +51,12 @@ class PointMap:
     kind: str = "cloud"
 
 
-def load_cloud(path: Path) -> PointMap:
-    """Load a point cloud, choosing the reader by extension."""
+def load_cloud(path: Path, memory_limit: int | None = None) -> PointMap:
+    """Load a point cloud, choosing the reader by extension; a .npy whose header declares more
+    rows than ``memory_limit`` bytes hold (None: the default limit) is refused unread."""
     readers: dict[str, Callable[[Path], np.ndarray]] = {
         ".ply": read_open3d, ".pcd": read_open3d, ".xyz": read_text, ".txt": read_text,
-        ".npy": read_npy, ".bin": read_kitti_bin,
+        ".npy": lambda p: read_npy(p, memory_limit), ".bin": read_kitti_bin,
     }
     try:
         block = vertex_block(path) if path.suffix.lower() == ".ply" else None
@@ -136,19 +137,19 @@ def read_text(path: Path) -> np.ndarray:
         raise InputError(f"{path}: not a table of numbers: {one_line(exc)}") from None
 
 
-def read_npy(path: Path) -> np.ndarray:
+def read_npy(path: Path, memory_limit: int | None = None) -> np.ndarray:
     """A NumPy array N x 2 or N x 3+ of numbers (no pickles)."""
-    check_npy(path)
+    check_npy(path, memory_limit)
     try:
         return np.load(path, allow_pickle=False)
     except (ValueError, EOFError) as exc:
         raise InputError(f"{path}: cannot be read as .npy: {one_line(exc)}") from None
 
 
-def check_npy(path: Path) -> None:
+def check_npy(path: Path, memory_limit: int | None = None) -> None:
     """InputError, before anything is allocated, when the header of the .npy ``path`` declares
     more bytes than the file holds (truncated, or an absurd shape) or an array the memory guard
-    (:mod:`pcmapq.memory`, the default limit) refuses as a cloud."""
+    (:mod:`pcmapq.memory`; ``memory_limit`` bytes, None: the default) refuses as a cloud."""
     with path.open("rb") as f:
         try:
             version = npy.read_magic(f)
@@ -163,7 +164,7 @@ def check_npy(path: Path) -> None:
     if declared > held:
         raise InputError(f"{path}: truncated or corrupt: header declares shape "
                          f"{tuple(shape)} ({declared} bytes), the file holds {held} bytes")
-    memory.guard(memory.needed_bytes(0, 0, 0.0, int(rows)), None, str(path))
+    memory.guard(memory.needed_bytes(0, 0, 0.0, int(rows)), memory_limit, str(path))
 
 
 def read_kitti_bin(path: Path) -> np.ndarray:

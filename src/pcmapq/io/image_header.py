@@ -33,15 +33,16 @@ def declared_size(path: Path) -> tuple[int, int, int] | None:
     return None
 
 
-def check_image_size(path: Path) -> None:
+def check_image_size(path: Path, memory_limit: int | None = None) -> None:
     """InputError (one line) when the image's declared pixels would need more memory to read
-    and classify than the memory guard allows (:mod:`pcmapq.memory`, the default limit)."""
+    and classify than the memory guard allows (:mod:`pcmapq.memory`; ``memory_limit`` bytes,
+    None: the default limit)."""
     size = declared_size(path)
     if size is None:
         return
     rows, cols, per_pixel = size
     need = int(memory.BASE + rows * cols * (per_pixel + _CLASSIFY_BYTES))
-    memory.guard(need, None, f"{path} ({cols} x {rows} pixels declared in its header)")
+    memory.guard(need, memory_limit, f"{path} ({cols} x {rows} pixels declared in its header)")
 
 
 #: Bytes per pixel, beyond the decoded image, of turning it into cell states (the int32 sum of

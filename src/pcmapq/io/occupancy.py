@@ -87,11 +87,14 @@ def _pick(value: _T | None, default: _T) -> _T:
 
 def load_occupancy(path: Path, resolution: float | None = None,
                    fallback: float | None = None,
-                   thresholds: Thresholds | None = None) -> OccupancyMap:
+                   thresholds: Thresholds | None = None,
+                   memory_limit: int | None = None) -> OccupancyMap:
     """Load an occupancy image or a map_server YAML. ``resolution`` (metres per cell), if given,
     overrides the YAML's; an image without a YAML beside it (same stem) needs it, or a
     ``fallback`` resolution (a starting guess for a map whose scale will be estimated).
-    ``thresholds`` override the YAML's occupied_thresh, free_thresh and negate."""
+    ``thresholds`` override the YAML's occupied_thresh, free_thresh and negate; an image whose
+    header declares more pixels than ``memory_limit`` bytes hold (None: the default) is refused
+    unread."""
     if path.suffix.lower() in YAML_SUFFIXES:
         meta, image = read_yaml(path)
         if not image.is_file():
@@ -103,7 +106,7 @@ def load_occupancy(path: Path, resolution: float | None = None,
         meta = replace(meta, resolution=_resolution(path, resolution))
     if thresholds is not None:
         meta = thresholds.apply(meta)
-    levels, channels, scale, transparent = read_levels(image)
+    levels, channels, scale, transparent = read_levels(image, memory_limit)
     if meta.resolution is None and fallback is not None:
         meta = replace(meta, resolution=_resolution(path, fallback))
     if meta.resolution is None:
@@ -173,12 +176,14 @@ def read_yaml(path: Path) -> tuple[MapMeta, Path]:
     return meta, path.parent / doc["image"]
 
 
-def read_levels(path: Path) -> tuple[np.ndarray, int, float, np.ndarray]:
+def read_levels(path: Path,
+                memory_limit: int | None = None) -> tuple[np.ndarray, int, float, np.ndarray]:
     """An image's pixels as integer levels (rows, cols): the sum of its colour channels; the
     number of those channels, the grey value (0..255 scale) of one level of one channel, and
     a bool mask of transparent (alpha 0) pixels. A pixel's grey value is
-    ``level / channels * scale``. The size its header declares is checked first."""
-    check_image_size(path)
+    ``level / channels * scale``. The size its header declares is checked first, against
+    ``memory_limit`` bytes (None: the default limit)."""
+    check_image_size(path, memory_limit)
     try:
         img = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
     except cv2.error:

@@ -29,11 +29,11 @@ from pcmapq.cells import FREE, OCCUPIED
 from pcmapq.config import Settings
 from pcmapq.frames import Frames, Levelling
 from pcmapq.grid import MetricGrid
-from pcmapq.io import OccupancyMap, PointMap, load_map
+from pcmapq.io import OccupancyMap, PointMap
 from pcmapq.io.export import DISTANCE_FIELD, record_dtype, records, write_matrix, write_records
 from pcmapq.io.ply import CHUNK
 from pcmapq.io.writers import OutputSet, write_ros_map
-from pcmapq.pipeline import plan_points
+from pcmapq.plan import MAP_CROP, TRUTH_CROP, cropped, load_input, plan_points
 from pcmapq.raster.draw import warp_state
 from pcmapq.result import Result
 from pcmapq.transform import Similarity2D
@@ -81,11 +81,12 @@ def map_matrix(result: Result, source: OccupancyMap | PointMap) -> np.ndarray:
 
 def load_source(result: Result, given: Path | PointMap, settings: Settings
                 ) -> OccupancyMap | PointMap:
-    """The map as the run read it (a map built from scans is passed as it is)."""
+    """The map as the run read it, cropped as it was (a map built from scans is passed as it
+    is)."""
     if isinstance(given, PointMap):
-        return given
+        return cropped(given, settings.map, MAP_CROP)
     fallback = result.grid.resolution if settings.alignment.scale else None
-    return load_map(given, settings.map.resolution, fallback, settings.map.thresholds)
+    return load_input(given, settings.map, MAP_CROP, fallback)
 
 
 def moved(points: np.ndarray, matrix: np.ndarray) -> Iterator[np.ndarray]:
@@ -195,8 +196,7 @@ def write_distances(path: Path, result: Result, source: OccupancyMap | PointMap,
     """The map's points in the truth's frame with their distance to the truth (float
     ``scalar_distance_m``) and a colour (0 m to the largest ``--tau``), as a binary PLY (with
     ``outputs``: staged there, written when it is committed)."""
-    truth = load_map(result.truth_path, settings.truth.resolution,
-                     thresholds=settings.truth.thresholds)
+    truth = load_input(result.truth_path, settings.truth, TRUTH_CROP)
     count, chunks = distance_chunks(result, source, truth, settings)
     dtype = record_dtype(DISTANCE_FIELD, colour=True)
     clip = max(settings.distances.taus)

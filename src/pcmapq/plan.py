@@ -1,0 +1,97 @@
+"""Each input made ready to score: read and cropped as its options say, checked for an absurd
+extent, and its 2D structure (plan points) taken out and checked for something to align.
+
+An input is refused with exit 2 when it is wider than :data:`pcmapq.io.extent.MAX_SPAN`, and
+with exit 1 when its walls fill fewer than :data:`MIN_CELLS` cells or form one straight line
+(nothing fixes a pose along it).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from pcmapq import memory
+from pcmapq.config import Settings, SourceConfig
+from pcmapq.errors import EvaluationError, InputError
+from pcmapq.frames import Levelling
+from pcmapq.io import OccupancyMap, PointMap, load_map
+from pcmapq.io.extent import crop
+from pcmapq.raster.draw import OCCUPIED
+from pcmapq.raster.slice import wall_band
+
+#: The crop option of each side, named in messages.
+MAP_CROP, TRUTH_CROP = "--map-crop", "--truth-crop"
+#: The fewest distinct occupied cells (of memory.WORKING_CELL, 0.05 m) a map or truth needs to
+#: be scored: fewer (one point, a few identical points, a 1x1 image) is refused, exit 1.
+MIN_CELLS = 10
+#: Walls narrower than this across their main direction, metres, are one straight line.
+LINE_WIDTH = 0.5
+#: Plan points looked at by the structure checks (a stride through larger plans).
+SAMPLE = 100_000
+
+
+def load_input(path: str | Path, config: SourceConfig, option: str,
+               fallback: float | None = None,
+               memory_limit: int | None = None) -> OccupancyMap | PointMap:
+    """An input read as ``config`` says (resolution, thresholds; ``fallback``: the resolution of
+    an image that has none) and cut to its crop box; see :func:`pcmapq.io.load_map`."""
+    return cropped(load_map(path, config.resolution, fallback, config.thresholds, memory_limit),
+                   config, option)
+
+
+def cropped(source: OccupancyMap | PointMap, config: SourceConfig,
+            option: str) -> OccupancyMap | PointMap:
+    """The input cut to ``config.crop`` (``option`` names the crop in messages), or as it is."""
+    return source if config.crop is None else crop(source, config.crop, option)
+
+
+def plan_points(source: OccupancyMap | PointMap,
+                settings: Settings) -> tuple[np.ndarray, Levelling | None]:
+    """The 2D structure of an input, (N, 2) metres in its own plan frame: occupied cell centres
+    of an image, the wall band of a 3D cloud (with the levelling that made its plan), or a 2D
+    cloud as it is. Refused (EvaluationError) when it has nothing to align: see the module
+    docstring."""
+    levelling = None
+    if isinstance(source, OccupancyMap):
+        xy = source.grid.cell_centres(source.state == OCCUPIED)
+    elif source.is_3d:
+        try:
+            xy, levelling = wall_band(source.points, settings.raster.band_low,
+                                       settings.raster.band_high)
+        except ValueError as err:
+            raise InputError(f"{source.path}: {err}") from None
+    else:
+        xy = source.points[:, :2]
+    if len(xy) == 0:
+        raise InputError(f"{source.path}: no occupied cells or wall points")
+    check_structure(source.path, xy)
+    return xy, levelling
+
+
+def check_structure(path: Path, xy: np.ndarray) -> None:
+    """EvaluationError (exit 1, one line) when the plan points ``xy`` (N, 2, metres) fill fewer
+    than :data:`MIN_CELLS` cells or lie along one straight line narrower than
+    :data:`LINE_WIDTH`: nothing to align or score."""
+    sample = np.asarray(xy[::max(1, len(xy) // SAMPLE)], dtype=np.float64)
+    cells = distinct_cells(sample)
+    if cells < MIN_CELLS and len(sample) < len(xy):
+        cells = distinct_cells(xy)
+    if cells < MIN_CELLS:
+        raise EvaluationError(f"{path}: degenerate map: its walls fill {cells} distinct "
+                              f"{memory.WORKING_CELL:g} m cells, fewer than {MIN_CELLS}: "
+                              "nothing to align or score")
+    centred = sample - sample.mean(axis=0)
+    _, axes = np.linalg.eigh(centred.T @ centred)
+    along, across = centred @ axes[:, 1], centred @ axes[:, 0]
+    width = float(np.ptp(np.percentile(across, [1, 99])))
+    if width < LINE_WIDTH:
+        raise EvaluationError(f"{path}: its walls form one straight line "
+                              f"({np.ptp(along):.1f} m long, {width:.2f} m wide): nothing fixes "
+                              "a pose along it; a map needs walls in two directions")
+
+
+def distinct_cells(xy: np.ndarray) -> int:
+    """How many distinct cells of memory.WORKING_CELL (metres) the points ``xy`` (metres) fill."""
+    return len(np.unique(np.floor(np.asarray(xy[:, :2]) / memory.WORKING_CELL), axis=0))
