@@ -52,7 +52,7 @@ def measure(folder: Path, scans: int = SCANS) -> Maps:
     middle = time.perf_counter()
     poses = lidar_poses_from_camera(read_kitti_poses(folder / "poses.txt"),
                                     np.vstack([TR, [0, 0, 0, 1]]))[:scans]
-    reference = build_map_from_poses(folder / "velodyne", poses)
+    reference = build_map_from_poses(folder / "velodyne", poses, max_scans=scans)
     built = (middle - start, time.perf_counter() - middle)
     with tempfile.TemporaryDirectory(prefix="pcmapq_kitti_") as tmp:
         write_cloud(Path(tmp) / "kiss.ply", kiss)
