@@ -16,6 +16,7 @@ import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
+from tokenize import TokenError
 
 import numpy as np
 from numpy.lib import format as npy
@@ -154,7 +155,7 @@ def check_npy(path: Path) -> None:
             version = npy.read_magic(f)
             read = npy.read_array_header_1_0 if version == (1, 0) else npy.read_array_header_2_0
             shape, _, dtype = read(f, max_header_size=10_000)
-        except ValueError as exc:
+        except (ValueError, TypeError, SyntaxError, TokenError) as exc:  # a garbled header
             raise InputError(f"{path}: not a .npy file: {one_line(exc)}") from None
         offset = f.tell()
     rows = shape[0] if shape else 1
