@@ -49,3 +49,20 @@ def _npy_with_header(path: Path, header: bytes) -> Path:
 def test_npy_with_a_garbled_header_is_refused(tmp_path: Path, header: bytes,
                                               capfd: pytest.CaptureFixture[str]) -> None:
     _refused(_npy_with_header(tmp_path / "m.npy", header), "not a .npy file", capfd)
+
+
+@pytest.mark.unit
+def test_a_signalling_nan_in_a_kitti_scan_drops_its_point_without_a_warning(
+        tmp_path: Path, capfd: pytest.CaptureFixture[str]) -> None:
+    records = np.tile(np.array([1.0, 2.0, 3.0, 0.5], dtype="<f4"), (5, 1))
+    records[:, 0] = np.arange(5)
+    raw = bytearray(records.tobytes())
+    raw[16:20] = struct.pack("<I", 0x7F800001)  # x of the second point: a signalling NaN
+    path = tmp_path / "scan.bin"
+    path.write_bytes(bytes(raw))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        cloud = load_map(path)
+    assert isinstance(cloud, PointMap)
+    np.testing.assert_array_equal(cloud.points[:, 0], [0.0, 2.0, 3.0, 4.0])
+    assert capfd.readouterr() == ("", "")

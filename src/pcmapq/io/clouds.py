@@ -105,7 +105,8 @@ def with_z(path: Path, table: np.ndarray) -> np.ndarray:
         raise InputError(f"{path}: expected numbers, got {table.dtype} values")
     out = np.zeros((len(table), 3), dtype=np.float64)
     cols = min(table.shape[1], 3)
-    out[:, :cols] = table[:, :cols]
+    with np.errstate(invalid="ignore"):  # a float32 signalling NaN (the row is dropped later)
+        out[:, :cols] = table[:, :cols]
     return out
 
 
