@@ -66,3 +66,42 @@ def test_a_signalling_nan_in_a_kitti_scan_drops_its_point_without_a_warning(
     assert isinstance(cloud, PointMap)
     np.testing.assert_array_equal(cloud.points[:, 0], [0.0, 2.0, 3.0, 4.0])
     assert capfd.readouterr() == ("", "")
+
+
+def _ascii_ply(path: Path, rows: list[str]) -> Path:
+    path.write_text(f"ply\nformat ascii 1.0\nelement vertex {len(rows)}\nproperty float x\n"
+                    "property float y\nproperty float z\nend_header\n" + "\n".join(rows) + "\n")
+    return path
+
+
+def _ply_with_faces(path: Path, first_count: int) -> Path:
+    """A binary PLY of 4 triangles, then 30 vertices; the first face's list count is
+    ``first_count``."""
+    faces = b"".join(struct.pack("<Biii", first_count if i == 0 else 3, i, i + 1, i + 2)
+                     for i in range(4))
+    head = (b"ply\nformat binary_little_endian 1.0\nelement face 4\n"
+            b"property list uchar int vertex_indices\nelement vertex 30\nproperty float x\n"
+            b"property float y\nproperty float z\nend_header\n")
+    path.write_bytes(head + faces + np.arange(90, dtype="<f4").tobytes())
+    return path
+
+
+@pytest.mark.unit
+@pytest.mark.parametrize("name", ["word", "faces"])
+def test_a_ply_that_rply_cannot_parse_is_refused_without_its_message_on_stderr(
+        tmp_path: Path, name: str, capfd: pytest.CaptureFixture[str]) -> None:
+    """Open3D printed 'RPly: Error reading ...' and returned the cloud padded with zeros."""
+    if name == "word":
+        path = _ascii_ply(tmp_path / "m.ply", ["1 2 3", "4 abc 6", "7 8 9"])
+        expected = "corrupt PLY: Error reading 'y' of 'vertex' number 1"
+    else:
+        path = _ply_with_faces(tmp_path / "m.ply", 200)
+        expected = "corrupt PLY: Error reading value number"
+    _refused(path, expected, capfd)
+
+
+@pytest.mark.unit
+def test_a_sound_ply_with_faces_before_its_vertices_loads(tmp_path: Path) -> None:
+    cloud = load_map(_ply_with_faces(tmp_path / "m.ply", 3))
+    assert isinstance(cloud, PointMap)
+    np.testing.assert_array_equal(cloud.points, np.arange(90).reshape(30, 3))

@@ -12,6 +12,7 @@ Open3D.
 
 from __future__ import annotations
 
+import sys
 import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -25,6 +26,7 @@ from pcmapq import memory
 from pcmapq.errors import InputError
 from pcmapq.io import pcd, ply
 from pcmapq.io.ply import CHUNK, VertexBlock, vertex_block
+from pcmapq.io.stderr import stderr_captured
 from pcmapq.io.writers import one_line
 
 CLOUD_SUFFIXES = (".ply", ".pcd", ".xyz", ".txt", ".npy", ".bin")
@@ -113,15 +115,22 @@ def with_z(path: Path, table: np.ndarray) -> np.ndarray:
 def read_open3d(path: Path) -> np.ndarray:
     """PLY or PCD via Open3D, once its header is checked against the data the file holds
     (InputError for a truncated file). Open3D reports unreadable files by returning no
-    points."""
+    points, and a PLY that RPly cannot parse by RPly's message on stderr (the points after it
+    zeros): that message, captured, is the InputError's."""
     import open3d as o3d  # heavy: loaded when a PLY or PCD is read
 
     if path.suffix.lower() == ".ply":
         ply.check_size(path)  # Open3D pads a short file with zeros, printing RPly errors
     else:
         pcd.check_size(path)
-    with o3d.utility.VerbosityContextManager(o3d.utility.VerbosityLevel.Error):
+    with (o3d.utility.VerbosityContextManager(o3d.utility.VerbosityLevel.Error),
+          stderr_captured() as printed):
         cloud = o3d.io.read_point_cloud(str(path))
+    rply = [line[6:] for line in printed if line.startswith("RPly: ")]
+    if rply:  # Open3D gives the points read before the error, padded with zeros
+        raise InputError(f"{path}: corrupt PLY: {rply[0].strip()}")
+    if printed:  # not RPly's: passed on
+        print("\n".join(printed), file=sys.stderr)
     if not cloud.has_points():
         raise InputError(f"{path}: no points (empty or unreadable)")
     return np.asarray(cloud.points, dtype=np.float64)
