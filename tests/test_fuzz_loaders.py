@@ -105,3 +105,14 @@ def test_a_sound_ply_with_faces_before_its_vertices_loads(tmp_path: Path) -> Non
     cloud = load_map(_ply_with_faces(tmp_path / "m.ply", 3))
     assert isinstance(cloud, PointMap)
     np.testing.assert_array_equal(cloud.points, np.arange(90).reshape(30, 3))
+
+
+@pytest.mark.unit
+@pytest.mark.parametrize("data", [b"P5\n20 16\n25", b"P5\n20 16\n255\n" + bytes(100)],
+                         ids=["header", "pixels"])
+def test_a_truncated_pgm_is_refused_without_opencvs_error_line(
+        tmp_path: Path, data: bytes, capfd: pytest.CaptureFixture[str]) -> None:
+    """OpenCV printed '[ERROR:0@...] global loadsave.cpp ... can't read header/data'."""
+    path = tmp_path / "m.pgm"
+    path.write_bytes(data)
+    _refused(path, "cannot be read as an image", capfd)

@@ -12,6 +12,8 @@ from __future__ import annotations
 import math
 import re
 import warnings
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TypeVar
@@ -180,7 +182,8 @@ def read_levels(path: Path) -> tuple[np.ndarray, int, float, np.ndarray]:
     ``level / channels * scale``. The size its header declares is checked first."""
     check_image_size(path)
     try:
-        img = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
+        with _opencv_quiet():
+            img = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
     except cv2.error:
         img = None
     if img is None or img.size == 0:
@@ -195,6 +198,18 @@ def read_levels(path: Path) -> tuple[np.ndarray, int, float, np.ndarray]:
     colour = img[:, :, : channels - 1] if has_alpha else img
     transparent = img[:, :, -1] == 0 if has_alpha else np.zeros(img.shape[:2], dtype=bool)
     return colour.sum(axis=2, dtype=np.int32), colour.shape[2], scale, transparent
+
+
+@contextmanager
+def _opencv_quiet() -> Iterator[None]:
+    """OpenCV's log silenced in the block: a corrupt image is reported by ``imread`` returning
+    nothing (an InputError here), not by OpenCV's ``[ERROR...]`` lines on stderr."""
+    level = cv2.utils.logging.getLogLevel()
+    cv2.utils.logging.setLogLevel(cv2.utils.logging.LOG_LEVEL_SILENT)
+    try:
+        yield
+    finally:
+        cv2.utils.logging.setLogLevel(level)
 
 
 def classify(levels: np.ndarray, channels: int, scale: float, transparent: np.ndarray,
