@@ -116,3 +116,33 @@ def test_a_truncated_pgm_is_refused_without_opencvs_error_line(
     path = tmp_path / "m.pgm"
     path.write_bytes(data)
     _refused(path, "cannot be read as an image", capfd)
+
+
+def _png(width: int | None = None, flip: int | None = None, keep: int | None = None) -> bytes:
+    """A 24 x 32 grey PNG: its IHDR width replaced (CRC recomputed), a bit flipped at byte
+    ``flip``, or cut to ``keep`` bytes."""
+    import cv2
+    image = np.full((24, 32), 254, dtype=np.uint8)
+    image[4:20, 5] = 0
+    data = bytearray(cv2.imencode(".png", image)[1].tobytes())
+    if width is not None:
+        data[16:20] = struct.pack(">I", width)
+        data[29:33] = struct.pack(">I", zlib.crc32(bytes(data[12:29])))
+    if flip is not None:
+        data[flip] ^= 1
+    return bytes(data[:keep])
+
+
+@pytest.mark.unit
+@pytest.mark.parametrize(("data", "expected"), [
+    (_png(flip=16), "corrupt PNG (CRC error in chunk 'IHDR' at byte 8)"),
+    (_png(flip=45), "corrupt PNG (CRC error in chunk 'IDAT'"),
+    (_png(keep=60), "truncated PNG (chunk 'IDAT' at byte 33"),
+    (_png(width=1), "cannot be read as an image: libpng error: "),
+], ids=["ihdr_crc", "idat_crc", "cut", "width"])
+def test_a_corrupt_png_is_refused_without_libpngs_error_line(
+        tmp_path: Path, data: bytes, expected: str, capfd: pytest.CaptureFixture[str]) -> None:
+    """libpng printed 'libpng error: IHDR: CRC error', '... bad adaptive filter value'."""
+    path = tmp_path / "m.png"
+    path.write_bytes(data)
+    _refused(path, expected, capfd)

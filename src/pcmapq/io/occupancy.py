@@ -26,6 +26,7 @@ from pcmapq.cells import FREE, OCCUPIED, UNKNOWN
 from pcmapq.errors import InputError
 from pcmapq.grid import MetricGrid
 from pcmapq.io.image_header import check_image_size
+from pcmapq.io.stderr import stderr_captured
 from pcmapq.io.writers import one_line
 
 IMAGE_SUFFIXES = (".png", ".pgm", ".jpg", ".jpeg", ".bmp")
@@ -182,12 +183,16 @@ def read_levels(path: Path) -> tuple[np.ndarray, int, float, np.ndarray]:
     ``level / channels * scale``. The size its header declares is checked first."""
     check_image_size(path)
     try:
-        with _opencv_quiet():
+        with _opencv_quiet(), stderr_captured() as printed:
             img = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
     except cv2.error:
         img = None
-    if img is None or img.size == 0:
-        raise InputError(f"{path}: cannot be read as an image")
+    # libpng prints its errors (then OpenCV gives up, or keeps a partial image) and warnings
+    # (about a sound image: dropped)
+    errors = [line for line in printed if "error" in line.lower()]
+    if img is None or img.size == 0 or errors:
+        why = f": {errors[0].strip()}" if errors else ""
+        raise InputError(f"{path}: cannot be read as an image{why}")
     if img.dtype not in (np.uint8, np.uint16):
         raise InputError(f"{path}: unsupported pixel type {img.dtype} (expected 8 or 16 bit)")
     scale = 255.0 / np.iinfo(img.dtype).max
