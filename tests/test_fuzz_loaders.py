@@ -21,7 +21,7 @@ from tools.fuzz_loaders import MUTATIONS, Op, make_seeds, run_example
 
 SEEDS = make_seeds()
 #: Mutated inputs per seed: about 2 s per seed (18 seeds) on one core.
-EXAMPLES = 250
+EXAMPLES = 200
 
 
 @pytest.mark.unit
