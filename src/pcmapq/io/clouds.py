@@ -12,10 +12,12 @@ Open3D.
 
 from __future__ import annotations
 
+import sys
 import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
+from tokenize import TokenError
 
 import numpy as np
 from numpy.lib import format as npy
@@ -24,6 +26,7 @@ from pcmapq import memory
 from pcmapq.errors import InputError
 from pcmapq.io import pcd, ply
 from pcmapq.io.ply import CHUNK, VertexBlock, vertex_block
+from pcmapq.io.stderr import stderr_captured
 from pcmapq.io.writers import one_line
 
 CLOUD_SUFFIXES = (".ply", ".pcd", ".xyz", ".txt", ".npy", ".bin")
@@ -105,22 +108,30 @@ def with_z(path: Path, table: np.ndarray) -> np.ndarray:
         raise InputError(f"{path}: expected numbers, got {table.dtype} values")
     out = np.zeros((len(table), 3), dtype=np.float64)
     cols = min(table.shape[1], 3)
-    out[:, :cols] = table[:, :cols]
+    with np.errstate(invalid="ignore"):  # a float32 signalling NaN (the row is dropped later)
+        out[:, :cols] = table[:, :cols]
     return out
 
 
 def read_open3d(path: Path) -> np.ndarray:
     """PLY or PCD via Open3D, once its header is checked against the data the file holds
     (InputError for a truncated file). Open3D reports unreadable files by returning no
-    points."""
+    points, and a PLY that RPly cannot parse by RPly's message on stderr (the points after it
+    zeros): that message, captured, is the InputError's."""
     import open3d as o3d  # heavy: loaded when a PLY or PCD is read
 
     if path.suffix.lower() == ".ply":
         ply.check_size(path)  # Open3D pads a short file with zeros, printing RPly errors
     else:
         pcd.check_size(path)
-    with o3d.utility.VerbosityContextManager(o3d.utility.VerbosityLevel.Error):
+    with (o3d.utility.VerbosityContextManager(o3d.utility.VerbosityLevel.Error),
+          stderr_captured() as printed):
         cloud = o3d.io.read_point_cloud(str(path))
+    rply = [line[6:] for line in printed if line.startswith("RPly: ")]
+    if rply:  # Open3D gives the points read before the error, padded with zeros
+        raise InputError(f"{path}: corrupt PLY: {rply[0].strip()}")
+    if printed:  # not RPly's: passed on
+        print("\n".join(printed), file=sys.stderr)
     if not cloud.has_points():
         raise InputError(f"{path}: no points (empty or unreadable)")
     return np.asarray(cloud.points, dtype=np.float64)
@@ -155,7 +166,7 @@ def check_npy(path: Path, memory_limit: int | None = None) -> None:
             version = npy.read_magic(f)
             read = npy.read_array_header_1_0 if version == (1, 0) else npy.read_array_header_2_0
             shape, _, dtype = read(f, max_header_size=10_000)
-        except ValueError as exc:
+        except (ValueError, TypeError, SyntaxError, TokenError) as exc:  # a garbled header
             raise InputError(f"{path}: not a .npy file: {one_line(exc)}") from None
         offset = f.tell()
     rows = shape[0] if shape else 1

@@ -2,19 +2,22 @@
 memory guard before OpenCV allocates it (a 1 MB PNG can declare 30000 x 30000 pixels).
 
 PNG (the IHDR chunk at a fixed offset), PGM / PPM (a text header) and BMP (fixed offsets) are
-read here; other formats (JPEG) are left to OpenCV's own limit on pixels.
+read here; other formats (JPEG) are left to OpenCV's own limit on pixels. A PNG's chunks are
+checked too (lengths, CRCs), so that libpng has nothing to print.
 """
 
 from __future__ import annotations
 
 import struct
+import zlib
 from pathlib import Path
 
 from pcmapq import memory
 from pcmapq.errors import InputError
 
-__all__ = ["check_image_size", "declared_size"]
+__all__ = ["check_image_size", "check_png_chunks", "declared_size"]
 
+_PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 #: PNG colour type -> channels OpenCV decodes (a palette becomes BGR).
 _PNG_CHANNELS = {0: 1, 2: 3, 3: 3, 4: 2, 6: 4}
 
@@ -24,7 +27,7 @@ def declared_size(path: Path) -> tuple[int, int, int] | None:
     not read here. InputError for a header too short or malformed to hold them."""
     with path.open("rb") as f:
         head = f.read(512)
-    if head.startswith(b"\x89PNG\r\n\x1a\n"):
+    if head.startswith(_PNG_MAGIC):
         return _png(path, head)
     if head[:2] in (b"P2", b"P3", b"P5", b"P6"):
         return _netpbm(path, head)
@@ -40,6 +43,10 @@ def check_image_size(path: Path, memory_limit: int | None = None) -> None:
     size = declared_size(path)
     if size is None:
         return
+    with path.open("rb") as f:
+        is_png = f.read(len(_PNG_MAGIC)) == _PNG_MAGIC
+    if is_png:
+        check_png_chunks(path)
     rows, cols, per_pixel = size
     need = int(memory.BASE + rows * cols * (per_pixel + _CLASSIFY_BYTES))
     memory.guard(need, memory_limit, f"{path} ({cols} x {rows} pixels declared in its header)")
@@ -48,6 +55,27 @@ def check_image_size(path: Path, memory_limit: int | None = None) -> None:
 #: Bytes per pixel, beyond the decoded image, of turning it into cell states (the int32 sum of
 #: its channels, the transparency mask, the int8 state).
 _CLASSIFY_BYTES = 6
+
+
+def check_png_chunks(path: Path) -> None:
+    """InputError when a PNG's chunks run past the end of the file, one fails its CRC, or there
+    is no IEND: libpng would print ``libpng error: ...`` on stderr before OpenCV gives up. One
+    step per chunk (a few hundred in a large map), one CRC pass over the file."""
+    data = memoryview(path.read_bytes())
+    at = len(_PNG_MAGIC)
+    while at + 12 <= len(data):
+        length = int.from_bytes(data[at:at + 4], "big")
+        kind = bytes(data[at + 4:at + 8]).decode("latin-1")
+        end = at + 12 + length
+        if end > len(data):
+            raise InputError(f"{path}: truncated PNG (chunk {kind!r} at byte {at} needs "
+                             f"{length} bytes, the file ends before)")
+        if zlib.crc32(data[at + 4:end - 4]) != int.from_bytes(data[end - 4:end], "big"):
+            raise InputError(f"{path}: corrupt PNG (CRC error in chunk {kind!r} at byte {at})")
+        if kind == "IEND":
+            return
+        at = end
+    raise InputError(f"{path}: truncated PNG (no IEND chunk)")
 
 
 def _png(path: Path, head: bytes) -> tuple[int, int, int]:

@@ -12,6 +12,8 @@ from __future__ import annotations
 import math
 import re
 import warnings
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TypeVar
@@ -24,6 +26,7 @@ from pcmapq.cells import FREE, OCCUPIED, UNKNOWN
 from pcmapq.errors import InputError
 from pcmapq.grid import MetricGrid
 from pcmapq.io.image_header import check_image_size
+from pcmapq.io.stderr import stderr_captured
 from pcmapq.io.writers import one_line
 
 IMAGE_SUFFIXES = (".png", ".pgm", ".jpg", ".jpeg", ".bmp")
@@ -185,11 +188,16 @@ def read_levels(path: Path,
     ``memory_limit`` bytes (None: the default limit)."""
     check_image_size(path, memory_limit)
     try:
-        img = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
+        with _opencv_quiet(), stderr_captured() as printed:
+            img = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
     except cv2.error:
         img = None
-    if img is None or img.size == 0:
-        raise InputError(f"{path}: cannot be read as an image")
+    # libpng prints its errors (then OpenCV gives up, or keeps a partial image) and warnings
+    # (about a sound image: dropped)
+    errors = [line for line in printed if "error" in line.lower()]
+    if img is None or img.size == 0 or errors:
+        why = f": {errors[0].strip()}" if errors else ""
+        raise InputError(f"{path}: cannot be read as an image{why}")
     if img.dtype not in (np.uint8, np.uint16):
         raise InputError(f"{path}: unsupported pixel type {img.dtype} (expected 8 or 16 bit)")
     scale = 255.0 / np.iinfo(img.dtype).max
@@ -200,6 +208,18 @@ def read_levels(path: Path,
     colour = img[:, :, : channels - 1] if has_alpha else img
     transparent = img[:, :, -1] == 0 if has_alpha else np.zeros(img.shape[:2], dtype=bool)
     return colour.sum(axis=2, dtype=np.int32), colour.shape[2], scale, transparent
+
+
+@contextmanager
+def _opencv_quiet() -> Iterator[None]:
+    """OpenCV's log silenced in the block: a corrupt image is reported by ``imread`` returning
+    nothing (an InputError here), not by OpenCV's ``[ERROR...]`` lines on stderr."""
+    level = cv2.utils.logging.getLogLevel()
+    cv2.utils.logging.setLogLevel(cv2.utils.logging.LOG_LEVEL_SILENT)
+    try:
+        yield
+    finally:
+        cv2.utils.logging.setLogLevel(level)
 
 
 def classify(levels: np.ndarray, channels: int, scale: float, transparent: np.ndarray,

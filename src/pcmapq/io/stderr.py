@@ -1,0 +1,31 @@
+"""What C libraries print on stderr while they read a file, captured so that it becomes the one
+line of an InputError (RPly inside Open3D, libpng inside OpenCV print their errors there and
+go on or give up) instead of noise beside it."""
+
+from __future__ import annotations
+
+import os
+import sys
+import tempfile
+from collections.abc import Iterator
+from contextlib import contextmanager
+
+__all__ = ["stderr_captured"]
+
+
+@contextmanager
+def stderr_captured() -> Iterator[list[str]]:
+    """File descriptor 2 redirected to a temporary file in the block; the list yielded holds,
+    after the block, the lines written there. Meant for one library call: output of other
+    threads in the meantime is captured too."""
+    sys.stderr.flush()
+    saved, lines = os.dup(2), []
+    with tempfile.TemporaryFile() as sink:
+        os.dup2(sink.fileno(), 2)
+        try:
+            yield lines
+        finally:
+            os.dup2(saved, 2)
+            os.close(saved)
+            sink.seek(0)
+            lines += sink.read().decode("utf-8", errors="replace").splitlines()
