@@ -297,3 +297,31 @@ def test_unwritable_destination(tmp_path: Path) -> None:
     with pytest.raises(InputError) as info:
         write_atomic(target, "x")
     assert str(info.value).startswith(f"{target}: cannot write: ")
+
+
+def test_stderr_captures_in_threads_at_once_restore_descriptor_2():
+    """The map and the truth are read on two threads: their captures take turns, each gets its
+    own lines, and descriptor 2 ends where it started."""
+    import os
+    import threading
+    import time
+
+    from pcmapq.io.stderr import stderr_captured
+
+    before = os.fstat(2)
+    got: dict[int, list[str]] = {}
+
+    def read(k: int) -> None:
+        with stderr_captured() as lines:
+            os.write(2, f"library says {k}\n".encode())
+            time.sleep(0.01)
+        got[k] = lines
+
+    threads = [threading.Thread(target=read, args=(k,)) for k in range(8)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    after = os.fstat(2)
+    assert (after.st_dev, after.st_ino) == (before.st_dev, before.st_ino)
+    assert got == {k: [f"library says {k}"] for k in range(8)}

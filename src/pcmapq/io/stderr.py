@@ -7,20 +7,25 @@ from __future__ import annotations
 import os
 import sys
 import tempfile
+import threading
 from collections.abc import Iterator
 from contextlib import contextmanager
 
 __all__ = ["stderr_captured"]
+
+#: One capture at a time: two threads swapping descriptor 2 at once (the map and the truth are
+#: read in parallel) would each restore the other's sink and leave stderr pointing at a file.
+_ONE_AT_A_TIME = threading.Lock()
 
 
 @contextmanager
 def stderr_captured() -> Iterator[list[str]]:
     """File descriptor 2 redirected to a temporary file in the block; the list yielded holds,
     after the block, the lines written there. Meant for one library call: output of other
-    threads in the meantime is captured too."""
-    sys.stderr.flush()
-    saved, lines = os.dup(2), []
-    with tempfile.TemporaryFile() as sink:
+    threads in the meantime is captured too; captures in other threads wait for this one."""
+    with _ONE_AT_A_TIME, tempfile.TemporaryFile() as sink:
+        sys.stderr.flush()
+        saved, lines = os.dup(2), []
         os.dup2(sink.fileno(), 2)
         try:
             yield lines
