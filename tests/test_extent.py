@@ -187,7 +187,25 @@ def test_max_memory_reaches_the_loaders(tmp_path):
     code, _, stderr = _eval(str(SAMPLE / "scan.ply"), str(SAMPLE / "truth.yaml"),
                             "--max-memory", "0.1")
     assert code == 2 and "truth.png (521 x 361 pixels declared in its header)" in stderr, stderr
-    path = tmp_path / "cloud.npy"
-    np.save(path, np.zeros((1000, 3)))
-    with pytest.raises(InputError, match="cloud.npy: needs about"):
-        load_map(path, memory_limit=10**6)
+
+
+@pytest.mark.parametrize("name", ["b.ply", "a.ply", "b.pcd", "a.pcd", "c.npy", "k.bin"])
+def test_every_cloud_loader_checks_the_points_declared_against_the_limit(tmp_path, name):
+    """A limit that holds half of what the declared points need refuses the file before it is
+    read; one that holds them all loads it."""
+    from pcmapq import memory
+
+    n = 20_000
+    points = np.random.default_rng(3).uniform(0, 5, (n, 3))
+    path = tmp_path / name
+    if name.endswith(".npy"):
+        np.save(path, points)
+    elif name.endswith(".bin"):
+        np.column_stack([points, np.zeros(n)]).astype("<f4").tofile(path)
+    else:
+        cloud = o3d.geometry.PointCloud(o3d.utility.Vector3dVector(points))
+        assert o3d.io.write_point_cloud(str(path), cloud, write_ascii=name.startswith("a"))
+    need = memory.needed_bytes(0, 0, 0.0, n)
+    with pytest.raises(InputError, match=f"{name}.*needs about"):
+        load_map(path, memory_limit=need - 50 * n)
+    assert len(load_map(path, memory_limit=need).points) == n

@@ -55,11 +55,14 @@ class PointMap:
 
 
 def load_cloud(path: Path, memory_limit: int | None = None) -> PointMap:
-    """Load a point cloud, choosing the reader by extension; a .npy whose header declares more
-    rows than ``memory_limit`` bytes hold (None: the default limit) is refused unread."""
+    """Load a point cloud, choosing the reader by extension; a PLY, PCD, .npy or KITTI .bin whose
+    header (or size) declares more points than ``memory_limit`` bytes hold (None: the default
+    limit, see :mod:`pcmapq.memory`) is refused unread."""
     readers: dict[str, Callable[[Path], np.ndarray]] = {
-        ".ply": read_open3d, ".pcd": read_open3d, ".xyz": read_text, ".txt": read_text,
-        ".npy": lambda p: read_npy(p, memory_limit), ".bin": read_kitti_bin,
+        ".ply": lambda p: read_open3d(p, memory_limit),
+        ".pcd": lambda p: read_open3d(p, memory_limit), ".xyz": read_text, ".txt": read_text,
+        ".npy": lambda p: read_npy(p, memory_limit),
+        ".bin": lambda p: read_kitti_bin(p, memory_limit),
     }
     try:
         block = vertex_block(path) if path.suffix.lower() == ".ply" else None
@@ -67,6 +70,7 @@ def load_cloud(path: Path, memory_limit: int | None = None) -> PointMap:
             mapped = _mapped_3d(block) if block.count > MAP_POINTS else None
             if mapped is not None:
                 return PointMap(path, mapped, True)
+            check_points(path, block.count, memory_limit)
             points = np.empty((block.count, 3), dtype=np.float64)
             for start in range(0, block.count, CHUNK):
                 points[start:start + CHUNK] = block.read(start, start + CHUNK)
@@ -113,17 +117,25 @@ def with_z(path: Path, table: np.ndarray) -> np.ndarray:
     return out
 
 
-def read_open3d(path: Path) -> np.ndarray:
+def check_points(path: Path, count: int, memory_limit: int | None = None) -> None:
+    """InputError (one line) when ``count`` points, declared by the file ``path``, need more
+    memory than ``memory_limit`` bytes (None: the default limit)."""
+    memory.guard(memory.needed_bytes(0, 0, 0.0, int(count)), memory_limit,
+                 f"{path} ({count:,} points declared)")
+
+
+def read_open3d(path: Path, memory_limit: int | None = None) -> np.ndarray:
     """PLY or PCD via Open3D, once its header is checked against the data the file holds
     (InputError for a truncated file). Open3D reports unreadable files by returning no
     points, and a PLY that RPly cannot parse by RPly's message on stderr (the points after it
-    zeros): that message, captured, is the InputError's."""
+    zeros): that message, captured, is the InputError's. The points declared are checked
+    against ``memory_limit`` bytes first (:func:`check_points`)."""
     import open3d as o3d  # heavy: loaded when a PLY or PCD is read
 
-    if path.suffix.lower() == ".ply":
-        ply.check_size(path)  # Open3D pads a short file with zeros, printing RPly errors
+    if path.suffix.lower() == ".ply":  # Open3D pads a short file with zeros, printing RPly errors
+        check_points(path, ply.check_size(path), memory_limit)
     else:
-        pcd.check_size(path)
+        check_points(path, pcd.check_size(path).points, memory_limit)
     with (o3d.utility.VerbosityContextManager(o3d.utility.VerbosityLevel.Error),
           stderr_captured() as printed):
         cloud = o3d.io.read_point_cloud(str(path))
@@ -178,11 +190,13 @@ def check_npy(path: Path, memory_limit: int | None = None) -> None:
     memory.guard(memory.needed_bytes(0, 0, 0.0, int(rows)), memory_limit, str(path))
 
 
-def read_kitti_bin(path: Path) -> np.ndarray:
-    """KITTI Velodyne scan: little-endian float32 records x, y, z, reflectance."""
+def read_kitti_bin(path: Path, memory_limit: int | None = None) -> np.ndarray:
+    """KITTI Velodyne scan: little-endian float32 records x, y, z, reflectance (their count
+    checked against ``memory_limit`` bytes, None: the default limit)."""
     size = path.stat().st_size
     if size % 16:
         raise InputError(f"{path}: size {size} bytes is not a multiple of 16 "
                          "(expected float32 x, y, z, reflectance records)")
+    check_points(path, size // 16, memory_limit)
     return np.fromfile(path, dtype="<f4").reshape(-1, 4)[:, :3]
 

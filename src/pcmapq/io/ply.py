@@ -107,8 +107,9 @@ def vertex_block(path: Path) -> VertexBlock | None:
     raise InputError(f"{path}: no vertex element in the PLY header")
 
 
-def check_size(path: Path) -> None:
-    """InputError when ``path`` (a PLY) holds fewer records than its header declares: for a
+def check_size(path: Path) -> int:
+    """The vertices the PLY ``path`` declares; InputError when it holds fewer records than its
+    header declares: for a
     binary PLY, fewer bytes than its elements need (a list property counted at its smallest,
     an empty list), for an ASCII PLY fewer data lines than records. Open3D would pad the
     missing points with zeros."""
@@ -131,6 +132,7 @@ def check_size(path: Path) -> None:
         present = min(max(held - before, 0) // per_point, points)
         raise InputError(f"{path}: truncated: header declares {points} points, "
                          f"the file holds {present}")
+    return points
 
 
 def _header(path: Path) -> tuple[str, list[tuple[str, int, list]], int]:
