@@ -132,7 +132,7 @@ def rss_mb() -> float:
 def release_free_memory() -> None:
     """Collect garbage and hand the C heap's free pages back to the OS (glibc ``malloc_trim``;
     nothing where it is absent), so the RSS read next is the memory still in use, not what the
-    allocator keeps for reuse: after a large evaluation it keeps up to ~0.15 GB here, different
+    allocator keeps for reuse: after these evaluations it kept about 0.1 GB, different
     from run to run, which would hide or fake a growth of 10 %."""
     gc.collect()
     name = ctypes.util.find_library("c")
