@@ -31,6 +31,12 @@ Progress = Callable[[str], None]
 #: The fewest distinct occupied cells (of memory.WORKING_CELL, 0.05 m) a map or truth needs to
 #: be scored: fewer (one point, a few identical points, a 1x1 image) is refused, exit 1.
 MIN_CELLS = 10
+#: The largest share of an image's cells that may be occupied: a map of walls draws thin lines
+#: on free space (0.3-19 % in every real map of ../shared/data, 6 % in data/sample/truth.png).
+#: More is a picture read inverted (``negate: 1`` on a black-walls image, free space below
+#: occupied_thresh) or a filled area, not walls; it is refused (exit 1) before the alignment,
+#: whose cost grows with the occupied cells (an inverted sample took 10-20 times as long).
+MAX_OCCUPIED_SHARE = 0.5
 
 
 def plan_points(source: OccupancyMap | PointMap,
@@ -58,7 +64,21 @@ def plan_points(source: OccupancyMap | PointMap,
         raise EvaluationError(f"{source.path}: degenerate map: its walls fill {cells} distinct "
                               f"{memory.WORKING_CELL:g} m cells, fewer than {MIN_CELLS}: "
                               "nothing to align or score")
+    if isinstance(source, OccupancyMap):
+        _check_occupied_share(source, len(xy))
     return xy, levelling
+
+
+def _check_occupied_share(source: OccupancyMap, occupied: int) -> None:
+    """Refuse (EvaluationError) an image more than MAX_OCCUPIED_SHARE of whose cells are
+    occupied: not a map of walls."""
+    share = occupied / source.state.size
+    if share > MAX_OCCUPIED_SHARE:
+        raise EvaluationError(
+            f"{source.path}: not a map of walls: {share:.0%} of its cells are occupied (at most "
+            f"{MAX_OCCUPIED_SHARE:.0%} expected: walls are thin lines on free space); is the "
+            "picture inverted? check negate, occupied_thresh and free_thresh in its YAML, or "
+            "the --map-/--truth- options that override them")
 
 
 def distinct_cells(xy: np.ndarray) -> int:
