@@ -32,7 +32,7 @@ Progress = Callable[[str], None]
 #: be scored: fewer (one point, a few identical points, a 1x1 image) is refused, exit 1.
 MIN_CELLS = 10
 #: The largest share of an image's cells that may be occupied: a map of walls draws thin lines
-#: on free space (0.3-19 % in every real map of ../shared/data, 6 % in data/sample/truth.png).
+#: on free space (at most 15 % in every real map of ../shared/data, 5 % in data/sample/truth.png).
 #: More is a picture read inverted (``negate: 1`` on a black-walls image, free space below
 #: occupied_thresh) or a filled area, not walls; it is refused (exit 1) before the alignment,
 #: whose cost grows with the occupied cells (an inverted sample took 10-20 times as long).
