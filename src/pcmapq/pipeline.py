@@ -33,9 +33,9 @@ Progress = Callable[[str], None]
 MIN_CELLS = 10
 #: The largest share of an image's cells that may be occupied: a map of walls draws thin lines
 #: on free space (at most 15 % in every real map of ../shared/data, 5 % in data/sample/truth.png).
-#: More is a picture read inverted (``negate: 1`` on a black-walls image, free space below
+#: More is a picture read inverted (``negate: 1`` on a black-walls image, free space read above
 #: occupied_thresh) or a filled area, not walls; it is refused (exit 1) before the alignment,
-#: whose cost grows with the occupied cells (an inverted sample took 10-20 times as long).
+#: whose cost grows with the occupied cells (the inverted sample took 10 times the CPU time).
 MAX_OCCUPIED_SHARE = 0.5
 
 
