@@ -57,15 +57,18 @@ def test_results_yaml_warning_on_the_command_line(tmp_path):
 
 def test_negate_option_overrides_the_yaml(tmp_path):
     """The sample plan with its grey values inverted (walls white) and a YAML saying negate 0:
-    read as it says, the rooms are walls (F@0.05 m 0.07); --map-negate reads the walls as
-    walls, and the map then lies on the truth where it stands."""
+    read as it says, the rooms are walls (95 % of the cells occupied: refused, exit 1, as not a
+    map of walls, pointing at negate); --map-negate reads the walls as walls, and the map then
+    lies on the truth where it stands."""
     inverted = 255 - cv2.imread(str(SAMPLE / "truth.png"), cv2.IMREAD_GRAYSCALE)
     cv2.imwrite(str(tmp_path / "inv.png"), inverted)
     (tmp_path / "inv.yaml").write_text((SAMPLE / "truth.yaml").read_text().replace(
         "image: truth.png", "image: inv.png"))
     as_yaml = run("eval", str(tmp_path / "inv.png"), str(SAMPLE / "truth.png"), "--no-align",
                   "--detectors", "hough", "--json", "-")
-    assert json.loads(as_yaml.stdout)["distances"]["f_score"][0]["f"] < 0.2
+    assert as_yaml.returncode == 1 and as_yaml.stdout == "", as_yaml.stderr
+    assert "not a map of walls: 95% of its cells are occupied" in as_yaml.stderr
+    assert "negate" in as_yaml.stderr
     negated = run("eval", str(tmp_path / "inv.png"), str(SAMPLE / "truth.png"), "--no-align",
                   "--map-negate", "--detectors", "hough", "--json", "-")
     assert negated.returncode == 0, negated.stderr

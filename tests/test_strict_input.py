@@ -31,8 +31,9 @@ def test_non_finite_option_values_are_refused_at_parsing(option: list[str], tmp_
     out = tmp_path / "r.json"
     got = CliRunner().invoke(app, ["eval", TRUTH, TRUTH, *option, "--json", str(out)])
     assert got.exit_code == 2 and isinstance(got.exception, SystemExit), got.output
-    errors = [line for line in got.stderr.splitlines() if line.startswith("Error:")]
-    assert len(errors) == 1 and option[0] in errors[0], got.stderr
+    errors = got.stderr.splitlines()
+    assert len(errors) == 1 and errors[0].startswith("pcmapq: error: "), got.stderr
+    assert option[0] in errors[0], got.stderr
     assert "Traceback" not in got.stderr and not out.exists()
 
 

@@ -4,15 +4,21 @@ from __future__ import annotations
 
 import sys
 import warnings
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import replace
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Any
 
 import typer
 from rich.console import Console
 from rich.progress import Progress
+from typer.core import TyperGroup
+
+try:  # recent typer carries its own copy of click
+    from typer._click.exceptions import NoSuchOption, UsageError
+except ImportError:  # older typer runs on click itself
+    from click.exceptions import NoSuchOption, UsageError
 
 from pcmapq import __version__, options
 from pcmapq.config import DETECTOR_NAMES, DistancesConfig, MatchingConfig, Settings, SourceConfig
@@ -46,8 +52,57 @@ DEFAULTS = Settings()
 #: text: rich's markup would eat "[default: ...]" and squeeze the help into a narrow column.
 HELP_WIDTH = 200
 
-app = typer.Typer(add_completion=False, no_args_is_help=True, pretty_exceptions_enable=False,
-                  rich_markup_mode=None, context_settings={"max_content_width": HELP_WIDTH},
+
+class _OneLineUsageErrors(TyperGroup):
+    """pcmapq's commands, with a usage error (unknown option or command, bad or missing value)
+    said in one line like pcmapq's own errors, exit 2, instead of click's four lines."""
+
+    def main(self, args: Sequence[str] | None = None, prog_name: str | None = None,
+             complete_var: str | None = None, standalone_mode: bool = True,
+             **extra: Any) -> Any:
+        """Click's main; in standalone mode, a usage error becomes one line on stderr."""
+        if not standalone_mode:
+            return super().main(args, prog_name, complete_var, standalone_mode, **extra)
+        try:
+            code = super().main(args, prog_name, complete_var, False, **extra)
+        except UsageError as error:
+            if type(error).__name__ == "NoArgsIsHelpError":  # 'pcmapq' alone: click's help
+                error.show()  # (the class is new in click 8.2, hence by name, as typer does)
+                sys.exit(error.exit_code)
+            print(f"pcmapq: error: {usage_message(error)}", file=sys.stderr)
+            sys.exit(error.exit_code)
+        sys.exit(code if isinstance(code, int) else 0)
+
+    def invoke(self, ctx: typer.Context) -> Any:
+        """Click's invoke; an error of the option parser, which names no command, is given
+        this group's context (whose ``invoked_subcommand`` says which command failed)."""
+        try:
+            return super().invoke(ctx)
+        except UsageError as error:
+            if error.ctx is None:
+                error.ctx = ctx
+            raise
+
+
+def usage_message(error: UsageError) -> str:
+    """A click usage error as one line: its message, then which --help to read."""
+    if isinstance(error, NoSuchOption) and error.possibilities:
+        text = f"{error.message}; did you mean {' or '.join(sorted(error.possibilities))}?"
+    else:
+        text = error.format_message().rstrip(".")
+    text = " ".join(text.split())
+    if text[:2].istitle():  # "No such option" -> "no such option"; "MAP" stays
+        text = text[0].lower() + text[1:]
+    ctx = error.ctx
+    if ctx is None:
+        return text
+    command = " ".join(filter(None, (ctx.command_path, ctx.invoked_subcommand)))
+    return f"{text} (see '{command} --help')"
+
+
+app = typer.Typer(cls=_OneLineUsageErrors, add_completion=False, no_args_is_help=True,
+                  pretty_exceptions_enable=False, rich_markup_mode=None,
+                  context_settings={"max_content_width": HELP_WIDTH},
                   help="Map quality against a ground-truth map, in metres.")
 
 

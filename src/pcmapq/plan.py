@@ -3,7 +3,8 @@ extent, and its 2D structure (plan points) taken out and checked for something t
 
 An input is refused with exit 2 when it is wider than :data:`pcmapq.io.extent.MAX_SPAN`, and
 with exit 1 when its walls fill fewer than :data:`MIN_CELLS` cells or form one straight line
-(nothing fixes a pose along it).
+(nothing fixes a pose along it), or when more than :data:`MAX_OCCUPIED_SHARE` of an image is
+occupied (not walls: a picture read inverted).
 """
 
 from __future__ import annotations
@@ -26,6 +27,12 @@ MAP_CROP, TRUTH_CROP = "--map-crop", "--truth-crop"
 #: The fewest distinct occupied cells (of memory.WORKING_CELL, 0.05 m) a map or truth needs to
 #: be scored: fewer (one point, a few identical points, a 1x1 image) is refused, exit 1.
 MIN_CELLS = 10
+#: The largest share of an image's cells that may be occupied: a map of walls draws thin lines
+#: on free space (at most 15 % in every real map of ../shared/data, 5 % in data/sample/truth.png).
+#: More is a picture read inverted (``negate: 1`` on a black-walls image, free space read above
+#: occupied_thresh) or a filled area, not walls; it is refused (exit 1) before the alignment,
+#: whose cost grows with the occupied cells (the inverted sample took 10 times the CPU time).
+MAX_OCCUPIED_SHARE = 0.5
 #: Walls narrower than this across their main direction, metres, are one straight line.
 LINE_WIDTH = 0.5
 #: Plan points looked at by the structure checks (a stride through larger plans).
@@ -67,7 +74,21 @@ def plan_points(source: OccupancyMap | PointMap,
     if len(xy) == 0:
         raise InputError(f"{source.path}: no occupied cells or wall points")
     check_structure(source.path, xy)
+    if isinstance(source, OccupancyMap):
+        check_occupied_share(source, len(xy))
     return xy, levelling
+
+
+def check_occupied_share(source: OccupancyMap, occupied: int) -> None:
+    """Refuse (EvaluationError) an image more than MAX_OCCUPIED_SHARE of whose cells are
+    occupied: not a map of walls."""
+    share = occupied / source.state.size
+    if share > MAX_OCCUPIED_SHARE:
+        raise EvaluationError(
+            f"{source.path}: not a map of walls: {share:.0%} of its cells are occupied (at most "
+            f"{MAX_OCCUPIED_SHARE:.0%} expected: walls are thin lines on free space); is the "
+            "picture inverted? check negate, occupied_thresh and free_thresh in its YAML, or "
+            "the --map-/--truth- options that override them")
 
 
 def check_structure(path: Path, xy: np.ndarray) -> None:
