@@ -206,11 +206,19 @@ def _errors(console: Console) -> Iterator[None]:
 
 @contextmanager
 def _warnings(console: Console) -> Iterator[None]:
-    """pcmapq's warnings: one line each on stderr, as they come, every time."""
+    """pcmapq's warnings (``warnings.warn`` in pcmapq's code): one line each on stderr, as they
+    come, every time. A library's warning (a NumPy RuntimeWarning, ...) is not pcmapq's to
+    print: dropped."""
+    package = str(Path(__file__).parent)
+
+    def show(message: Warning | str, category: type[Warning], filename: str, *_: object) -> None:
+        if category is UserWarning and filename.startswith(package):
+            console.print(f"pcmapq: warning: {message}", markup=False, highlight=False,
+                          soft_wrap=True)
+
     with warnings.catch_warnings():
         warnings.filterwarnings("always", module=r"pcmapq\.")
-        warnings.showwarning = lambda message, *_: console.print(
-            f"pcmapq: warning: {message}", markup=False, highlight=False, soft_wrap=True)
+        warnings.showwarning = show
         yield
 
 
