@@ -57,11 +57,12 @@ def span(source: OccupancyMap | PointMap) -> tuple[float, float]:
 def main_group(xy: np.ndarray) -> Box | None:
     """Where most points ``xy`` (N, 2, metres) lie when the rest are far away: the box of the
     largest group (split at gaps of at least :data:`MIN_GAP` metres and wider than the group,
-    along x or y), grown by :data:`BIN` and rounded outwards to 0.1 m; None when the points
-    form one group."""
+    along x, then the points kept split along y), grown by :data:`BIN` and rounded outwards to
+    0.1 m; None when the points form one group."""
     keep = np.ones(len(xy), dtype=bool)
     for axis in (0, 1):
-        bins = np.floor(xy[:, axis] / BIN)
+        kept = np.flatnonzero(keep)  # y splits what x kept: the two never keep disjoint sets
+        bins = np.floor(xy[kept, axis] / BIN)
         edges = np.unique(bins)
         gap = np.diff(edges) * BIN
         cuts = np.flatnonzero(gap >= MIN_GAP)
@@ -73,7 +74,7 @@ def main_group(xy: np.ndarray) -> Box | None:
         width = (hi[largest] - lo[largest] + 1) * BIN
         near = np.concatenate([gap[cuts][largest - 1:largest], gap[cuts][largest:largest + 1]])
         if near.max() > width:
-            keep &= group == largest
+            keep[kept[group != largest]] = False
     if keep.all():
         return None
     inside = xy[keep]

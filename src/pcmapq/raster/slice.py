@@ -139,7 +139,10 @@ def level_rotation(points: np.ndarray) -> np.ndarray:
             break
         o3d.utility.random.seed(0)
         model, inliers = cloud.segment_plane(PLANE_DISTANCE, 3, 1000)
-        normal = np.asarray(model[:3]) / np.linalg.norm(model[:3])
+        length = float(np.linalg.norm(model[:3]))
+        if length == 0.0:  # points on one line: RANSAC returns a zero model, no plane
+            break
+        normal = np.asarray(model[:3]) / length
         if abs(normal[2]) >= np.cos(np.radians(MAX_TILT_DEG)):
             return _rotation_to_z(_fit_normal(np.asarray(cloud.points)[inliers]))
         cloud = cloud.select_by_index(inliers, invert=True)
