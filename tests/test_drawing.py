@@ -123,3 +123,23 @@ def test_cores_on_the_rows_and_columns_of_objects_equal_the_whole_image():
     for width in (3.0, 6.0):
         want = objects & (depth >= deepest[label] - 0.5 * width)
         assert np.array_equal(cores(objects, width), want)
+
+
+def test_a_filled_area_is_drawn_along_its_outline():
+    """A solid 20 m square is no wall: it is thinned as a band THICKEST / 2 wide along its
+    outline, so its centre line runs THICKEST / 4 inside the outline and nothing is drawn in its
+    middle; a wall as thick as THICKEST is thinned whole (one line along its middle)."""
+    from pcmapq.features.walls import THICKEST
+
+    res = 0.05
+    grid = MetricGrid(res, (0.0, 0.0, 0.0), (600, 600))
+    square = np.zeros(grid.shape, bool)
+    square[100:500, 100:500] = True  # 5 m to 25 m
+    image = wall_image(square, grid).image
+    centres = grid.cell_centres(image > 0.5)
+    inset = np.minimum(np.abs(centres - 5.0), np.abs(centres - 25.0)).min(axis=1)
+    assert len(centres) > 0 and np.all(inset < THICKEST / 4 + 0.15), inset.max()
+    thick = np.zeros(grid.shape, bool)
+    thick[100:500, 290:290 + int(THICKEST / res)] = True  # a wall 1 m thick, 14.5 m to 15.5 m
+    centres = grid.cell_centres(wall_image(thick, grid).image > 0.5)
+    assert np.all(np.abs(centres[:, 0] - (14.5 + THICKEST / 2)) < 0.1)

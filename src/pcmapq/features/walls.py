@@ -13,7 +13,10 @@ thin one has none). So the detectors never see the cells as drawn. They see the 
 2. a closing with a disc of ``closing`` metres joins the two faces of a wall drawn as outlines
    (faces up to about twice that apart) and bridges one-cell breaks;
 3. the result is thinned to its skeleton (scikit-image ``skeletonize``), the medial axis: one
-   line per wall, whatever its thickness;
+   line per wall, whatever its thickness up to :data:`THICKEST` metres. A thicker area is no
+   wall but a filled region: its cells deeper than half that are left out first, so it is
+   thinned as a band ``THICKEST / 2`` wide along its outline (and the thinning, whose cost
+   grows with the cube of a solid area's side, stays fast);
 4. spurs are pruned: a branch that ends free and meets the rest of the skeleton at a junction
    is dropped when it is shorter than ``spur`` metres. These are the branches the medial axis
    grows into the outer corner of a thick wall's bend and into the two corners of a thick
@@ -48,6 +51,8 @@ from pcmapq.morphology import disc, distance_to
 #: Working cells a side of a tile of a large raster, and the halo drawn around each, metres:
 #: more than any step looks (a small object's 1 m, a spur's 0.25 m, the closing's 0.1 m).
 TILE, HALO = 2048, 4.0
+#: The thickest wall, metres: thicker occupied areas are filled regions (module docstring, 3).
+THICKEST = 2.0
 #: Threads drawing tiles, at most.
 THREADS = 4
 
@@ -141,7 +146,8 @@ def centreline(occupied: np.ndarray, grid: MetricGrid, resolution: float, closin
     is_small = size <= small
     is_small[0] = False
     objects = fill_holes(is_small[label])
-    line = prune(skeletonize(wall.astype(bool) & ~objects), spur / resolution)
+    deep = cv2.distanceTransform(wall, cv2.DIST_L2, 5) > 0.5 * THICKEST / resolution
+    line = prune(skeletonize(wall.astype(bool) & ~objects & ~deep), spur / resolution)
     return line, cores(objects, width / resolution), fine
 
 
