@@ -84,7 +84,8 @@ def main_group(xy: np.ndarray) -> Box | None:
 
 
 def _box_text(box: Box) -> str:
-    return ",".join(f"{value:.1f}" for value in box)
+    """``x0,y0,x1,y1`` to 0.1 m (to 6 digits beyond a million kilometres)."""
+    return ",".join(f"{value:.1f}" if abs(value) < 1e9 else f"{value:.6g}" for value in box)
 
 
 def _count(source: OccupancyMap | PointMap) -> int:
