@@ -98,7 +98,8 @@ def test_slabs_give_the_same_figures_as_one_pass_and_runs_are_identical():
     assert sliced.mpv_points == whole.mpv_points and sliced.mme_points == whole.mme_points
     assert sliced.mme == pytest.approx(whole.mme, abs=1e-12)
     assert sliced.mpv == pytest.approx(whole.mpv, rel=1e-12)
-    assert noref.scores(points, 0.3, 5, pair_budget=50_000) == sliced
+    assert noref.scores(points, 0.3, 5, pair_budget=50_000, workers=1) == sliced
+    assert noref.scores(points, 0.3, 5, pair_budget=50_000, workers=3) == sliced
 
 
 def test_sparse_points_score_zero_as_map_metrics():

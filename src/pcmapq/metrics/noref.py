@@ -17,7 +17,9 @@ relative to each slab's centre.
 from __future__ import annotations
 
 import math
+import os
 from collections.abc import Iterator, Sequence
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
@@ -34,6 +36,8 @@ MAX_NN = 30
 MOM_MIN_NEIGHBOURS = 3
 #: Neighbour pairs held at once (about 16 bytes each, plus sums): bounds memory on big maps.
 PAIR_BUDGET = 20_000_000
+#: Threads over slabs by default (CI machines have two cores).
+WORKERS = 2
 #: ln(2 pi e): MME's constant per dimension.
 LN_2PIE = math.log(2.0 * math.pi * math.e)
 
@@ -143,33 +147,53 @@ def _sample_counts(points: np.ndarray, sample: np.ndarray, r: float) -> np.ndarr
     return counts
 
 
-def neighbourhood_sums(points: np.ndarray, radius: float,
-                       pair_budget: int = PAIR_BUDGET) -> Iterator[tuple[np.ndarray, np.ndarray]]:
+def _slab_sums(pts: np.ndarray, order: np.ndarray, r: float,
+               bounds: tuple[int, int, int, int]) -> tuple[np.ndarray, np.ndarray]:
+    """(indices, moment sums) of the core [a, b) of one slab, its neighbours from [lo, hi)."""
+    a, b, lo, hi = bounds
+    sub = pts[order[lo:hi]]
+    origin = sub.mean(axis=0)
+    core = sub[a - lo:b - lo] - origin
+    f_core = _moments(core)
+    core_tree = cKDTree(core)
+    upper = _pairs(core_tree, r)
+    sums = f_core + upper @ f_core + upper.T @ f_core
+    del upper
+    halo = np.concatenate([sub[:a - lo], sub[b - lo:]]) - origin
+    if len(halo):
+        sums += _cross(core_tree, cKDTree(halo), r) @ _moments(halo)
+    return order[a:b], sums
+
+
+def neighbourhood_sums(points: np.ndarray, radius: float, pair_budget: int = PAIR_BUDGET,
+                       workers: int | None = None) -> Iterator[tuple[np.ndarray, np.ndarray]]:
     """Yield (indices into ``points``, (k, 10) moment sums) over every point's neighbourhood:
     count, sums of x, y, z and of the products xx, xy, xz, yy, yz, zz, in coordinates relative
-    to a per-slab origin. Covariances: :func:`covariances`. Memory: about ``pair_budget``
-    neighbour pairs (16 bytes each) at a time."""
+    to a per-slab origin. Covariances: :func:`covariances`. The slabs (at least two, each of
+    about ``pair_budget / 2`` neighbour pairs) do not depend on ``workers``, the threads that
+    run them (SciPy's kd-trees release the GIL) and they are yielded in order, so the figures
+    are the same bit for bit whatever the thread count. Memory: about ``pair_budget``
+    neighbour pairs (16 bytes each) with two workers."""
     pts = np.asarray(points, dtype=np.float64)
     if pts.ndim != 2 or pts.shape[1] != 3:
         raise ValueError(f"points must be (N, 3), got {pts.shape}")
     if len(pts) == 0:
         return
+    workers = max(1, workers or min(WORKERS, os.cpu_count() or 1))
     r = strict_radius(radius)
     axis = int(np.argmax(np.ptp(pts, axis=0)))
     order = np.argsort(pts[:, axis], kind="stable")
     x = pts[order, axis]
-    for a, b, lo, hi in _slabs(x, radius, _slab_size(pts, r, pair_budget)):
-        sub = pts[order[lo:hi]]
-        origin = sub.mean(axis=0)
-        core = sub[a - lo:b - lo] - origin
-        f_core = _moments(core)
-        core_tree = cKDTree(core)
-        upper = _pairs(core_tree, r)
-        sums = f_core + upper @ f_core + upper.T @ f_core
-        halo = np.concatenate([sub[:a - lo], sub[b - lo:]]) - origin
-        if len(halo):
-            sums += _cross(core_tree, cKDTree(halo), r) @ _moments(halo)
-        yield order[a:b], sums
+    size = min(_slab_size(pts, r, pair_budget // 2), -(-len(pts) // 2))
+    slabs = list(_slabs(x, radius, max(size, 1)))
+    if workers == 1 or len(slabs) == 1:
+        for bounds in slabs:
+            yield _slab_sums(pts, order, r, bounds)
+        return
+    with ThreadPoolExecutor(workers) as pool:
+        for start in range(0, len(slabs), workers):
+            yield from pool.map(lambda bounds: _slab_sums(pts, order, r, bounds),
+                                slabs[start:start + workers])
 
 
 def entropies(cov: np.ndarray) -> np.ndarray:
@@ -188,14 +212,14 @@ def plane_variances(cov: np.ndarray) -> np.ndarray:
 
 
 def scores(points: np.ndarray, radius: float = LIDAR_RADIUS, min_knn: int = MIN_KNN,
-           pair_budget: int = PAIR_BUDGET) -> NoRefScores:
+           pair_budget: int = PAIR_BUDGET, workers: int | None = None) -> NoRefScores:
     """MME and MPV of a map (N, 3 metres) in one pass: the means, over the points with more than
     ``min_knn`` neighbours (itself included) closer than ``radius`` metres, of the entropy
     0.5 ln det(2 pi e Sigma) (points with det <= 0 skipped) and of Sigma's smallest
     eigenvalue. 0.0 when no point qualifies, as map-metrics."""
     ent_sum = var_sum = 0.0
     ent_n = var_n = 0
-    for _, sums in neighbourhood_sums(points, radius, pair_budget):
+    for _, sums in neighbourhood_sums(points, radius, pair_budget, workers):
         cov = covariances(sums[sums[:, 0] > min_knn])
         ent = entropies(cov)
         ok = ~np.isnan(ent)
