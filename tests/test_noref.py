@@ -215,3 +215,23 @@ def test_depth_data_reproduces_map_metrics():
     planes = posed.place_subset(posed.read_orthogonal_subset(depth / "orth_subset/orth-0091.npy"),
                                 posed.read_pose_file(depth / "poses/pose-0091.txt"), poses[0])
     assert noref.mom(points, planes, noref.DEPTH_RADIUS) == pytest.approx(DEPTH_MOM, abs=1e-12)
+
+
+def test_noref_figures_extracts_a_subset_or_says_why_not():
+    from pcmapq.metrics.inspection import noref_figures
+
+    rng = np.random.default_rng(7)
+    walls = []
+    for axis in range(3):
+        w = rng.uniform(0, 2, (1500, 3))
+        w[:, axis] = rng.normal(0, 0.002, len(w))
+        walls.append(w)
+    corner = np.vstack(walls)
+    got = noref_figures(corner, radius=0.2)
+    assert got["orth_subset"] == "extracted" and len(got["orth_plane_points"]) == 3
+    assert got["mom"] == pytest.approx(noref.mom(corner, orthogonal.extract_orthogonal_subset(
+        corner, 0.2), 0.2))
+    assert got["points"] == 4500 and got["mpv"] == pytest.approx(noref.scores(corner, 0.2).mpv)
+    flat = walls[2]
+    got = noref_figures(flat, radius=0.2)
+    assert got["mom"] is None and "orthogonal" in got["mom_note"]
