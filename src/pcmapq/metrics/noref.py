@@ -34,8 +34,9 @@ MAX_NN = 30
 #: MOM keeps an orthogonal-subset point whose neighbourhood holds more than this many map
 #: points (hard-coded in map-metrics, independent of ``min_knn``).
 MOM_MIN_NEIGHBOURS = 3
-#: Neighbour pairs held at once (about 16 bytes each, plus sums): bounds memory on big maps.
-PAIR_BUDGET = 20_000_000
+#: Neighbour pairs held at once, two slabs of half as many (about 40 bytes a pair while a slab
+#: is summed): bounds memory on big maps.
+PAIR_BUDGET = 24_000_000
 #: Threads over slabs by default (CI machines have two cores).
 WORKERS = 2
 #: ln(2 pi e): MME's constant per dimension.
@@ -120,8 +121,9 @@ def _slabs(x: np.ndarray, radius: float, size: int) -> Iterator[tuple[int, int, 
 
 
 def _slab_size(points: np.ndarray, r: float, pair_budget: int) -> int:
-    """Core points per slab so that one slab holds about ``pair_budget`` neighbour pairs,
-    from the neighbour counts of a fixed sample of points."""
+    """Core points per slab so that one slab holds about ``pair_budget`` neighbour pairs (each
+    point's neighbours, itself excepted, halved: every pair is found once), from the neighbour
+    counts of a fixed sample of points."""
     n = len(points)
     if n <= 1:
         return max(n, 1)
@@ -129,7 +131,7 @@ def _slab_size(points: np.ndarray, r: float, pair_budget: int) -> int:
     sample = points[::step]
     counts = cKDTree(points).query_ball_point(sample, r, return_length=True) if n <= 2_000_000 \
         else _sample_counts(points, sample, r)
-    per_point = max(float(np.mean(counts)), 1.0)
+    per_point = max((float(np.mean(counts)) - 1.0) / 2.0, 1.0)
     return int(min(n, max(1000, pair_budget / per_point)))
 
 
@@ -173,7 +175,7 @@ def neighbourhood_sums(points: np.ndarray, radius: float, pair_budget: int = PAI
     about ``pair_budget / 2`` neighbour pairs) do not depend on ``workers``, the threads that
     run them (SciPy's kd-trees release the GIL) and they are yielded in order, so the figures
     are the same bit for bit whatever the thread count. Memory: about ``pair_budget``
-    neighbour pairs (16 bytes each) with two workers."""
+    neighbour pairs (about 40 bytes each) with two workers."""
     pts = np.asarray(points, dtype=np.float64)
     if pts.ndim != 2 or pts.shape[1] != 3:
         raise ValueError(f"points must be (N, 3), got {pts.shape}")
