@@ -12,7 +12,8 @@ from numpy.lib import format as npy
 
 from pcmapq.errors import EvaluationError, InputError
 from pcmapq.metrics import noref, orthogonal, posed
-from tests.conftest import shared
+
+from .conftest import shared
 
 #: map-metrics' own figures on its depth test data (radius 0.2 m, more than 5 neighbours),
 #: from running its code (Python 0.0.4, and its C++ rewrite's test_depth.cpp for MME and MPV).
