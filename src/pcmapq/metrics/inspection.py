@@ -1,0 +1,46 @@
+"""The no-reference figures of a 3D map as one JSON-ready record (``pcmapq inspect``, the
+``"noref"`` block of ``eval``): MME, MPV, MOM and what they were computed over."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from pcmapq.errors import EvaluationError
+from pcmapq.metrics.noref import LIDAR_RADIUS, MAX_NN, MIN_KNN, mom, scores
+from pcmapq.metrics.orthogonal import extract_orthogonal_subset
+
+
+def _finite(value: float) -> float | None:
+    return value if math.isfinite(value) else None
+
+
+def noref_figures(points: np.ndarray, radius: float = LIDAR_RADIUS, min_knn: int = MIN_KNN,
+                  max_nn: int = MAX_NN, orth_subset: Sequence[np.ndarray] | None = None,
+                  mom_source: np.ndarray | None = None) -> dict[str, Any]:
+    """MME (nats), MPV and MOM (m^2) of ``points`` (N, 3 metres) with their parameters.
+
+    MOM uses ``orth_subset`` (planes in the map's frame) or else extracts one from
+    ``mom_source`` (map-metrics: the first scan; None: the map itself); when none can be found,
+    ``mom`` is None and ``mom_note`` says why. Figures that are not finite are None.
+    """
+    s = scores(points, radius, min_knn)
+    note = None
+    planes = orth_subset
+    source = "given" if planes is not None else "extracted"
+    if planes is None:
+        try:
+            planes = extract_orthogonal_subset(points if mom_source is None else mom_source,
+                                               radius, max_nn)
+        except EvaluationError as exc:
+            note, source = str(exc), None
+    value = None if planes is None else _finite(mom(points, planes, radius))
+    return {
+        "mme": _finite(s.mme), "mpv": _finite(s.mpv), "mom": value, "mom_note": note,
+        "points": s.total_points, "mme_points": s.mme_points, "mpv_points": s.mpv_points,
+        "radius_m": radius, "min_knn": min_knn, "max_nn": max_nn, "orth_subset": source,
+        "orth_plane_points": None if planes is None else [len(p) for p in planes],
+    }

@@ -1,0 +1,276 @@
+"""No-reference 3D map metrics: Mean Map Entropy (MME), Mean Plane Variance (MPV) and the
+Mutually Orthogonal Metric (MOM), computed exactly as the ``map-metrics`` package
+(MobileRoboticsSkoltech/map-metrics, Python 0.0.4 and its C++ rewrite) defines them.
+
+The neighbourhood of a point q is every map point p with |p - q| < radius (strictly, as Open3D's
+``search_radius_vector_3d``), the point itself included; there is no cap on the number of
+neighbours. Covariances are unbiased (divided by n - 1, as ``np.cov``). Units: points and radius
+in metres, MPV and MOM in square metres, MME in nats (ln of metres).
+
+Neighbourhoods come from SciPy kd-trees (pairs of points closer than the radius, each found
+once) and sparse sums, never a Python loop over points. The map is processed in slabs along its
+longest axis, each with the points within the radius on either side, so memory stays bounded
+(``pair_budget`` neighbour pairs at a time) whatever the map's size; coordinates are taken
+relative to each slab's centre.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from collections.abc import Iterator, Sequence
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.spatial import cKDTree
+
+#: map-metrics' presets (metres, neighbour counts): ``LidarConfig`` and ``DepthConfig``.
+LIDAR_RADIUS = 1.0
+DEPTH_RADIUS = 0.2
+MIN_KNN = 5
+MAX_NN = 30
+#: MOM keeps an orthogonal-subset point whose neighbourhood holds more than this many map
+#: points (hard-coded in map-metrics, independent of ``min_knn``).
+MOM_MIN_NEIGHBOURS = 3
+#: Neighbour pairs held at once, two slabs of half as many (about 40 bytes a pair while a slab
+#: is summed): bounds memory on big maps.
+PAIR_BUDGET = 24_000_000
+#: Threads over slabs by default (CI machines have two cores).
+WORKERS = 2
+#: ln(2 pi e): MME's constant per dimension.
+LN_2PIE = math.log(2.0 * math.pi * math.e)
+
+
+@dataclass(frozen=True)
+class NoRefScores:
+    """MME (nats) and MPV (m^2) of one map, with the number of points each mean is over.
+
+    mme_points: points with more than ``min_knn`` neighbours and a positive determinant;
+    mpv_points: points with more than ``min_knn`` neighbours; total_points: the map's size.
+    """
+
+    mme: float
+    mpv: float
+    mme_points: int
+    mpv_points: int
+    total_points: int
+
+
+def strict_radius(radius: float) -> float:
+    """The largest r' whose square is below ``radius``^2, so that SciPy's inclusive test
+    d^2 <= r'^2 keeps the pairs with d^2 < radius^2 (Open3D's strict test). The two agree
+    except for a squared distance between r'^2 and radius^2 when no double squares to the
+    double just below radius^2: an interval of one or two units in the last place (a point at
+    exactly sqrt(2) from another with ``radius=math.sqrt(2)``, say); never met in measured
+    clouds."""
+    if not radius > 0:
+        raise ValueError(f"radius must be positive, got {radius}")
+    target = np.nextafter(radius * radius, 0.0)
+    r = math.sqrt(target)
+    while r * r > target:
+        r = np.nextafter(r, 0.0)
+    while np.nextafter(r, np.inf) ** 2 <= target:
+        r = np.nextafter(r, np.inf)
+    return float(r)
+
+
+def _moments(xyz: np.ndarray) -> np.ndarray:
+    """(N, 3) metres -> (N, 10): 1, x, y, z, xx, xy, xz, yy, yz, zz."""
+    x, y, z = xyz[:, 0], xyz[:, 1], xyz[:, 2]
+    return np.column_stack([np.ones(len(xyz)), x, y, z, x * x, x * y, x * z, y * y, y * z, z * z])
+
+
+def covariances(sums: np.ndarray) -> np.ndarray:
+    """(N, 10) moment sums (count first) -> (N, 3, 3) unbiased covariances, m^2 (NaN where
+    the count is below 2)."""
+    n = sums[:, 0]
+    mean = sums[:, 1:4] / n[:, None]
+    second = np.empty((len(sums), 3, 3))
+    for k, (a, b) in enumerate(((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))):
+        second[:, a, b] = second[:, b, a] = sums[:, 4 + k]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        cov = (second - n[:, None, None] * mean[:, :, None] * mean[:, None, :]) / (n - 1)[:, None,
+                                                                                         None]
+    return cov
+
+
+def _pairs(tree: cKDTree, r: float) -> sp.coo_matrix:
+    """Upper-triangular adjacency (i < j, |p_i - p_j|^2 <= r^2) of a tree's points (COO: its
+    products with dense arrays need no conversion)."""
+    ij = tree.query_pairs(r, output_type="ndarray")
+    n = tree.n
+    return sp.coo_matrix((np.ones(len(ij)), (ij[:, 0], ij[:, 1])), shape=(n, n))
+
+
+def _cross(tree: cKDTree, other: cKDTree, r: float) -> sp.coo_matrix:
+    """Adjacency rows = ``tree``'s points, columns = ``other``'s, for pairs within r."""
+    d = tree.sparse_distance_matrix(other, r, output_type="ndarray")
+    return sp.coo_matrix((np.ones(len(d)), (d["i"], d["j"])), shape=(tree.n, other.n))
+
+
+def _slabs(x: np.ndarray, radius: float, size: int) -> Iterator[tuple[int, int, int, int]]:
+    """Index ranges over sorted ``x``: core [a, b) and, around it, [lo, hi) within radius."""
+    n = len(x)
+    for a in range(0, n, size):
+        b = min(a + size, n)
+        lo = int(np.searchsorted(x, x[a] - radius, side="left"))
+        hi = int(np.searchsorted(x, x[b - 1] + radius, side="right"))
+        yield a, b, lo, hi
+
+
+def _slab_size(points: np.ndarray, r: float, pair_budget: int) -> int:
+    """Core points per slab so that one slab holds about ``pair_budget`` neighbour pairs (each
+    point's neighbours, itself excepted, halved: every pair is found once), from the neighbour
+    counts of a fixed sample of points."""
+    n = len(points)
+    if n <= 1:
+        return max(n, 1)
+    step = max(1, n // 2000)
+    sample = points[::step]
+    counts = cKDTree(points).query_ball_point(sample, r, return_length=True) if n <= 2_000_000 \
+        else _sample_counts(points, sample, r)
+    per_point = max((float(np.mean(counts)) - 1.0) / 2.0, 1.0)
+    return int(min(n, max(1000, pair_budget / per_point)))
+
+
+def _sample_counts(points: np.ndarray, sample: np.ndarray, r: float) -> np.ndarray:
+    """Neighbour counts of ``sample`` in ``points`` without a tree over all of them: only the
+    points within r of the sample's boxes are indexed (a big map's tree is its own cost)."""
+    order = np.argsort(sample[:, 0], kind="stable")
+    sample = sample[order]
+    counts = np.empty(len(sample))
+    for k in range(0, len(sample), 100):
+        q = sample[k:k + 100]
+        lo, hi = q.min(0) - r, q.max(0) + r
+        near = points[np.all((points >= lo) & (points <= hi), axis=1)]
+        counts[k:k + 100] = cKDTree(near).query_ball_point(q, r, return_length=True)
+    return counts
+
+
+def _slab_sums(pts: np.ndarray, order: np.ndarray, r: float,
+               bounds: tuple[int, int, int, int]) -> tuple[np.ndarray, np.ndarray]:
+    """(indices, moment sums) of the core [a, b) of one slab, its neighbours from [lo, hi)."""
+    a, b, lo, hi = bounds
+    sub = pts[order[lo:hi]]
+    origin = sub.mean(axis=0)
+    core = sub[a - lo:b - lo] - origin
+    f_core = _moments(core)
+    core_tree = cKDTree(core)
+    upper = _pairs(core_tree, r)
+    sums = f_core + upper @ f_core + upper.T @ f_core
+    del upper
+    halo = np.concatenate([sub[:a - lo], sub[b - lo:]]) - origin
+    if len(halo):
+        sums += _cross(core_tree, cKDTree(halo), r) @ _moments(halo)
+    return order[a:b], sums
+
+
+def neighbourhood_sums(points: np.ndarray, radius: float, pair_budget: int = PAIR_BUDGET,
+                       workers: int | None = None) -> Iterator[tuple[np.ndarray, np.ndarray]]:
+    """Yield (indices into ``points``, (k, 10) moment sums) over every point's neighbourhood:
+    count, sums of x, y, z and of the products xx, xy, xz, yy, yz, zz, in coordinates relative
+    to a per-slab origin. Covariances: :func:`covariances`. The slabs (at least two, each of
+    about ``pair_budget / 2`` neighbour pairs) do not depend on ``workers``, the threads that
+    run them (SciPy's kd-trees release the GIL) and they are yielded in order, so the figures
+    are the same bit for bit whatever the thread count. Memory: about ``pair_budget``
+    neighbour pairs (about 40 bytes each) with two workers."""
+    pts = np.asarray(points, dtype=np.float64)
+    if pts.ndim != 2 or pts.shape[1] != 3:
+        raise ValueError(f"points must be (N, 3), got {pts.shape}")
+    if len(pts) == 0:
+        return
+    workers = max(1, workers or min(WORKERS, os.cpu_count() or 1))
+    r = strict_radius(radius)
+    axis = int(np.argmax(np.ptp(pts, axis=0)))
+    order = np.argsort(pts[:, axis], kind="stable")
+    x = pts[order, axis]
+    size = min(_slab_size(pts, r, pair_budget // 2), -(-len(pts) // 2))
+    slabs = list(_slabs(x, radius, max(size, 1)))
+    if workers == 1 or len(slabs) == 1:
+        for bounds in slabs:
+            yield _slab_sums(pts, order, r, bounds)
+        return
+    with ThreadPoolExecutor(workers) as pool:
+        for start in range(0, len(slabs), workers):
+            yield from pool.map(lambda bounds: _slab_sums(pts, order, r, bounds),
+                                slabs[start:start + workers])
+
+
+def entropies(cov: np.ndarray) -> np.ndarray:
+    """0.5 ln det(2 pi e Sigma) per (3, 3) covariance (nats); NaN where the determinant is not
+    positive (map-metrics skips those points)."""
+    det = np.linalg.det(2.0 * np.pi * np.e * cov)
+    out = np.full(len(cov), np.nan)
+    ok = det > 0
+    out[ok] = 0.5 * np.log(det[ok])
+    return out
+
+
+def plane_variances(cov: np.ndarray) -> np.ndarray:
+    """Smallest eigenvalue of each (3, 3) covariance, m^2."""
+    return np.linalg.eigvalsh(cov)[:, 0]
+
+
+def scores(points: np.ndarray, radius: float = LIDAR_RADIUS, min_knn: int = MIN_KNN,
+           pair_budget: int = PAIR_BUDGET, workers: int | None = None) -> NoRefScores:
+    """MME and MPV of a map (N, 3 metres) in one pass: the means, over the points with more than
+    ``min_knn`` neighbours (itself included) closer than ``radius`` metres, of the entropy
+    0.5 ln det(2 pi e Sigma) (points with det <= 0 skipped) and of Sigma's smallest
+    eigenvalue. 0.0 when no point qualifies, as map-metrics."""
+    ent_sum = var_sum = 0.0
+    ent_n = var_n = 0
+    for _, sums in neighbourhood_sums(points, radius, pair_budget, workers):
+        cov = covariances(sums[sums[:, 0] > min_knn])
+        ent = entropies(cov)
+        ok = ~np.isnan(ent)
+        ent_sum += float(ent[ok].sum())
+        ent_n += int(ok.sum())
+        var_sum += float(plane_variances(cov).sum())
+        var_n += len(cov)
+    return NoRefScores(mme=ent_sum / ent_n if ent_n else 0.0,
+                       mpv=var_sum / var_n if var_n else 0.0,
+                       mme_points=ent_n, mpv_points=var_n, total_points=len(points))
+
+
+def mme(points: np.ndarray, radius: float = LIDAR_RADIUS, min_knn: int = MIN_KNN) -> float:
+    """Mean Map Entropy, nats (see :func:`scores`)."""
+    return scores(points, radius, min_knn).mme
+
+
+def mpv(points: np.ndarray, radius: float = LIDAR_RADIUS, min_knn: int = MIN_KNN) -> float:
+    """Mean Plane Variance, m^2 (see :func:`scores`)."""
+    return scores(points, radius, min_knn).mpv
+
+
+def query_covariances(points: np.ndarray, queries: np.ndarray,
+                      radius: float) -> tuple[np.ndarray, np.ndarray]:
+    """For each query (Q, 3 metres): its number of map points closer than ``radius`` and their
+    unbiased covariance (Q, 3, 3), m^2. Only the map points near the queries are indexed."""
+    q = np.asarray(queries, dtype=np.float64).reshape(-1, 3)
+    pts = np.asarray(points, dtype=np.float64)
+    if len(q) == 0:
+        return np.zeros(0, dtype=np.int64), np.zeros((0, 3, 3))
+    r = strict_radius(radius)
+    lo, hi = q.min(axis=0) - radius, q.max(axis=0) + radius
+    near = pts[np.all((pts >= lo) & (pts <= hi), axis=1)]
+    origin = q.mean(axis=0)
+    if len(near) == 0:
+        return np.zeros(len(q), dtype=np.int64), np.full((len(q), 3, 3), np.nan)
+    sums = _cross(cKDTree(q - origin), cKDTree(near - origin), r) @ _moments(near - origin)
+    return sums[:, 0].astype(np.int64), covariances(sums)
+
+
+def mom(points: np.ndarray, orth_subset: Sequence[np.ndarray], radius: float = LIDAR_RADIUS,
+        min_neighbours: int = MOM_MIN_NEIGHBOURS) -> float:
+    """Mutually Orthogonal Metric, m^2: for each plane of ``orth_subset`` (arrays of points in
+    the map's frame, metres), the median over its points with more than ``min_neighbours`` map
+    points closer than ``radius`` of the neighbourhood's smallest covariance eigenvalue; the
+    sum of those medians (NaN for a plane with no such point, as ``np.median([])``)."""
+    total = 0.0
+    for plane in orth_subset:
+        counts, cov = query_covariances(points, plane, radius)
+        values = plane_variances(cov[counts > min_neighbours])
+        total += float(np.median(values)) if len(values) else math.nan
+    return total

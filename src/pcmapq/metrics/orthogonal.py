@@ -1,0 +1,95 @@
+"""MOM's orthogonal subset, extracted as map-metrics' ``extract_orthogonal_subsets`` does:
+
+1. normals of the cloud by Open3D (hybrid search: ``radius`` metres, at most ``max_nn``);
+2. planar points: more than 3 neighbours closer than ``radius`` and, of their neighbourhood's
+   covariance eigenvalues, 100 * lambda_0 < lambda_1;
+3. their normals clustered by Ward linkage, cut at distance 0.1 (scikit-learn's
+   ``AgglomerativeClustering(distance_threshold=0.1)``, here SciPy's identical Ward tree);
+4. clusters of more than ``min_cluster`` points, their mean normals normalised;
+5. of the triples of clusters whose mean normals are pairwise nearly orthogonal
+   (|cos| < ``eps``), the one holding the most points (map-metrics: the largest maximal clique,
+   and in 3D no four directions are pairwise that orthogonal, so its cliques are triples).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.cluster.hierarchy import fcluster, ward
+
+from pcmapq.errors import EvaluationError
+from pcmapq.metrics.noref import MAX_NN, covariances, neighbourhood_sums
+
+#: map-metrics' constants: Ward cut distance, near-orthogonality |cos|, smallest cluster.
+WARD_CUT = 0.1
+ORTHOGONAL_COS = 0.1
+MIN_CLUSTER = 5
+#: Ward clustering holds N^2 / 2 distances: more planar points than this are refused.
+MAX_PLANAR_POINTS = 30_000
+
+
+def planar_points(cloud: np.ndarray, radius: float) -> np.ndarray:
+    """Mask of the points whose neighbourhood (more than 3 points closer than ``radius``
+    metres) is flat: 100 * smallest eigenvalue < middle eigenvalue."""
+    keep = np.zeros(len(cloud), dtype=bool)
+    for idx, sums in neighbourhood_sums(cloud, radius):
+        ok = sums[:, 0] > 3
+        lam = np.linalg.eigvalsh(covariances(sums[ok]))
+        keep[idx[ok]] = 100.0 * lam[:, 0] < lam[:, 1]
+    return keep
+
+
+def _normals(cloud: np.ndarray, radius: float, max_nn: int) -> np.ndarray:
+    import open3d as o3d  # heavy: loaded when a subset is extracted
+
+    pc = o3d.geometry.PointCloud(o3d.utility.Vector3dVector(np.asarray(cloud, dtype=np.float64)))
+    pc.estimate_normals(search_param=o3d.geometry.KDTreeSearchParamHybrid(radius=radius,
+                                                                          max_nn=max_nn))
+    return np.asarray(pc.normals)
+
+
+def _best_triple(means: np.ndarray, sizes: np.ndarray, eps: float) -> tuple[int, int, int]:
+    """Indices of the pairwise-orthogonal triple of unit normals with the largest total size
+    (the first, in lexicographic order, among equals)."""
+    adj = np.abs(means @ means.T) < eps
+    i, j, k = _triples(len(means))
+    ok = adj[i, j] & adj[i, k] & adj[j, k]
+    if not ok.any():
+        raise EvaluationError("no three mutually orthogonal planes found for MOM "
+                              "(give an orthogonal subset instead)")
+    total = np.where(ok, sizes[i] + sizes[j] + sizes[k], -1)
+    best = int(np.argmax(total))
+    return int(i[best]), int(j[best]), int(k[best])
+
+
+def _triples(n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """All i < j < k below n, lexicographic."""
+    grid = np.indices((n, n, n)).reshape(3, -1)
+    keep = (grid[0] < grid[1]) & (grid[1] < grid[2])
+    return grid[0][keep], grid[1][keep], grid[2][keep]
+
+
+def extract_orthogonal_subset(cloud: np.ndarray, radius: float, max_nn: int = MAX_NN,
+                              min_cluster: int = MIN_CLUSTER,
+                              eps: float = ORTHOGONAL_COS) -> list[np.ndarray]:
+    """Three arrays of points (metres, the cloud's frame) on mutually orthogonal planes of
+    ``cloud`` (map-metrics extracts them from the first scan). EvaluationError when none."""
+    cloud = np.asarray(cloud, dtype=np.float64)
+    normals = _normals(cloud, radius, max_nn)
+    keep = planar_points(cloud, radius)
+    points, normals = cloud[keep], normals[keep]
+    if len(points) < 3 * (min_cluster + 1):
+        raise EvaluationError(f"only {len(points)} planar points for MOM's orthogonal subset")
+    if len(points) > MAX_PLANAR_POINTS:
+        raise EvaluationError(f"{len(points)} planar points: more than {MAX_PLANAR_POINTS} to "
+                              "cluster for MOM's orthogonal subset (give one instead)")
+    tree = ward(normals)
+    clusters = int(np.count_nonzero(tree[:, 2] >= WARD_CUT)) + 1
+    labels = fcluster(tree, clusters, criterion="maxclust")
+    ids, sizes = np.unique(labels, return_counts=True)
+    big = sizes > min_cluster
+    ids, sizes = ids[big], sizes[big]
+    if len(ids) < 3:
+        raise EvaluationError("fewer than three planes for MOM's orthogonal subset")
+    means = np.stack([normals[labels == c].mean(axis=0) for c in ids])
+    means /= np.linalg.norm(means, axis=1, keepdims=True)
+    return [points[labels == ids[c]] for c in _best_triple(means, sizes, eps)]
