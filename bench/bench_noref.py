@@ -105,12 +105,14 @@ def _map_metrics() -> types.ModuleType | None:
 
 
 def depth_rows(repeat: int, theirs: bool) -> list[str]:
+    from pcmapq.mapping.poses import read_pose_matrix, read_poses
+    from pcmapq.mapping.reference import posed_map
     from pcmapq.metrics import noref, posed
 
-    points = posed.load_posed_map(DEPTH / "pcs", DEPTH / "poses")
-    poses = posed.read_poses(DEPTH / "poses")
+    points = posed_map(DEPTH / "pcs", read_poses(DEPTH / "poses"))
+    poses = read_poses(DEPTH / "poses")
     planes = posed.place_subset(posed.read_orthogonal_subset(DEPTH / "orth_subset/orth-0091.npy"),
-                                posed.read_pose_file(DEPTH / "poses/pose-0091.txt"), poses[0])
+                                read_pose_matrix(DEPTH / "poses/pose-0091.txt"), poses[0])
     s, wall, cpu = _timed(lambda: noref.scores(points, RADIUS, MIN_KNN), repeat)
     m, m_wall, m_cpu = _timed(lambda: noref.mom(points, planes, RADIUS), repeat)
     ours = {"MME": (s.mme, wall, cpu), "MPV": (s.mpv, wall, cpu), "MOM": (m, m_wall, m_cpu)}

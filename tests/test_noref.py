@@ -11,6 +11,8 @@ import pytest
 from numpy.lib import format as npy
 
 from pcmapq.errors import EvaluationError, InputError
+from pcmapq.mapping.poses import read_pose_matrix, read_poses
+from pcmapq.mapping.reference import posed_map
 from pcmapq.metrics import noref, orthogonal, posed
 
 from .conftest import shared
@@ -172,14 +174,14 @@ def test_pose_files_kitti_tum_and_folder(tmp_path):
     np.savetxt(folder / "b.txt", pose)
     np.savetxt(folder / "a.txt", np.eye(4))
     for source in (kitti, tum, folder):
-        got = posed.read_poses(source)
+        got = read_poses(source)
         assert len(got) == 2
         np.testing.assert_allclose(got[0], np.eye(4), atol=1e-12)
         np.testing.assert_allclose(got[1], pose, atol=1e-12)
     bad = tmp_path / "bad.txt"
     bad.write_text("1 2 3\n")
     with pytest.raises(InputError, match="bad.txt"):
-        posed.read_poses(bad)
+        read_poses(bad)
 
 
 class _Evil:
@@ -205,16 +207,16 @@ def test_orthogonal_subset_file_runs_no_pickled_code(tmp_path, capsys):
 
 def test_depth_data_reproduces_map_metrics():
     depth = shared("map-metrics", "depth")
-    points = posed.load_posed_map(depth / "pcs", depth / "poses")
+    points = posed_map(depth / "pcs", read_poses(depth / "poses"))
     assert len(points) == 103_975
     got = noref.scores(points, noref.DEPTH_RADIUS, noref.MIN_KNN)
     assert got.mme == pytest.approx(DEPTH_MME, abs=1e-9)
     assert got.mpv == pytest.approx(DEPTH_MPV, abs=1e-12)
     # the 0.003242 of map-metrics' test file belongs to its earlier 473-scan data set
     assert abs(got.mpv - 0.003242216) > 5e-4
-    poses = posed.read_poses(depth / "poses")
+    poses = read_poses(depth / "poses")
     planes = posed.place_subset(posed.read_orthogonal_subset(depth / "orth_subset/orth-0091.npy"),
-                                posed.read_pose_file(depth / "poses/pose-0091.txt"), poses[0])
+                                read_pose_matrix(depth / "poses/pose-0091.txt"), poses[0])
     assert noref.mom(points, planes, noref.DEPTH_RADIUS) == pytest.approx(DEPTH_MOM, abs=1e-12)
 
 

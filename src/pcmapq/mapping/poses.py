@@ -6,6 +6,8 @@ the world frame, ``p_world = P_k @ p_sensor``; translations in metres.
 - KITTI: one pose per line, 12 numbers, the top 3x4 of ``P_k`` in row-major order.
 - TUM: one pose per line, ``t x y z qx qy qz qw`` (seconds, metres, unit quaternion with the
   scalar last).
+- A folder of pose files, one per scan in name order, each the 4x4 matrix ``P_k`` (or its top
+  3x4) as four (three) rows of numbers: map-metrics' layout.
 
 Both are written with single spaces, no header and full float precision, as ``evo`` reads them.
 Lines that are empty or start with ``#`` are skipped when reading.
@@ -36,6 +38,8 @@ __all__ = [
     "moves_along_z",
     "read_calib",
     "read_kitti_poses",
+    "read_pose_matrix",
+    "read_poses",
     "read_tum_poses",
     "write_kitti_poses",
     "write_tum_poses",
@@ -106,10 +110,28 @@ def write_tum_poses(path: str | Path, poses: np.ndarray, timestamps: np.ndarray 
     write_atomic(path, _format_rows(rows), outputs)
 
 
+def read_pose_matrix(path: str | Path) -> np.ndarray:
+    """One pose from a text file of four rows of four numbers (or the top three): 4x4, sensor ->
+    world, metres."""
+    path = Path(path)
+    rows = _read_table(path, 4, "4 numbers (a row of a 4x4 pose)")
+    if len(rows) == 3:
+        rows = np.vstack([rows, [0.0, 0.0, 0.0, 1.0]])
+    if len(rows) != 4:
+        raise InputError(f"{path}: {len(rows)} rows, expected a 4x4 pose")
+    return _check_poses(rows[None], path)[0]
+
+
 def read_poses(path: str | Path) -> np.ndarray:
     """Read a KITTI (12 columns) or TUM (8 columns) pose file, told apart by its first data
-    line: (K, 4, 4) poses, sensor -> world, metres."""
+    line, or a folder of 4x4 pose files (name order): (K, 4, 4) poses, sensor -> world,
+    metres."""
     path = Path(path)
+    if path.is_dir():
+        files = sorted(p for p in path.iterdir() if p.is_file() and not p.name.startswith("."))
+        if not files:
+            raise InputError(f"{path}: no pose files in the folder")
+        return np.stack([read_pose_matrix(f) for f in files])
     lines = [ln for ln in _read_text(path).splitlines() if ln.strip() and not ln.startswith("#")]
     if lines and len(lines[0].split()) == 8:
         return read_tum_poses(path)[1]

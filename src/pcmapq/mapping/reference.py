@@ -19,6 +19,7 @@ import numpy as np
 
 from pcmapq.errors import InputError
 from pcmapq.mapping.scans import ScanSequence, open_scans
+from pcmapq.metrics.posed import place
 from pcmapq.voxels import VoxelMap
 
 __all__ = ["build_map_from_poses", "describe_scans", "scans_for_poses"]
@@ -83,3 +84,12 @@ def build_map_from_poses(source: str | Path | ScanSequence, poses: np.ndarray,
         if progress is not None:
             progress(index + 1, len(scans))
     return grid.points()
+
+
+def posed_map(source: str | Path | ScanSequence, poses: np.ndarray, *,
+              max_scans: int | None = None) -> np.ndarray:
+    """Every scan placed at its pose relative to the first, as map-metrics' ``aggregate_map``
+    (no voxel, no range limit): the map (N, 3) float64, metres, in the first scan's frame.
+    ``poses``: (K, 4, 4), one per scan (see :func:`scans_for_poses`)."""
+    scans = scans_for_poses(source, len(poses), max_scans=max_scans)
+    return place([points for points, _ in scans], list(poses[:len(scans)]))

@@ -1,9 +1,9 @@
-"""A map built from scans placed at their poses (a SLAM run's output), and map-metrics'
-orthogonal-subset files.
+"""Scans placed at their poses as map-metrics places them, and its orthogonal-subset files.
 
 Poses are 4x4 rigid transforms taking scan coordinates to the world, metres. The map is every
 scan placed at its pose relative to the first: ``inv(T_0) @ T_i`` (as map-metrics'
-``aggregate_map``), so it is in the first scan's frame.
+``aggregate_map``), so it is in the first scan's frame. Pose files and scan folders are read by
+:mod:`pcmapq.mapping` (:func:`pcmapq.mapping.reference.posed_map`).
 """
 
 from __future__ import annotations
@@ -16,7 +16,6 @@ import numpy as np
 from numpy.lib import format as npy
 
 from pcmapq.errors import InputError
-from pcmapq.io.clouds import CLOUD_SUFFIXES, load_cloud
 
 
 def place(clouds: Sequence[np.ndarray], poses: Sequence[np.ndarray]) -> np.ndarray:
@@ -31,75 +30,6 @@ def place(clouds: Sequence[np.ndarray], poses: Sequence[np.ndarray]) -> np.ndarr
         t = first @ np.asarray(pose, dtype=np.float64)
         out.append(np.asarray(cloud, dtype=np.float64) @ t[:3, :3].T + t[:3, 3])
     return np.vstack(out)
-
-
-def read_pose_file(path: Path) -> np.ndarray:
-    """One 4x4 pose from a text file (4 rows of 4 numbers; a 3x4 top is accepted)."""
-    try:
-        m = np.loadtxt(path, dtype=np.float64, ndmin=2)
-    except (ValueError, OSError) as exc:
-        raise InputError(f"{path}: not a 4x4 pose: {exc}") from None
-    if m.shape == (3, 4):
-        m = np.vstack([m, [0.0, 0.0, 0.0, 1.0]])
-    if m.shape != (4, 4) or not np.all(np.isfinite(m)):
-        raise InputError(f"{path}: expected a 4x4 pose, got shape {m.shape}")
-    return m
-
-
-def read_poses(path: Path) -> list[np.ndarray]:
-    """Poses from a folder of 4x4 text files (name order), a KITTI file (12 numbers a line:
-    the top 3x4, row-major) or a TUM file (8 numbers a line: t x y z qx qy qz qw)."""
-    path = Path(path)
-    if path.is_dir():
-        files = sorted(p for p in path.iterdir() if p.is_file())
-        if not files:
-            raise InputError(f"{path}: no pose files in the folder")
-        return [read_pose_file(p) for p in files]
-    try:
-        table = np.loadtxt(path, dtype=np.float64, ndmin=2, comments="#")
-    except (ValueError, OSError) as exc:
-        raise InputError(f"{path}: not a KITTI or TUM pose file: {exc}") from None
-    if table.shape[1] == 12:
-        tops = table.reshape(-1, 3, 4)
-        bottom = np.broadcast_to([0.0, 0.0, 0.0, 1.0], (len(tops), 1, 4))
-        return list(np.concatenate([tops, bottom], axis=1))
-    if table.shape[1] == 8:
-        return list(_tum(table[:, 1:4], table[:, 4:8]))
-    raise InputError(f"{path}: expected 12 (KITTI) or 8 (TUM) numbers a line, "
-                     f"got {table.shape[1]}")
-
-
-def _tum(t: np.ndarray, q: np.ndarray) -> np.ndarray:
-    """(N, 3) translations and (N, 4) quaternions x, y, z, w -> (N, 4, 4) poses."""
-    q = q / np.linalg.norm(q, axis=1, keepdims=True)
-    x, y, z, w = q.T
-    out = np.zeros((len(q), 4, 4))
-    out[:, 0] = np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w),
-                          t[:, 0]], axis=1)
-    out[:, 1] = np.stack([2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w),
-                          t[:, 1]], axis=1)
-    out[:, 2] = np.stack([2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y),
-                          t[:, 2]], axis=1)
-    out[:, 3, 3] = 1.0
-    return out
-
-
-def scan_files(folder: Path) -> list[Path]:
-    """The point-cloud files of a folder, in name order."""
-    files = sorted(p for p in Path(folder).iterdir() if p.suffix.lower() in CLOUD_SUFFIXES)
-    if not files:
-        raise InputError(f"{folder}: no scans ({', '.join(CLOUD_SUFFIXES)}) in the folder")
-    return files
-
-
-def load_posed_map(scans: Path, poses: Path) -> np.ndarray:
-    """The map (N, 3 metres, first scan's frame) of the scans in folder ``scans`` placed at the
-    poses of ``poses`` (see :func:`read_poses`); one pose per scan, in name order."""
-    files = scan_files(scans)
-    transforms = read_poses(poses)
-    if len(transforms) != len(files):
-        raise InputError(f"{poses}: {len(transforms)} poses for {len(files)} scans in {scans}")
-    return place([load_cloud(f).points for f in files], transforms)
 
 
 class _ArraysOnly(pickle.Unpickler):
