@@ -2,6 +2,7 @@
 
 - :func:`build_map_kiss`: KISS-ICP odometry over the scans, deskewed scans accumulated.
 - :func:`build_map_from_poses`: the scans placed with known poses (a reference map).
+- :func:`posed_map`: the scans placed relative to the first pose, as map-metrics places them.
 - :mod:`pcmapq.mapping.poses`: KITTI / TUM pose files and calibrations.
 
 Frames: ``p_world = pose_k @ calib @ p_sensor``; every length in metres.
@@ -15,12 +16,18 @@ from pcmapq.mapping.poses import (
     moves_along_z,
     read_calib,
     read_kitti_poses,
+    read_pose_matrix,
     read_poses,
     read_tum_poses,
     write_kitti_poses,
     write_tum_poses,
 )
-from pcmapq.mapping.reference import build_map_from_poses, describe_scans, scans_for_poses
+from pcmapq.mapping.reference import (
+    build_map_from_poses,
+    describe_scans,
+    posed_map,
+    scans_for_poses,
+)
 from pcmapq.mapping.scans import ScanSequence, open_scans
 from pcmapq.voxels import VoxelMap, voxel_centroids
 
@@ -34,8 +41,10 @@ __all__ = [
     "lidar_poses_from_camera",
     "moves_along_z",
     "open_scans",
+    "posed_map",
     "read_calib",
     "read_kitti_poses",
+    "read_pose_matrix",
     "read_poses",
     "read_tum_poses",
     "scans_for_poses",

@@ -1,0 +1,89 @@
+"""``pcmapq inspect``: no-reference figures from the command line, equal to the library's on the
+same points, map-metrics' own figures on its data, and one-line usage errors."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from pcmapq.cli import app
+from pcmapq.io import load_map
+from pcmapq.metrics import noref
+from pcmapq.raster.draw import FREE, OCCUPIED
+
+from .conftest import shared
+
+SAMPLE = Path(__file__).resolve().parents[1] / "data" / "sample"
+
+
+def _inspect(*args: str) -> tuple[int, str, str]:
+    got = CliRunner().invoke(app, ["inspect", *args])
+    return got.exit_code, got.stdout, got.stderr
+
+
+def test_a_3d_cloud_gets_the_library_figures_and_the_same_json_twice(tmp_path):
+    """A noisy floor and two walls (1 cm noise): the JSON holds noref.scores' MME and MPV of
+    the same points and is byte-identical across runs; the floor alone has an MPV of the
+    noise's variance."""
+    rng = np.random.default_rng(5)
+    floor = np.column_stack([rng.uniform(0, 4, (3000, 2)), rng.normal(0, 0.01, 3000)])
+    wall_x = np.column_stack([rng.normal(0, 0.01, 3000), rng.uniform(0, 4, 3000),
+                              rng.uniform(0, 2, 3000)])
+    wall_y = np.column_stack([rng.uniform(0, 4, 3000), rng.normal(0, 0.01, 3000),
+                              rng.uniform(0, 2, 3000)])
+    points = np.vstack([floor, wall_x, wall_y])
+    path = tmp_path / "room.npy"
+    np.save(path, points)
+    texts = []
+    for _ in range(2):  # one path: the JSON holds the command line
+        code, _, stderr = _inspect(str(path), "--radius", "0.3", "--json",
+                                   str(tmp_path / "r.json"), "--quiet")
+        assert code == 0, stderr
+        texts.append((tmp_path / "r.json").read_text())
+    assert texts[0] == texts[1]
+    got = json.loads(texts[0])["noref"]
+    want = noref.scores(points, 0.3, noref.MIN_KNN)
+    assert got["mme"] == want.mme and got["mpv"] == want.mpv
+    assert got["points"] == len(points) and got["radius_m"] == 0.3
+    np.save(path, floor)  # one plane alone: MPV is the noise's variance, 1e-4 m^2
+    code, stdout, stderr = _inspect(str(path), "--radius", "0.3", "--json", "-")
+    assert code == 0, stderr
+    assert json.loads(stdout)["noref"]["mpv"] == pytest.approx(1e-4, rel=0.1)
+
+
+def test_an_image_gets_its_occupancy_figures():
+    code, stdout, stderr = _inspect(str(SAMPLE / "truth.yaml"), "--json", "-")
+    assert code == 0, stderr
+    grid = json.loads(stdout)["grid"]
+    state = load_map(SAMPLE / "truth.yaml").state
+    assert grid["occupied_cells"] == int((state == OCCUPIED).sum())
+    assert grid["free_cells"] == int((state == FREE).sum())
+    assert grid["resolution_m"] == 0.05 and grid["corners"] > 0
+    assert json.loads(stdout)["noref"] is None
+
+
+def test_depth_scans_at_their_poses_give_map_metrics_figures():
+    """map-metrics' own test data through the command line: its published MME, MPV and MOM."""
+    depth = shared("map-metrics", "depth")
+    code, stdout, stderr = _inspect(
+        "--scans", str(depth / "pcs"), "--poses", str(depth / "poses"), "--radius", "0.2",
+        "--orth-subset", str(depth / "orth_subset" / "orth-0091.npy"),
+        "--orth-pose", str(depth / "poses" / "pose-0091.txt"), "--json", "-")
+    assert code == 0, stderr
+    got = json.loads(stdout)["noref"]
+    assert got["points"] == 103_975
+    assert got["mme"] == pytest.approx(-3.614439, abs=1e-6)
+    assert got["mpv"] == pytest.approx(0.002539, abs=1e-6)
+    assert got["mom"] == pytest.approx(0.006183, abs=1e-6)
+
+
+@pytest.mark.parametrize("args", [[], ["--scans", "x"], ["m.ply", "--scans", "x", "--poses", "p"],
+                                  ["m.ply", "--orth-pose", "p.txt"]])
+def test_usage_mistakes_are_one_line_exit_2(args):
+    code, _, stderr = _inspect(*args)
+    assert code == 2 and len(stderr.strip().splitlines()) == 1, stderr
+    assert stderr.startswith("pcmapq: error:"), stderr
