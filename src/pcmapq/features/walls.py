@@ -14,7 +14,8 @@ thin one has none). So the detectors never see the cells as drawn. They see the 
    (faces up to about twice that apart) and bridges one-cell breaks;
 3. the result is thinned to its skeleton (scikit-image ``skeletonize``), the medial axis: one
    line per wall, whatever its thickness up to :data:`THICKEST` metres. A thicker area is no
-   wall but a filled region: its cells deeper than half that are left out first, so it is
+   wall but a filled region: its cells deeper than half that (the centres of a square of
+   that half-side all wall; a diagonal wall that thick holds none) are left out first, so it is
    thinned as a band ``THICKEST / 2`` wide along its outline (and the thinning, whose cost
    grows with the cube of a solid area's side, stays fast);
 4. spurs are pruned: a branch that ends free and meets the rest of the skeleton at a junction
@@ -146,7 +147,9 @@ def centreline(occupied: np.ndarray, grid: MetricGrid, resolution: float, closin
     is_small = size <= small
     is_small[0] = False
     objects = fill_holes(is_small[label])
-    deep = cv2.distanceTransform(wall, cv2.DIST_L2, 5) > 0.5 * THICKEST / resolution
+    half = int(0.5 * THICKEST / resolution)  # deep: a square of this half-side all wall
+    deep = cv2.erode(wall, cv2.getStructuringElement(cv2.MORPH_RECT, (2 * half + 1,) * 2),
+                     borderType=cv2.BORDER_CONSTANT, borderValue=0).astype(bool)
     line = prune(skeletonize(wall.astype(bool) & ~objects & ~deep), spur / resolution)
     return line, cores(objects, width / resolution), fine
 
