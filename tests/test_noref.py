@@ -128,14 +128,19 @@ def test_mom_sums_the_median_plane_variance_of_each_plane():
     assert got == pytest.approx(sum(s * s for s in sigmas), rel=0.1)
 
 
-def test_orthogonal_subset_of_a_room_corner():
-    rng = np.random.default_rng(5)
+def room_corner(seed: int) -> np.ndarray:
+    """Three orthogonal 2 m walls meeting at the origin, 1500 points each, 2 mm noise."""
+    rng = np.random.default_rng(seed)
     walls = []
     for axis in range(3):
         w = rng.uniform(0, 2, (1500, 3))
         w[:, axis] = rng.normal(0, 0.002, len(w))
         walls.append(w)
-    planes = orthogonal.extract_orthogonal_subset(np.vstack(walls), 0.2)
+    return np.vstack(walls)
+
+
+def test_orthogonal_subset_of_a_room_corner():
+    planes = orthogonal.extract_orthogonal_subset(room_corner(5), 0.2)
     assert len(planes) == 3
     normals = np.stack([np.linalg.eigh(np.cov(p.T))[1][:, 0] for p in planes])
     assert np.abs(normals @ normals.T - np.eye(3)).max() < 0.05
@@ -223,13 +228,7 @@ def test_depth_data_reproduces_map_metrics():
 def test_noref_figures_extracts_a_subset_or_says_why_not():
     from pcmapq.metrics.inspection import noref_figures
 
-    rng = np.random.default_rng(7)
-    walls = []
-    for axis in range(3):
-        w = rng.uniform(0, 2, (1500, 3))
-        w[:, axis] = rng.normal(0, 0.002, len(w))
-        walls.append(w)
-    corner = np.vstack(walls)
+    corner = room_corner(7)
     got = noref_figures(corner, radius=0.2)
     assert got["orth_subset"] == "extracted" and len(got["orth_plane_points"]) == 3
     assert got["mom"] == pytest.approx(noref.mom(corner, orthogonal.extract_orthogonal_subset(
