@@ -234,6 +234,6 @@ def test_noref_figures_extracts_a_subset_or_says_why_not():
     assert got["mom"] == pytest.approx(noref.mom(corner, orthogonal.extract_orthogonal_subset(
         corner, 0.2), 0.2))
     assert got["points"] == 4500 and got["mpv"] == pytest.approx(noref.scores(corner, 0.2).mpv)
-    flat = walls[2]
+    flat = corner[3000:]  # the third wall alone
     got = noref_figures(flat, radius=0.2)
     assert got["mom"] is None and "orthogonal" in got["mom_note"]
