@@ -19,6 +19,7 @@ from . import (
     halmstad,
     kitti,
     lidar,
+    noref,
     same_place,
 )
 from .common import ROOT, Case, Section
@@ -28,7 +29,8 @@ COMMAND = "python -m bench.validation --write"
 #: Every section of the document, in its order: a module with ``cases`` and ``section``.
 SECTIONS: dict[str, ModuleType] = {
     "drawings": drawings, "fr79": fr79, "lidar": lidar, "kitti": kitti, "gazebo": gazebo,
-    "halmstad": halmstad, "floorplans": floorplans, "carmen": carmen, "same_place": same_place,
+    "halmstad": halmstad, "floorplans": floorplans, "carmen": carmen, "noref": noref,
+    "same_place": same_place,
 }
 
 
