@@ -93,16 +93,35 @@ def test_mme_of_a_gaussian_cloud_matches_the_closed_form():
     assert got.mpv == pytest.approx(np.linalg.eigvalsh(np.cov(points.T))[0], rel=1e-9)
 
 
-def test_slabs_give_the_same_figures_as_one_pass_and_runs_are_identical():
+def test_chunks_give_the_same_figures_as_one_pass_and_runs_are_identical():
     rng = np.random.default_rng(2)
     points = rng.uniform(0, 1, (20_000, 3)) * [20.0, 3.0, 1.0]
-    whole = noref.scores(points, 0.3, 5, pair_budget=10**9)
-    sliced = noref.scores(points, 0.3, 5, pair_budget=50_000)
+    whole = noref.scores(points, 0.3, 5, chunk_points=10**9)
+    sliced = noref.scores(points, 0.3, 5, chunk_points=3_000)
     assert sliced.mpv_points == whole.mpv_points and sliced.mme_points == whole.mme_points
     assert sliced.mme == pytest.approx(whole.mme, abs=1e-12)
     assert sliced.mpv == pytest.approx(whole.mpv, rel=1e-12)
-    assert noref.scores(points, 0.3, 5, pair_budget=50_000, workers=1) == sliced
-    assert noref.scores(points, 0.3, 5, pair_budget=50_000, workers=3) == sliced
+    assert noref.scores(points, 0.3, 5, chunk_points=3_000, workers=1) == sliced
+    assert noref.scores(points, 0.3, 5, chunk_points=3_000, workers=3) == sliced
+
+
+def test_sums_equal_a_kd_tree_count_and_np_cov_per_point():
+    from scipy.spatial import cKDTree
+
+    rng = np.random.default_rng(8)
+    # a dense clump (one cell of many points: products cut into row chunks) and a sparse spread
+    points = np.vstack([rng.normal(0, 0.05, (3000, 3)), rng.uniform(-5, 5, (2000, 3))])
+    radius = 0.4
+    counts = cKDTree(points).query_ball_point(points, noref.strict_radius(radius),
+                                              return_length=True)
+    got_n, got_cov = np.zeros(len(points)), np.zeros((len(points), 3, 3))
+    for idx, sums in noref.neighbourhood_sums(points, radius):
+        got_n[idx], got_cov[idx] = sums[:, 0], noref.covariances(sums)
+    np.testing.assert_array_equal(got_n, counts)
+    tree = cKDTree(points)
+    for i in rng.choice(np.flatnonzero(counts > 3), 50, replace=False):
+        near = points[tree.query_ball_point(points[i], noref.strict_radius(radius))]
+        np.testing.assert_allclose(got_cov[i], np.cov(near.T), rtol=1e-9, atol=1e-15)
 
 
 def test_sparse_points_score_zero_as_map_metrics():

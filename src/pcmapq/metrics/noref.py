@@ -7,24 +7,24 @@ The neighbourhood of a point q is every map point p with |p - q| < radius (stric
 neighbours. Covariances are unbiased (divided by n - 1, as ``np.cov``). Units: points and radius
 in metres, MPV and MOM in square metres, MME in nats (ln of metres).
 
-Neighbourhoods come from SciPy kd-trees (pairs of points closer than the radius, each found
-once) and sparse sums, never a Python loop over points. The map is processed in slabs along its
-longest axis, each with the points within the radius on either side, so memory stays bounded
-(``pair_budget`` neighbour pairs at a time) whatever the map's size; coordinates are taken
-relative to each slab's centre.
+The map's neighbourhood sums come from :mod:`pcmapq.metrics.ballsums` (a grid of cells of
+side ``radius``, dense distance blocks and matrix products, each candidate within rounding of the
+radius decided again exactly as Open3D's search does), never a Python loop over points; memory
+stays bounded whatever the map's size, coordinates are taken relative to each block's mean. The
+neighbourhoods of MOM's few query points come from SciPy kd-trees.
 """
 
 from __future__ import annotations
 
 import math
-import os
 from collections.abc import Iterator, Sequence
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
 from scipy.spatial import cKDTree
+
+from pcmapq.metrics.ballsums import CHUNK_POINTS, ball_sums, moments
 
 #: map-metrics' presets (metres, neighbour counts): ``LidarConfig`` and ``DepthConfig``.
 LIDAR_RADIUS = 1.0
@@ -34,11 +34,6 @@ MAX_NN = 30
 #: MOM keeps an orthogonal-subset point whose neighbourhood holds more than this many map
 #: points (hard-coded in map-metrics, independent of ``min_knn``).
 MOM_MIN_NEIGHBOURS = 3
-#: Neighbour pairs held at once, two slabs of half as many (about 40 bytes a pair while a slab
-#: is summed): bounds memory on big maps.
-PAIR_BUDGET = 24_000_000
-#: Threads over slabs by default (CI machines have two cores).
-WORKERS = 2
 #: ln(2 pi e): MME's constant per dimension.
 LN_2PIE = math.log(2.0 * math.pi * math.e)
 
@@ -76,12 +71,6 @@ def strict_radius(radius: float) -> float:
     return float(r)
 
 
-def _moments(xyz: np.ndarray) -> np.ndarray:
-    """(N, 3) metres -> (N, 10): 1, x, y, z, xx, xy, xz, yy, yz, zz."""
-    x, y, z = xyz[:, 0], xyz[:, 1], xyz[:, 2]
-    return np.column_stack([np.ones(len(xyz)), x, y, z, x * x, x * y, x * z, y * y, y * z, z * z])
-
-
 def covariances(sums: np.ndarray) -> np.ndarray:
     """(N, 10) moment sums (count first) -> (N, 3, 3) unbiased covariances, m^2 (NaN where
     the count is below 2)."""
@@ -96,106 +85,25 @@ def covariances(sums: np.ndarray) -> np.ndarray:
     return cov
 
 
-def _pairs(tree: cKDTree, r: float) -> sp.coo_matrix:
-    """Upper-triangular adjacency (i < j, |p_i - p_j|^2 <= r^2) of a tree's points (COO: its
-    products with dense arrays need no conversion)."""
-    ij = tree.query_pairs(r, output_type="ndarray")
-    n = tree.n
-    return sp.coo_matrix((np.ones(len(ij)), (ij[:, 0], ij[:, 1])), shape=(n, n))
-
-
 def _cross(tree: cKDTree, other: cKDTree, r: float) -> sp.coo_matrix:
     """Adjacency rows = ``tree``'s points, columns = ``other``'s, for pairs within r."""
     d = tree.sparse_distance_matrix(other, r, output_type="ndarray")
     return sp.coo_matrix((np.ones(len(d)), (d["i"], d["j"])), shape=(tree.n, other.n))
 
 
-def _slabs(x: np.ndarray, radius: float, size: int) -> Iterator[tuple[int, int, int, int]]:
-    """Index ranges over sorted ``x``: core [a, b) and, around it, [lo, hi) within radius."""
-    n = len(x)
-    for a in range(0, n, size):
-        b = min(a + size, n)
-        lo = int(np.searchsorted(x, x[a] - radius, side="left"))
-        hi = int(np.searchsorted(x, x[b - 1] + radius, side="right"))
-        yield a, b, lo, hi
-
-
-def _slab_size(points: np.ndarray, r: float, pair_budget: int) -> int:
-    """Core points per slab so that one slab holds about ``pair_budget`` neighbour pairs (each
-    point's neighbours, itself excepted, halved: every pair is found once), from the neighbour
-    counts of a fixed sample of points."""
-    n = len(points)
-    if n <= 1:
-        return max(n, 1)
-    step = max(1, n // 2000)
-    sample = points[::step]
-    counts = cKDTree(points).query_ball_point(sample, r, return_length=True) if n <= 2_000_000 \
-        else _sample_counts(points, sample, r)
-    per_point = max((float(np.mean(counts)) - 1.0) / 2.0, 1.0)
-    return int(min(n, max(1000, pair_budget / per_point)))
-
-
-def _sample_counts(points: np.ndarray, sample: np.ndarray, r: float) -> np.ndarray:
-    """Neighbour counts of ``sample`` in ``points`` without a tree over all of them: only the
-    points within r of the sample's boxes are indexed (a big map's tree is its own cost)."""
-    order = np.argsort(sample[:, 0], kind="stable")
-    sample = sample[order]
-    counts = np.empty(len(sample))
-    for k in range(0, len(sample), 100):
-        q = sample[k:k + 100]
-        lo, hi = q.min(0) - r, q.max(0) + r
-        near = points[np.all((points >= lo) & (points <= hi), axis=1)]
-        counts[k:k + 100] = cKDTree(near).query_ball_point(q, r, return_length=True)
-    return counts
-
-
-def _slab_sums(pts: np.ndarray, order: np.ndarray, r: float,
-               bounds: tuple[int, int, int, int]) -> tuple[np.ndarray, np.ndarray]:
-    """(indices, moment sums) of the core [a, b) of one slab, its neighbours from [lo, hi)."""
-    a, b, lo, hi = bounds
-    sub = pts[order[lo:hi]]
-    origin = sub.mean(axis=0)
-    core = sub[a - lo:b - lo] - origin
-    f_core = _moments(core)
-    core_tree = cKDTree(core)
-    upper = _pairs(core_tree, r)
-    sums = f_core + upper @ f_core + upper.T @ f_core
-    del upper
-    halo = np.concatenate([sub[:a - lo], sub[b - lo:]]) - origin
-    if len(halo):
-        sums += _cross(core_tree, cKDTree(halo), r) @ _moments(halo)
-    return order[a:b], sums
-
-
-def neighbourhood_sums(points: np.ndarray, radius: float, pair_budget: int = PAIR_BUDGET,
+def neighbourhood_sums(points: np.ndarray, radius: float, chunk_points: int = CHUNK_POINTS,
                        workers: int | None = None) -> Iterator[tuple[np.ndarray, np.ndarray]]:
     """Yield (indices into ``points``, (k, 10) moment sums) over every point's neighbourhood:
     count, sums of x, y, z and of the products xx, xy, xz, yy, yz, zz, in coordinates relative
-    to a per-slab origin. Covariances: :func:`covariances`. The slabs (at least two, each of
-    about ``pair_budget / 2`` neighbour pairs) do not depend on ``workers``, the threads that
-    run them (SciPy's kd-trees release the GIL) and they are yielded in order, so the figures
-    are the same bit for bit whatever the thread count. Memory: about ``pair_budget``
-    neighbour pairs (about 40 bytes each) with two workers."""
+    to an origin of each point's own (covariances: :func:`covariances`). Chunks of about
+    ``chunk_points`` points; order and figures are the same bit for bit whatever ``workers``
+    (threads)."""
     pts = np.asarray(points, dtype=np.float64)
     if pts.ndim != 2 or pts.shape[1] != 3:
         raise ValueError(f"points must be (N, 3), got {pts.shape}")
-    if len(pts) == 0:
-        return
-    workers = max(1, workers or min(WORKERS, os.cpu_count() or 1))
-    r = strict_radius(radius)
-    axis = int(np.argmax(np.ptp(pts, axis=0)))
-    order = np.argsort(pts[:, axis], kind="stable")
-    x = pts[order, axis]
-    size = min(_slab_size(pts, r, pair_budget // 2), -(-len(pts) // 2))
-    slabs = list(_slabs(x, radius, max(size, 1)))
-    if workers == 1 or len(slabs) == 1:
-        for bounds in slabs:
-            yield _slab_sums(pts, order, r, bounds)
-        return
-    with ThreadPoolExecutor(workers) as pool:
-        for start in range(0, len(slabs), workers):
-            yield from pool.map(lambda bounds: _slab_sums(pts, order, r, bounds),
-                                slabs[start:start + workers])
+    if not radius > 0:
+        raise ValueError(f"radius must be positive, got {radius}")
+    yield from ball_sums(pts, radius, chunk_points, workers)
 
 
 def entropies(cov: np.ndarray) -> np.ndarray:
@@ -214,14 +122,14 @@ def plane_variances(cov: np.ndarray) -> np.ndarray:
 
 
 def scores(points: np.ndarray, radius: float = LIDAR_RADIUS, min_knn: int = MIN_KNN,
-           pair_budget: int = PAIR_BUDGET, workers: int | None = None) -> NoRefScores:
+           chunk_points: int = CHUNK_POINTS, workers: int | None = None) -> NoRefScores:
     """MME and MPV of a map (N, 3 metres) in one pass: the means, over the points with more than
     ``min_knn`` neighbours (itself included) closer than ``radius`` metres, of the entropy
     0.5 ln det(2 pi e Sigma) (points with det <= 0 skipped) and of Sigma's smallest
     eigenvalue. 0.0 when no point qualifies, as map-metrics."""
     ent_sum = var_sum = 0.0
     ent_n = var_n = 0
-    for _, sums in neighbourhood_sums(points, radius, pair_budget, workers):
+    for _, sums in neighbourhood_sums(points, radius, chunk_points, workers):
         cov = covariances(sums[sums[:, 0] > min_knn])
         ent = entropies(cov)
         ok = ~np.isnan(ent)
@@ -258,7 +166,7 @@ def query_covariances(points: np.ndarray, queries: np.ndarray,
     origin = q.mean(axis=0)
     if len(near) == 0:
         return np.zeros(len(q), dtype=np.int64), np.full((len(q), 3, 3), np.nan)
-    sums = _cross(cKDTree(q - origin), cKDTree(near - origin), r) @ _moments(near - origin)
+    sums = _cross(cKDTree(q - origin), cKDTree(near - origin), r) @ moments(near - origin)
     return sums[:, 0].astype(np.int64), covariances(sums)
 
 
