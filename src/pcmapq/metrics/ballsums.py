@@ -16,15 +16,13 @@ calling thread: threads of our own run the blocks, and the figures do not depend
 
 from __future__ import annotations
 
-import ctypes
 import functools
-import glob
 import os
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 from concurrent.futures import ThreadPoolExecutor
-from contextlib import contextmanager
 
 import numpy as np
+from threadpoolctl import threadpool_limits
 
 #: Candidate pairs in one product (8 bytes each, a few arrays of them per thread).
 BLOCK = 2000000
@@ -136,44 +134,6 @@ def _exact(near: np.ndarray, band: np.ndarray, a: np.ndarray, b: np.ndarray, r2:
     near[ii, jj] = d2 < r2
 
 
-@functools.cache
-def _openblas() -> tuple[Callable[[], int], Callable[[int], None]] | None:
-    """NumPy's OpenBLAS thread-count getter and setter, or None (another BLAS, not found)."""
-    here = os.path.dirname(np.__file__)
-    paths = glob.glob(os.path.join(here + ".libs", "*openblas*")) + glob.glob(
-        os.path.join(here, ".dylibs", "*openblas*"))
-    for path in sorted(paths):
-        try:
-            lib = ctypes.CDLL(path, mode=getattr(os, "RTLD_NOLOAD", 0) | ctypes.RTLD_GLOBAL)
-        except OSError:
-            continue
-        for name in ("scipy_openblas_{}64_", "openblas_{}64_", "scipy_openblas_{}",
-                     "openblas_{}"):
-            get = getattr(lib, name.format("get_num_threads"), None)
-            put = getattr(lib, name.format("set_num_threads"), None)
-            if get is not None and put is not None:
-                get.restype, put.argtypes = ctypes.c_int, [ctypes.c_int]
-                return get, put
-    return None
-
-
-@contextmanager
-def _blas_on_one_thread() -> Iterator[None]:
-    """OpenBLAS on the calling thread for a while: its own threads busy-wait, and on a loaded
-    machine a product of ours then costs ten times as long (our blocks have threads of their
-    own). Nothing happens when NumPy's BLAS is not OpenBLAS."""
-    blas = _openblas()
-    if blas is None:
-        yield
-        return
-    before = blas[0]()
-    blas[1](1)
-    try:
-        yield
-    finally:
-        blas[1](before)
-
-
 def ball_sums(points: np.ndarray, radius: float, chunk_points: int = CHUNK_POINTS,
               workers: int | None = None) -> Iterator[tuple[np.ndarray, np.ndarray]]:
     """Yield (indices into ``points``, (k, 10) moment sums) over every point's neighbourhood
@@ -195,6 +155,6 @@ def ball_sums(points: np.ndarray, radius: float, chunk_points: int = CHUNK_POINT
             p0, p1 = int(grid.start[c0]), int(grid.end[c1 - 1])
             out = np.empty((p1 - p0, 10))
             parts = np.array_split(np.arange(c0, c1), min(c1 - c0, workers * 8))
-            with _blas_on_one_thread():
+            with threadpool_limits(1, user_api="blas"):  # its own threads busy-wait beside ours
                 list(pool.map(functools.partial(_blocks, grid, r2, out, p0), parts))
             yield grid.order[p0:p1], out
