@@ -96,7 +96,7 @@ def _foreign_lines(args: list[str], capfd: pytest.CaptureFixture[str],
             yield
         caught.extend(log)
 
-    monkeypatch.setattr(cli, "_warnings", recorded)
+    monkeypatch.setattr(cli, "show_warnings", recorded)
     capfd.readouterr()
     got = CliRunner().invoke(cli.app, args)
     outside = capfd.readouterr()

@@ -4,26 +4,17 @@ from __future__ import annotations
 
 import sys
 import warnings
-from collections.abc import Callable, Iterator, Sequence
-from contextlib import contextmanager
 from dataclasses import replace
 from pathlib import Path
-from typing import Annotated, Any
+from typing import Annotated
 
 import numpy as np
 import typer
 from rich.console import Console
-from rich.progress import Progress
-from typer.core import TyperGroup
-
-try:  # recent typer carries its own copy of click
-    from typer._click.exceptions import NoSuchOption, UsageError
-except ImportError:  # older typer runs on click itself
-    from click.exceptions import NoSuchOption, UsageError
 
 from pcmapq import __version__, options
 from pcmapq.config import DETECTOR_NAMES, DistancesConfig, MatchingConfig, Settings, SourceConfig
-from pcmapq.errors import EvaluationError, InputError
+from pcmapq.errors import InputError
 from pcmapq.inspect_map import NoRefConfig, inspect_map, summary_lines, to_json
 from pcmapq.io import PointMap, load_map
 from pcmapq.io.writers import OutputSet, write_atomic, write_cloud
@@ -50,63 +41,22 @@ from pcmapq.report import export
 from pcmapq.report.style import ARROW_SCALE
 from pcmapq.report.table import print_table
 from pcmapq.result import Result
+from pcmapq.terminal import (
+    HELP_WIDTH,
+    OneLineUsageErrors,
+    report_errors,
+    scan_bar,
+    show_warnings,
+    step_progress,
+)
 
 #: The documented defaults, read from the one place that defines them.
 DEFAULTS = Settings()
 
 #: Help at the terminal's width (click caps it at 80 columns unless told otherwise), as plain
 #: text: rich's markup would eat "[default: ...]" and squeeze the help into a narrow column.
-HELP_WIDTH = 200
 
-
-class _OneLineUsageErrors(TyperGroup):
-    """pcmapq's commands, with a usage error (unknown option or command, bad or missing value)
-    said in one line like pcmapq's own errors, exit 2, instead of click's four lines."""
-
-    def main(self, args: Sequence[str] | None = None, prog_name: str | None = None,
-             complete_var: str | None = None, standalone_mode: bool = True,
-             **extra: Any) -> Any:
-        """Click's main; in standalone mode, a usage error becomes one line on stderr."""
-        if not standalone_mode:
-            return super().main(args, prog_name, complete_var, standalone_mode, **extra)
-        try:
-            code = super().main(args, prog_name, complete_var, False, **extra)
-        except UsageError as error:
-            if type(error).__name__ == "NoArgsIsHelpError":  # 'pcmapq' alone: click's help
-                error.show()  # (the class is new in click 8.2, hence by name, as typer does)
-                sys.exit(error.exit_code)
-            print(f"pcmapq: error: {usage_message(error)}", file=sys.stderr)
-            sys.exit(error.exit_code)
-        sys.exit(code if isinstance(code, int) else 0)
-
-    def invoke(self, ctx: typer.Context) -> Any:
-        """Click's invoke; an error of the option parser, which names no command, is given
-        this group's context (whose ``invoked_subcommand`` says which command failed)."""
-        try:
-            return super().invoke(ctx)
-        except UsageError as error:
-            if error.ctx is None:
-                error.ctx = ctx
-            raise
-
-
-def usage_message(error: UsageError) -> str:
-    """A click usage error as one line: its message, then which --help to read."""
-    if isinstance(error, NoSuchOption) and error.possibilities:
-        text = f"{error.message}; did you mean {' or '.join(sorted(error.possibilities))}?"
-    else:
-        text = error.format_message().rstrip(".")
-    text = " ".join(text.split())
-    if text[:2].istitle():  # "No such option" -> "no such option"; "MAP" stays
-        text = text[0].lower() + text[1:]
-    ctx = error.ctx
-    if ctx is None:
-        return text
-    command = " ".join(filter(None, (ctx.command_path, ctx.invoked_subcommand)))
-    return f"{text} (see '{command} --help')"
-
-
-app = typer.Typer(cls=_OneLineUsageErrors, add_completion=False, no_args_is_help=True,
+app = typer.Typer(cls=OneLineUsageErrors, add_completion=False, no_args_is_help=True,
                   pretty_exceptions_enable=False, rich_markup_mode=None,
                   context_settings={"max_content_width": HELP_WIDTH},
                   help="Map quality against a ground-truth map, in metres.")
@@ -158,13 +108,13 @@ def map_command(
 ) -> None:
     """Build a map from LiDAR scans with KISS-ICP (or with given poses) and save it."""
     err = Console(stderr=True)
-    with _errors(err), _warnings(err):
+    with report_errors(err), show_warnings(err):
         if calib is not None and poses is None:
             raise InputError(f"{calib}: --calib places scans with --poses only (KISS-ICP's "
                              "map is in the first scanner's frame already)")
         options.check_outputs({"--out": out, "--poses-out": poses_out, "--tum-out": tum_out},
                               None, inputs=(source, poses, calib))
-        with _bar(err, enabled=not quiet) as tick:
+        with scan_bar(err, enabled=not quiet) as tick:
             if poses is None:
                 points, trajectory = build_map_kiss(source, max_scans=max_scans, voxel=voxel,
                                                     progress=tick)
@@ -239,7 +189,7 @@ def inspect_command(
     """How good is a map without a ground truth: MME, MPV and MOM of a 3D cloud, occupancy
     figures of a 2D map (docs/metrics.md)."""
     err = Console(stderr=True)
-    with _errors(err), _warnings(err):
+    with report_errors(err), show_warnings(err):
         if (map_path is None) == (scans is None) or (scans is None) != (poses is None):
             raise typer.BadParameter("give MAP, or --scans DIR with --poses FILE",
                                      param_hint="MAP")
@@ -272,54 +222,6 @@ def inspect_command(
         if json_path is not None:
             err.print(f"wrote {json_path}", markup=False, highlight=False, soft_wrap=True)
 
-
-@contextmanager
-def _errors(console: Console) -> Iterator[None]:
-    """Bad input or a failed evaluation: one line on stderr and the error's exit code."""
-    try:
-        yield
-    except (InputError, EvaluationError) as error:
-        console.print(f"pcmapq: error: {error}", markup=False, highlight=False, soft_wrap=True)
-        raise typer.Exit(error.exit_code) from None
-
-
-@contextmanager
-def _warnings(console: Console) -> Iterator[None]:
-    """pcmapq's warnings (``warnings.warn`` in pcmapq's code): one line each on stderr, as they
-    come, every time. A library's warning (a NumPy RuntimeWarning, ...) is not pcmapq's to
-    print: dropped."""
-    package = str(Path(__file__).parent)
-
-    def show(message: Warning | str, category: type[Warning], filename: str, *_: object) -> None:
-        if category is UserWarning and filename.startswith(package):
-            console.print(f"pcmapq: warning: {message}", markup=False, highlight=False,
-                          soft_wrap=True)
-
-    with warnings.catch_warnings():
-        warnings.filterwarnings("always", module=r"pcmapq\.")
-        warnings.showwarning = show
-        yield
-
-
-@contextmanager
-def _bar(console: Console, enabled: bool) -> Iterator[Callable[[int, int], None]]:
-    """A progress bar over scans on the terminal; nothing when not a terminal."""
-    if not (enabled and console.is_terminal):
-        yield lambda done, total: None
-        return
-    with Progress(console=console, transient=True) as bar:
-        task = bar.add_task("scans", total=None)
-        yield lambda done, total: bar.update(task, completed=done, total=total)
-
-
-@contextmanager
-def _progress(console: Console, enabled: bool) -> Iterator[Callable[[str], None]]:
-    """A spinner on the terminal naming the current step; nothing when not a terminal."""
-    if not (enabled and console.is_terminal):
-        yield lambda step: None
-        return
-    with console.status("pcmapq") as status:
-        yield lambda step: status.update(f"{step}...")
 
 
 @app.command("eval")
@@ -466,8 +368,8 @@ def eval_command(
     exports = {"--aligned": aligned, "--transform": transform, "--distances": distances}
     err = Console(stderr=True)
     out = Console(quiet=quiet or json_path == "-")  # not a terminal: COLUMNS or 80 wide
-    with _errors(err), _warnings(err), \
-            _progress(err, enabled=not quiet and json_path != "-") as progress:
+    with report_errors(err), show_warnings(err), \
+            step_progress(err, enabled=not quiet and json_path != "-") as progress:
         options.check_eval_options(scans=scans, max_scans=max_scans, no_align=no_align,
                                    auto_scale=auto)
         options.check_outputs({"--json": json_path, "--vectors": vectors, "--plot": plot,
