@@ -256,3 +256,11 @@ def test_noref_figures_extracts_a_subset_or_says_why_not():
     flat = corner[3000:]  # the third wall alone
     got = noref_figures(flat, radius=0.2)
     assert got["mom"] is None and "orthogonal" in got["mom_note"]
+
+
+def test_scores_find_the_planar_points_of_the_subset_extraction_in_the_same_pass():
+    corner = room_corner(11)
+    got = noref.scores(corner, 0.2, with_flat=True)
+    np.testing.assert_array_equal(got.flat, orthogonal.planar_points(corner, 0.2))
+    assert got.flat.any() and noref.scores(corner, 0.2).flat is None
+    assert (got.mme, got.mpv) == (noref.scores(corner, 0.2).mme, noref.scores(corner, 0.2).mpv)

@@ -27,14 +27,15 @@ def noref_figures(points: np.ndarray, radius: float = LIDAR_RADIUS, min_knn: int
     ``mom_source`` (map-metrics: the first scan; None: the map itself); when none can be found,
     ``mom`` is None and ``mom_note`` says why. Figures that are not finite are None.
     """
-    s = scores(points, radius, min_knn)
+    reuse = orth_subset is None and mom_source is None  # the planar points of this pass
+    s = scores(points, radius, min_knn, with_flat=reuse)
     note = None
     planes = orth_subset
     source = "given" if planes is not None else "extracted"
     if planes is None:
         try:
             planes = extract_orthogonal_subset(points if mom_source is None else mom_source,
-                                               radius, max_nn)
+                                               radius, max_nn, planar=s.flat)
         except EvaluationError as exc:
             note, source = str(exc), None
     value = None if planes is None else _finite(mom(points, planes, radius))

@@ -44,6 +44,8 @@ class NoRefScores:
 
     mme_points: points with more than ``min_knn`` neighbours and a positive determinant;
     mpv_points: points with more than ``min_knn`` neighbours; total_points: the map's size.
+    flat: per point, whether its neighbourhood is flat (:func:`flat`), when asked for; else
+    None.
     """
 
     mme: float
@@ -51,6 +53,7 @@ class NoRefScores:
     mme_points: int
     mpv_points: int
     total_points: int
+    flat: np.ndarray | None = None
 
 
 def strict_radius(radius: float) -> float:
@@ -121,15 +124,32 @@ def plane_variances(cov: np.ndarray) -> np.ndarray:
     return np.linalg.eigvalsh(cov)[:, 0]
 
 
+def flat(sums: np.ndarray) -> np.ndarray:
+    """Per row of moment sums (see :func:`neighbourhood_sums`), whether the neighbourhood is
+    flat as map-metrics' planar points are: more than 3 points, and of its covariance's
+    eigenvalues 100 * lambda_0 < lambda_1."""
+    ok = sums[:, 0] > 3
+    out = np.zeros(len(sums), dtype=bool)
+    lam = np.linalg.eigvalsh(covariances(sums[ok]))
+    out[ok] = 100.0 * lam[:, 0] < lam[:, 1]
+    return out
+
+
 def scores(points: np.ndarray, radius: float = LIDAR_RADIUS, min_knn: int = MIN_KNN,
-           chunk_points: int = CHUNK_POINTS, workers: int | None = None) -> NoRefScores:
+           chunk_points: int = CHUNK_POINTS, workers: int | None = None,
+           with_flat: bool = False) -> NoRefScores:
     """MME and MPV of a map (N, 3 metres) in one pass: the means, over the points with more than
     ``min_knn`` neighbours (itself included) closer than ``radius`` metres, of the entropy
     0.5 ln det(2 pi e Sigma) (points with det <= 0 skipped) and of Sigma's smallest
-    eigenvalue. 0.0 when no point qualifies, as map-metrics."""
+    eigenvalue. 0.0 when no point qualifies, as map-metrics. ``with_flat``: also which points'
+    neighbourhoods are flat (:func:`flat`), from the same pass (MOM's subset extraction needs
+    them)."""
     ent_sum = var_sum = 0.0
     ent_n = var_n = 0
-    for _, sums in neighbourhood_sums(points, radius, chunk_points, workers):
+    flat_points = np.zeros(len(points), dtype=bool) if with_flat else None
+    for idx, sums in neighbourhood_sums(points, radius, chunk_points, workers):
+        if flat_points is not None:
+            flat_points[idx] = flat(sums)
         cov = covariances(sums[sums[:, 0] > min_knn])
         ent = entropies(cov)
         ok = ~np.isnan(ent)
@@ -139,7 +159,8 @@ def scores(points: np.ndarray, radius: float = LIDAR_RADIUS, min_knn: int = MIN_
         var_n += len(cov)
     return NoRefScores(mme=ent_sum / ent_n if ent_n else 0.0,
                        mpv=var_sum / var_n if var_n else 0.0,
-                       mme_points=ent_n, mpv_points=var_n, total_points=len(points))
+                       mme_points=ent_n, mpv_points=var_n, total_points=len(points),
+                       flat=flat_points)
 
 
 def mme(points: np.ndarray, radius: float = LIDAR_RADIUS, min_knn: int = MIN_KNN) -> float:

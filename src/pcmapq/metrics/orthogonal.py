@@ -17,7 +17,7 @@ import numpy as np
 from scipy.cluster.hierarchy import fcluster, ward
 
 from pcmapq.errors import EvaluationError
-from pcmapq.metrics.noref import MAX_NN, covariances, neighbourhood_sums
+from pcmapq.metrics.noref import MAX_NN, flat, neighbourhood_sums
 
 #: map-metrics' constants: Ward cut distance, near-orthogonality |cos|, smallest cluster.
 WARD_CUT = 0.1
@@ -32,9 +32,7 @@ def planar_points(cloud: np.ndarray, radius: float) -> np.ndarray:
     metres) is flat: 100 * smallest eigenvalue < middle eigenvalue."""
     keep = np.zeros(len(cloud), dtype=bool)
     for idx, sums in neighbourhood_sums(cloud, radius):
-        ok = sums[:, 0] > 3
-        lam = np.linalg.eigvalsh(covariances(sums[ok]))
-        keep[idx[ok]] = 100.0 * lam[:, 0] < lam[:, 1]
+        keep[idx] = flat(sums)
     return keep
 
 
@@ -70,12 +68,14 @@ def _triples(n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 def extract_orthogonal_subset(cloud: np.ndarray, radius: float, max_nn: int = MAX_NN,
                               min_cluster: int = MIN_CLUSTER,
-                              eps: float = ORTHOGONAL_COS) -> list[np.ndarray]:
+                              eps: float = ORTHOGONAL_COS,
+                              planar: np.ndarray | None = None) -> list[np.ndarray]:
     """Three arrays of points (metres, the cloud's frame) on mutually orthogonal planes of
-    ``cloud`` (map-metrics extracts them from the first scan). EvaluationError when none."""
+    ``cloud`` (map-metrics extracts them from the first scan). EvaluationError when none.
+    ``planar``: :func:`planar_points` of the cloud at ``radius``, when already found."""
     cloud = np.asarray(cloud, dtype=np.float64)
     normals = _normals(cloud, radius, max_nn)
-    keep = planar_points(cloud, radius)
+    keep = planar_points(cloud, radius) if planar is None else planar
     points, normals = cloud[keep], normals[keep]
     if len(points) < 3 * (min_cluster + 1):
         raise EvaluationError(f"only {len(points)} planar points for MOM's orthogonal subset")
