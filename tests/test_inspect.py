@@ -87,3 +87,18 @@ def test_usage_mistakes_are_one_line_exit_2(args):
     code, _, stderr = _inspect(*args)
     assert code == 2 and len(stderr.strip().splitlines()) == 1, stderr
     assert stderr.startswith("pcmapq: error:"), stderr
+
+
+def test_a_2d_cloud_gets_its_occupied_cells_and_no_free_space(tmp_path):
+    """An L of 100 points 0.1 m apart, each given twice: 100 occupied 0.05 m cells; a cloud has
+    no free cells, so its ratio and enclosed areas are None."""
+    leg = np.arange(50) * 0.1 + 0.025
+    xy = np.vstack([np.column_stack([leg, np.full(50, 0.025)]),
+                    np.column_stack([np.full(50, -0.475), leg + 0.5])])
+    path = tmp_path / "l.npy"
+    np.save(path, np.vstack([xy, xy]))
+    code, stdout, stderr = _inspect(str(path), "--json", "-")
+    assert code == 0, stderr
+    grid = json.loads(stdout)["grid"]
+    assert grid["occupied_cells"] == 100 and grid["resolution_m"] == 0.05
+    assert grid["free_cells"] is None and grid["enclosed_areas"] is None

@@ -15,13 +15,13 @@ from typing import Any
 import numpy as np
 
 from pcmapq import __version__
-from pcmapq.config import RasterConfig
-from pcmapq.grid import MetricGrid
+from pcmapq.config import Settings
 from pcmapq.io import OccupancyMap, PointMap
 from pcmapq.metrics.inspection import noref_figures
 from pcmapq.metrics.noref import LIDAR_RADIUS, MAX_NN, MIN_KNN
 from pcmapq.metrics.noref2d import grid_scores
-from pcmapq.raster.draw import OCCUPIED, UNKNOWN, points_to_grid
+from pcmapq.pipeline import truth_raster
+from pcmapq.raster.draw import OCCUPIED, UNKNOWN
 
 
 @dataclass(frozen=True)
@@ -56,14 +56,14 @@ def inspect_map(source: OccupancyMap | PointMap, config: NoRefConfig = NoRefConf
 
 
 def occupancy_figures(source: OccupancyMap | PointMap) -> dict[str, Any]:
-    """The 2D figures of an image, or of a 2D cloud drawn at RasterConfig's cloud resolution
-    (a cloud has no free cells: its occupied/free ratio and enclosed areas are None)."""
+    """The 2D figures of an image, or of a 2D cloud drawn as ``eval`` draws a cloud truth
+    (:func:`pcmapq.pipeline.truth_raster`; a cloud has no free cells: its occupied/free ratio
+    and enclosed areas are None)."""
     if isinstance(source, OccupancyMap):
         state, grid = source.state, source.grid
     else:
-        xy = source.points[:, :2]
-        grid = MetricGrid.covering(xy, RasterConfig().cloud_resolution)
-        state = np.where(points_to_grid(xy, grid, 1), OCCUPIED, UNKNOWN).astype(np.int8)
+        grid, occupied = truth_raster(source, source.points[:, :2], Settings())
+        state = np.where(occupied, OCCUPIED, UNKNOWN).astype(np.int8)
     figures = asdict(grid_scores(state, grid))
     figures["resolution_m"] = grid.resolution
     if isinstance(source, PointMap):
