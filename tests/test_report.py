@@ -80,16 +80,19 @@ def test_vectorial_figure_draws_the_displacements(moved_result, perfect_result):
     assert black(perfect_result) == 0
 
 
+def heatmap_yellow(result, panel: int, box: tuple) -> int:
+    """Pixels of viridis' yellow end (distances clipped at 0.5 m) in ``box`` of the distance
+    heatmap's panel ``panel``."""
+    fig = distance_heatmap(result)
+    img = region(fig, fig.axes[panel], box).astype(int)
+    b, g, r = img[..., 0], img[..., 1], img[..., 2]
+    return int(np.count_nonzero((r > 200) & (g > 200) & (b < 80)))
+
+
 def test_heatmap_colours_the_moved_wall(moved_result, perfect_result):
     """viridis' yellow end (0.5 m, clipped) on the moved arm, none there when nothing moved."""
-    def yellow(result) -> int:
-        fig = distance_heatmap(result)
-        img = region(fig, fig.axes[0], MOVED_ARM).astype(int)
-        b, g, r = img[..., 0], img[..., 1], img[..., 2]
-        return int(np.count_nonzero((r > 200) & (g > 200) & (b < 80)))
-
-    assert yellow(moved_result) > 10
-    assert yellow(perfect_result) == 0
+    assert heatmap_yellow(moved_result, 0, MOVED_ARM) > 10
+    assert heatmap_yellow(perfect_result, 0, MOVED_ARM) == 0
 
 
 def test_report_is_self_contained(moved_result):
@@ -272,15 +275,8 @@ def test_completeness_heatmap_colours_the_truth_wall_the_map_left(moved_result,
     """Right panel: the truth's arm, 0.5 m west of where the map has it, in viridis' yellow
     (0.5 m); none there when nothing moved."""
     truth_arm = (MOVED_ARM[0] - 0.5, MOVED_ARM[1] - 0.5, *MOVED_ARM[2:])
-
-    def yellow(result) -> int:
-        fig = distance_heatmap(result)
-        img = region(fig, fig.axes[1], truth_arm).astype(int)
-        b, g, r = img[..., 0], img[..., 1], img[..., 2]
-        return int(np.count_nonzero((r > 200) & (g > 200) & (b < 80)))
-
-    assert yellow(moved_result) > 10
-    assert yellow(perfect_result) == 0
+    assert heatmap_yellow(moved_result, 1, truth_arm) > 10
+    assert heatmap_yellow(perfect_result, 1, truth_arm) == 0
 
 
 def test_report_lists_every_missing_and_extra_feature(moved_result):
