@@ -45,14 +45,14 @@ def test_a_3d_cloud_gets_the_library_figures_and_the_same_json_twice(tmp_path):
         assert code == 0, stderr
         texts.append((tmp_path / "r.json").read_text())
     assert texts[0] == texts[1]
-    got = json.loads(texts[0])["noref"]
+    got = json.loads(texts[0])["cloud"]
     want = noref.scores(points, 0.3, noref.MIN_KNN)
     assert got["mme"] == want.mme and got["mpv"] == want.mpv
     assert got["points"] == len(points) and got["radius_m"] == 0.3
     np.save(path, floor)  # one plane alone: MPV is the noise's variance, 1e-4 m^2
     code, stdout, stderr = _inspect(str(path), "--radius", "0.3", "--json", "-")
     assert code == 0, stderr
-    assert json.loads(stdout)["noref"]["mpv"] == pytest.approx(1e-4, rel=0.1)
+    assert json.loads(stdout)["cloud"]["mpv"] == pytest.approx(1e-4, rel=0.1)
 
 
 def test_an_image_gets_its_occupancy_figures():
@@ -63,7 +63,7 @@ def test_an_image_gets_its_occupancy_figures():
     assert grid["occupied_cells"] == int((state == OCCUPIED).sum())
     assert grid["free_cells"] == int((state == FREE).sum())
     assert grid["resolution_m"] == 0.05 and grid["corners"] > 0
-    assert json.loads(stdout)["noref"] is None
+    assert json.loads(stdout)["cloud"] is None
 
 
 def test_depth_scans_at_their_poses_give_map_metrics_figures():
@@ -74,7 +74,7 @@ def test_depth_scans_at_their_poses_give_map_metrics_figures():
         "--orth-subset", str(depth / "orth_subset" / "orth-0091.npy"),
         "--orth-pose", str(depth / "poses" / "pose-0091.txt"), "--json", "-")
     assert code == 0, stderr
-    got = json.loads(stdout)["noref"]
+    got = json.loads(stdout)["cloud"]
     assert got["points"] == 103_975
     assert got["mme"] == pytest.approx(-3.614439, abs=1e-6)
     assert got["mpv"] == pytest.approx(0.002539, abs=1e-6)

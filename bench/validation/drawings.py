@@ -24,8 +24,7 @@ from pcmapq.features import Features, detect
 from pcmapq.grid import MetricGrid
 from pcmapq.io import OccupancyMap, load_map
 from pcmapq.match import match
-from pcmapq.pipeline import truth_raster
-from pcmapq.plan import plan_points
+from pcmapq.plan import plan_points, truth_raster
 from pcmapq.raster.draw import OCCUPIED
 
 from .common import Case, Record, Section, header, row

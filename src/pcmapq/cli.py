@@ -13,9 +13,16 @@ import typer
 from rich.console import Console
 
 from pcmapq import __version__, options
-from pcmapq.config import DETECTOR_NAMES, DistancesConfig, MatchingConfig, Settings, SourceConfig
+from pcmapq.config import (
+    DETECTOR_NAMES,
+    DistancesConfig,
+    MatchingConfig,
+    NoRefConfig,
+    Settings,
+    SourceConfig,
+)
 from pcmapq.errors import InputError
-from pcmapq.inspect_map import NoRefConfig, inspect_map, summary_lines, to_json
+from pcmapq.inspect_map import inspect_map, summary_lines, to_json
 from pcmapq.io import PointMap, load_map
 from pcmapq.io.writers import OutputSet, write_atomic, write_cloud
 from pcmapq.mapping import (
@@ -172,6 +179,10 @@ def inspect_command(
     max_nn: Annotated[int, typer.Option(
         help="Nearest neighbours of the normals that pick MOM's orthogonal planes.", min=3)
     ] = MAX_NN,
+    voxel: Annotated[float, typer.Option(
+        help="First reduce a 3D cloud to one point (the centroid) per cell of this size, "
+        "metres; 0: as it is, as map-metrics ('pcmapq eval' uses 0.1).", min=0.0,
+        callback=options.finite)] = 0.0,
     orth_subset: Annotated[Path | None, typer.Option(
         help="MOM's orthogonal planes (a map-metrics .npy or .npz) in the map's frame, or in "
         "the frame of the scan at --orth-pose; otherwise pcmapq extracts them.")] = None,
@@ -208,8 +219,8 @@ def inspect_command(
         planes = None if orth_subset is None else read_orthogonal_subset(orth_subset)
         if planes is not None and orth_pose is not None:
             planes = place_subset(planes, read_pose_matrix(orth_pose), first)
-        record = inspect_map(source, NoRefConfig(radius, min_knn, max_nn), planes,
-                             options.command_line(ctx))
+        config = NoRefConfig(radius=radius, min_knn=min_knn, max_nn=max_nn, voxel=voxel)
+        record = inspect_map(source, config, planes, options.command_line(ctx))
         if json_path not in (None, "-"):
             with OutputSet() as outputs:
                 write_atomic(Path(json_path), to_json(record), outputs)
@@ -340,6 +351,18 @@ def eval_command(
     distances: Annotated[Path | None, typer.Option(
         help="Write the map's points in the truth's frame with their distance to the truth "
         "(.ply: scalar field scalar_distance_m, metres, and a colour).")] = None,
+    noref: Annotated[bool, typer.Option(
+        "--noref/--no-noref", help="Also report each input's no-reference figures, as "
+        "'pcmapq inspect' does (MME, MPV, MOM of a 3D cloud; occupancy figures of a 2D map).")
+    ] = DEFAULTS.noref.enabled,
+    noref_radius: Annotated[float, typer.Option(
+        help="Neighbourhood of the 3D no-reference figures, metres (0.2 for depth-camera "
+        "maps, with --noref-voxel 0.02).", min=1e-6, callback=options.finite)
+    ] = DEFAULTS.noref.radius,
+    noref_voxel: Annotated[float, typer.Option(
+        help="A 3D cloud is first reduced to one point per cell of this size for its "
+        "no-reference figures, metres (0: as it is).", min=0.0, callback=options.finite)
+    ] = DEFAULTS.noref.voxel,
     quiet: Annotated[bool, typer.Option(
         "--quiet", "-q", help="Print nothing but warnings and errors (and the JSON of "
         "--json -).")] = False,
@@ -364,7 +387,8 @@ def eval_command(
                           force=force),
         footprint=replace(DEFAULTS.footprint, rule=options.parse_footprint(footprint), full=full),
         matching=MatchingConfig(options.parse_detectors(detectors), threshold),
-        distances=DistancesConfig(options.parse_taus(tau)))
+        distances=DistancesConfig(options.parse_taus(tau)),
+        noref=replace(DEFAULTS.noref, enabled=noref, radius=noref_radius, voxel=noref_voxel))
     exports = {"--aligned": aligned, "--transform": transform, "--distances": distances}
     err = Console(stderr=True)
     out = Console(quiet=quiet or json_path == "-")  # not a terminal: COLUMNS or 80 wide

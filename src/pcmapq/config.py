@@ -11,6 +11,7 @@ from pcmapq.features import DETECTORS, default_params
 from pcmapq.io.extent import Box
 from pcmapq.io.occupancy import Thresholds
 from pcmapq.metrics.distances import DEFAULT_TAUS
+from pcmapq.metrics.noref import LIDAR_RADIUS, MAX_NN, MIN_KNN
 from pcmapq.transform import Similarity2D
 
 #: Every registered detector (a module of :mod:`pcmapq.features` that defines ``DETECTOR``).
@@ -118,6 +119,31 @@ class DistancesConfig:
 
 
 @dataclass(frozen=True)
+class NoRefConfig:
+    """The no-reference figures of each input (:mod:`pcmapq.noref_figures`, ``pcmapq
+    inspect``).
+
+    enabled: ``eval`` reports them for the map and the truth (``--no-noref``: not).
+    radius: the 3D figures' neighbourhood, metres (1.0 for LiDAR maps, 0.2 for depth cameras).
+    min_knn: a point counts in MME and MPV with more than this many neighbours.
+    max_nn: nearest neighbours of the normals that pick MOM's orthogonal planes.
+    voxel: a 3D cloud is first reduced to the centroid of its points in each cell of this
+        size, metres (0: as it is, as map-metrics; ``eval`` uses ``EVAL_NOREF_VOXEL``).
+    """
+
+    enabled: bool = True
+    radius: float = LIDAR_RADIUS
+    min_knn: int = MIN_KNN
+    max_nn: int = MAX_NN
+    voxel: float = 0.0
+
+
+#: ``eval``'s voxel for the 3D no-reference figures, metres: a tenth of LiDAR's radius. It bounds
+#: their cost on dense clouds and puts maps of unlike density on one footing (MME depends on it).
+EVAL_NOREF_VOXEL = 0.1
+
+
+@dataclass(frozen=True)
 class Settings:
     """Options of ``pcmapq eval``, one group per stage; defaults are the documented ones.
 
@@ -132,6 +158,7 @@ class Settings:
     footprint: FootprintConfig = field(default_factory=FootprintConfig)
     matching: MatchingConfig = field(default_factory=MatchingConfig)
     distances: DistancesConfig = field(default_factory=DistancesConfig)
+    noref: NoRefConfig = field(default_factory=lambda: NoRefConfig(voxel=EVAL_NOREF_VOXEL))
 
     def to_dict(self) -> dict:
         """Every option as plain JSON types, one object per stage, in metres and degrees:
@@ -160,7 +187,8 @@ class Settings:
             matching=MatchingConfig(tuple(m["detectors"]), m["threshold"],
                                     {name: DETECTORS[name].params(**p)
                                      for name, p in m["params"].items()}),
-            distances=DistancesConfig(tuple(doc["distances"]["taus"])))
+            distances=DistancesConfig(tuple(doc["distances"]["taus"])),
+            noref=NoRefConfig(**doc.get("noref", {"enabled": False})))  # older: none
 
 
 def _plain(value):

@@ -21,40 +21,23 @@ from pcmapq.io import OccupancyMap, PointMap
 from pcmapq.io.extent import check_span, far_points, hint
 from pcmapq.match import match
 from pcmapq.metrics.distances import distances, distances_3d, nearest_distance
-from pcmapq.plan import MAP_CROP, TRUTH_CROP, cropped, load_input, plan_points
+from pcmapq.noref_figures import input_figures
+from pcmapq.plan import (
+    MAP_CROP,
+    TRUTH_CROP,
+    cropped,
+    load_input,
+    min_hits,
+    plan_points,
+    truth_grid,
+    truth_raster,
+)
 from pcmapq.raster.draw import OCCUPIED, UNKNOWN, points_to_grid, warp_state
 from pcmapq.raster.footprint import footprint_rule, map_footprint
 from pcmapq.result import DetectorResult, Overlap, Result
 from pcmapq.transform import Similarity2D
 
 Progress = Callable[[str], None]
-
-def min_hits(cloud: PointMap, settings: Settings) -> int:
-    """Points needed to mark a cell of this cloud occupied (see RasterConfig.min_hits)."""
-    if settings.raster.min_hits is not None:
-        return settings.raster.min_hits
-    return 2 if cloud.is_3d else 1
-
-
-def truth_grid(truth: OccupancyMap | PointMap, truth_xy: np.ndarray,
-               settings: Settings) -> MetricGrid:
-    """The grid everything is drawn on: an image's own; for a cloud, an axis-aligned grid
-    around its plan points ``truth_xy`` at the truth's resolution (or the raster's
-    ``cloud_resolution``). Nothing is allocated."""
-    if isinstance(truth, OccupancyMap):
-        return truth.grid
-    return MetricGrid.covering(truth_xy,
-                               settings.truth.resolution or settings.raster.cloud_resolution)
-
-
-def truth_raster(truth: OccupancyMap | PointMap, truth_xy: np.ndarray,
-                 settings: Settings) -> tuple[MetricGrid, np.ndarray]:
-    """The truth's grid (:func:`truth_grid`) and its occupied cells."""
-    grid = truth_grid(truth, truth_xy, settings)
-    if isinstance(truth, OccupancyMap):
-        return grid, truth.state == OCCUPIED
-    return grid, points_to_grid(truth_xy, grid, min_hits(truth, settings))
-
 
 def map_footprint_rule(source: OccupancyMap | PointMap, settings: Settings) -> str:
     """The footprint rule this map follows: ``settings.footprint.rule`` with ``auto`` resolved (see
@@ -262,7 +245,7 @@ def score(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap, setti
     (InputError) when that would need more than ``memory_limit`` bytes (None: the default).
     The truth's features do not depend on the map: they are found on a second thread while
     the map is aligned and drawn (see :class:`~pcmapq.features.SideBySide`)."""
-    map_path, truth_path = source.path, truth.path
+    map_path, truth_path, loaded = source.path, truth.path, source
     check_span(truth, TRUTH_CROP)
     check_span(source, MAP_CROP)
     rule = map_footprint_rule(source, settings)
@@ -307,6 +290,12 @@ def score(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap, setti
         detectors[name] = DetectorResult(truth_f, map_f,
                                          match(name, truth_f, map_f, threshold,
                                                settings.matching.params.get(name)))
+    noref = None
+    if settings.noref.enabled:
+        progress("no-reference figures")
+        scale = alignment.transform.scale if settings.alignment.scale else 1.0
+        noref = {"map": input_figures(loaded, settings.noref, scale=scale),
+                 "truth": input_figures(truth, settings.noref)}
     cloud_distances = None
     if registration is not None:
         progress("distances in 3D")
@@ -319,4 +308,4 @@ def score(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap, setti
                   registration_3d=registration, distances_3d=cloud_distances,
                   threshold=threshold, full=full, detectors=detectors,
                   footprint_rule=rule, frames=frames, settings=settings.to_dict(),
-                  truth_occupied=truth_occ, map_occupied=map_occ)
+                  truth_occupied=truth_occ, map_occupied=map_occ, noref=noref)

@@ -1,5 +1,6 @@
 """Each input made ready to score: read and cropped as its options say, checked for an absurd
-extent, and its 2D structure (plan points) taken out and checked for something to align.
+extent, its 2D structure (plan points) taken out and checked for something to align, and the
+truth's grid and occupied cells, on which everything is drawn.
 
 An input is refused with exit 2 when it is wider than :data:`pcmapq.io.extent.MAX_SPAN`, and
 with exit 1 when its walls fill fewer than :data:`MIN_CELLS` cells or form one straight line
@@ -17,9 +18,10 @@ from pcmapq import memory
 from pcmapq.config import Settings, SourceConfig
 from pcmapq.errors import EvaluationError, InputError
 from pcmapq.frames import Levelling
+from pcmapq.grid import MetricGrid
 from pcmapq.io import OccupancyMap, PointMap, load_map
 from pcmapq.io.extent import crop
-from pcmapq.raster.draw import OCCUPIED
+from pcmapq.raster.draw import OCCUPIED, points_to_grid
 from pcmapq.raster.slice import wall_band
 
 #: The crop option of each side, named in messages.
@@ -116,3 +118,30 @@ def check_structure(path: Path, xy: np.ndarray) -> None:
 def distinct_cells(xy: np.ndarray) -> int:
     """How many distinct cells of memory.WORKING_CELL (metres) the points ``xy`` (metres) fill."""
     return len(np.unique(np.floor(np.asarray(xy[:, :2]) / memory.WORKING_CELL), axis=0))
+
+
+def min_hits(cloud: PointMap, settings: Settings) -> int:
+    """Points needed to mark a cell of this cloud occupied (see RasterConfig.min_hits)."""
+    if settings.raster.min_hits is not None:
+        return settings.raster.min_hits
+    return 2 if cloud.is_3d else 1
+
+
+def truth_grid(truth: OccupancyMap | PointMap, truth_xy: np.ndarray,
+               settings: Settings) -> MetricGrid:
+    """The grid everything is drawn on: an image's own; for a cloud, an axis-aligned grid
+    around its plan points ``truth_xy`` at the truth's resolution (or the raster's
+    ``cloud_resolution``). Nothing is allocated."""
+    if isinstance(truth, OccupancyMap):
+        return truth.grid
+    return MetricGrid.covering(truth_xy,
+                               settings.truth.resolution or settings.raster.cloud_resolution)
+
+
+def truth_raster(truth: OccupancyMap | PointMap, truth_xy: np.ndarray,
+                 settings: Settings) -> tuple[MetricGrid, np.ndarray]:
+    """The truth's grid (:func:`truth_grid`) and its occupied cells."""
+    grid = truth_grid(truth, truth_xy, settings)
+    if isinstance(truth, OccupancyMap):
+        return grid, truth.state == OCCUPIED
+    return grid, points_to_grid(truth_xy, grid, min_hits(truth, settings))

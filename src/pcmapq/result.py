@@ -82,7 +82,9 @@ class Result:
     frames: the chain from each input to the truth's plan (levelling, 3D registration, the 2D
     alignment; :mod:`pcmapq.frames`). settings: the options it ran with (``Settings.to_dict()``,
     metres and degrees); command: the command line that made it (``pcmapq eval ...``, defaults
-    left out), None from the library. truth_occupied, map_occupied (and the overlap's
+    left out), None from the library. noref: each input's no-reference figures,
+    ``{"map": ..., "truth": ...}`` (:func:`pcmapq.noref_figures.input_figures`), None when not
+    asked for. truth_occupied, map_occupied (and the overlap's
     footprint): the rasters on ``grid``; None in a result read back by :meth:`from_json`, which
     holds everything the JSON holds and no more.
     """
@@ -106,6 +108,7 @@ class Result:
     footprint_rule: str = "known"
     settings: dict | None = None
     command: str | None = None
+    noref: dict | None = None
 
     @property
     def transform(self) -> Similarity2D:
@@ -149,6 +152,7 @@ class Result:
             "footprint": self.footprint_rule,
             "scored_against": "whole truth" if self.full else "footprint",
             "distances": _distances_dict(self.distances),
+            "noref": None,
             "detectors": {},
             "matches": [], "missing": [], "extra": [],
         }
@@ -178,7 +182,9 @@ class Result:
                                for t in det.truth.xy[m.missing].tolist()]
             doc["extra"] += [{"detector": name, "map_xy_m": p}
                              for p in det.map.xy[m.extra].tolist()]
-        return _rounded(doc)
+        doc = _rounded(doc)
+        doc["noref"] = self.noref  # unrounded: MPV and MOM are small areas (1e-3 m^2 and less)
+        return doc
 
     def to_json(self) -> str:
         """The JSON document, strict: a NaN or infinity in it is a ValueError, never bare
@@ -279,7 +285,7 @@ def _from_dict(doc: dict) -> Result:
         full=doc["scored_against"] == "whole truth", detectors=detectors,
         truth_occupied=None, map_occupied=None, frames=frames,
         footprint_rule=doc["footprint"], settings=doc["settings"],
-        command=doc["pcmapq"]["command"])
+        command=doc["pcmapq"]["command"], noref=doc.get("noref"))
 
 
 def _rounded(value):

@@ -36,7 +36,7 @@ def print_table(result: Result, console: Console) -> None:
         console.print()
         _displacements(console, result)
     console.print()
-    for label, parts in _distances(result):
+    for label, parts in _distances(result) + _noref(result):
         _field(console, label, _values(console, parts))
     for i, note in enumerate(result.notes()):
         _field(console, "notes" if i == 0 else "", words(note, width - LABEL - 1))
@@ -95,6 +95,32 @@ def _distances(result: Result) -> list[tuple[str, list[str]]]:
                   ("3D complete", _stats_parts(d3.completeness, "truth -> map, 3D")),
                   ("3D", [f"Chamfer {metres(d3.chamfer_m)}"])]
     return lines
+
+
+def _noref(result: Result) -> list[tuple[str, list[str]]]:
+    """Each input's no-reference figures (``pcmapq inspect``'s) as a line, units in each."""
+    if result.noref is None:
+        return []
+    return [(f"{side} noref", _noref_parts(result.noref[side])) for side in ("map", "truth")]
+
+
+def _noref_parts(figures: dict) -> list[str]:
+    cloud, grid = figures["cloud"], figures["grid"]
+    if cloud is not None:
+        return [f"MME {_g(cloud['mme'])} nats", f"MPV {_g(cloud['mpv'])} m²",
+                f"MOM {_g(cloud['mom'])}" + (" m²" if cloud["mom"] is not None else ""),
+                f"within {cloud['radius_m']:g} m"]
+    parts = [f"{grid['occupied_cells']:,} occupied cells of {grid['resolution_m']:g} m"]
+    if grid["occupied_free_ratio"] is not None:
+        parts.append(f"occupied/free {grid['occupied_free_ratio']:.4f}")
+    parts.append(f"{grid['corners']:,} corners")
+    if grid["enclosed_areas"] is not None:
+        parts.append(f"{grid['enclosed_areas']:,} enclosed areas")
+    return parts
+
+
+def _g(value: float | None) -> str:
+    return "n/a" if value is None else f"{value:.4g}"
 
 
 def _stats_parts(stats: Stats, direction: str) -> list[str]:

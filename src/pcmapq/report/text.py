@@ -15,8 +15,9 @@ LEGEND = ("quality: share of the truth's features the map has (the paper's q = m
           "map); f1: their harmonic mean; n/a: nothing to count; pair: a matched truth feature "
           "and map feature; displacement: the length from a pair's truth feature to its map "
           "feature; accuracy: distance from the map's walls to the truth's; completeness: from "
-          "the truth's walls to the map's; F@tau: F-score of the walls within tau; definitions "
-          "in docs/metrics.md")
+          "the truth's walls to the map's; F@tau: F-score of the walls within tau; noref: the "
+          "input's own figures without a ground truth, as 'pcmapq inspect' gives them (lower "
+          "is better, between maps of one place only); definitions in docs/metrics.md")
 
 
 def score(value: float | None, digits: int = 3) -> str:

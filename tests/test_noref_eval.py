@@ -1,0 +1,87 @@
+"""``pcmapq eval``'s ``"noref"`` block: each input's no-reference figures, as ``pcmapq inspect``
+gives them (the map's at eval's voxel and at the estimated scale), and MOM's orthogonal planes
+found through a sample of the planar points of a large cloud."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from pcmapq.cli import app
+from pcmapq.config import AlignmentConfig, NoRefConfig, Settings, SourceConfig
+from pcmapq.io import load_map
+from pcmapq.metrics import orthogonal
+from pcmapq.noref_figures import input_figures
+from pcmapq.pipeline import evaluate
+from pcmapq.result import Result
+
+from .conftest import write_image_map
+from .test_noref import room_corner
+
+SAMPLE = Path(__file__).resolve().parents[1] / "data" / "sample"
+
+
+def test_eval_reports_the_figures_inspect_gives_for_map_and_truth():
+    """The sample: the scan's 3D figures at eval's 0.1 m voxel, the truth image's occupancy
+    figures; both equal to input_figures of the loaded inputs, and kept by the JSON."""
+    result = evaluate(SAMPLE / "scan.ply", SAMPLE / "truth.yaml")
+    scan, truth = load_map(SAMPLE / "scan.ply"), load_map(SAMPLE / "truth.yaml")
+    assert result.noref["map"] == input_figures(scan, Settings().noref)
+    assert result.noref["truth"] == input_figures(truth, Settings().noref)
+    cloud = result.noref["map"]["cloud"]
+    assert cloud["voxel_m"] == 0.1 and cloud["points"] < len(scan.points)
+    assert result.noref["map"]["grid"] is None and result.noref["truth"]["cloud"] is None
+    assert result.noref["truth"]["grid"]["occupied_cells"] > 0
+    assert Result.from_json(result.to_json()).noref == result.noref
+    got = CliRunner().invoke(app, ["inspect", str(SAMPLE / "scan.ply"), "--voxel", "0.1",
+                                   "--json", "-"])
+    assert got.exit_code == 0, got.stderr
+    assert json.loads(got.stdout)["cloud"] == cloud  # what the docs say: inspect --voxel 0.1
+
+
+def test_no_noref_leaves_the_block_null(plan, truth_png, tmp_path):
+    settings = replace(Settings(), noref=NoRefConfig(enabled=False))
+    result = evaluate(truth_png, truth_png, settings)
+    assert result.noref is None and result.to_dict()["noref"] is None
+    assert result.to_dict()["settings"]["noref"]["enabled"] is False
+
+
+def test_a_map_of_unknown_scale_gets_figures_in_the_truths_metres(plan, truth_png, tmp_path):
+    """The plan drawn at 0.05 m a pixel but read as 0.1 m, scale estimated: its figures are
+    those of 0.05 m cells (corner and enclosed-area parameters are in metres)."""
+    path = write_image_map(plan, tmp_path / "map.png")
+    settings = Settings(map=SourceConfig(resolution=0.1), alignment=AlignmentConfig(scale=True))
+    result = evaluate(path, truth_png, settings)
+    got = result.noref["map"]["grid"]
+    assert result.transform.scale == pytest.approx(0.5, abs=0.01)
+    assert got["resolution_m"] == pytest.approx(0.05, abs=0.001)
+    want = input_figures(load_map(path), Settings().noref)["grid"]
+    assert got["corners"] == want["corners"]
+    assert got["enclosed_areas"] == want["enclosed_areas"]
+
+
+def test_older_results_read_back_without_noref():
+    doc = Settings().to_dict()
+    del doc["noref"]
+    assert Settings.from_dict(doc).noref.enabled is False
+
+
+def test_planes_found_through_a_sample_of_the_planar_points(monkeypatch):
+    """A room corner (4,500 points on three walls): clustering 500 of its planar normals finds
+    the same three walls, every planar point of each on it, as clustering all of them."""
+    corner = room_corner(5)
+    whole = orthogonal.extract_orthogonal_subset(corner, 0.2)
+    monkeypatch.setattr(orthogonal, "MAX_WARD_POINTS", 500)
+    sampled = orthogonal.extract_orthogonal_subset(corner, 0.2)
+    axes = [int(np.argmax(np.abs(np.linalg.eigh(np.cov(p.T))[1][:, 0]))) for p in sampled]
+    assert sorted(axes) == [0, 1, 2]
+    for plane, axis in zip(sampled, axes, strict=True):
+        assert np.abs(plane[:, axis]).max() < 0.01  # every point on its wall
+    assert sum(map(len, sampled)) >= 0.98 * sum(map(len, whole))
+    assert sum(map(len, whole)) > 500
+
