@@ -12,7 +12,7 @@ import numpy as np
 import typer
 from rich.console import Console
 
-from pcmapq import __version__, options
+from pcmapq import __version__, gates, options
 from pcmapq.config import (
     DETECTOR_NAMES,
     DistancesConfig,
@@ -363,6 +363,15 @@ def eval_command(
         help="A 3D cloud is first reduced to one point per cell of this size for its "
         "no-reference figures, metres (0: as it is).", min=0.0, callback=options.finite)
     ] = DEFAULTS.noref.voxel,
+    fail_under: Annotated[str | None, typer.Option(
+        metavar="<KEY=VALUE,...>",
+        help="CI gate: exit 3 when a figure is below its bound, e.g. harris.quality=0.8,"
+        "coverage=0.9 (keys: docs/ci.md; a figure that is n/a fails). The outputs are "
+        "written all the same.")] = None,
+    fail_over: Annotated[str | None, typer.Option(
+        metavar="<KEY=VALUE,...>",
+        help="CI gate for distances: exit 3 when a figure is above its bound, e.g. "
+        "accuracy.mean=0.05 (metres).")] = None,
     quiet: Annotated[bool, typer.Option(
         "--quiet", "-q", help="Print nothing but warnings and errors (and the JSON of "
         "--json -).")] = False,
@@ -394,6 +403,8 @@ def eval_command(
     out = Console(quiet=quiet or json_path == "-")  # not a terminal: COLUMNS or 80 wide
     with report_errors(err), show_warnings(err), \
             step_progress(err, enabled=not quiet and json_path != "-") as progress:
+        rules = gates.parse_gates(fail_under, gates.UNDER) + \
+            gates.parse_gates(fail_over, gates.OVER)
         options.check_eval_options(scans=scans, max_scans=max_scans, no_align=no_align,
                                    auto_scale=auto)
         options.check_outputs({"--json": json_path, "--vectors": vectors, "--plot": plot,
@@ -408,28 +419,38 @@ def eval_command(
         limit = None if max_memory is None else int(max_memory * 1e9)
         result = replace(evaluate(map_path, truth_path, settings, progress, limit),
                          command=options.command_line(ctx))
+        doc = result.to_dict() if rules else {}
+        outcomes = gates.check(rules, doc)  # an unknown key: exit 2, before any output
+        json_text = gates.to_json(gates.with_gates(doc, outcomes)) if rules else None
         progress("writing outputs")
         wrote = _write_outputs(result, map_path, settings, arrow_scale, json_path=json_path,
-                               vectors=vectors, plot=plot, report=report, exports=exports)
+                               vectors=vectors, plot=plot, report=report, exports=exports,
+                               json_text=json_text)
         if json_path == "-":
-            sys.stdout.write(result.to_json())
+            sys.stdout.write(json_text or result.to_json())
     if not quiet:
         for path in wrote:
             err.print(f"wrote {path}", markup=False, highlight=False, soft_wrap=True)
     print_table(result, out)
+    if failed := [o.line() for o in outcomes if not o.passed]:  # a verdict, not an error
+        for line in failed:
+            err.print(f"pcmapq: gate failed: {line}", markup=False, highlight=False,
+                      soft_wrap=True)
+        raise typer.Exit(gates.EXIT_CODE)
 
 
 def _write_outputs(result: Result, map_path: Path | PointMap, settings: Settings,
                    arrow_scale: float, *, json_path: str | None, vectors: Path | None,
                    plot: Path | None, report: Path | None,
-                   exports: dict[str, Path | None]) -> list[Path]:
+                   exports: dict[str, Path | None], json_text: str | None = None) -> list[Path]:
     """Write the run's output files, all or nothing: each is produced into a temporary file
     beside its target, and all are renamed into place only once every one is produced
-    (:class:`OutputSet`). The files written (an ``--aligned`` image's YAML too)."""
+    (:class:`OutputSet`); the JSON is ``json_text`` when given (with gates), else the result's.
+    The files written (an ``--aligned`` image's YAML too)."""
     with OutputSet() as outputs:
         wrote: list[Path] = []
         if json_path not in (None, "-"):
-            write_atomic(Path(json_path), result.to_json(), outputs)
+            write_atomic(Path(json_path), json_text or result.to_json(), outputs)
             wrote.append(Path(json_path))
         if vectors is not None:
             write_atomic(vectors, result.vectors_csv(), outputs)
