@@ -48,11 +48,11 @@ def summary_row(name: str, result: dict) -> dict[str, object]:
     alignment (fitness, confidence, x, y metres, yaw degrees, scale), the wall distances
     (metres) and the F-score at each tau; exit_code 0, error "". A document missing one of
     these is a ValueError naming the key."""
+    row: dict[str, object] = {"name": name, "map": _get(result, "map", "path"),
+                              "truth": _get(result, "truth", "path")}
     detectors = _get(result, "detectors")
     align = _get(result, "alignment")
     dist = _get(result, "distances")
-    row: dict[str, object] = {"name": name, "map": _get(result, "map", "path"),
-                              "truth": _get(result, "truth", "path")}
     for score in SCORES:
         for det in DETECTOR_NAMES:
             row[f"{det}_{score}"] = (_number(detectors[det], score, f"detectors.{det}")
@@ -116,6 +116,40 @@ def table_md(rows: Sequence[dict[str, object]]) -> str:
         status = f"failed (exit {row['exit_code']}): {row.get('error', '')}" if failed else "ok"
         lines.append("| " + " | ".join([*cells, _escape(status)]) + " |")
     return "\n".join(lines) + "\n"
+
+
+#: The columns of the terminal's table and their short headers: the comparison at a glance
+#: (the files hold every column).
+TERMINAL = {**{f"{d}_quality": d for d in DETECTOR_NAMES}, "coverage": "coverage",
+            "accuracy_mean_m": "accuracy\n(m)", "completeness_mean_m": "completeness\n(m)"}
+
+
+def print_summary(rows: Sequence[dict[str, object]], console) -> None:
+    """The rows at a glance on a rich ``console``: name, each detector's quality, coverage,
+    the mean wall distances (metres) and 'ok' or the exit code, cells as in the markdown
+    table; then one line per failed row with its error."""
+    from rich import box
+    from rich.table import Table
+    from rich.text import Text
+
+    table = Table(box=box.SIMPLE_HEAD, show_edge=False, pad_edge=False, padding=(0, 0, 0, 1),
+                  title="feature quality per detector; accuracy, completeness: mean wall "
+                  "distances", title_justify="left")
+    table.add_column("name", no_wrap=True)
+    for header in TERMINAL.values():
+        table.add_column(header, justify="right", no_wrap=True)
+    table.add_column("status", no_wrap=True)
+    for row in rows:
+        failed = bool(row.get("exit_code"))
+        table.add_row(Text(str(row.get("name"))),
+                      *(_md_cell(c, row.get(c), failed) for c in TERMINAL),
+                      f"exit {row['exit_code']}" if failed else "ok")
+    console.print(table, highlight=False)
+    for row in rows:
+        if row.get("exit_code"):
+            console.print(f"{row.get('name')}: failed (exit {row['exit_code']}): "
+                          f"{row.get('error', '')}", markup=False, highlight=False,
+                          soft_wrap=True)
 
 
 def summary_figure(rows: Sequence[dict[str, object]]):
