@@ -128,3 +128,13 @@ def test_the_same_results_give_the_same_bytes_in_another_process(saved, tmp_path
     assert proc.returncode == 0, proc.stderr
     for name in ("table.csv", "table.md", "figure.png"):
         assert (tmp_path / "one" / name).read_bytes() == (tmp_path / "two" / name).read_bytes()
+
+
+def test_alike_file_stems_are_named_by_their_paths(saved, tmp_path):
+    (tmp_path / "again").mkdir()
+    copy = tmp_path / "again" / "a.json"
+    copy.write_bytes(saved["a"].read_bytes())
+    proc = run("compare", str(saved["a"]), str(copy), "--out", str(tmp_path / "cmp"), "-q")
+    assert proc.returncode == 0, proc.stderr
+    assert [r["name"] for r in table(tmp_path / "cmp")] == \
+        [str(saved["a"].with_suffix("")), str(copy.with_suffix(""))]
