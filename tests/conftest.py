@@ -70,7 +70,7 @@ def shared(*parts: str) -> Path:
 #: fixtures), ``e2e`` when it runs the whole pipeline, the command line or a subprocess (or uses
 #: a fixture that does), ``unit`` otherwise: ``pytest -m unit`` runs the fast ones alone.
 REALDATA_FIXTURES = {"fr79", "kitti_maps", "registration_pair"}
-E2E_FIXTURES = {"moved_result", "perfect_result", "sample_json", "round_png"}
+E2E_FIXTURES = {"moved_result", "perfect_result", "sample_json", "round_png", "summary_docs"}
 E2E_CALLS = ("evaluate(", "score(", ".invoke(", "subprocess", "run(", "build_map", "_ladder(",
              "main(")
 

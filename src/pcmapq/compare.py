@@ -1,0 +1,93 @@
+"""``pcmapq compare``: saved results (``eval --json``, or a batch's per-map JSONs) side by side,
+like evo_res. They must share a truth (same path, grid shape, resolution and origin) unless
+told otherwise; each becomes one row of the comparison table and figure (report/summary.py)."""
+
+from __future__ import annotations
+
+import json
+import os
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+from pcmapq.errors import InputError
+from pcmapq.io.writers import one_line
+from pcmapq.report.summary import summary_row
+
+#: What makes two truths the same, beside their path: the truth grid's keys in the JSON.
+TRUTH_GRID = ("shape", "resolution_m", "origin")
+
+
+@dataclass(frozen=True)
+class Saved:
+    """One saved result: its file, the row name, the parsed document and its table row."""
+
+    path: Path
+    name: str
+    doc: dict
+    row: dict[str, object]
+
+
+def read_results(paths: Sequence[Path], names: Sequence[str] | None = None) -> list[Saved]:
+    """Read every result JSON; name its row ``names[i]``, else the file's stem (its path
+    without the suffix when two stems are alike). A file that cannot be read, is not JSON or
+    is not a pcmapq eval result is an InputError naming it."""
+    if names is not None and len(names) != len(paths):
+        raise InputError(f"--names gives {len(names)} names for {len(paths)} result(s)")
+    if names is None:
+        stems = [p.stem for p in paths]
+        names = [s if stems.count(s) == 1 else str(p.with_suffix(""))
+                 for s, p in zip(stems, paths, strict=True)]
+    return [_read(path, name) for path, name in zip(paths, names, strict=True)]
+
+
+def truth_differences(results: Sequence[Saved]) -> list[str]:
+    """The results whose truth differs from the first's, each as 'file (what differs)'."""
+    first = _truth_key(results[0].doc)
+    out = []
+    for saved in results[1:]:
+        key = _truth_key(saved.doc)
+        what = [field for field, a, b in zip(("path", *TRUTH_GRID), first, key, strict=True)
+                if a != b]
+        if what:
+            out.append(f"{saved.path} ({', '.join(what)})")
+    return out
+
+
+def check_same_truth(results: Sequence[Saved], allow_different: bool) -> str | None:
+    """Refuse (InputError) results that do not share the first's truth, in one line naming
+    them; with ``allow_different``, that line as a warning to show instead (None when they
+    all share it)."""
+    differ = truth_differences(results)
+    if not differ:
+        return None
+    line = (f"{len(differ)} of {len(results)} results have another truth than "
+            f"{results[0].path} ({results[0].doc['truth']['path']}): {'; '.join(differ)}")
+    if not allow_different:
+        raise InputError(line + " (--allow-different-truths to compare them anyway)")
+    return line
+
+
+def _read(path: Path, name: str) -> Saved:
+    """One result JSON and its row; InputError naming the file when it is not one."""
+    try:
+        doc = json.loads(Path(path).read_bytes())
+    except OSError as exc:
+        raise InputError(f"{path}: cannot read: {one_line(exc)}") from None
+    except ValueError as exc:  # not UTF-8 or not JSON
+        raise InputError(f"{path}: not a JSON file: {one_line(exc)}") from None
+    try:
+        if not isinstance(doc, dict) or "pcmapq" not in doc:
+            raise ValueError("no 'pcmapq' section")
+        row = summary_row(name, doc)
+        _truth_key(doc)
+    except (ValueError, TypeError, KeyError) as exc:
+        raise InputError(f"{path}: not a pcmapq eval result: {one_line(exc)}") from None
+    return Saved(Path(path), name, doc, row)
+
+
+def _truth_key(doc: dict) -> tuple:
+    """The truth's path (normalised) and grid (None for what the JSON lacks)."""
+    truth = doc["truth"]
+    grid = tuple(json.dumps(truth.get(k), sort_keys=True) for k in TRUTH_GRID)
+    return (os.path.normpath(str(truth["path"])), *grid)

@@ -1,0 +1,261 @@
+"""Many results side by side: one flat row per map (from a saved result JSON, or a failed run),
+written as ``table.csv``, ``table.md`` and ``figure.png`` (the qualities grouped per map, like
+the paper's Figure 7). Metres and degrees; an undefined figure stays None: an empty CSV cell,
+'n/a' or '-' in the markdown, a gap marked 'n/a' in the figure, never a zero."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from pathlib import Path
+
+from pcmapq.config import DETECTOR_NAMES
+from pcmapq.errors import InputError
+from pcmapq.io.writers import OutputSet, one_line, write_atomic
+from pcmapq.result import DECIMALS
+
+#: The figures of a detector, in column order (``harris_quality`` ...).
+SCORES = ("quality", "precision", "f1")
+#: Columns before the F-scores: the name and inputs, each detector's scores (quality of every
+#: detector, then precision, then f1), coverage, the alignment, the wall distances (metres).
+HEAD = ("name", "map", "truth",
+        *(f"{d}_{s}" for s in SCORES for d in DETECTOR_NAMES),
+        "coverage", "fitness", "confidence", "x_m", "y_m", "yaw_deg", "scale",
+        "accuracy_mean_m", "accuracy_median_m", "completeness_mean_m", "completeness_median_m",
+        "chamfer_m")
+#: Columns after the F-scores: how the evaluation ended (0 and "" when it finished).
+TAIL = ("exit_code", "error")
+#: An F-score column: the F-score of the walls within tau metres (``f_score@0.05m``).
+FSCORE = "f_score@{tau:g}m"
+#: Markdown headers of the columns (units in brackets); an F-score's is ``F@0.05 m``.
+HEADERS = {"name": "name", "map": "map", "truth": "truth",
+           **{f"{d}_{s}": f"{d} {s}" for s in SCORES for d in DETECTOR_NAMES},
+           "coverage": "coverage", "fitness": "fitness", "confidence": "confidence",
+           "x_m": "x (m)", "y_m": "y (m)", "yaw_deg": "yaw (deg)", "scale": "scale",
+           "accuracy_mean_m": "accuracy mean (m)", "accuracy_median_m": "accuracy median (m)",
+           "completeness_mean_m": "completeness mean (m)",
+           "completeness_median_m": "completeness median (m)", "chamfer_m": "Chamfer (m)",
+           "exit_code": "exit code", "error": "error"}
+#: Decimals of the markdown table: scale 4, degrees 2, everything else 3 (as the terminal).
+MD_DECIMALS = {"scale": 4, "yaw_deg": 2}
+#: Bar colours of the detectors in the figure.
+COLOURS = {"harris": "#4477aa", "hough": "#ee6677", "sift": "#228833"}
+
+
+def summary_row(name: str, result: dict) -> dict[str, object]:
+    """One flat row of a result JSON document (``pcmapq eval --json``): the inputs' paths,
+    each detector's quality, precision and f1 (None when undefined or not run), coverage, the
+    alignment (fitness, confidence, x, y metres, yaw degrees, scale), the wall distances
+    (metres) and the F-score at each tau; exit_code 0, error "". A document missing one of
+    these is a ValueError naming the key."""
+    row: dict[str, object] = {"name": name, "map": _get(result, "map", "path"),
+                              "truth": _get(result, "truth", "path")}
+    detectors = _get(result, "detectors")
+    align = _get(result, "alignment")
+    dist = _get(result, "distances")
+    for score in SCORES:
+        for det in DETECTOR_NAMES:
+            row[f"{det}_{score}"] = (_number(detectors[det], score, f"detectors.{det}")
+                                     if det in detectors else None)
+    row["coverage"] = _number(result, "coverage")
+    for key in ("fitness", "confidence", "x_m", "y_m", "yaw_deg", "scale"):
+        row[key] = _number(align, key, "alignment")
+    for side in ("accuracy", "completeness"):
+        stats = _get(dist, f"{side}_m")
+        for key in ("mean", "median"):
+            row[f"{side}_{key}_m"] = _number(stats, key, f"distances.{side}_m")
+    row["chamfer_m"] = _number(dist, "chamfer_m", "distances")
+    for f in _get(dist, "f_score"):
+        row[FSCORE.format(tau=_number(f, "tau_m", "f_score"))] = _number(f, "f", "f_score")
+    return {**row, "exit_code": 0, "error": ""}
+
+
+def failed_row(name: str, map_path: str, truth_path: str, exit_code: int,
+               error: str) -> dict[str, object]:
+    """The row of an evaluation that failed: its inputs, exit code and one-line error, every
+    figure None."""
+    row: dict[str, object] = dict.fromkeys(HEAD)
+    return {**row, "name": name, "map": str(map_path), "truth": str(truth_path),
+            "exit_code": int(exit_code), "error": " ".join(str(error).split())}
+
+
+def columns(rows: Sequence[dict[str, object]]) -> list[str]:
+    """The table's columns: :data:`HEAD`, the F-score of every tau any row has (ascending),
+    :data:`TAIL`."""
+    taus = sorted({float(k[len("f_score@"):-1]) for row in rows for k in row
+                   if k.startswith("f_score@")})
+    return [*HEAD, *(FSCORE.format(tau=t) for t in taus), *TAIL]
+
+
+def table_csv(rows: Sequence[dict[str, object]]) -> str:
+    """The rows as CSV, one per map in the order given, :func:`columns` order: floats with
+    :data:`~pcmapq.result.DECIMALS` decimals, an empty cell for None."""
+    import csv
+    import io
+
+    cols = columns(rows)
+    out = io.StringIO()
+    writer = csv.writer(out, lineterminator="\n")
+    writer.writerow(cols)
+    writer.writerows([_csv_cell(row.get(c)) for c in cols] for row in rows)
+    return out.getvalue()
+
+
+def table_md(rows: Sequence[dict[str, object]]) -> str:
+    """The rows as a markdown table (units in the headers): scores 'n/a' when undefined,
+    other figures '-' when there is none, blank in a failed row, whose status says its exit
+    code and error."""
+    cols = [c for c in columns(rows) if c not in TAIL]
+    headers = [_header(c) for c in cols] + ["status"]
+    lines = ["| " + " | ".join(headers) + " |",
+             "|" + "|".join("---" if c in ("name", "map", "truth") else "---:"
+                            for c in cols) + "|---|"]
+    for row in rows:
+        failed = bool(row.get("exit_code"))
+        cells = [_md_cell(c, row.get(c), failed) for c in cols]
+        status = f"failed (exit {row['exit_code']}): {row.get('error', '')}" if failed else "ok"
+        lines.append("| " + " | ".join([*cells, _escape(status)]) + " |")
+    return "\n".join(lines) + "\n"
+
+
+#: The columns of the terminal's table and their short headers: the comparison at a glance
+#: (the files hold every column).
+TERMINAL = {**{f"{d}_quality": d for d in DETECTOR_NAMES}, "coverage": "coverage",
+            "accuracy_mean_m": "accuracy\n(m)", "completeness_mean_m": "completeness\n(m)"}
+
+
+def print_summary(rows: Sequence[dict[str, object]], console) -> None:
+    """The rows at a glance on a rich ``console``: name, each detector's quality, coverage,
+    the mean wall distances (metres) and 'ok' or the exit code, cells as in the markdown
+    table; then one line per failed row with its error."""
+    from rich import box
+    from rich.table import Table
+    from rich.text import Text
+
+    table = Table(box=box.SIMPLE_HEAD, show_edge=False, pad_edge=False, padding=(0, 0, 0, 1),
+                  title="feature quality per detector; accuracy, completeness: mean wall "
+                  "distances", title_justify="left")
+    table.add_column("name", no_wrap=True)
+    for header in TERMINAL.values():
+        table.add_column(header, justify="right", no_wrap=True)
+    table.add_column("status", no_wrap=True)
+    for row in rows:
+        failed = bool(row.get("exit_code"))
+        table.add_row(Text(str(row.get("name"))),
+                      *(_md_cell(c, row.get(c), failed) for c in TERMINAL),
+                      f"exit {row['exit_code']}" if failed else "ok")
+    console.print(table, highlight=False)
+    for row in rows:
+        if row.get("exit_code"):
+            console.print(f"{row.get('name')}: failed (exit {row['exit_code']}): "
+                          f"{row.get('error', '')}", markup=False, highlight=False,
+                          soft_wrap=True)
+
+
+def summary_figure(rows: Sequence[dict[str, object]]):
+    """The qualities grouped per map (the paper's Figure 7): one bar per detector, a gap
+    marked 'n/a' where a quality is undefined, 'failed (exit N)' over a failed map's group.
+    A matplotlib Figure (Agg)."""
+    from pcmapq.report.plot import plt  # matplotlib on the Agg backend
+
+    n, k = len(rows), len(DETECTOR_NAMES)
+    width = 0.8 / k
+    fig, ax = plt.subplots(figsize=(min(max(4.0, 1.2 + 0.9 * n), 20.0), 4.0),
+                           layout="constrained")
+    for j, det in enumerate(DETECTOR_NAMES):
+        xs = [i + (j - (k - 1) / 2) * width for i in range(n)]
+        values = [row.get(f"{det}_quality") for row in rows]
+        shown = [(x, v) for x, v, row in zip(xs, values, rows, strict=True)
+                 if v is not None and not row.get("exit_code")]
+        ax.bar([x for x, _ in shown], [v for _, v in shown], width, color=COLOURS.get(det),
+               label=det)
+        for x, v, row in zip(xs, values, rows, strict=True):
+            if v is None and not row.get("exit_code"):
+                ax.text(x, 0.02, "n/a", rotation=90, ha="center", va="bottom", fontsize=7,
+                        color="0.4")
+    for i, row in enumerate(rows):
+        if row.get("exit_code"):
+            ax.text(i, 0.5, f"failed (exit {row['exit_code']})", rotation=90, ha="center",
+                    va="center", fontsize=8, color="#aa3377")
+    ax.set_xticks(range(n), [str(row.get("name")) for row in rows],
+                  rotation=30 if n > 6 else 0, ha="right" if n > 6 else "center")
+    ax.set_xlim(-0.6, n - 0.4)
+    ax.set_ylim(0.0, 1.05)
+    ax.set_ylabel("quality (matched truth / truth features)")
+    ax.set_title("feature quality per map")
+    ax.legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), frameon=False)
+    return fig
+
+
+def write_summary(rows: Sequence[dict[str, object]], out_dir: Path) -> list[Path]:
+    """Write ``out_dir/table.csv``, ``table.md`` and ``figure.png`` (made if missing), all or
+    none (:class:`~pcmapq.io.writers.OutputSet`); the same rows give the same bytes. The
+    paths written."""
+    from pcmapq.report.plot import figure_bytes
+
+    out_dir = Path(out_dir)
+    try:
+        out_dir.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise InputError(f"{out_dir}: cannot make the folder: {one_line(exc)}") from None
+    with OutputSet() as outputs:
+        write_atomic(out_dir / "table.csv", table_csv(rows), outputs)
+        write_atomic(out_dir / "table.md", table_md(rows), outputs)
+        write_atomic(out_dir / "figure.png", figure_bytes(summary_figure(rows), "png"),
+                     outputs)
+        return outputs.commit()
+
+
+def _get(doc: dict, *keys: str) -> object:
+    """``doc[k0][k1]...``; a ValueError naming the dotted key when it is absent."""
+    value: object = doc
+    for i, key in enumerate(keys):
+        if not isinstance(value, dict) or key not in value:
+            raise ValueError(f"no '{'.'.join(keys[:i + 1])}'")
+        value = value[key]
+    return value
+
+
+def _number(doc: dict, key: str, where: str = "") -> float | None:
+    """``doc[key]`` as a float, or None; a ValueError when it is absent or not a number."""
+    if not isinstance(doc, dict) or key not in doc:
+        raise ValueError(f"no '{where + '.' if where else ''}{key}'")
+    value = doc[key]
+    if value is None:
+        return None
+    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+        raise ValueError(f"'{where + '.' if where else ''}{key}' is not a number: {value!r}")
+    return float(value)
+
+
+def _csv_cell(value: object) -> str:
+    """A CSV cell: empty for None, DECIMALS decimals for a float (-0 as 0)."""
+    if value is None:
+        return ""
+    if isinstance(value, float):
+        return f"{value + 0.0:.{DECIMALS}f}"
+    return str(value)
+
+
+def _header(column: str) -> str:
+    """A column's markdown header, units in brackets."""
+    if column.startswith("f_score@"):
+        return f"F@{column[len('f_score@'):-1]} m"
+    return HEADERS[column]
+
+
+def _md_cell(column: str, value: object, failed: bool) -> str:
+    """A markdown cell: a score 'n/a' when undefined, another figure '-' when there is none,
+    blank in a failed row."""
+    if value is None:
+        if failed:
+            return ""
+        return "n/a" if column.endswith(SCORES) else "-"
+    if isinstance(value, float):
+        return f"{value + 0.0:.{MD_DECIMALS.get(column, 3)}f}"
+    return _escape(str(value))
+
+
+def _escape(text: str) -> str:
+    """Text safe in a markdown cell: one line, '|' escaped."""
+    return " ".join(text.split()).replace("|", "\\|")

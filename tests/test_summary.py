@@ -1,0 +1,169 @@
+"""The comparison table and figure of many results (report/summary.py): rows from real result
+JSONs, nulls kept as nulls (empty cell, 'n/a', a gap in the figure), failed rows, outputs
+written whole and the same bytes every time."""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+from pathlib import Path
+
+import pytest
+
+from pcmapq import synth
+from pcmapq.config import DETECTOR_NAMES, MatchingConfig, Settings
+from pcmapq.errors import InputError
+from pcmapq.pipeline import evaluate
+from pcmapq.report import summary
+from pcmapq.report.summary import (
+    HEAD,
+    failed_row,
+    summary_figure,
+    summary_row,
+    table_csv,
+    table_md,
+    write_summary,
+)
+
+from .conftest import write_image_map
+
+ROOT = Path(__file__).resolve().parents[1]
+SAMPLE = ROOT / "data" / "sample"
+
+
+@pytest.fixture(scope="module")
+def summary_docs(plan, truth_png, tmp_path_factory) -> dict[str, dict]:
+    """Result JSON documents, as ``eval --json`` writes them: the sample; and a synthetic map
+    with 30 % of its walls dropped, scored with harris and sift only (hough null)."""
+    degraded = write_image_map(synth.drop_walls(plan, 0.3, seed=1),
+                               tmp_path_factory.mktemp("degraded") / "degraded.png")
+    return {
+        "sample": json.loads(evaluate(SAMPLE / "scan.ply", SAMPLE / "truth.yaml").to_json()),
+        "degraded": json.loads(evaluate(degraded, truth_png, Settings(
+            matching=MatchingConfig(("harris", "sift")))).to_json()),
+    }
+
+
+@pytest.fixture(scope="module")
+def summary_rows(summary_docs) -> list[dict[str, object]]:
+    return [summary_row(name, doc) for name, doc in summary_docs.items()] + [
+        failed_row("broken", "maps/broken.ply", "truth.yaml", 2,
+                   "maps/broken.ply: not a point cloud | nor an image\n(second line)")]
+
+
+def test_a_row_holds_the_documents_figures(summary_docs):
+    doc = summary_docs["sample"]
+    row = summary_row("sample", doc)
+    assert list(row)[:len(HEAD)] == list(HEAD)
+    assert row["map"] == doc["map"]["path"] and row["truth"] == doc["truth"]["path"]
+    for det in DETECTOR_NAMES:
+        for score in ("quality", "precision", "f1"):
+            assert row[f"{det}_{score}"] == doc["detectors"][det][score]
+    a, d = doc["alignment"], doc["distances"]
+    assert [row[k] for k in ("fitness", "confidence", "x_m", "y_m", "yaw_deg", "scale")] == \
+        [a[k] for k in ("fitness", "confidence", "x_m", "y_m", "yaw_deg", "scale")]
+    assert row["coverage"] == doc["coverage"]
+    assert row["accuracy_mean_m"] == d["accuracy_m"]["mean"]
+    assert row["completeness_median_m"] == d["completeness_m"]["median"]
+    assert row["chamfer_m"] == d["chamfer_m"]
+    assert [row[f"f_score@{f['tau_m']:g}m"] for f in d["f_score"]] == \
+        [f["f"] for f in d["f_score"]]
+    assert (row["exit_code"], row["error"]) == (0, "")
+
+
+def test_a_detector_not_run_is_null_not_zero(summary_docs):
+    row = summary_row("degraded", summary_docs["degraded"])
+    assert row["hough_quality"] is None and row["hough_f1"] is None
+    assert 0.0 < row["harris_quality"] < 1.0  # the dropped walls cost features
+
+
+def test_a_document_missing_a_figure_is_refused_by_name(summary_docs):
+    doc = json.loads(json.dumps(summary_docs["sample"]))
+    del doc["alignment"]["confidence"]
+    with pytest.raises(ValueError, match="alignment.confidence"):
+        summary_row("x", doc)
+    doc = json.loads(json.dumps(summary_docs["sample"]))
+    doc["coverage"] = "high"
+    with pytest.raises(ValueError, match="coverage"):
+        summary_row("x", doc)
+
+
+def test_failed_row_has_no_figures():
+    row = failed_row("b", "m.ply", "t.yaml", 1, "m.ply: alignment failed")
+    assert set(HEAD) <= set(row)
+    assert all(row[k] is None for k in HEAD if k not in ("name", "map", "truth"))
+    assert (row["exit_code"], row["error"]) == (1, "m.ply: alignment failed")
+
+
+def test_csv_has_empty_cells_for_nulls_and_the_failures_exit_code(summary_rows):
+    table = list(csv.DictReader(io.StringIO(table_csv(summary_rows))))
+    assert [r["name"] for r in table] == ["sample", "degraded", "broken"]
+    sample, degraded, broken = table
+    assert float(sample["harris_quality"]) == summary_rows[0]["harris_quality"]
+    assert degraded["hough_quality"] == "" and degraded["hough_precision"] == ""
+    assert float(degraded["sift_quality"]) == summary_rows[1]["sift_quality"]
+    assert broken["exit_code"] == "2" and broken["harris_quality"] == ""
+    assert broken["error"] == "maps/broken.ply: not a point cloud | nor an image (second line)"
+    assert sample["exit_code"] == "0" and sample["error"] == ""
+
+
+def test_csv_columns_are_the_union_of_taus_in_order():
+    a = {**failed_row("a", "a", "t", 1, "x"), "f_score@0.5m": 0.5}
+    b = {**failed_row("b", "b", "t", 1, "x"), "f_score@0.05m": 0.1}
+    header = table_csv([a, b]).splitlines()[0].split(",")
+    assert header[len(HEAD):] == ["f_score@0.05m", "f_score@0.5m", "exit_code", "error"]
+
+
+def test_markdown_table_shows_nulls_and_failures(summary_rows):
+    lines = table_md(summary_rows).splitlines()
+    header = [c.strip() for c in lines[0].strip("|").split("|")]
+    assert "accuracy mean (m)" in header and "yaw (deg)" in header and "F@0.05 m" in header
+    cells = {line.split("|")[1].strip(): [c.strip() for c in line.strip("|").split("|")]
+             for line in lines[2:]}
+    assert len(lines) == 2 + len(summary_rows)
+    assert cells["degraded"][header.index("hough quality")] == "n/a"
+    assert cells["sample"][header.index("status")] == "ok"
+    assert cells["broken"][header.index("harris quality")] == ""
+    assert lines[-1].endswith("| failed (exit 2): maps/broken.ply: not a point cloud \\| "
+                              "nor an image (second line) |")
+
+
+def test_figure_draws_a_bar_per_defined_quality_and_marks_the_gaps(summary_rows):
+    fig = summary_figure(summary_rows)
+    ax = fig.axes[0]
+    bars = {c.get_label(): c for c in ax.containers}
+    assert list(bars) == list(DETECTOR_NAMES)
+    for det, container in bars.items():
+        expected = [r[f"{det}_quality"] for r in summary_rows
+                    if r[f"{det}_quality"] is not None and not r["exit_code"]]
+        assert [p.get_height() for p in container.patches] == pytest.approx(expected)
+    assert len(bars["hough"].patches) == 1  # the degraded map's and the failed one's: gaps
+    texts = [t.get_text() for t in ax.texts]
+    assert texts.count("n/a") == 1 and texts.count("failed (exit 2)") == 1
+    assert [t.get_text() for t in ax.get_xticklabels()] == ["sample", "degraded", "broken"]
+
+
+def test_outputs_are_the_same_bytes_every_time(summary_rows, tmp_path):
+    first = write_summary(summary_rows, tmp_path / "a")
+    second = write_summary(summary_rows, tmp_path / "b" / "nested")
+    assert [p.name for p in first] == ["table.csv", "table.md", "figure.png"]
+    for a, b in zip(first, second, strict=True):
+        assert a.read_bytes() == b.read_bytes()
+    assert first[2].read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_outputs_are_written_whole_or_not_at_all(summary_rows, tmp_path, monkeypatch):
+    def broken_figure(_rows):
+        raise RuntimeError("no figure")
+
+    monkeypatch.setattr(summary, "summary_figure", broken_figure)
+    with pytest.raises(RuntimeError):
+        write_summary(summary_rows, tmp_path)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_an_unwritable_folder_is_an_input_error(summary_rows, tmp_path):
+    (tmp_path / "file").write_text("x")
+    with pytest.raises(InputError, match="file"):
+        write_summary(summary_rows, tmp_path / "file" / "out")
