@@ -8,7 +8,8 @@ from the reference poses with a yaw drift per metre (:func:`yaw_drifted`), voxel
 alike and scored by MME, MPV and MOM (:func:`pcmapq.metrics.inspection.noref_figures`), beside
 ``pcmapq eval`` of each map against the reference map. Each figure's Spearman rank correlation
 with the drift level says whether it ranks the maps as the drift does (+1: it grows with the
-drift, as it should; every figure here is lower-is-better).
+drift, as it should; every figure here is lower-is-better). Then the real 2D maps of the other
+sections beside their truths (:mod:`bench.validation.noref_grids`).
 """
 
 from __future__ import annotations
@@ -39,7 +40,7 @@ from pcmapq.metrics.orthogonal import extract_orthogonal_subset
 from pcmapq.raster.draw import hit_counts
 from pcmapq.voxels import voxel_centroids
 
-from . import carmen, drift
+from . import carmen, drift, noref_grids
 from .common import Case, Record, Run, Section, f_at, header, row, timed_evaluate
 from .kitti import TR
 
@@ -232,7 +233,7 @@ def cases(data: Path) -> list[Case]:
                  lambda log=log: grid_ladder(data / "carmen" / log)) for log in carmen.LOGS] + [
         Case(f"noref-kitti00-{base.split('-')[0].lower()}",
              lambda base=base: cloud_ladder(data / "kitti00", base))
-        for base in ("reference", "KISS-ICP")]
+        for base in ("reference", "KISS-ICP")] + noref_grids.cases(data)
 
 
 def rho(levels: Sequence[float], values: Sequence[float | None]) -> float | None:
@@ -326,7 +327,8 @@ def cloud_table(ladder: CloudLadder) -> tuple[list[str], dict[str, float | None]
 def section(data: Path, record: Record) -> Section:
     """Both ladders' tables, their rank correlations, and what they show."""
     got = [case.run(record) for case in cases(data)]
-    grids, clouds = got[:len(carmen.LOGS)], got[len(carmen.LOGS):]
+    n = len(carmen.LOGS)
+    grids, clouds, pairs = got[:n], got[n:n + 2], got[n + 2:]
     lines = [
         "## No-reference figures against the truth: do they rank maps by drift?", "",
         "Every no-reference figure is lower-is-better, so one that ranks maps as the drift does "
@@ -360,6 +362,7 @@ def section(data: Path, record: Record) -> Section:
         "after: the drifted scans' fans spread free space over more new cells than their "
         "smeared walls add occupied ones. Occupied cells and corners rank the rungs best, but they "
         "also grow with how much of a place is mapped: they compare maps of the same scans only.",
+        "", *noref_grids.section_lines(pairs),
     ]
     first = clouds[0].rungs[0].noref["orth_plane_points"]
     lines += [
