@@ -16,6 +16,7 @@ from typer.testing import CliRunner
 from pcmapq import synth
 from pcmapq.batch import Task, read_rows, run_batch, run_row
 from pcmapq.batch.manifest import glob_rows, parse_assignments
+from pcmapq.batch.run import run_local
 from pcmapq.cli import app
 from pcmapq.config import MatchingConfig, Settings
 from pcmapq.errors import InputError
@@ -211,6 +212,39 @@ def test_resume(inputs, local):
     forced = run_batch(rows[:1], out, workers=1, force=True)
     assert forced[0].status == "computed"
     assert (out / "straight.json").read_bytes() == results["straight"]
+
+
+class DyingTask(Task):
+    """A task whose worker process dies (SIGKILL) the first time it runs: when
+    ``DyingTask.marker`` (a file) is absent."""
+
+    marker: str = ""
+
+    def outputs(self) -> dict[str, Path]:
+        import os
+        import signal
+
+        if not os.path.exists(self.marker):
+            Path(self.marker).touch()
+            os.kill(os.getpid(), signal.SIGKILL)
+        return super().outputs()
+
+
+def test_local_worker_killed(inputs, local, tmp_path):
+    """A local worker process killed mid-row loses no row: the unfinished rows run again in
+    a new pool."""
+    out, results, _ = local
+    rows = read_rows(inputs / "runs.csv", {})
+    marker = tmp_path / "killed"
+    tasks = [Task(rows[0], out, force=True), DyingTask(rows[1], out, force=True),
+             Task(rows[3], out, force=True)]
+    object.__setattr__(tasks[1], "marker", str(marker))
+    outcomes = run_local(tasks, workers=2)
+    assert marker.exists()
+    assert [(o.name, o.exit_code) for o in outcomes] == [
+        ("straight", 0), ("turned", 0), ("scaled", 0)]
+    for name, data in results.items():
+        assert (out / f"{name}.json").read_bytes() == data, name
 
 
 def test_dask_cluster_same_bytes(inputs, local, cluster):
