@@ -133,8 +133,13 @@ def test_bad_manifest(tmp_path, text, message):
     assert not (tmp_path / "out").exists()
 
 
-def test_set_and_glob(inputs):
-    """--set fills every row; a glob's rows are its maps, sorted, named by stem."""
+def test_set_and_glob(inputs, tmp_path, monkeypatch):
+    """--set fills every row (its truth from the current folder, a manifest's paths from the
+    manifest's); a glob's rows are its maps, sorted, named by stem."""
+    (tmp_path / "runs.csv").write_text(f"map\n{inputs / 'maps' / 'turned.png'}\n")
+    monkeypatch.chdir(inputs)
+    (row,) = read_rows(tmp_path / "runs.csv", parse_assignments(["truth=truth.png"]))
+    assert row.truth == inputs / "truth.png"
     rows = glob_rows([str(inputs / "maps" / "s*.png")], inputs / "truth.png",
                      parse_assignments(["threshold=0.25"]))
     assert [r.name for r in rows] == ["scaled", "straight"]
@@ -208,7 +213,6 @@ def test_resume(inputs, local):
     assert run_batch(other, out, workers=1)[0].status == "computed"
     assert json.loads((out / "straight.json").read_bytes())["settings"]["distances"] == {
         "taus": [0.1]}
-    assert [o.status for o in run_batch(other, out, workers=1)] == ["skipped"]
     forced = run_batch(rows[:1], out, workers=1, force=True)
     assert forced[0].status == "computed"
     assert (out / "straight.json").read_bytes() == results["straight"]

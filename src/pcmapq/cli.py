@@ -471,6 +471,10 @@ def batch_command(
     with report_errors(err), show_warnings(err):
         defaults = parse_assignments(set_options or [])
         if truth is not None:
+            if any(s.lower().endswith(".csv") for s in sources):
+                raise InputError("--truth gives the truth of maps given as MAP...; a "
+                                 "manifest's rows name their own ('truth' column, or --set "
+                                 "truth=FILE)")
             rows = glob_rows(sources, truth, defaults)
         elif len(sources) == 1:
             rows = read_rows(Path(sources[0]), defaults)

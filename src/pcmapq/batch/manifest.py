@@ -118,15 +118,17 @@ def glob_rows(patterns: list[str], truth: Path, defaults: dict[str, object]) -> 
 
 
 def parse_assignments(pairs: list[str]) -> dict[str, object]:
-    """``--set KEY=VALUE`` options as defaults of every row (keys as manifest columns)."""
+    """``--set KEY=VALUE`` options as defaults of every row (keys as manifest columns but
+    name and map; a truth path is the current folder's)."""
     values: dict[str, object] = {}
     for pair in pairs:
         key, sep, value = pair.partition("=")
         key = _column(key, f"--set {pair}")
-        if not sep or key == "name":
+        if not sep or key in ("name", "map"):
             raise InputError(f"--set {pair}: expected KEY=VALUE with KEY an option of a row "
-                             f"({', '.join(c for c in COLUMNS if c != 'name')})")
-        values[key] = value
+                             f"({', '.join(c for c in COLUMNS if c not in ('name', 'map'))})")
+        values[key] = os.path.abspath(Path(value).expanduser()) \
+            if key == "truth" and value.strip() else value
     return values
 
 

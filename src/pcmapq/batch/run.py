@@ -10,6 +10,8 @@ import hashlib
 import json
 import multiprocessing
 import os
+import threading
+import uuid
 import warnings
 from collections.abc import Callable
 from concurrent.futures import ProcessPoolExecutor, as_completed
@@ -36,6 +38,9 @@ DASK_RETRIES = 2
 LOCAL_ROUNDS = 2
 #: Bytes read at a time when hashing an input.
 CHUNK = 1 << 20
+#: One row at a time in a process: a Dask worker with several threads runs its rows in turn
+#: (warnings are caught per process, and matplotlib's pyplot is not thread-safe).
+ONE_AT_A_TIME = threading.Lock()
 
 
 @dataclass(frozen=True)
@@ -80,16 +85,21 @@ def run_row(task: Task) -> Outcome:
     """The task function, local or on Dask: skip the row when its saved result is valid (and
     not ``task.force``), else evaluate it and write its outputs and record atomically. Never
     raises: an error becomes a failed Outcome (InputError 2, EvaluationError 1, other 1)."""
-    row = task.row
     try:
-        key = row_key(task)
-        if not task.force and (doc := saved_result(task, key)) is not None:
-            return Outcome(row.name, "skipped", 0, "", summary_row(row.name, doc))
-        return _compute(task, key)
+        with ONE_AT_A_TIME:
+            return _run(task)
     except (InputError, EvaluationError) as exc:
         return failed(task, exc.exit_code, one_line(exc))
     except Exception as exc:  # noqa: BLE001 - any error is the row's, never the batch's
         return failed(task, 1, f"{type(exc).__name__}: {one_line(exc)}")
+
+
+def _run(task: Task) -> Outcome:
+    """:func:`run_row` without its safety net."""
+    row, key = task.row, row_key(task)
+    if not task.force and (doc := saved_result(task, key)) is not None:
+        return Outcome(row.name, "skipped", 0, "", summary_row(row.name, doc))
+    return _compute(task, key)
 
 
 def row_key(task: Task) -> dict:
@@ -207,14 +217,18 @@ def run_local(tasks: list[Task], workers: int,
         with ProcessPoolExecutor(max(1, min(workers, len(pending))),
                                  mp_context=context) as pool:
             futures = {pool.submit(run_row, tasks[i]): i for i in pending}
-            for future in as_completed(futures):
-                i = futures[future]
-                try:
-                    outcomes[i] = future.result()
-                except BrokenProcessPool:
-                    broken.append(i)
-                    continue
-                done(outcomes[i])
+            try:
+                for future in as_completed(futures):
+                    i = futures[future]
+                    try:
+                        outcomes[i] = future.result()
+                    except BrokenProcessPool:
+                        broken.append(i)
+                        continue
+                    done(outcomes[i])
+            except BaseException:  # Ctrl-C: the rows not started are not run
+                pool.shutdown(wait=False, cancel_futures=True)
+                raise
         pending = sorted(broken)
         if not pending:
             break
@@ -241,9 +255,10 @@ def run_dask(tasks: list[Task], address: str,
         raise InputError(f"{address}: cannot reach the Dask scheduler: {one_line(exc)}"
                          ) from None
     outcomes: list[Outcome | None] = [None] * len(tasks)
+    batch = uuid.uuid4().hex  # a key of its own per run: Dask keeps results by key
     with client:
         futures = {client.submit(run_row, task, pure=False, retries=DASK_RETRIES,
-                                 key=f"pcmapq-batch-{task.row.name}-{i}-{id(tasks)}"): i
+                                 key=f"pcmapq-batch-{task.row.name}-{batch}"): i
                    for i, task in enumerate(tasks)}
         for future in dask_completed(list(futures)):
             i = futures[future]
