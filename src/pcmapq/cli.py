@@ -483,7 +483,11 @@ def batch_command(
                                      param_hint="MANIFEST | MAP...")
         if out.exists() and not out.is_dir():
             raise InputError(f"{out}: --out: not a folder")
-        options.check_outputs({"--json": json_path}, None, inputs=())
+        if json_path not in (None, "-"):
+            out.mkdir(parents=True, exist_ok=True)  # --json may go into it
+            options.check_outputs({"--json": json_path}, None, inputs=())
+            if any(options.same_file(Path(json_path), out / f"{r.name}.json") for r in rows):
+                raise InputError(f"{json_path}: --json would overwrite a row's result")
         with row_bar(err, len(rows), enabled=not quiet and json_path != "-") as tick:
             outcomes = run_batch(rows, out, plot=plot, report=report, force=force,
                                  workers=workers, scheduler=scheduler, done=tick)
