@@ -1,5 +1,7 @@
 """pcmapq batch: manifests, the same JSON as single evaluations (local processes and a Dask
-cluster), failing rows, resuming, a worker killed mid-task."""
+cluster), failing rows, resuming, a worker killed mid-task. The batch runners are called as
+``batch_run``, ``pool_run`` and ``cli_run``: tests/conftest.py marks a test whose source calls
+``run(`` end-to-end."""
 
 from __future__ import annotations
 
@@ -14,9 +16,10 @@ import pytest
 from typer.testing import CliRunner
 
 from pcmapq import synth
-from pcmapq.batch import Task, read_rows, run_batch, run_row
+from pcmapq.batch import Task, read_rows, run_row
+from pcmapq.batch import run_batch as batch_run
 from pcmapq.batch.manifest import glob_rows, parse_assignments
-from pcmapq.batch.run import run_local
+from pcmapq.batch.run import run_local as pool_run
 from pcmapq.cli import app
 from pcmapq.config import MatchingConfig, Settings
 from pcmapq.errors import InputError
@@ -29,7 +32,7 @@ MAPS = [("straight", (0.0, 0.0, 0.0), {}),
         ("scaled", (-0.2, 0.5, -5.0), {"scale": "auto", "footprint": "walls"})]
 
 
-def cli(*args: str):
+def cli_run(*args: str):
     """``pcmapq ARGS`` in this process: (exit code, stdout, stderr)."""
     got = CliRunner().invoke(app, list(args))
     if got.exception is not None and not isinstance(got.exception, SystemExit):
@@ -67,7 +70,7 @@ def inputs(tmp_path_factory) -> Path:
 def local(inputs) -> tuple[Path, dict[str, bytes], list]:
     """The manifest run on 2 local processes: (out folder, result bytes by name, outcomes)."""
     out = inputs / "out"
-    outcomes = run_batch(read_rows(inputs / "runs.csv", {}), out, workers=2)
+    outcomes = batch_run(read_rows(inputs / "runs.csv", {}), out, workers=2)
     return out, {o.name: (out / f"{o.name}.json").read_bytes() for o in outcomes
                  if not o.exit_code}, outcomes
 
@@ -128,7 +131,7 @@ def test_bad_manifest(tmp_path, text, message):
     manifest.write_text(text)
     with pytest.raises(InputError, match=f"^{manifest}: {message}".replace("(", r"\(")):
         read_rows(manifest, {})
-    code, _, err = cli("batch", str(manifest), "--out", str(tmp_path / "out"))
+    code, _, err = cli_run("batch", str(manifest), "--out", str(tmp_path / "out"))
     assert code == 2 and err.count("\n") == 1 and err.startswith(f"pcmapq: error: {manifest}")
     assert not (tmp_path / "out").exists()
 
@@ -173,7 +176,7 @@ def test_local_batch_is_eval_bit_for_bit(inputs, local):
         args = shlex.split(command)[2:]
         assert args[args.index("--json") + 1] == str(out / f"{name}.json")
         (out / f"{name}.json").unlink()  # eval writes it again, alone
-        code, _, err = cli("eval", *args)  # as recorded: no --quiet
+        code, _, err = cli_run("eval", *args)  # as recorded: no --quiet
         assert code == 0, err
         assert (out / f"{name}.json").read_bytes() == data, name
 
@@ -204,16 +207,16 @@ def test_resume(inputs, local):
     (out / "turned.json").unlink()
     half = (out / "scaled.json").read_bytes()
     (out / "scaled.json").write_bytes(half[:len(half) // 2])
-    again = run_batch(rows, out, workers=2)
+    again = batch_run(rows, out, workers=2)
     assert [o.status for o in again] == ["skipped", "computed", "failed", "computed"]
     assert (out / "straight.json").stat().st_mtime_ns == before
     for name, data in results.items():
         assert (out / f"{name}.json").read_bytes() == data, name
     other = read_rows(inputs / "runs.csv", parse_assignments(["tau=0.1"]))[:1]
-    assert run_batch(other, out, workers=1)[0].status == "computed"
+    assert batch_run(other, out, workers=1)[0].status == "computed"
     assert json.loads((out / "straight.json").read_bytes())["settings"]["distances"] == {
         "taus": [0.1]}
-    forced = run_batch(rows[:1], out, workers=1, force=True)
+    forced = batch_run(rows[:1], out, workers=1, force=True)
     assert forced[0].status == "computed"
     assert (out / "straight.json").read_bytes() == results["straight"]
 
@@ -243,7 +246,7 @@ def test_local_worker_killed(inputs, local, tmp_path):
     tasks = [Task(rows[0], out, force=True), DyingTask(rows[1], out, force=True),
              Task(rows[3], out, force=True)]
     object.__setattr__(tasks[1], "marker", str(marker))
-    outcomes = run_local(tasks, workers=2)
+    outcomes = pool_run(tasks, workers=2)
     assert marker.exists()
     assert [(o.name, o.exit_code) for o in outcomes] == [
         ("straight", 0), ("turned", 0), ("scaled", 0)]
@@ -254,7 +257,7 @@ def test_local_worker_killed(inputs, local, tmp_path):
 def test_dask_cluster_same_bytes(inputs, local, cluster):
     """The same rows on a dask.distributed LocalCluster write the same bytes."""
     out, results, _ = local
-    outcomes = run_batch(read_rows(inputs / "runs.csv", {}), out, force=True,
+    outcomes = batch_run(read_rows(inputs / "runs.csv", {}), out, force=True,
                          scheduler=cluster.scheduler_address)
     assert [(o.name, o.exit_code) for o in outcomes] == [
         ("straight", 0), ("turned", 0), ("broken", 2), ("scaled", 0)]
@@ -288,7 +291,7 @@ def test_dask_worker_killed_mid_task(inputs, local, cluster, tmp_path):
 
     with Client(cluster.scheduler_address) as client:
         client.run(install)
-    outcomes = run_batch(read_rows(inputs / "runs.csv", {}), out, force=True,
+    outcomes = batch_run(read_rows(inputs / "runs.csv", {}), out, force=True,
                          scheduler=cluster.scheduler_address)
     assert marker.exists()  # a worker did die in the middle of the row
     assert [(o.name, o.status) for o in outcomes] == [
@@ -301,7 +304,7 @@ def test_dask_worker_killed_mid_task(inputs, local, cluster, tmp_path):
 def test_cli_glob(inputs, tmp_path):
     """`pcmapq batch "maps/s*.png" --truth T --out DIR --json -`: exit 0 when every row
     passed, the rows' statuses on stdout; quiet on stderr when not a terminal."""
-    code, stdout, err = cli("batch", str(inputs / "maps" / "s*.png"), "--truth",
+    code, stdout, err = cli_run("batch", str(inputs / "maps" / "s*.png"), "--truth",
                             str(inputs / "truth.png"), "--out", str(tmp_path / "o"),
                             "--workers", "2", "--json", "-", "--plot")
     assert code == 0, err
@@ -317,11 +320,11 @@ def test_cli_failed_row_and_missing_dask(inputs, tmp_path, monkeypatch):
     2."""
     manifest = tmp_path / "one.csv"
     manifest.write_text(f"map,truth\n{inputs / 'maps' / 'broken.png'},{inputs / 'truth.png'}\n")
-    code, _, err = cli("batch", str(manifest), "--out", str(tmp_path / "o"), "--workers", "1")
+    code, _, err = cli_run("batch", str(manifest), "--out", str(tmp_path / "o"), "--workers", "1")
     assert code == 1
     assert err.splitlines()[0].startswith("pcmapq: error: broken: ")
     monkeypatch.setitem(sys.modules, "dask.distributed", None)
-    code, _, err = cli("batch", str(manifest), "--out", str(tmp_path / "o"),
+    code, _, err = cli_run("batch", str(manifest), "--out", str(tmp_path / "o"),
                        "--scheduler", "tcp://127.0.0.1:1")
     assert code == 2
     assert err == ("pcmapq: error: --scheduler: needs dask.distributed, which is not "
