@@ -323,6 +323,9 @@ def test_cli_failed_row_and_missing_dask(inputs, tmp_path, monkeypatch):
     code, _, err = cli_run("batch", str(manifest), "--out", str(tmp_path / "o"), "--workers", "1")
     assert code == 1
     assert err.splitlines()[0].startswith("pcmapq: error: broken: ")
+    code, _, err = cli_run("batch", str(manifest), "--out", str(tmp_path / "o"),
+                           "--workers", "2", "--scheduler", "tcp://127.0.0.1:1")
+    assert code == 2 and err.startswith("pcmapq: error: --workers") and err.count("\n") == 1
     monkeypatch.setitem(sys.modules, "dask.distributed", None)
     code, _, err = cli_run("batch", str(manifest), "--out", str(tmp_path / "o"),
                        "--scheduler", "tcp://127.0.0.1:1")

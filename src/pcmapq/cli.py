@@ -469,6 +469,9 @@ def batch_command(
 
     err = Console(stderr=True)
     with report_errors(err), show_warnings(err):
+        if workers is not None and scheduler is not None:
+            raise InputError("--workers sets local processes; with --scheduler the cluster's "
+                             "workers run the rows: give one of the two")
         defaults = parse_assignments(set_options or [])
         if truth is not None:
             if any(s.lower().endswith(".csv") for s in sources):
