@@ -1,0 +1,8 @@
+"""Many evaluations at once (``pcmapq batch``): the manifest's rows, run on local processes
+or a Dask cluster, resumable, each row's failure its own."""
+
+from pcmapq.batch.manifest import Row, glob_rows, parse_assignments, read_rows
+from pcmapq.batch.run import Outcome, Task, run_batch, run_row
+
+__all__ = ["Outcome", "Row", "Task", "glob_rows", "parse_assignments", "read_rows",
+           "run_batch", "run_row"]

@@ -1,0 +1,299 @@
+"""A batch's rows: read from a CSV or YAML manifest, or one per map of a glob. Each row's
+options are ``pcmapq eval``'s, by name (``threshold``, ``map_resolution`` ...), turned into
+:class:`~pcmapq.config.Settings` by the same parsers as eval's, and into the ``pcmapq eval``
+command line that makes the same result. A bad manifest is one InputError (exit 2) naming
+the file, the row and the problem."""
+
+from __future__ import annotations
+
+import csv
+import glob
+import math
+import os
+import shlex
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+import typer
+import yaml
+
+from pcmapq import options
+from pcmapq.config import DistancesConfig, MatchingConfig, Settings, SourceConfig
+from pcmapq.errors import InputError
+
+DEFAULTS = Settings()
+#: Names a row cannot take: the batch's own table and figure are written beside the rows.
+RESERVED = ("table", "figure")
+MANIFEST_SUFFIXES = (".csv", ".yaml", ".yml")
+
+
+@dataclass(frozen=True)
+class Column:
+    """A per-row option: how its text is read. kind: 'float', 'int', 'bool' (a flag of eval),
+    'switch' (eval's ``--x/--no-x``) or 'text' (parsed with the settings); lo, hi: bounds."""
+
+    kind: str
+    lo: float = -math.inf
+    hi: float = math.inf
+
+
+#: The per-row options, in ``pcmapq eval``'s order (its command line lists them so), split
+#: where eval's output options (``--json``, ``--plot``, ``--report``) stand.
+BEFORE_OUTPUTS = {
+    "map_resolution": Column("text"), "scale": Column("text"),
+    "truth_resolution": Column("float", 1e-6),
+    "map_occupied_thresh": Column("float", 0.0, 1.0), "map_free_thresh": Column("float", 0.0, 1.0),
+    "map_negate": Column("switch"),
+    "truth_occupied_thresh": Column("float", 0.0, 1.0),
+    "truth_free_thresh": Column("float", 0.0, 1.0), "truth_negate": Column("switch"),
+    "map_crop": Column("text"), "truth_crop": Column("text"), "init": Column("text"),
+    "no_align": Column("bool"), "force": Column("bool"),
+    "threshold": Column("float", 1e-6), "band_low": Column("float"),
+    "band_high": Column("float"), "min_hits": Column("int", 1), "detectors": Column("text"),
+}
+AFTER_OUTPUTS = {"voxel_3d": Column("float", 0.01), "tau": Column("text"),
+                 "footprint": Column("text"), "full": Column("bool")}
+OPTIONS = {**BEFORE_OUTPUTS, **AFTER_OUTPUTS}
+#: Every column a manifest may have.
+COLUMNS = ("name", "map", "truth", *OPTIONS)
+
+
+@dataclass(frozen=True)
+class Row:
+    """One evaluation: its name (the stem of its outputs), map and truth (absolute paths, as
+    the workers read them), settings, and its options as given (parsed values, by column)."""
+
+    name: str
+    map: Path
+    truth: Path
+    settings: Settings
+    options: dict[str, object]
+
+    def command(self, outputs: dict[str, Path]) -> str:
+        """The ``pcmapq eval`` command line that makes this row's result and writes
+        ``outputs`` (``{"--json": path, ...}``), as eval records its own (defaults left out)."""
+        words = ["pcmapq", "eval", str(self.map), str(self.truth)]
+        words += _words(self.options, BEFORE_OUTPUTS)
+        for option in ("--json", "--plot", "--report"):
+            if option in outputs:
+                words += [option, str(outputs[option])]
+        words += _words(self.options, AFTER_OUTPUTS)
+        return shlex.join(words)
+
+
+def read_rows(manifest: Path, defaults: dict[str, object]) -> list[Row]:
+    """The rows of a CSV or YAML manifest. Relative paths in it are relative to its folder;
+    ``defaults`` (column -> text, e.g. from ``--set``) fill the cells a row leaves empty."""
+    suffix = manifest.suffix.lower()
+    if suffix not in MANIFEST_SUFFIXES:
+        raise InputError(f"{manifest}: a manifest is .csv, .yaml or .yml")
+    try:
+        text = manifest.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InputError(f"{manifest}: cannot read: {getattr(exc, 'strerror', None) or exc}"
+                         ) from None
+    cells = _csv_cells(manifest, text) if suffix == ".csv" else _yaml_cells(manifest, text)
+    if not cells:
+        raise InputError(f"{manifest}: no rows")
+    base = Path(os.path.abspath(manifest.parent))
+    rows = [make_row({**defaults, **row}, base, f"{manifest}: row {i}")
+            for i, row in enumerate(cells, 1)]
+    check_names(rows, str(manifest))
+    return rows
+
+
+def glob_rows(patterns: list[str], truth: Path, defaults: dict[str, object]) -> list[Row]:
+    """One row per map matching ``patterns`` (globs or paths, relative to the current folder,
+    sorted, each map once), all against ``truth``; a row's name is its map's stem."""
+    maps: list[str] = []
+    for pattern in patterns:
+        found = sorted(glob.glob(pattern)) if glob.has_magic(pattern) else [pattern]
+        if not found:
+            raise InputError(f"{pattern}: matches no file")
+        maps += [m for m in found if m not in maps]
+    here = Path(os.path.abspath("."))
+    rows = [make_row({**defaults, "map": m, "truth": str(truth)}, here, m) for m in maps]
+    check_names(rows, " ".join(patterns))
+    return rows
+
+
+def parse_assignments(pairs: list[str]) -> dict[str, object]:
+    """``--set KEY=VALUE`` options as defaults of every row (keys as manifest columns but
+    name and map; a truth path is the current folder's)."""
+    values: dict[str, object] = {}
+    for pair in pairs:
+        key, sep, value = pair.partition("=")
+        key = _column(key, f"--set {pair}")
+        if not sep or key in ("name", "map"):
+            raise InputError(f"--set {pair}: expected KEY=VALUE with KEY an option of a row "
+                             f"({', '.join(c for c in COLUMNS if c not in ('name', 'map'))})")
+        values[key] = os.path.abspath(Path(value).expanduser()) \
+            if key == "truth" and value.strip() else value
+    return values
+
+
+def make_row(cells: dict[str, object], base: Path, where: str) -> Row:
+    """A row from its cells (column -> text or YAML value; None or '' is unset); paths
+    relative to ``base``; errors name ``where``."""
+    given = {_column(k, where): _text(v, where, k) for k, v in cells.items()}
+    given = {k: v for k, v in given.items() if v != ""}
+    for required in ("map", "truth"):
+        if required not in given:
+            raise InputError(f"{where}: no '{required}'")
+    values = {k: _value(k, v, where) for k, v in given.items() if k in OPTIONS}
+    map_path = Path(os.path.abspath(base / Path(given["map"]).expanduser()))
+    name = given.get("name", map_path.stem)
+    try:
+        return Row(name, map_path,
+                   Path(os.path.abspath(base / Path(given["truth"]).expanduser())),
+                   settings(values), values)
+    except typer.BadParameter as exc:
+        hint = str(exc.param_hint or "").lstrip("-").replace("-", "_")
+        raise InputError(f"{where}: {hint}: {exc.message}") from None
+    except InputError as exc:
+        raise InputError(f"{where}: {exc}") from None
+
+
+def settings(values: dict[str, object]) -> Settings:
+    """A row's Settings, built as ``pcmapq eval`` builds them from the same options."""
+    v = values.get
+    resolution, auto = options.parse_resolution(v("map_resolution"), v("scale", "fixed"))
+    options.check_eval_options(scans=None, max_scans=None, no_align=bool(v("no_align")),
+                               auto_scale=auto)
+    raster, align, foot = DEFAULTS.raster, DEFAULTS.alignment, DEFAULTS.footprint
+    return Settings(
+        map=SourceConfig(resolution, options.thresholds(
+            v("map_occupied_thresh"), v("map_free_thresh"), v("map_negate")),
+            options.parse_box(v("map_crop"), "map_crop")),
+        truth=SourceConfig(v("truth_resolution"), options.thresholds(
+            v("truth_occupied_thresh"), v("truth_free_thresh"), v("truth_negate")),
+            options.parse_box(v("truth_crop"), "truth_crop")),
+        raster=replace(raster, band_low=v("band_low", raster.band_low),
+                       band_high=v("band_high", raster.band_high), min_hits=v("min_hits")),
+        alignment=replace(align, enabled=not v("no_align"), init=options.parse_init(v("init")),
+                          scale=auto, voxel_3d=v("voxel_3d", align.voxel_3d),
+                          force=bool(v("force"))),
+        footprint=replace(foot, rule=options.parse_footprint(v("footprint", foot.rule)),
+                          full=bool(v("full"))),
+        matching=MatchingConfig(options.parse_detectors(
+            v("detectors", ",".join(DEFAULTS.matching.detectors))),
+            v("threshold", DEFAULTS.matching.threshold)),
+        distances=DistancesConfig(options.parse_taus(
+            v("tau", ",".join(f"{t:g}" for t in DEFAULTS.distances.taus)))))
+
+
+def check_names(rows: list[Row], where: str) -> None:
+    """Refuse a name that is not a plain file stem, reserved, or given to two rows."""
+    seen: dict[str, int] = {}
+    for i, row in enumerate(rows, 1):
+        name = row.name
+        if not name or name.startswith(".") or "/" in name or "\\" in name or \
+                any(ord(c) < 32 for c in name):
+            raise InputError(f"{where}: row {i}: name {name!r}: not a plain file name")
+        if name.lower() in RESERVED:
+            raise InputError(f"{where}: row {i}: name {name!r} is reserved for the batch's "
+                             "table and figure; give another 'name'")
+        if name in seen:
+            raise InputError(f"{where}: row {i}: name {name!r} is also row {seen[name]}'s; "
+                             "give each row its own 'name'")
+        seen[name] = i
+
+
+def _csv_cells(manifest: Path, text: str) -> list[dict[str, object]]:
+    """A CSV manifest's rows as cells by column (a header line first; '#' lines skipped)."""
+    lines = [line for line in text.splitlines() if not line.lstrip().startswith("#")]
+    reader = csv.DictReader(lines, skipinitialspace=True, restkey="\0extra")
+    if not reader.fieldnames:
+        raise InputError(f"{manifest}: no header line (name,map,truth,... columns)")
+    rows = []
+    for i, row in enumerate(reader, 1):
+        if "\0extra" in row:
+            raise InputError(f"{manifest}: row {i}: more cells than the header's "
+                             f"{len(reader.fieldnames)} columns")
+        rows.append({k.strip(): ("" if v is None else v.strip()) for k, v in row.items()})
+    return [row for row in rows if any(row.values())]
+
+
+def _yaml_cells(manifest: Path, text: str) -> list[dict[str, object]]:
+    """A YAML manifest's rows: a list of mappings, or ``{defaults: {...}, rows: [...]}``."""
+    try:
+        doc = yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        raise InputError(f"{manifest}: not YAML: {' '.join(str(exc).split())}") from None
+    defaults: dict = {}
+    if isinstance(doc, dict) and "rows" in doc:
+        extra = set(doc) - {"rows", "defaults"}
+        if extra:
+            raise InputError(f"{manifest}: unknown key(s) {sorted(map(str, extra))}; a "
+                             "manifest has 'rows' and optional 'defaults'")
+        defaults, doc = doc.get("defaults") or {}, doc["rows"]
+        if not isinstance(defaults, dict):
+            raise InputError(f"{manifest}: 'defaults' is not a mapping of options")
+    if not isinstance(doc, list):
+        raise InputError(f"{manifest}: expected a list of rows (or 'rows:' and 'defaults:')")
+    for i, row in enumerate(doc, 1):
+        if not isinstance(row, dict):
+            raise InputError(f"{manifest}: row {i}: not a mapping of columns (map: ..., "
+                             "truth: ...)")
+    return [{**defaults, **row} for row in doc]
+
+
+def _column(key: object, where: str) -> str:
+    """A column's name (``map-resolution`` and ``map_resolution`` alike); refuse others."""
+    name = str(key).strip().lower().replace("-", "_")
+    if name not in COLUMNS:
+        raise InputError(f"{where}: unknown column {str(key)!r}; columns: {', '.join(COLUMNS)}")
+    return name
+
+
+def _text(value: object, where: str, column: object) -> str:
+    """A cell as text: YAML numbers and booleans as written, a list comma-separated."""
+    if value is None:
+        return ""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, list | tuple):
+        return ",".join(_text(v, where, column) for v in value)
+    if isinstance(value, dict):
+        raise InputError(f"{where}: {column}: expected a value, got a mapping")
+    return str(value).strip()
+
+
+TRUE, FALSE = ("true", "yes", "1", "on"), ("false", "no", "0", "off")
+
+
+def _value(column: str, text: str, where: str) -> object:
+    """A cell's text as its column's type, within its bounds."""
+    spec = OPTIONS[column]
+    if spec.kind in ("bool", "switch"):
+        if text.lower() not in TRUE + FALSE:
+            raise InputError(f"{where}: {column}: expected true or false, got {text!r}")
+        return text.lower() in TRUE
+    if spec.kind == "text":
+        return text
+    try:
+        number = int(text) if spec.kind == "int" else float(text)
+    except ValueError:
+        number = math.nan
+    if not (math.isfinite(number) and spec.lo <= number <= spec.hi):
+        bounds = "" if spec.lo == -math.inf else f" >= {spec.lo:g}" if spec.hi == math.inf \
+            else f" in [{spec.lo:g}, {spec.hi:g}]"
+        kind = "an integer" if spec.kind == "int" else "a finite number"
+        raise InputError(f"{where}: {column}: expected {kind}{bounds}, got {text!r}")
+    return number
+
+
+def _words(values: dict[str, object], columns: dict[str, Column]) -> list[str]:
+    """The options among ``columns`` that a row gives, as eval's command line shows them."""
+    words: list[str] = []
+    for column, spec in columns.items():
+        if column not in values:
+            continue
+        option, value = "--" + column.replace("_", "-"), values[column]
+        if spec.kind == "bool":
+            words += [option] if value else []
+        elif spec.kind == "switch":
+            words.append(option if value else option.replace("-negate", "-no-negate"))
+        else:
+            words += [option, str(value)]
+    return words

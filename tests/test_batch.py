@@ -1,0 +1,334 @@
+"""pcmapq batch: manifests, the same JSON as single evaluations (local processes and a Dask
+cluster), failing rows, resuming, a worker killed mid-task. The batch runners are called as
+``batch_run``, ``pool_run`` and ``cli_run``: tests/conftest.py marks a test whose source calls
+``run(`` end-to-end."""
+
+from __future__ import annotations
+
+import csv
+import json
+import shlex
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from pcmapq import synth
+from pcmapq.batch import Task, read_rows, run_row
+from pcmapq.batch import run_batch as batch_run
+from pcmapq.batch.manifest import glob_rows, parse_assignments
+from pcmapq.batch.run import run_local as pool_run
+from pcmapq.cli import app
+from pcmapq.config import MatchingConfig, Settings
+from pcmapq.errors import InputError
+from pcmapq.transform import Similarity2D
+from tests.conftest import in_map_frame, write_image_map
+
+#: name, map pose in the truth frame (x m, y m, yaw deg), manifest cells of the row's options.
+MAPS = [("straight", (0.0, 0.0, 0.0), {}),
+        ("turned", (0.4, -0.3, 8.0), {"threshold": "0.3"}),
+        ("scaled", (-0.2, 0.5, -5.0), {"scale": "auto", "footprint": "walls"})]
+
+
+def cli_run(*args: str):
+    """``pcmapq ARGS`` in this process: (exit code, stdout, stderr)."""
+    got = CliRunner().invoke(app, list(args))
+    if got.exception is not None and not isinstance(got.exception, SystemExit):
+        raise got.exception
+    return got.exit_code, got.stdout, got.stderr
+
+
+@pytest.fixture(scope="module")
+def inputs(tmp_path_factory) -> Path:
+    """A small truth (12 m x 8 m plan), three maps of it seen from other poses and a map file
+    that is not an image, with a manifest (relative paths) naming them; the folder."""
+    folder = tmp_path_factory.mktemp("batch")
+    (folder / "maps").mkdir()
+    plan = synth.building_plan(0, 12.0, 8.0)
+    write_image_map(plan, folder / "truth.png")
+    for i, (name, (x, y, yaw), _) in enumerate(MAPS):
+        seen = synth.move_wall(plan, 2, (0.1 * i, 0.0))
+        write_image_map(in_map_frame(seen, Similarity2D(x, y, np.radians(yaw))),
+                        folder / "maps" / f"{name}.png")
+    (folder / "maps" / "broken.png").write_bytes(b"not a png at all")
+    (folder / "maps" / "broken.yaml").write_text("image: broken.png\nresolution: 0.05\n"
+                                                 "origin: [0, 0, 0]\n")
+    columns = ["name", "map", "truth", "threshold", "scale", "footprint"]
+    rows = [{"name": n, "map": f"maps/{n}.png", "truth": "truth.png", **cells}
+            for n, _, cells in MAPS]
+    rows.insert(2, {"name": "broken", "map": "maps/broken.png", "truth": "truth.png"})
+    with open(folder / "runs.csv", "w", newline="") as f:
+        writer = csv.DictWriter(f, columns)
+        writer.writeheader()
+        writer.writerows(rows)
+    return folder
+
+
+@pytest.fixture(scope="module")
+def local(inputs) -> tuple[Path, dict[str, bytes], list]:
+    """The manifest run on 2 local processes: (out folder, result bytes by name, outcomes)."""
+    out = inputs / "out"
+    outcomes = batch_run(read_rows(inputs / "runs.csv", {}), out, workers=2)
+    return out, {o.name: (out / f"{o.name}.json").read_bytes() for o in outcomes
+                 if not o.exit_code}, outcomes
+
+
+@pytest.fixture(scope="module")
+def cluster():
+    """A dask.distributed LocalCluster of 2 worker processes, closed at the end."""
+    distributed = pytest.importorskip("dask.distributed")
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                  host="127.0.0.1", dashboard_address=None) as c:
+        yield c
+
+
+def test_manifest_rows(inputs):
+    """Relative paths are the manifest folder's; each row's options give the Settings eval
+    builds from the same options, and its eval command line."""
+    rows = read_rows(inputs / "runs.csv", {"tau": "0.1,0.2"})
+    assert [r.name for r in rows] == ["straight", "turned", "broken", "scaled"]
+    assert rows[0].map == inputs / "maps" / "straight.png"
+    assert rows[0].truth == inputs / "truth.png"
+    assert rows[1].settings.matching == MatchingConfig(threshold=0.3)
+    assert rows[3].settings.alignment.scale and rows[3].settings.footprint.rule == "walls"
+    assert rows[0].settings.distances.taus == (0.1, 0.2)
+    assert rows[0].settings.alignment == Settings().alignment
+    assert rows[3].command({"--json": Path("/o/scaled.json")}) == shlex.join(
+        ["pcmapq", "eval", str(rows[3].map), str(rows[3].truth), "--scale", "auto",
+         "--json", "/o/scaled.json", "--tau", "0.1,0.2", "--footprint", "walls"])
+
+
+def test_yaml_manifest(inputs, tmp_path):
+    """A YAML manifest with defaults: the same rows as the CSV with those cells."""
+    doc = {"defaults": {"truth": str(inputs / "truth.png"), "min_hits": 2},
+           "rows": [{"map": str(inputs / "maps" / "turned.png"), "threshold": 0.3,
+                     "detectors": ["harris", "sift"], "map_negate": False}]}
+    (tmp_path / "runs.yaml").write_text(json.dumps(doc))
+    (row,) = read_rows(tmp_path / "runs.yaml", {})
+    assert row.name == "turned"
+    assert row.settings.matching.detectors == ("harris", "sift")
+    assert row.settings.raster.min_hits == 2
+    assert "--map-no-negate" in row.command({"--json": Path("x.json")})
+
+
+@pytest.mark.parametrize("text, message", [
+    ("map,truth,bogus\na.png,t.png,1\n", "row 1: unknown column 'bogus'"),
+    ("map,truth,threshold\na.png,t.png,1\nb.png,t.png,-1\n",
+     "row 2: threshold: expected a finite number >= 1e-06, got '-1'"),
+    ("map,truth,scale\na.png,t.png,sometimes\n", "row 1: scale: expected 'fixed' or 'auto'"),
+    ("name,map,truth\nx,a.png,t.png\nx,b.png,t.png\n", "row 2: name 'x' is also row 1's"),
+    ("map,threshold\na.png,0.3\n", "row 1: no 'truth'"),
+    ("map,truth,no_align,scale\na.png,t.png,true,auto\n", "row 1: --no-align and --scale auto"),
+    ("map,truth\na.png,t.png,extra\n", "row 1: more cells than the header's 2 columns"),
+    ("name,map,truth\nfigure,a.png,t.png\n", "row 1: name 'figure' is reserved"),
+])
+def test_bad_manifest(tmp_path, text, message):
+    """A bad manifest: one InputError naming the file, the row and the problem; the command
+    line says it in one line, exit 2, before any work."""
+    manifest = tmp_path / "runs.csv"
+    manifest.write_text(text)
+    with pytest.raises(InputError, match=f"^{manifest}: {message}".replace("(", r"\(")):
+        read_rows(manifest, {})
+    code, _, err = cli_run("batch", str(manifest), "--out", str(tmp_path / "out"))
+    assert code == 2 and err.count("\n") == 1 and err.startswith(f"pcmapq: error: {manifest}")
+    assert not (tmp_path / "out").exists()
+
+
+def test_set_and_glob(inputs, tmp_path, monkeypatch):
+    """--set fills every row (its truth from the current folder, a manifest's paths from the
+    manifest's); a glob's rows are its maps, sorted, named by stem."""
+    (tmp_path / "runs.csv").write_text(f"map\n{inputs / 'maps' / 'turned.png'}\n")
+    monkeypatch.chdir(inputs)
+    (row,) = read_rows(tmp_path / "runs.csv", parse_assignments(["truth=truth.png"]))
+    assert row.truth == inputs / "truth.png"
+    rows = glob_rows([str(inputs / "maps" / "s*.png")], inputs / "truth.png",
+                     parse_assignments(["threshold=0.25"]))
+    assert [r.name for r in rows] == ["scaled", "straight"]
+    assert {r.settings.matching.threshold for r in rows} == {0.25}
+    with pytest.raises(InputError, match="matches no file"):
+        glob_rows([str(inputs / "none*.png")], inputs / "truth.png", {})
+    with pytest.raises(InputError, match="--set thresh=1: unknown column"):
+        parse_assignments(["thresh=1"])
+
+
+def test_local_batch_is_eval_bit_for_bit(inputs, local):
+    """Each row's JSON is the one `pcmapq eval --json` writes for the same inputs and options
+    (its recorded command line), byte for byte; the broken row is recorded with its exit code
+    and one-line error and the others complete; the table lists all four in manifest order."""
+    out, results, outcomes = local
+    assert [(o.name, o.status, o.exit_code) for o in outcomes] == [
+        ("straight", "computed", 0), ("turned", "computed", 0), ("broken", "failed", 2),
+        ("scaled", "computed", 0)]
+    broken = outcomes[2]
+    assert str(inputs / "maps" / "broken.png") in broken.error and "\n" not in broken.error
+    assert not (out / "broken.json").exists()
+    with open(out / "table.csv") as f:
+        table = list(csv.DictReader(f))
+    assert [(r["name"], r["exit_code"]) for r in table] == [
+        ("straight", "0"), ("turned", "0"), ("broken", "2"), ("scaled", "0")]
+    assert table[2]["error"] == broken.error and table[2]["harris_quality"] == ""
+    assert (out / "table.md").exists() and (out / "figure.png").exists()
+    assert json.loads(results["turned"])["settings"]["matching"]["threshold"] == 0.3
+    for name, data in results.items():
+        command = json.loads(data)["pcmapq"]["command"]
+        args = shlex.split(command)[2:]
+        assert args[args.index("--json") + 1] == str(out / f"{name}.json")
+        (out / f"{name}.json").unlink()  # eval writes it again, alone
+        code, _, err = cli_run("eval", *args)  # as recorded: no --quiet
+        assert code == 0, err
+        assert (out / f"{name}.json").read_bytes() == data, name
+
+
+def test_a_row_that_raises(inputs, tmp_path, monkeypatch):
+    """An unexpected exception in a row is the row's failure (exit 1, one line), not the
+    batch's."""
+    import pcmapq.batch.run as run_module
+
+    def explode(*_args, **_kwargs):
+        raise RuntimeError("boom\nsecond line")
+
+    monkeypatch.setattr(run_module, "evaluate", explode)
+    row = read_rows(inputs / "runs.csv", {})[0]
+    outcome = run_row(Task(row, tmp_path))
+    assert (outcome.status, outcome.exit_code, outcome.error) == (
+        "failed", 1, "RuntimeError: boom")
+    assert outcome.summary["exit_code"] == 1 and outcome.summary["harris_quality"] is None
+
+
+def test_resume(inputs, local):
+    """A batch interrupted part-way (one result missing, one half written) resumes: those
+    rows are computed, the others skipped (their files untouched), every result as before;
+    other settings, or --force, recompute a row."""
+    out, results, _ = local
+    rows = read_rows(inputs / "runs.csv", {})
+    before = (out / "straight.json").stat().st_mtime_ns
+    (out / "turned.json").unlink()
+    half = (out / "scaled.json").read_bytes()
+    (out / "scaled.json").write_bytes(half[:len(half) // 2])
+    again = batch_run(rows, out, workers=2)
+    assert [o.status for o in again] == ["skipped", "computed", "failed", "computed"]
+    assert (out / "straight.json").stat().st_mtime_ns == before
+    for name, data in results.items():
+        assert (out / f"{name}.json").read_bytes() == data, name
+    other = read_rows(inputs / "runs.csv", parse_assignments(["tau=0.1"]))[:1]
+    assert batch_run(other, out, workers=1)[0].status == "computed"
+    assert json.loads((out / "straight.json").read_bytes())["settings"]["distances"] == {
+        "taus": [0.1]}
+    forced = batch_run(rows[:1], out, workers=1, force=True)
+    assert forced[0].status == "computed"
+    assert (out / "straight.json").read_bytes() == results["straight"]
+
+
+class DyingTask(Task):
+    """A task whose worker process dies (SIGKILL) the first time it runs: when
+    ``DyingTask.marker`` (a file) is absent."""
+
+    marker: str = ""
+
+    def outputs(self) -> dict[str, Path]:
+        import os
+        import signal
+
+        if not os.path.exists(self.marker):
+            Path(self.marker).touch()
+            os.kill(os.getpid(), signal.SIGKILL)
+        return super().outputs()
+
+
+def test_local_worker_killed(inputs, local, tmp_path):
+    """A local worker process killed mid-row loses no row: the unfinished rows run again in
+    a new pool."""
+    out, results, _ = local
+    rows = read_rows(inputs / "runs.csv", {})
+    marker = tmp_path / "killed"
+    tasks = [Task(rows[0], out, force=True), DyingTask(rows[1], out, force=True),
+             Task(rows[3], out, force=True)]
+    object.__setattr__(tasks[1], "marker", str(marker))
+    outcomes = pool_run(tasks, workers=2)
+    assert marker.exists()
+    assert [(o.name, o.exit_code) for o in outcomes] == [
+        ("straight", 0), ("turned", 0), ("scaled", 0)]
+    for name, data in results.items():
+        assert (out / f"{name}.json").read_bytes() == data, name
+
+
+def test_dask_cluster_same_bytes(inputs, local, cluster):
+    """The same rows on a dask.distributed LocalCluster write the same bytes."""
+    out, results, _ = local
+    outcomes = batch_run(read_rows(inputs / "runs.csv", {}), out, force=True,
+                         scheduler=cluster.scheduler_address)
+    assert [(o.name, o.exit_code) for o in outcomes] == [
+        ("straight", 0), ("turned", 0), ("broken", 2), ("scaled", 0)]
+    for name, data in results.items():
+        assert (out / f"{name}.json").read_bytes() == data, name
+
+
+def test_dask_worker_killed_mid_task(inputs, local, cluster, tmp_path):
+    """A worker process killed while it evaluates a row (once, the first time any worker
+    reaches that row) loses no row: Dask runs the task again on a worker."""
+    from dask.distributed import Client
+
+    out, results, _ = local
+    marker = tmp_path / "killed"
+
+    def install(marker=str(marker)):
+        import os
+        import signal
+
+        import pcmapq.batch.run as run_module
+
+        original = run_module.evaluate
+
+        def evaluate_or_die(map_path, *args, **kwargs):
+            if Path(map_path).stem == "turned" and not os.path.exists(marker):
+                open(marker, "w").close()
+                os.kill(os.getpid(), signal.SIGKILL)
+            return original(map_path, *args, **kwargs)
+
+        run_module.evaluate = evaluate_or_die
+
+    with Client(cluster.scheduler_address) as client:
+        client.run(install)
+    outcomes = batch_run(read_rows(inputs / "runs.csv", {}), out, force=True,
+                         scheduler=cluster.scheduler_address)
+    assert marker.exists()  # a worker did die in the middle of the row
+    assert [(o.name, o.status) for o in outcomes] == [
+        ("straight", "computed"), ("turned", "computed"), ("broken", "failed"),
+        ("scaled", "computed")]
+    for name, data in results.items():
+        assert (out / f"{name}.json").read_bytes() == data, name
+
+
+def test_cli_glob(inputs, tmp_path):
+    """`pcmapq batch "maps/s*.png" --truth T --out DIR --json -`: exit 0 when every row
+    passed, the rows' statuses on stdout; quiet on stderr when not a terminal."""
+    code, stdout, err = cli_run("batch", str(inputs / "maps" / "s*.png"), "--truth",
+                            str(inputs / "truth.png"), "--out", str(tmp_path / "o"),
+                            "--workers", "2", "--json", "-", "--plot")
+    assert code == 0, err
+    assert err == ""
+    doc = json.loads(stdout)
+    assert [(r["name"], r["status"]) for r in doc["rows"]] == [
+        ("scaled", "computed"), ("straight", "computed")]
+    assert (tmp_path / "o" / "scaled.png").read_bytes()[:4] == b"\x89PNG"
+
+
+def test_cli_failed_row_and_missing_dask(inputs, tmp_path, monkeypatch):
+    """A failed row: its line on stderr, exit 1. --scheduler without dask: one line, exit
+    2."""
+    manifest = tmp_path / "one.csv"
+    manifest.write_text(f"map,truth\n{inputs / 'maps' / 'broken.png'},{inputs / 'truth.png'}\n")
+    code, _, err = cli_run("batch", str(manifest), "--out", str(tmp_path / "o"), "--workers", "1")
+    assert code == 1
+    assert err.splitlines()[0].startswith("pcmapq: error: broken: ")
+    code, _, err = cli_run("batch", str(manifest), "--out", str(tmp_path / "o"),
+                           "--workers", "2", "--scheduler", "tcp://127.0.0.1:1")
+    assert code == 2 and err.startswith("pcmapq: error: --workers") and err.count("\n") == 1
+    monkeypatch.setitem(sys.modules, "dask.distributed", None)
+    code, _, err = cli_run("batch", str(manifest), "--out", str(tmp_path / "o"),
+                       "--scheduler", "tcp://127.0.0.1:1")
+    assert code == 2
+    assert err == ("pcmapq: error: --scheduler: needs dask.distributed, which is not "
+                   "installed: pip install 'pcmapq[cluster]'\n")
