@@ -21,7 +21,7 @@ from pcmapq.batch import run_batch as batch_run
 from pcmapq.batch.manifest import glob_rows, parse_assignments
 from pcmapq.batch.run import run_local as pool_run
 from pcmapq.cli import app
-from pcmapq.config import MatchingConfig, Settings
+from pcmapq.config import MatchingConfig, NoRefConfig, Settings
 from pcmapq.errors import InputError
 from pcmapq.transform import Similarity2D
 from tests.conftest import in_map_frame, write_image_map
@@ -98,6 +98,18 @@ def test_manifest_rows(inputs):
     assert rows[3].command({"--json": Path("/o/scaled.json")}) == shlex.join(
         ["pcmapq", "eval", str(rows[3].map), str(rows[3].truth), "--scale", "auto",
          "--json", "/o/scaled.json", "--tau", "0.1,0.2", "--footprint", "walls"])
+
+
+def test_noref_columns_are_evals_options(inputs):
+    """noref, noref_radius, noref_voxel: the Settings and the command line eval has for
+    --no-noref --noref-radius 0.2 --noref-voxel 0.02."""
+    rows = read_rows(inputs / "runs.csv", {"noref": "false", "noref_radius": "0.2",
+                                           "noref_voxel": "0.02"})
+    assert rows[0].settings.noref == NoRefConfig(enabled=False, radius=0.2, voxel=0.02)
+    words = shlex.split(rows[0].command({"--json": Path("/o/s.json")}))
+    assert words[-5:] == ["--no-noref", "--noref-radius", "0.2", "--noref-voxel", "0.02"]
+    got = CliRunner().invoke(app, ["eval", *words[2:], "--help"])  # eval knows every option
+    assert got.exit_code == 0, got.stderr
 
 
 def test_yaml_manifest(inputs, tmp_path):

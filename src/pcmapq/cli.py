@@ -16,11 +16,8 @@ from rich.console import Console
 from pcmapq import __version__, gates, options
 from pcmapq.config import (
     DETECTOR_NAMES,
-    DistancesConfig,
-    MatchingConfig,
     NoRefConfig,
     Settings,
-    SourceConfig,
 )
 from pcmapq.errors import InputError
 from pcmapq.inspect_map import inspect_map, summary_lines, to_json
@@ -382,23 +379,16 @@ def eval_command(
         raise typer.BadParameter("give MAP and TRUTH, or --scans DIR and TRUTH",
                                  param_hint="MAP TRUTH")
     truth_path = paths[-1]
-    resolution, auto = options.parse_resolution(map_resolution, scale)
-    settings = Settings(
-        map=SourceConfig(resolution, options.thresholds(map_occupied_thresh, map_free_thresh,
-                                                        map_negate),
-                         options.parse_box(map_crop, "--map-crop")),
-        truth=SourceConfig(truth_resolution, options.thresholds(
-            truth_occupied_thresh, truth_free_thresh, truth_negate),
-            options.parse_box(truth_crop, "--truth-crop")),
-        raster=replace(DEFAULTS.raster, band_low=band_low, band_high=band_high,
-                       min_hits=min_hits),
-        alignment=replace(DEFAULTS.alignment, enabled=not no_align,
-                          init=options.parse_init(init), scale=auto, voxel_3d=voxel_3d,
-                          force=force),
-        footprint=replace(DEFAULTS.footprint, rule=options.parse_footprint(footprint), full=full),
-        matching=MatchingConfig(options.parse_detectors(detectors), threshold),
-        distances=DistancesConfig(options.parse_taus(tau)),
-        noref=replace(DEFAULTS.noref, enabled=noref, radius=noref_radius, voxel=noref_voxel))
+    settings = options.eval_settings(dict(
+        map_resolution=map_resolution, scale=scale, truth_resolution=truth_resolution,
+        map_occupied_thresh=map_occupied_thresh, map_free_thresh=map_free_thresh,
+        map_negate=map_negate, truth_occupied_thresh=truth_occupied_thresh,
+        truth_free_thresh=truth_free_thresh, truth_negate=truth_negate, map_crop=map_crop,
+        truth_crop=truth_crop, init=init, no_align=no_align, force=force, threshold=threshold,
+        band_low=band_low, band_high=band_high, min_hits=min_hits, detectors=detectors,
+        voxel_3d=voxel_3d, tau=tau, footprint=footprint, full=full, noref=noref,
+        noref_radius=noref_radius, noref_voxel=noref_voxel))
+    auto = settings.alignment.scale
     exports = {"--aligned": aligned, "--transform": transform, "--distances": distances}
     err = Console(stderr=True)
     out = Console(quiet=quiet or json_path == "-")  # not a terminal: COLUMNS or 80 wide

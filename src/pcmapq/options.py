@@ -9,12 +9,13 @@ import os
 import shlex
 import stat
 from collections.abc import Iterable
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 import typer
 
-from pcmapq.config import DETECTOR_NAMES
+from pcmapq.config import DETECTOR_NAMES, DistancesConfig, MatchingConfig, Settings, SourceConfig
 from pcmapq.errors import InputError
 from pcmapq.io import Thresholds
 from pcmapq.io.occupancy import IMAGE_SUFFIXES, YAML_SUFFIXES, read_yaml
@@ -248,3 +249,34 @@ def _alternatives(suffixes: tuple[str, ...]) -> str:
     """``.png, .svg or .pdf``."""
     return suffixes[0] if len(suffixes) == 1 else \
         f"{', '.join(suffixes[:-1])} or {suffixes[-1]}"
+
+
+def eval_settings(values: dict[str, object]) -> Settings:
+    """The Settings of ``pcmapq eval`` from its options by parameter name (``threshold``,
+    ``map_resolution``, ``noref_voxel`` ...; a name left out takes eval's default): the one
+    place eval and each row of a batch build them."""
+    d = Settings()
+    v = values.get
+    resolution, auto = parse_resolution(v("map_resolution"), v("scale") or "fixed")
+    return Settings(
+        map=SourceConfig(resolution, thresholds(
+            v("map_occupied_thresh"), v("map_free_thresh"), v("map_negate")),
+            parse_box(v("map_crop"), "--map-crop")),
+        truth=SourceConfig(v("truth_resolution"), thresholds(
+            v("truth_occupied_thresh"), v("truth_free_thresh"), v("truth_negate")),
+            parse_box(v("truth_crop"), "--truth-crop")),
+        raster=replace(d.raster, band_low=v("band_low", d.raster.band_low),
+                       band_high=v("band_high", d.raster.band_high), min_hits=v("min_hits")),
+        alignment=replace(d.alignment, enabled=not v("no_align"), init=parse_init(v("init")),
+                          scale=auto, voxel_3d=v("voxel_3d", d.alignment.voxel_3d),
+                          force=bool(v("force"))),
+        footprint=replace(d.footprint, rule=parse_footprint(v("footprint", d.footprint.rule)),
+                          full=bool(v("full"))),
+        matching=MatchingConfig(
+            parse_detectors(v("detectors", ",".join(d.matching.detectors))),
+            v("threshold", d.matching.threshold)),
+        distances=DistancesConfig(parse_taus(
+            v("tau", ",".join(f"{t:g}" for t in d.distances.taus)))),
+        noref=replace(d.noref, enabled=v("noref", d.noref.enabled),
+                      radius=v("noref_radius", d.noref.radius),
+                      voxel=v("noref_voxel", d.noref.voxel)))

@@ -11,17 +11,16 @@ import glob
 import math
 import os
 import shlex
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from pathlib import Path
 
 import typer
 import yaml
 
 from pcmapq import options
-from pcmapq.config import DistancesConfig, MatchingConfig, Settings, SourceConfig
+from pcmapq.config import Settings
 from pcmapq.errors import InputError
 
-DEFAULTS = Settings()
 #: Names a row cannot take: the batch's own table and figure are written beside the rows.
 RESERVED = ("table", "figure")
 MANIFEST_SUFFIXES = (".csv", ".yaml", ".yml")
@@ -52,7 +51,9 @@ BEFORE_OUTPUTS = {
     "band_high": Column("float"), "min_hits": Column("int", 1), "detectors": Column("text"),
 }
 AFTER_OUTPUTS = {"voxel_3d": Column("float", 0.01), "tau": Column("text"),
-                 "footprint": Column("text"), "full": Column("bool")}
+                 "footprint": Column("text"), "full": Column("bool"),
+                 "noref": Column("switch"), "noref_radius": Column("float", 1e-6),
+                 "noref_voxel": Column("float", 0.0)}
 OPTIONS = {**BEFORE_OUTPUTS, **AFTER_OUTPUTS}
 #: Every column a manifest may have.
 COLUMNS = ("name", "map", "truth", *OPTIONS)
@@ -156,30 +157,10 @@ def make_row(cells: dict[str, object], base: Path, where: str) -> Row:
 
 def settings(values: dict[str, object]) -> Settings:
     """A row's Settings, built as ``pcmapq eval`` builds them from the same options."""
-    v = values.get
-    resolution, auto = options.parse_resolution(v("map_resolution"), v("scale", "fixed"))
-    options.check_eval_options(scans=None, max_scans=None, no_align=bool(v("no_align")),
-                               auto_scale=auto)
-    raster, align, foot = DEFAULTS.raster, DEFAULTS.alignment, DEFAULTS.footprint
-    return Settings(
-        map=SourceConfig(resolution, options.thresholds(
-            v("map_occupied_thresh"), v("map_free_thresh"), v("map_negate")),
-            options.parse_box(v("map_crop"), "map_crop")),
-        truth=SourceConfig(v("truth_resolution"), options.thresholds(
-            v("truth_occupied_thresh"), v("truth_free_thresh"), v("truth_negate")),
-            options.parse_box(v("truth_crop"), "truth_crop")),
-        raster=replace(raster, band_low=v("band_low", raster.band_low),
-                       band_high=v("band_high", raster.band_high), min_hits=v("min_hits")),
-        alignment=replace(align, enabled=not v("no_align"), init=options.parse_init(v("init")),
-                          scale=auto, voxel_3d=v("voxel_3d", align.voxel_3d),
-                          force=bool(v("force"))),
-        footprint=replace(foot, rule=options.parse_footprint(v("footprint", foot.rule)),
-                          full=bool(v("full"))),
-        matching=MatchingConfig(options.parse_detectors(
-            v("detectors", ",".join(DEFAULTS.matching.detectors))),
-            v("threshold", DEFAULTS.matching.threshold)),
-        distances=DistancesConfig(options.parse_taus(
-            v("tau", ",".join(f"{t:g}" for t in DEFAULTS.distances.taus)))))
+    built = options.eval_settings(values)
+    options.check_eval_options(scans=None, max_scans=None, no_align=bool(values.get("no_align")),
+                               auto_scale=built.alignment.scale)
+    return built
 
 
 def check_names(rows: list[Row], where: str) -> None:
@@ -293,7 +274,7 @@ def _words(values: dict[str, object], columns: dict[str, Column]) -> list[str]:
         if spec.kind == "bool":
             words += [option] if value else []
         elif spec.kind == "switch":
-            words.append(option if value else option.replace("-negate", "-no-negate"))
+            words.append(option if value else "-no-".join(option.rsplit("-", 1)))
         else:
             words += [option, str(value)]
     return words
