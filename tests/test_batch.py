@@ -327,6 +327,25 @@ def test_cli_glob(inputs, tmp_path):
     assert (tmp_path / "o" / "scaled.png").read_bytes()[:4] == b"\x89PNG"
 
 
+def test_cli_gates_judge_every_row(inputs, tmp_path):
+    """--fail-under harris.quality=1.01 fails every row (a quality is at most 1): exit 3, one
+    line per row, the table's gates column names the figure, the rows' JSON stay eval's;
+    a rerun with a gate they pass skips every row and exits 0."""
+    args = ["batch", str(inputs / "maps" / "s*.png"), "--truth", str(inputs / "truth.png"),
+            "--out", str(tmp_path / "o"), "--workers", "2"]
+    code, _, err = cli_run(*args, "--fail-under", "harris.quality=1.01")
+    assert code == 3, err
+    assert err.count("pcmapq: gate failed: ") == 2 and "harris.quality = " in err
+    with open(tmp_path / "o" / "table.csv", newline="") as f:
+        table = list(csv.DictReader(f))
+    assert [r["gates"] for r in table] == ["fail: harris.quality"] * 2
+    assert [r["exit_code"] for r in table] == ["0", "0"]  # each evaluation itself finished
+    assert "gates" not in json.loads((tmp_path / "o" / "straight.json").read_text())
+    code, stdout, err = cli_run(*args, "--fail-under", "coverage=0", "--json", "-")
+    assert code == 0, err
+    assert {r["status"] for r in json.loads(stdout)["rows"]} == {"skipped"}
+
+
 def test_cli_failed_row_and_missing_dask(inputs, tmp_path, monkeypatch):
     """A failed row: its line on stderr, exit 1. --scheduler without dask: one line, exit
     2."""

@@ -112,7 +112,8 @@ def test_csv_columns_are_the_union_of_taus_in_order():
     a = {**failed_row("a", "a", "t", 1, "x"), "f_score@0.5m": 0.5}
     b = {**failed_row("b", "b", "t", 1, "x"), "f_score@0.05m": 0.1}
     header = table_csv([a, b]).splitlines()[0].split(",")
-    assert header[len(HEAD):] == ["f_score@0.05m", "f_score@0.5m", "exit_code", "error"]
+    assert header[len(HEAD):] == ["f_score@0.05m", "f_score@0.5m", "gates", "exit_code",
+                                       "error"]
 
 
 def test_markdown_table_shows_nulls_and_failures(summary_rows):
@@ -167,3 +168,13 @@ def test_an_unwritable_folder_is_an_input_error(summary_rows, tmp_path):
     (tmp_path / "file").write_text("x")
     with pytest.raises(InputError, match="file"):
         write_summary(summary_rows, tmp_path / "file" / "out")
+
+
+def test_gates_verdict_in_a_word():
+    from pcmapq.report.summary import gates_verdict
+    assert gates_verdict(None) == ""
+    assert gates_verdict([{"key": "coverage", "passed": True}]) == "pass"
+    assert gates_verdict([{"key": "harris.quality", "passed": False},
+                          {"key": "coverage", "passed": True},
+                          {"key": "accuracy.mean", "passed": False}]) == \
+        "fail: harris.quality, accuracy.mean"

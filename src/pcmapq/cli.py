@@ -528,11 +528,18 @@ def batch_command(
     json_path: Annotated[str | None, typer.Option(
         "--json", help="Write how each row ended as JSON to this path ('-' for stdout only)."
     )] = None,
+    fail_under: Annotated[str | None, typer.Option(
+        metavar="<KEY=VALUE,...>", help="CI gate on every row, as eval's: exit 3 when a "
+        "row's figure is below its bound (the table's gates column names it).")] = None,
+    fail_over: Annotated[str | None, typer.Option(
+        metavar="<KEY=VALUE,...>", help="CI gate on every row for distances: exit 3 when a "
+        "row's figure is above its bound.")] = None,
     quiet: Annotated[bool, typer.Option(
         "--quiet", "-q", help="Print nothing but warnings and errors.")] = False,
 ) -> None:
     """Evaluate many maps, on local processes or a Dask cluster: a result per row, a table
-    and a figure of them all; a rerun skips the rows already done. Exit 1 if any row failed."""
+    and a figure of them all; a rerun skips the rows already done. Exit 1 if any row failed,
+    else 3 if a row failed a gate."""
     from pcmapq.batch import glob_rows, parse_assignments, read_rows, run_batch
     from pcmapq.batch.progress import row_bar
 
@@ -541,6 +548,8 @@ def batch_command(
         if workers is not None and scheduler is not None:
             raise InputError("--workers sets local processes; with --scheduler the cluster's "
                              "workers run the rows: give one of the two")
+        rules = gates.parse_gates(fail_under, gates.UNDER) + \
+            gates.parse_gates(fail_over, gates.OVER)
         defaults = parse_assignments(set_options or [])
         if truth is not None:
             if any(s.lower().endswith(".csv") for s in sources):
@@ -562,8 +571,10 @@ def batch_command(
                 raise InputError(f"{json_path}: --json would overwrite a row's result")
         with row_bar(err, len(rows), enabled=not quiet and json_path != "-") as tick:
             outcomes = run_batch(rows, out, plot=plot, report=report, force=force,
-                                 workers=workers, scheduler=scheduler, done=tick)
-        code = 1 if any(o.exit_code for o in outcomes) else 0
+                                 workers=workers, scheduler=scheduler, done=tick,
+                                 rules=rules)
+        codes = {o.exit_code for o in outcomes}
+        code = 1 if codes - {0, gates.EXIT_CODE} else max(codes)
         doc = {"out": str(out), "exit_code": code,
                "rows": [{"name": o.name, "status": o.status, "exit_code": o.exit_code,
                          "error": o.error,
@@ -578,7 +589,10 @@ def batch_command(
         for line in o.warnings:
             err.print(f"pcmapq: warning: {o.name}: {line}", markup=False, highlight=False,
                       soft_wrap=True)
-        if o.exit_code:
+        if o.exit_code == gates.EXIT_CODE:
+            err.print(f"pcmapq: gate failed: {o.name}: {o.error}", markup=False,
+                      highlight=False, soft_wrap=True)
+        elif o.exit_code:
             err.print(f"pcmapq: error: {o.name}: {o.error} (exit {o.exit_code})", markup=False,
                       highlight=False, soft_wrap=True)
     if json_path == "-":
@@ -586,7 +600,9 @@ def batch_command(
     elif not quiet:
         counts = {s: sum(o.status == s for o in outcomes) for s in ("computed", "skipped",
                                                                     "failed")}
+        gated = sum(o.exit_code == gates.EXIT_CODE for o in outcomes)
         err.print(f"{len(outcomes)} rows: " + ", ".join(f"{n} {s}" for s, n in counts.items())
+                  + (f", {gated} failing a gate" if rules else "")
                   + f"; wrote {out / 'table.csv'}, table.md, figure.png", markup=False,
                   highlight=False, soft_wrap=True)
     if code:

@@ -19,9 +19,10 @@ from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-from pcmapq import __version__
+from pcmapq import __version__, gates
 from pcmapq.batch.manifest import Row
 from pcmapq.errors import EvaluationError, InputError
+from pcmapq.gates import Gate
 from pcmapq.io.writers import OutputSet, one_line, write_atomic
 from pcmapq.options import input_files
 from pcmapq.pipeline import evaluate
@@ -205,7 +206,8 @@ def _pcmapq_warnings(caught: list[warnings.WarningMessage]) -> tuple[str, ...]:
 
 
 def run_local(tasks: list[Task], workers: int,
-              done: Callable[[Outcome], None] = lambda o: None) -> list[Outcome]:
+              done: Callable[[Outcome], None] = lambda o: None,
+              rules: tuple[Gate, ...] | list[Gate] = ()) -> list[Outcome]:
     """Run the tasks on ``workers`` local processes (spawned); the outcomes in task order.
     When a worker process dies (killed, out of memory), the unfinished rows run again in a
     new pool, :data:`LOCAL_ROUNDS` times at most, then are recorded as failed (exit 1)."""
@@ -273,11 +275,13 @@ def run_dask(tasks: list[Task], address: str,
 
 def run_batch(rows: list[Row], out_dir: Path, *, plot: bool = False, report: bool = False,
               force: bool = False, workers: int | None = None, scheduler: str | None = None,
-              done: Callable[[Outcome], None] = lambda o: None) -> list[Outcome]:
+              done: Callable[[Outcome], None] = lambda o: None,
+              rules: tuple[Gate, ...] | list[Gate] = ()) -> list[Outcome]:
     """Run every row into ``out_dir`` (made if missing) on ``workers`` local processes
     (default: one per core) or, with ``scheduler``, on that Dask cluster; then write
-    ``table.csv``, ``table.md`` and ``figure.png`` there, rows in manifest order. The
-    outcomes, in that order; ``done`` is called with each as it ends."""
+    ``table.csv``, ``table.md`` and ``figure.png`` there, rows in manifest order, each finished
+    row judged by the gates ``rules`` (:func:`judged`). The outcomes, in that order; ``done``
+    is called with each as it ends."""
     out_dir = Path(os.path.abspath(out_dir))
     try:
         (out_dir / RECORDS).mkdir(parents=True, exist_ok=True)
@@ -288,5 +292,21 @@ def run_batch(rows: list[Row], out_dir: Path, *, plot: bool = False, report: boo
         outcomes = run_dask(tasks, scheduler, done)
     else:
         outcomes = run_local(tasks, workers or os.cpu_count() or 1, done)
+    if rules:
+        outcomes = [judged(o, rules, out_dir) for o in outcomes]
     write_summary([o.summary for o in outcomes], out_dir)
     return outcomes
+
+
+def judged(outcome: Outcome, rules: list[Gate], out_dir: Path) -> Outcome:
+    """A finished row judged by the gates on its saved JSON: its table row gains their verdict;
+    a failing row's exit code becomes :data:`pcmapq.gates.EXIT_CODE` (3) and its error the
+    failing figures. The JSON itself stays eval's (no ``gates`` block). A failed row as it is."""
+    if outcome.exit_code:
+        return outcome
+    doc = json.loads((out_dir / f"{outcome.name}.json").read_text(encoding="utf-8"))
+    verdicts = gates.check(rules, doc)
+    summary = summary_row(outcome.name, gates.with_gates(doc, verdicts))
+    lines = [v.line() for v in verdicts if not v.passed]
+    return replace(outcome, summary=summary, exit_code=gates.EXIT_CODE if lines else 0,
+                   error="; ".join(lines))

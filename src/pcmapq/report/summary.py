@@ -23,8 +23,9 @@ HEAD = ("name", "map", "truth",
         "coverage", "fitness", "confidence", "x_m", "y_m", "yaw_deg", "scale",
         "accuracy_mean_m", "accuracy_median_m", "completeness_mean_m", "completeness_median_m",
         "chamfer_m")
-#: Columns after the F-scores: how the evaluation ended (0 and "" when it finished).
-TAIL = ("exit_code", "error")
+#: Columns after the F-scores: the gates' verdict ("" without gates, "pass", or "fail: " and
+#: the failing keys) and how the evaluation ended (0 and "" when it finished).
+TAIL = ("gates", "exit_code", "error")
 #: An F-score column: the F-score of the walls within tau metres (``f_score@0.05m``).
 FSCORE = "f_score@{tau:g}m"
 #: Markdown headers of the columns (units in brackets); an F-score's is ``F@0.05 m``.
@@ -35,7 +36,7 @@ HEADERS = {"name": "name", "map": "map", "truth": "truth",
            "accuracy_mean_m": "accuracy mean (m)", "accuracy_median_m": "accuracy median (m)",
            "completeness_mean_m": "completeness mean (m)",
            "completeness_median_m": "completeness median (m)", "chamfer_m": "Chamfer (m)",
-           "exit_code": "exit code", "error": "error"}
+           "gates": "gates", "exit_code": "exit code", "error": "error"}
 #: Decimals of the markdown table: scale 4, degrees 2, everything else 3 (as the terminal).
 MD_DECIMALS = {"scale": 4, "yaw_deg": 2}
 #: Bar colours of the detectors in the figure.
@@ -46,7 +47,8 @@ def summary_row(name: str, result: dict) -> dict[str, object]:
     """One flat row of a result JSON document (``pcmapq eval --json``): the inputs' paths,
     each detector's quality, precision and f1 (None when undefined or not run), coverage, the
     alignment (fitness, confidence, x, y metres, yaw degrees, scale), the wall distances
-    (metres) and the F-score at each tau; exit_code 0, error "". A document missing one of
+    (metres), the F-score at each tau and the verdict of its gates (:func:`gates_verdict`);
+    exit_code 0, error "". A document missing one of
     these is a ValueError naming the key."""
     row: dict[str, object] = {"name": name, "map": _get(result, "map", "path"),
                               "truth": _get(result, "truth", "path")}
@@ -67,7 +69,16 @@ def summary_row(name: str, result: dict) -> dict[str, object]:
     row["chamfer_m"] = _number(dist, "chamfer_m", "distances")
     for f in _get(dist, "f_score"):
         row[FSCORE.format(tau=_number(f, "tau_m", "f_score"))] = _number(f, "f", "f_score")
-    return {**row, "exit_code": 0, "error": ""}
+    return {**row, "gates": gates_verdict(result.get("gates")), "exit_code": 0, "error": ""}
+
+
+def gates_verdict(gates: list[dict] | None) -> str:
+    """A result's ``gates`` block (``pcmapq eval --fail-under/--fail-over``) in a word: "" when
+    none, "pass", or "fail: " and the keys that failed."""
+    if not gates:
+        return ""
+    failed = [g["key"] for g in gates if not g["passed"]]
+    return "fail: " + ", ".join(failed) if failed else "pass"
 
 
 def failed_row(name: str, map_path: str, truth_path: str, exit_code: int,
@@ -76,7 +87,7 @@ def failed_row(name: str, map_path: str, truth_path: str, exit_code: int,
     figure None."""
     row: dict[str, object] = dict.fromkeys(HEAD)
     return {**row, "name": name, "map": str(map_path), "truth": str(truth_path),
-            "exit_code": int(exit_code), "error": " ".join(str(error).split())}
+            "gates": "", "exit_code": int(exit_code), "error": " ".join(str(error).split())}
 
 
 def columns(rows: Sequence[dict[str, object]]) -> list[str]:
