@@ -13,7 +13,13 @@ import pytest
 from typer.testing import CliRunner
 
 from pcmapq.cli import app
-from pcmapq.config import AlignmentConfig, NoRefConfig, Settings, SourceConfig
+from pcmapq.config import (
+    AlignmentConfig,
+    MatchingConfig,
+    NoRefConfig,
+    Settings,
+    SourceConfig,
+)
 from pcmapq.io import load_map
 from pcmapq.metrics import orthogonal
 from pcmapq.noref_figures import input_figures
@@ -49,6 +55,15 @@ def test_no_noref_leaves_the_block_null(plan, truth_png, tmp_path):
     result = evaluate(truth_png, truth_png, settings)
     assert result.noref is None and result.to_dict()["noref"] is None
     assert result.to_dict()["settings"]["noref"]["enabled"] is False
+
+
+def test_the_truths_corners_without_harris_among_the_detectors(truth_png):
+    """Eval takes an image truth's corners from its own Harris detection; run without Harris,
+    it counts them itself: the same figures."""
+    with_harris = evaluate(truth_png, truth_png).noref["truth"]
+    settings = replace(Settings(), matching=MatchingConfig(detectors=("sift",)))
+    assert evaluate(truth_png, truth_png, settings).noref["truth"] == with_harris
+    assert with_harris == input_figures(load_map(truth_png), Settings().noref)
 
 
 def test_a_map_of_unknown_scale_gets_figures_in_the_truths_metres(plan, truth_png, tmp_path):

@@ -21,12 +21,13 @@ from pcmapq.voxels import voxel_centroids
 
 
 def input_figures(source: OccupancyMap | PointMap, config: NoRefConfig = NoRefConfig(),
-                  orth_subset: list[np.ndarray] | None = None,
-                  scale: float = 1.0) -> dict[str, Any]:
+                  orth_subset: list[np.ndarray] | None = None, scale: float = 1.0,
+                  corners: int | None = None) -> dict[str, Any]:
     """``{"cloud": 3D figures or None, "grid": 2D figures or None}`` of one input, in metres
     times ``scale`` (the map's estimated scale under ``--scale auto``; 1: its own units).
     ``orth_subset``: MOM's planes in the input's frame (None: extracted from the cloud, after
-    the voxel reduction of ``config.voxel``)."""
+    the voxel reduction of ``config.voxel``). ``corners``: an image's Harris corners when
+    already found (see :func:`pcmapq.metrics.noref2d.grid_scores`)."""
     if isinstance(source, PointMap) and source.is_3d:
         points = np.asarray(source.points, dtype=np.float64) * scale
         if config.voxel > 0:
@@ -34,10 +35,11 @@ def input_figures(source: OccupancyMap | PointMap, config: NoRefConfig = NoRefCo
         planes = None if orth_subset is None else [p * scale for p in orth_subset]
         figures = noref_figures(points, config.radius, config.min_knn, config.max_nn, planes)
         return {"cloud": {**figures, "voxel_m": config.voxel}, "grid": None}
-    return {"cloud": None, "grid": occupancy_figures(source, scale)}
+    return {"cloud": None, "grid": occupancy_figures(source, scale, corners)}
 
 
-def occupancy_figures(source: OccupancyMap | PointMap, scale: float = 1.0) -> dict[str, Any]:
+def occupancy_figures(source: OccupancyMap | PointMap, scale: float = 1.0,
+                      corners: int | None = None) -> dict[str, Any]:
     """The 2D figures of an image, or of a 2D cloud drawn as ``eval`` draws a cloud truth
     (:func:`pcmapq.plan.truth_raster`, default settings; a cloud has no free cells: its
     occupied/free ratio and enclosed areas are None). Cells ``scale`` times their size."""
@@ -48,7 +50,7 @@ def occupancy_figures(source: OccupancyMap | PointMap, scale: float = 1.0) -> di
         state = np.where(occupied, OCCUPIED, UNKNOWN).astype(np.int8)
     if isinstance(source, OccupancyMap) and scale != 1.0:
         grid = replace(grid, resolution=grid.resolution * scale)
-    figures = asdict(grid_scores(state, grid))
+    figures = asdict(grid_scores(state, grid, corners=corners))
     figures["resolution_m"] = grid.resolution
     if isinstance(source, PointMap):
         figures.update(free_cells=None, occupied_free_ratio=None, enclosed_areas=None,

@@ -14,7 +14,7 @@ from pcmapq.align import Alignment, align
 from pcmapq.align.rigid3d import Registration3D, align_3d, apply
 from pcmapq.config import Settings
 from pcmapq.errors import EvaluationError, InputError
-from pcmapq.features import Features, SideBySide
+from pcmapq.features import Features, SideBySide, default_params
 from pcmapq.frames import Frames
 from pcmapq.grid import MetricGrid
 from pcmapq.io import OccupancyMap, PointMap
@@ -239,6 +239,17 @@ def needed_memory(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMa
     return memory.needed_bytes(images, cells, cells * grid.resolution**2, points)
 
 
+def harris_corners(truth: OccupancyMap | PointMap, found: dict[str, Features],
+                   settings: Settings) -> int | None:
+    """The strong Harris corners an image truth's no-reference figures count, taken from the
+    features the method found on it when it ran Harris with the default parameters (the same
+    detection on the same cells); None otherwise."""
+    if not isinstance(truth, OccupancyMap) or "harris" not in found or \
+            settings.matching.params.get("harris") != default_params()["harris"]:
+        return None
+    return int(np.count_nonzero(found["harris"].strong))
+
+
 def score(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap, settings: Settings,
           progress: Progress = lambda step: None, memory_limit: int | None = None) -> Result:
     """Score a loaded map against a loaded truth: align, raster, detect, match; stop first
@@ -295,7 +306,8 @@ def score(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap, setti
         progress("no-reference figures")
         scale = alignment.transform.scale if settings.alignment.scale else 1.0
         noref = {"map": input_figures(loaded, settings.noref, scale=scale),
-                 "truth": input_figures(truth, settings.noref)}
+                 "truth": input_figures(truth, settings.noref,
+                                        corners=harris_corners(truth, truth_found, settings))}
     cloud_distances = None
     if registration is not None:
         progress("distances in 3D")

@@ -70,11 +70,12 @@ def enclosed_areas(state: np.ndarray, resolution: float,
 
 
 def grid_scores(state: np.ndarray, grid: MetricGrid, params: HarrisParams | None = None,
-                min_area_m2: float = MIN_ENCLOSED_AREA) -> GridScores:
+                min_area_m2: float = MIN_ENCLOSED_AREA, corners: int | None = None) -> GridScores:
     """All three figures of an occupancy raster (``state``: int8 OCCUPIED / FREE / UNKNOWN on
-    ``grid``)."""
+    ``grid``). ``corners``: :func:`corner_count` of this raster when already found (``eval``
+    has the truth's Harris corners: on a large map the detector is most of the cost)."""
     occupied, free, ratio = occupied_free(state)
     areas = enclosed_areas(state, grid.resolution, min_area_m2)
     return GridScores(occupied_cells=occupied, free_cells=free, occupied_free_ratio=ratio,
-                      corners=corner_count(state, grid, params), enclosed_areas=len(areas),
-                      enclosed_area_m2=float(areas.sum()))
+                      corners=corner_count(state, grid, params) if corners is None else corners,
+                      enclosed_areas=len(areas), enclosed_area_m2=float(areas.sum()))
