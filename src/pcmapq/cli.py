@@ -233,6 +233,18 @@ def inspect_command(
 
 
 
+#: The CI gates of eval and batch (a batch judges every row; docs/ci.md).
+FailUnder = Annotated[str | None, typer.Option(
+    metavar="<KEY=VALUE,...>",
+    help="CI gate: exit 3 when a figure (of any row, in a batch) is below its bound, e.g. "
+    "harris.quality=0.8,coverage=0.9 (keys: docs/ci.md; a figure that is n/a fails). The "
+    "outputs are written all the same.")]
+FailOver = Annotated[str | None, typer.Option(
+    metavar="<KEY=VALUE,...>",
+    help="CI gate for distances: exit 3 when a figure is above its bound, e.g. "
+    "accuracy.mean=0.05 (metres).")]
+
+
 @app.command("eval")
 def eval_command(
     ctx: typer.Context,
@@ -361,15 +373,8 @@ def eval_command(
         help="A 3D cloud is first reduced to one point per cell of this size for its "
         "no-reference figures, metres (0: as it is).", min=0.0, callback=options.finite)
     ] = DEFAULTS.noref.voxel,
-    fail_under: Annotated[str | None, typer.Option(
-        metavar="<KEY=VALUE,...>",
-        help="CI gate: exit 3 when a figure is below its bound, e.g. harris.quality=0.8,"
-        "coverage=0.9 (keys: docs/ci.md; a figure that is n/a fails). The outputs are "
-        "written all the same.")] = None,
-    fail_over: Annotated[str | None, typer.Option(
-        metavar="<KEY=VALUE,...>",
-        help="CI gate for distances: exit 3 when a figure is above its bound, e.g. "
-        "accuracy.mean=0.05 (metres).")] = None,
+    fail_under: FailUnder = None,
+    fail_over: FailOver = None,
     quiet: Annotated[bool, typer.Option(
         "--quiet", "-q", help="Print nothing but warnings and errors (and the JSON of "
         "--json -).")] = False,
@@ -394,8 +399,7 @@ def eval_command(
     out = Console(quiet=quiet or json_path == "-")  # not a terminal: COLUMNS or 80 wide
     with report_errors(err), show_warnings(err), \
             step_progress(err, enabled=not quiet and json_path != "-") as progress:
-        rules = gates.parse_gates(fail_under, gates.UNDER) + \
-            gates.parse_gates(fail_over, gates.OVER)
+        rules = gates.parse_rules(fail_under, fail_over)
         options.check_eval_options(scans=scans, max_scans=max_scans, no_align=no_align,
                                    auto_scale=auto)
         options.check_outputs({"--json": json_path, "--vectors": vectors, "--plot": plot,
@@ -528,12 +532,8 @@ def batch_command(
     json_path: Annotated[str | None, typer.Option(
         "--json", help="Write how each row ended as JSON to this path ('-' for stdout only)."
     )] = None,
-    fail_under: Annotated[str | None, typer.Option(
-        metavar="<KEY=VALUE,...>", help="CI gate on every row, as eval's: exit 3 when a "
-        "row's figure is below its bound (the table's gates column names it).")] = None,
-    fail_over: Annotated[str | None, typer.Option(
-        metavar="<KEY=VALUE,...>", help="CI gate on every row for distances: exit 3 when a "
-        "row's figure is above its bound.")] = None,
+    fail_under: FailUnder = None,
+    fail_over: FailOver = None,
     quiet: Annotated[bool, typer.Option(
         "--quiet", "-q", help="Print nothing but warnings and errors.")] = False,
 ) -> None:
@@ -548,8 +548,7 @@ def batch_command(
         if workers is not None and scheduler is not None:
             raise InputError("--workers sets local processes; with --scheduler the cluster's "
                              "workers run the rows: give one of the two")
-        rules = gates.parse_gates(fail_under, gates.UNDER) + \
-            gates.parse_gates(fail_over, gates.OVER)
+        rules = gates.parse_rules(fail_under, fail_over)
         defaults = parse_assignments(set_options or [])
         if truth is not None:
             if any(s.lower().endswith(".csv") for s in sources):

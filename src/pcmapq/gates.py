@@ -115,6 +115,11 @@ def parse_gates(text: str | None, direction: str) -> list[Gate]:
     return gates
 
 
+def parse_rules(under: str | None, over: str | None) -> list[Gate]:
+    """The gates of ``--fail-under`` and ``--fail-over``, in that order."""
+    return parse_gates(under, UNDER) + parse_gates(over, OVER)
+
+
 def short_names(detectors: tuple[str, ...] = DETECTOR_NAMES) -> list[str]:
     """Every short key (``f_score@TAU`` stands for any tau)."""
     stats = [f"{d}.{s}" for d in ("accuracy", "completeness") for s in STAT_FIELDS]
