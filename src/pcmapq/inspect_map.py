@@ -46,9 +46,9 @@ def summary_lines(record: dict[str, Any]) -> list[str]:
                   f"{near})",
                   f"MME       {_num(noref['mme'])} nats (lower: crisper)",
                   f"MPV       {_num(noref['mpv'])} m² (lower: thinner surfaces)",
-                  f"MOM       {_num(noref['mom'])} m² "
-                  + (f"({noref['mom_note']})" if noref["mom"] is None else
-                     f"(orthogonal planes {noref['orth_subset']})")]
+                  f"MOM       {_num(noref['mom'])}"
+                  + (f" ({noref['mom_note']})" if noref["mom"] is None else
+                     f" m² (orthogonal planes {noref['orth_subset']})")]
     if grid is not None:
         ratio = grid["occupied_free_ratio"]
         lines += [f"cells     {grid['occupied_cells']:,} occupied of {grid['resolution_m']:g} m"

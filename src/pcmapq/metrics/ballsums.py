@@ -1,40 +1,34 @@
 """Moment sums over every point's ball (its map points strictly closer than a radius, itself
-included), on a uniform grid of cells of side ``radius`` and dense distance blocks.
+included), on a uniform grid of columns of side ``radius`` and a compiled loop over candidates.
 
-The points are sorted by cell (the longest axis varying fastest), and consecutive cells of one
-column along that axis are taken together as a *block* (at least ``MIN_BLOCK_POINTS`` points
-when the map is sparse). A block's candidate neighbours are the points of the cells within the
-radius of it, which the sort makes a few contiguous ranges. Squared distances come from one
-matrix product, d^2 = |a|^2 + |b|^2 - 2 a.b in coordinates relative to the block's mean; a
-candidate whose d^2 lies within a rounding bound of radius^2 is decided again exactly as
-Open3D's search does, ((dx dx + dy dy) + dz dz) < radius^2 in the map's own coordinates. The
-sums are a second matrix product, the 0/1 neighbour matrix times the candidates' moments
-(1, x, y, z, xx, xy, xz, yy, yz, zz relative to the block's mean). Both products are kept
-below OpenBLAS's threading threshold (``BLOCK`` candidates a product), so BLAS runs on the
-calling thread: threads of our own run the blocks, and the figures do not depend on how many.
+The points are sorted by column (square cells across the two shorter axes) and, within one,
+along the longest axis, so a point's candidates are, in each of the 3 x 3 columns around its
+own, one contiguous range: the points within the radius of it along that axis (a column
+farther than the radius across is skipped, and a nearer one's range narrowed to the chord
+left). Each candidate is decided exactly as Open3D's search does, ((dx dx + dy dy) + dz dz) <
+radius^2 in the map's own coordinates (no fused multiply-add), with margins of a millionth of
+the radius on the ranges so that no candidate the test would keep is left out. A point's sums
+(1, dx, dy, dz, dx dx, dx dy, dx dz, dy dy, dy dz, dz dz of its neighbours' offsets from it)
+are added by one thread in sorted order, so they are the same bit for bit whatever the number
+of threads. Numba compiles the loop on first use and caches it on disk.
 """
 
 from __future__ import annotations
 
-import functools
-import os
+import math
 from collections.abc import Iterator
-from concurrent.futures import ThreadPoolExecutor
 
+import numba
 import numpy as np
-from threadpoolctl import threadpool_limits
 
-#: Candidate pairs in one product (8 bytes each, a few arrays of them per thread).
-BLOCK = 2000000
-#: Columns across one radius, and the most points of a block.
-SPLIT = 1
-BLOCK_POINTS = 96
+#: Numba's threading layers in the order tried: OpenMP, then its own work queue (the TBB found
+#: beside some installs is too old, and Numba warns when it tries it first).
+numba.config.THREADING_LAYER_PRIORITY = ["omp", "workqueue", "tbb"]
+
 #: Points whose sums one yield holds (80 bytes each).
 CHUNK_POINTS = 1_000_000
-#: Threads over blocks by default (CI machines have two cores).
-WORKERS = 2
-#: Rounding bound factor: |computed - exact| d^2 stays within TOL * eps * (scale) for 3 terms.
-TOL = 16.0
+#: The 3 x 3 columns around a column: offsets across the two shorter axes.
+OFFSETS = np.array([(d0, d1) for d0 in (-1, 0, 1) for d1 in (-1, 0, 1)], dtype=np.int64)
 
 
 def moments(xyz: np.ndarray) -> np.ndarray:
@@ -43,118 +37,133 @@ def moments(xyz: np.ndarray) -> np.ndarray:
     return np.column_stack([np.ones(len(xyz)), x, y, z, x * x, x * y, x * z, y * y, y * z, z * z])
 
 
-def _columns(split: int) -> list[tuple[int, int]]:
-    """Offsets of the columns (side radius / ``split``) that come closer than one radius to a
-    column."""
-    reach = range(-split, split + 1)
-    return [(d0, d1) for d0 in reach for d1 in reach
-            if max(abs(d0) - 1, 0) ** 2 + max(abs(d1) - 1, 0) ** 2 < split * split]
-
-
 class _Grid:
-    """Points sorted by column (square cells of side ``radius / SPLIT`` across the two shorter
-    axes) and, within one, along the longest axis; the blocks ([start, end) in sorted order, at
-    most ``BLOCK_POINTS`` consecutive points of one column) and their candidate ranges (``lo``,
-    ``hi``: one per neighbouring column, the points within ``radius`` of the block along the
-    longest axis)."""
+    """Points sorted by column (cells of side ``radius`` across the two shorter axes ``axes[:2]``)
+    and, within one, along the longest axis ``axes[2]``; per point, the rank of its column;
+    per column, its two cell indices and the [start, end) of each of its 3 x 3 neighbouring
+    columns in sorted order (empty where there are no points)."""
 
     def __init__(self, pts: np.ndarray, radius: float) -> None:
-        axes = np.argsort(np.ptp(pts, axis=0), kind="stable")  # longest axis last
-        low = pts.min(axis=0)
-        side = radius / SPLIT
-        ij = np.floor((pts[:, axes[:2]] - low[axes[:2]]) / side).astype(np.int64) + SPLIT
-        dim1 = int(ij[:, 1].max()) + SPLIT + 1
-        if (int(ij[:, 0].max()) + SPLIT + 1) * dim1 >= 2**62:
+        self.axes = np.argsort(np.ptp(pts, axis=0), kind="stable")  # longest axis last
+        self.low = pts.min(axis=0)[self.axes[:2]]
+        ij = np.floor((pts[:, self.axes[:2]] - self.low) / radius).astype(np.int64) + 1
+        dim1 = int(ij[:, 1].max()) + 2
+        if (int(ij[:, 0].max()) + 2) * dim1 >= 2**62:
             raise ValueError(f"radius {radius} m is too small for the map's extent")
         col = ij[:, 0] * dim1 + ij[:, 1]
-        z = pts[:, axes[2]] - low[axes[2]]
-        self.order = np.lexsort((z, col))
-        self.points = pts[self.order]
-        col, z = col[self.order], z[self.order]
-        cols, starts, counts = np.unique(col, return_index=True, return_counts=True)
-        rank = np.repeat(np.arange(len(cols)), counts)
-        pos = np.arange(len(col)) - np.repeat(starts, counts)
-        first = np.flatnonzero(pos % BLOCK_POINTS == 0)
-        self.start = first
-        self.end = np.r_[first[1:], len(col)]
-        # one sorted float key per point: its column's rank, then its place along the axis
-        width = float(z.max()) + 4.0 * radius + 1.0
-        key = rank * width + z
-        margin = 8.0 * np.finfo(float).eps * (len(cols) * width) + 1e-9 * radius
-        zlo, zhi = z[self.start] - radius - margin, z[self.end - 1] + radius + margin
-        bcol = col[self.start]
-        lo, hi = [], []
-        for d0, d1 in _columns(SPLIT):
-            other = bcol + d0 * dim1 + d1
-            r = np.minimum(np.searchsorted(cols, other), len(cols) - 1)
-            there = cols[r] == other
-            lo.append(np.where(there, np.searchsorted(key, r * width + zlo, "left"), 0))
-            hi.append(np.where(there, np.searchsorted(key, r * width + zhi, "right"), 0))
-        self.lo = np.stack(lo, axis=1)
-        self.hi = np.stack(hi, axis=1)
+        self.order = np.lexsort((pts[:, self.axes[2]], col))
+        self.xyz = np.ascontiguousarray(pts[self.order].T)
+        cols, starts, counts = np.unique(col[self.order], return_index=True, return_counts=True)
+        self.rank = np.repeat(np.arange(len(cols)), counts)
+        self.cell = np.column_stack([cols // dim1, cols % dim1])
+        ends = starts + counts
+        other = cols[:, None] + OFFSETS[:, 0] * dim1 + OFFSETS[:, 1]
+        r = np.minimum(np.searchsorted(cols, other), len(cols) - 1)
+        there = cols[r] == other
+        self.lo = np.where(there, starts[r], 0)
+        self.hi = np.where(there, ends[r], 0)
 
 
-def _block(grid: _Grid, k: int, r2: float, out: np.ndarray, p0: int) -> None:
-    """Sums of block ``k`` into ``out`` (row i: the point at ``p0 + i`` in sorted order)."""
-    pts = grid.points
-    a0, a1 = int(grid.start[k]), int(grid.end[k])
-    spans = [(int(s), int(e)) for s, e in zip(grid.lo[k], grid.hi[k], strict=True) if e > s]
-    a_abs = pts[a0:a1]
-    b_abs = np.concatenate([pts[s:e] for s, e in spans])
-    centre = a_abs.mean(axis=0)
-    a = a_abs - centre
-    b = b_abs - centre
-    f = moments(b)
-    aa = np.einsum("ij,ij->i", a, a)
-    bb = np.einsum("ij,ij->i", b, b)
-    tol = TOL * np.finfo(float).eps * (2.0 * aa.max() + 2.0 * bb.max() + r2)
-    aa -= r2
-    bt = np.ascontiguousarray(-2.0 * b.T)
-    rows = max(1, BLOCK // max(len(b), 10))
-    for i in range(0, len(a), rows):
-        d = a[i:i + rows] @ bt
-        d += aa[i:i + rows, None]
-        d += bb
-        near = d < tol
-        if np.count_nonzero(near) != np.count_nonzero(d < -tol):
-            _exact(near, d > -tol, a_abs[i:i + rows], b_abs, r2)
-        out[a0 - p0 + i:a0 - p0 + i + len(d)] = near.astype(np.float64) @ f
+@numba.njit(cache=True, inline="always")
+def _first(w: np.ndarray, lo: int, hi: int, value: float) -> int:
+    """The first index in [lo, hi) of sorted ``w`` whose value is not below ``value`` (hi if
+    none): a binary search without branches on the data."""
+    n = hi - lo
+    while n > 0:
+        half = n // 2
+        below = w[lo + half] < value
+        lo = lo + half + 1 if below else lo
+        n = n - half - 1 if below else half
+    return lo
 
 
-def _blocks(grid: _Grid, r2: float, out: np.ndarray, p0: int, ks: np.ndarray) -> None:
-    for k in ks:
-        _block(grid, int(k), r2, out, p0)
+@numba.njit(cache=True)
+def _d2(dx: float, dy: float, dz: float) -> float:
+    """Squared distance as Open3D sums it (a function of its own: no reassociation here)."""
+    return (dx * dx + dy * dy) + dz * dz
 
 
-def _exact(near: np.ndarray, band: np.ndarray, a: np.ndarray, b: np.ndarray, r2: float) -> None:
-    """Decide the candidates within rounding of the radius as Open3D does (in place)."""
-    ii, jj = np.nonzero(near & band)
-    diff = a[ii] - b[jj]
-    d2 = (diff[:, 0] * diff[:, 0] + diff[:, 1] * diff[:, 1]) + diff[:, 2] * diff[:, 2]
-    near[ii, jj] = d2 < r2
+@numba.njit(cache=True, fastmath={"reassoc", "nsz"})
+def _span(xs: np.ndarray, ys: np.ndarray, zs: np.ndarray, start: int, end: int, x: float,
+          y: float, z: float, r2: float) -> tuple[float, ...]:
+    """Moment sums of the points [start, end) closer than sqrt(r2) to (x, y, z), offsets from
+    it (the sums vectorised: their order of additions is fixed by the machine's vector width,
+    not by the threads)."""
+    s1 = sx = sy = sz = sxx = sxy = sxz = syy = syz = szz = 0.0
+    for t in range(np.uint64(start), np.uint64(end)):  # unsigned: no wraparound test
+        dx, dy, dz = xs[t] - x, ys[t] - y, zs[t] - z
+        near = _d2(x - xs[t], y - ys[t], z - zs[t]) < r2
+        dx = dx if near else 0.0
+        dy = dy if near else 0.0
+        dz = dz if near else 0.0
+        s1 += 1.0 if near else 0.0
+        sx += dx
+        sy += dy
+        sz += dz
+        sxx += dx * dx
+        sxy += dx * dy
+        sxz += dx * dz
+        syy += dy * dy
+        syz += dy * dz
+        szz += dz * dz
+    return s1, sx, sy, sz, sxx, sxy, sxz, syy, syz, szz
+
+
+@numba.njit(cache=True, parallel=True)
+def _sums(xyz: np.ndarray, axes: np.ndarray, low: np.ndarray, rank: np.ndarray,
+          cell: np.ndarray, lo: np.ndarray, hi: np.ndarray, radius: float, p0: int,
+          out: np.ndarray) -> None:
+    """Sums of the points ``p0 + row`` (sorted order) into ``out[row]``. ``xyz``: the sorted
+    map's coordinates (3, N); ``axes``: its rows along the grid's axes, longest last."""
+    r2 = radius * radius
+    xs, ys, zs = xyz[0], xyz[1], xyz[2]
+    us, vs, ws = xyz[axes[0]], xyz[axes[1]], xyz[axes[2]]
+    margin = 1e-6 * radius + 64.0 * np.finfo(np.float64).eps * max(np.abs(xyz).max(), radius)
+    for row in numba.prange(out.shape[0]):
+        i = p0 + row
+        u, v, w = us[i], vs[i], ws[i]
+        c = rank[i]
+        acc = np.zeros(10)
+        for k in range(OFFSETS.shape[0]):
+            if hi[c, k] <= lo[c, k]:
+                continue
+            # the gaps across from the point to the column's cell, less the margin
+            c0 = low[0] + (cell[c, 0] + OFFSETS[k, 0] - 1) * radius
+            c1 = low[1] + (cell[c, 1] + OFFSETS[k, 1] - 1) * radius
+            g0 = max(c0 - u, u - (c0 + radius), 0.0) - margin
+            g1 = max(c1 - v, v - (c1 + radius), 0.0) - margin
+            h2 = max(g0, 0.0) ** 2 + max(g1, 0.0) ** 2
+            if h2 >= r2:
+                continue
+            half = math.sqrt(r2 - h2) + margin
+            start = _first(ws, lo[c, k], hi[c, k], w - half)
+            end = _first(ws, start, hi[c, k], w + half)
+            part = _span(xs, ys, zs, start, end, xs[i], ys[i], zs[i], r2)
+            for m in range(10):
+                acc[m] += part[m]
+        out[row] = acc
 
 
 def ball_sums(points: np.ndarray, radius: float, chunk_points: int = CHUNK_POINTS,
               workers: int | None = None) -> Iterator[tuple[np.ndarray, np.ndarray]]:
     """Yield (indices into ``points``, (k, 10) moment sums) over every point's neighbourhood
     (points with |p - q| < ``radius`` metres): count, sums of x, y, z, xx, xy, xz, yy, yz, zz
-    relative to an origin of its own block. Chunks of about ``chunk_points`` points, in an
-    order and with figures independent of ``workers`` (threads). Memory: the sorted map, one
-    chunk's sums and ``workers`` blocks of ``BLOCK`` candidates."""
+    of the neighbours' offsets from the point itself. Chunks of about ``chunk_points`` points,
+    in an order and with figures independent of ``workers`` (threads; default Numba's, at most
+    its ``NUMBA_NUM_THREADS``). Memory: the sorted map and one chunk's sums."""
     pts = np.asarray(points, dtype=np.float64)
     if len(pts) == 0:
         return
     grid = _Grid(pts, radius)
-    r2 = radius * radius
-    workers = max(1, workers or min(WORKERS, os.cpu_count() or 1))
-    n_blocks = len(grid.start)
-    bounds = np.searchsorted(grid.start, np.arange(0, len(pts), max(1, chunk_points)))
-    bounds = np.unique(np.r_[bounds, n_blocks])
-    with ThreadPoolExecutor(workers) as pool:
-        for c0, c1 in zip(bounds[:-1], bounds[1:], strict=True):
-            p0, p1 = int(grid.start[c0]), int(grid.end[c1 - 1])
-            out = np.empty((p1 - p0, 10))
-            parts = np.array_split(np.arange(c0, c1), min(c1 - c0, workers * 8))
-            with threadpool_limits(1, user_api="blas"):  # its own threads busy-wait beside ours
-                list(pool.map(functools.partial(_blocks, grid, r2, out, p0), parts))
-            yield grid.order[p0:p1], out
+    threads = min(workers or numba.get_num_threads(), numba.config.NUMBA_NUM_THREADS)
+    step = max(1, chunk_points)
+    for p0 in range(0, len(pts), step):
+        out = np.empty((min(step, len(pts) - p0), 10))
+        before = numba.get_num_threads()
+        numba.set_num_threads(max(1, threads))
+        try:
+            _sums(grid.xyz, grid.axes, grid.low, grid.rank, grid.cell, grid.lo, grid.hi,
+                  float(radius), p0, out)
+        finally:
+            numba.set_num_threads(before)
+        yield grid.order[p0:p0 + len(out)], out

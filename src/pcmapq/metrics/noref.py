@@ -7,11 +7,11 @@ The neighbourhood of a point q is every map point p with |p - q| < radius (stric
 neighbours. Covariances are unbiased (divided by n - 1, as ``np.cov``). Units: points and radius
 in metres, MPV and MOM in square metres, MME in nats (ln of metres).
 
-The map's neighbourhood sums come from :mod:`pcmapq.metrics.ballsums` (a grid of cells of
-side ``radius``, dense distance blocks and matrix products, each candidate within rounding of the
-radius decided again exactly as Open3D's search does), never a Python loop over points; memory
-stays bounded whatever the map's size, coordinates are taken relative to each block's mean. The
-neighbourhoods of MOM's few query points come from SciPy kd-trees.
+The map's neighbourhood sums come from :mod:`pcmapq.metrics.ballsums` (columns of side
+``radius`` and a loop over candidates compiled by Numba, each decided exactly as Open3D's search
+does), never a Python loop over points; memory stays bounded whatever the map's size, and each
+point's sums are of its neighbours' offsets from it. The neighbourhoods of MOM's few query points
+come from SciPy kd-trees.
 """
 
 from __future__ import annotations
