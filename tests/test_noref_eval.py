@@ -86,13 +86,12 @@ def test_older_results_read_back_without_noref():
     assert Settings.from_dict(doc).noref.enabled is False
 
 
-def test_planes_found_through_a_sample_of_the_planar_points(monkeypatch):
+def test_planes_found_through_a_sample_of_the_planar_points():
     """A room corner (4,500 points on three walls): clustering 500 of its planar normals finds
     the same three walls, every planar point of each on it, as clustering all of them."""
     corner = room_corner(5)
     whole = orthogonal.extract_orthogonal_subset(corner, 0.2)
-    monkeypatch.setattr(orthogonal, "MAX_WARD_POINTS", 500)
-    sampled = orthogonal.extract_orthogonal_subset(corner, 0.2)
+    sampled = orthogonal.extract_orthogonal_subset(corner, 0.2, max_ward=500)
     axes = [int(np.argmax(np.abs(np.linalg.eigh(np.cov(p.T))[1][:, 0]))) for p in sampled]
     assert sorted(axes) == [0, 1, 2]
     for plane, axis in zip(sampled, axes, strict=True):

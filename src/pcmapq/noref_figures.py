@@ -33,7 +33,8 @@ def input_figures(source: OccupancyMap | PointMap, config: NoRefConfig = NoRefCo
         if config.voxel > 0:
             points = voxel_centroids(points, config.voxel)
         planes = None if orth_subset is None else [p * scale for p in orth_subset]
-        figures = noref_figures(points, config.radius, config.min_knn, config.max_nn, planes)
+        figures = noref_figures(points, config.radius, config.min_knn, config.max_nn, planes,
+                                max_ward=config.max_ward)
         return {"cloud": {**figures, "voxel_m": config.voxel}, "grid": None}
     return {"cloud": None, "grid": occupancy_figures(source, scale, corners)}
 

@@ -11,7 +11,7 @@ import numpy as np
 
 from pcmapq.errors import EvaluationError
 from pcmapq.metrics.noref import LIDAR_RADIUS, MAX_NN, MIN_KNN, mom, scores
-from pcmapq.metrics.orthogonal import extract_orthogonal_subset
+from pcmapq.metrics.orthogonal import MAX_WARD_POINTS, extract_orthogonal_subset
 
 
 def _finite(value: float) -> float | None:
@@ -20,12 +20,15 @@ def _finite(value: float) -> float | None:
 
 def noref_figures(points: np.ndarray, radius: float = LIDAR_RADIUS, min_knn: int = MIN_KNN,
                   max_nn: int = MAX_NN, orth_subset: Sequence[np.ndarray] | None = None,
-                  mom_source: np.ndarray | None = None) -> dict[str, Any]:
+                  mom_source: np.ndarray | None = None,
+                  max_ward: int = MAX_WARD_POINTS) -> dict[str, Any]:
     """MME (nats), MPV and MOM (m^2) of ``points`` (N, 3 metres) with their parameters.
 
     MOM uses ``orth_subset`` (planes in the map's frame) or else extracts one from
     ``mom_source`` (map-metrics: the first scan; None: the map itself); when none can be found,
-    ``mom`` is None and ``mom_note`` says why. Figures that are not finite are None.
+    ``mom`` is None and ``mom_note`` says why (``max_ward``: see
+    :func:`~pcmapq.metrics.orthogonal.extract_orthogonal_subset`). Figures that are not finite
+    are None.
     """
     reuse = orth_subset is None and mom_source is None  # the planar points of this pass
     s = scores(points, radius, min_knn, with_flat=reuse)
@@ -35,7 +38,8 @@ def noref_figures(points: np.ndarray, radius: float = LIDAR_RADIUS, min_knn: int
     if planes is None:
         try:
             planes = extract_orthogonal_subset(points if mom_source is None else mom_source,
-                                               radius, max_nn, planar=s.flat)
+                                               radius, max_nn, planar=s.flat,
+                                               max_ward=max_ward)
         except EvaluationError as exc:
             note, source = str(exc), None
     value = None if planes is None else _finite(mom(points, planes, radius))

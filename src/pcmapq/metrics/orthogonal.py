@@ -5,8 +5,9 @@
    covariance eigenvalues, 100 * lambda_0 < lambda_1;
 3. their normals clustered by Ward linkage, cut at distance 0.1 (scikit-learn's
    ``AgglomerativeClustering(distance_threshold=0.1)``, here SciPy's identical Ward tree).
-   A Ward tree costs N^2 in time and memory: above ``MAX_WARD_POINTS`` planar points (a whole
-   map; map-metrics extracts from one scan) the tree is built on that many of
+   A Ward tree costs N^2 in time and memory: above ``max_ward`` planar points (default
+   ``MAX_WARD_POINTS``; a whole map: map-metrics extracts from one scan) the tree is built on
+   that many of
    them, evenly spaced in the cloud's order, and every planar point then joins the cluster whose
    mean normal is nearest (largest dot product); below it the result is map-metrics' own;
 4. clusters of more than ``min_cluster`` points, their mean normals normalised;
@@ -76,17 +77,20 @@ def _triples(n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 def extract_orthogonal_subset(cloud: np.ndarray, radius: float, max_nn: int = MAX_NN,
                               min_cluster: int = MIN_CLUSTER,
                               eps: float = ORTHOGONAL_COS,
-                              planar: np.ndarray | None = None) -> list[np.ndarray]:
+                              planar: np.ndarray | None = None,
+                              max_ward: int = MAX_WARD_POINTS) -> list[np.ndarray]:
     """Three arrays of points (metres, the cloud's frame) on mutually orthogonal planes of
     ``cloud`` (map-metrics extracts them from the first scan). EvaluationError when none.
-    ``planar``: :func:`planar_points` of the cloud at ``radius``, when already found."""
+    ``planar``: :func:`planar_points` of the cloud at ``radius``, when already found;
+    ``max_ward``: the most planar normals the Ward tree is built on (see the module
+    docstring)."""
     cloud = np.asarray(cloud, dtype=np.float64)
     normals = _normals(cloud, radius, max_nn)
     keep = planar_points(cloud, radius) if planar is None else planar
     points, normals = cloud[keep], normals[keep]
     if len(points) < 3 * (min_cluster + 1):
         raise EvaluationError(f"only {len(points)} planar points for MOM's orthogonal subset")
-    labels, ids, sizes = _clusters(normals, min_cluster)
+    labels, ids, sizes = _clusters(normals, min_cluster, max_ward)
     if len(ids) < 3:
         raise EvaluationError("fewer than three planes for MOM's orthogonal subset")
     means = np.stack([normals[labels == c].mean(axis=0) for c in ids])
@@ -94,12 +98,12 @@ def extract_orthogonal_subset(cloud: np.ndarray, radius: float, max_nn: int = MA
     return [points[labels == ids[c]] for c in _best_triple(means, sizes, eps)]
 
 
-def _clusters(normals: np.ndarray,
-              min_cluster: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _clusters(normals: np.ndarray, min_cluster: int,
+              max_ward: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Ward cluster label of every normal, and the labels and sizes of the clusters of more
-    than ``min_cluster`` normals (above ``MAX_WARD_POINTS`` normals: see the module docstring;
+    than ``min_cluster`` normals (above ``max_ward`` normals: see the module docstring;
     ``min_cluster`` then counts the sample's normals)."""
-    step = -(-len(normals) // MAX_WARD_POINTS)
+    step = -(-len(normals) // max_ward)
     sample = normals[::step]
     tree = ward(sample)
     clusters = int(np.count_nonzero(tree[:, 2] >= WARD_CUT)) + 1
