@@ -34,7 +34,9 @@ class Alignment:
     scale: float = 1.0
 
     def matrix(self) -> np.ndarray:
-        """The Sim(3) matrix [s R, t; 0, 1] (4, 4), evo's ``alignment_transformation_sim3``."""
+        """The Sim(3) matrix [s R, t; 0, 1] (4, 4) that maps the estimate's positions onto the
+        aligned ones: evo's ``alignment_transformation_sim3``, except that for a scale
+        correction alone evo reports the fitted rotation and translation it does not apply."""
         m = np.eye(4)
         m[:3, :3] = self.scale * self.rotation
         m[:3, 3] = self.translation
