@@ -9,6 +9,7 @@ import csv
 import json
 import shlex
 import sys
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -21,7 +22,7 @@ from pcmapq.batch import run_batch as batch_run
 from pcmapq.batch.manifest import glob_rows, parse_assignments
 from pcmapq.batch.run import run_local as pool_run
 from pcmapq.cli import app
-from pcmapq.config import MatchingConfig, NoRefConfig, Settings
+from pcmapq.config import MatchingConfig, Settings
 from pcmapq.errors import InputError
 from pcmapq.transform import Similarity2D
 from tests.conftest import in_map_frame, write_image_map
@@ -105,7 +106,8 @@ def test_noref_columns_are_evals_options(inputs):
     --no-noref --noref-radius 0.2 --noref-voxel 0.02."""
     rows = read_rows(inputs / "runs.csv", {"noref": "false", "noref_radius": "0.2",
                                            "noref_voxel": "0.02"})
-    assert rows[0].settings.noref == NoRefConfig(enabled=False, radius=0.2, voxel=0.02)
+    assert rows[0].settings.noref == replace(Settings().noref, enabled=False, radius=0.2,
+                                             voxel=0.02)
     words = shlex.split(rows[0].command({"--json": Path("/o/s.json")}))
     assert words[-5:] == ["--no-noref", "--noref-radius", "0.2", "--noref-voxel", "0.02"]
     got = CliRunner().invoke(app, ["eval", *words[2:], "--help"])  # eval knows every option
