@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -15,7 +15,7 @@ from pcmapq.align.rigid3d import Registration3D, align_3d, apply
 from pcmapq.config import Settings
 from pcmapq.errors import EvaluationError, InputError
 from pcmapq.features import Features, SideBySide, default_params
-from pcmapq.frames import Frames
+from pcmapq.frames import Frames, Levelling
 from pcmapq.grid import MetricGrid
 from pcmapq.io import OccupancyMap, PointMap
 from pcmapq.io.extent import check_span, far_points, hint
@@ -250,52 +250,133 @@ def harris_corners(truth: OccupancyMap | PointMap, found: dict[str, Features],
     return int(np.count_nonzero(found["harris"].strong))
 
 
+@dataclass(frozen=True)
+class PreparedTruth:
+    """The truth as every score against it needs it, whatever the map: its plan points ``xy``
+    (N, 2) metres with the ``level`` that made them, the ``grid`` everything is drawn on, its
+    ``occupied`` cells, its ``features`` by detector and, when computed, ``to_truth``: each
+    cell's distance to the nearest truth wall, metres. Made once by :func:`prepare_truth` for
+    many maps (``pcmapq track``'s steps)."""
+
+    source: OccupancyMap | PointMap
+    xy: np.ndarray
+    level: Levelling | None
+    grid: MetricGrid
+    occupied: np.ndarray
+    features: dict[str, Features]
+    to_truth: np.ndarray | None = None
+
+
+@dataclass(frozen=True)
+class MapSide:
+    """One map aligned and drawn on the truth's grid: ``source`` (in the truth frame after a
+    3D registration), its plan points ``xy`` (N, 2) metres in its own plan frame, the
+    alignment, its ``occupied`` cells, ``to_map`` (each cell's distance to them, metres), the
+    overlap and its features by detector."""
+
+    source: OccupancyMap | PointMap
+    registration: Registration3D | None
+    xy: np.ndarray
+    level: Levelling | None
+    alignment: Alignment
+    occupied: np.ndarray
+    to_map: np.ndarray
+    cover: Overlap
+    features: dict[str, Features]
+
+
+def prepare_truth(truth: OccupancyMap | PointMap, settings: Settings) -> PreparedTruth:
+    """Everything of the truth that does not depend on the map: plan points, raster, features
+    (on two threads) and distance field; see :class:`PreparedTruth`."""
+    check_span(truth, TRUTH_CROP)
+    truth_xy, level = plan_points(truth, settings)
+    grid, occupied = truth_raster(truth, truth_xy, settings)
+    sides = SideBySide(settings.matching.detectors, settings.matching.params)
+    return PreparedTruth(truth, truth_xy, level, grid, occupied,
+                         sides.features(occupied, grid, threads=2),
+                         nearest_distance(occupied, grid))
+
+
+def map_side(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap,
+             truth_xy: np.ndarray, grid: MetricGrid, truth_occ: np.ndarray, settings: Settings,
+             sides: SideBySide, rule: str, progress: Progress = lambda step: None,
+             threads: int = 2) -> MapSide:
+    """Align ``source`` to the truth (plan points ``truth_xy``, metres), draw it on ``grid``,
+    measure the overlap with ``truth_occ`` and find its features with ``sides`` on
+    ``threads`` threads; a map that does not seem to show the truth's place is refused
+    (EvaluationError) unless ``--force``."""
+    progress("aligning")
+    source, registration = align_clouds_3d(source, truth, settings)
+    map_xy, map_level = plan_points(source, settings)
+    alignment = align_plan(source, map_xy, truth_xy, registration, settings)
+
+    progress("rasterising")
+    map_occ, footprint = map_raster(source, map_xy, alignment.transform, grid, settings, rule)
+    to_map = nearest_distance(map_occ, grid)
+    cover = overlap(truth_occ, to_map, footprint, alignment)
+    option = settings.alignment
+    if cover.confidence < option.min_confidence and not option.force:
+        raise EvaluationError(refusal(source, truth.path, alignment, cover, settings, map_xy,
+                                      truth_xy))
+    progress("drawing the walls' centre lines and detecting features")
+    return MapSide(source, registration, map_xy, map_level, alignment, map_occ, to_map, cover,
+                   sides.features(map_occ, grid, threads=threads))
+
+
 def score(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap, settings: Settings,
           progress: Progress = lambda step: None, memory_limit: int | None = None) -> Result:
     """Score a loaded map against a loaded truth: align, raster, detect, match; stop first
     (InputError) when that would need more than ``memory_limit`` bytes (None: the default).
     The truth's features do not depend on the map: they are found on a second thread while
     the map is aligned and drawn (see :class:`~pcmapq.features.SideBySide`)."""
-    map_path, truth_path, loaded = source.path, truth.path, source
     check_span(truth, TRUTH_CROP)
     check_span(source, MAP_CROP)
     rule = map_footprint_rule(source, settings)
     truth_xy, truth_level = plan_points(truth, settings)
     cell = truth_grid(truth, truth_xy, settings).resolution
     memory.guard(needed_memory(source, truth, truth_xy, settings), memory_limit,
-                 f"{map_path} against {truth_path}",
+                 f"{source.path} against {truth.path}",
                  lambda: hint(truth, TRUTH_CROP, cell) or hint(source, MAP_CROP))
     grid, truth_occ = truth_raster(truth, truth_xy, settings)
     sides = SideBySide(settings.matching.detectors, settings.matching.params)
     with ThreadPoolExecutor(1) as background:
         truth_side = background.submit(sides.features, truth_occ, grid)
         try:
-            progress("aligning")
-            source, registration = align_clouds_3d(source, truth, settings)
-            map_xy, map_level = plan_points(source, settings)
-            alignment = align_plan(source, map_xy, truth_xy, registration, settings)
-
-            progress("rasterising")
-            map_occ, footprint = map_raster(source, map_xy, alignment.transform, grid, settings,
-                                            rule)
-            to_map = nearest_distance(map_occ, grid)
-            cover = overlap(truth_occ, to_map, footprint, alignment)
-            option = settings.alignment
-            if cover.confidence < option.min_confidence and not option.force:
-                raise EvaluationError(refusal(source, truth_path, alignment, cover, settings,
-                                              map_xy, truth_xy))
-            progress("drawing the walls' centre lines and detecting features")
-            map_found = sides.features(map_occ, grid, threads=2)
-            truth_found = truth_side.result()
+            side = map_side(source, truth, truth_xy, grid, truth_occ, settings, sides, rule,
+                            progress)
+            prepared = PreparedTruth(truth, truth_xy, truth_level, grid, truth_occ,
+                                     truth_side.result())
         except BaseException:
             sides.cancel()
             raise
-    frames = Frames(alignment.transform, map_level, truth_level,
+    return assemble(source, side, prepared, settings, rule, progress)
+
+
+def score_prepared(source: OccupancyMap | PointMap, prepared: PreparedTruth,
+                   settings: Settings, progress: Progress = lambda step: None) -> Result:
+    """:func:`score` against a truth prepared once (:func:`prepare_truth`) with the same
+    ``settings``: the same result, without the truth's work."""
+    check_span(source, MAP_CROP)
+    rule = map_footprint_rule(source, settings)
+    sides = SideBySide(settings.matching.detectors, settings.matching.params)
+    side = map_side(source, prepared.source, prepared.xy, prepared.grid, prepared.occupied,
+                    settings, sides, rule, progress)
+    return assemble(source, side, prepared, settings, rule, progress)
+
+
+def assemble(loaded: OccupancyMap | PointMap, side: MapSide, prepared: PreparedTruth,
+             settings: Settings, rule: str, progress: Progress = lambda step: None) -> Result:
+    """The result of the map ``loaded`` (as given, before any 3D registration), aligned and
+    drawn as ``side``, against ``prepared``: matches inside the footprint, wall distances, the
+    optional no-reference and 3D figures."""
+    truth, grid, alignment = prepared.source, prepared.grid, side.alignment
+    registration, footprint = side.registration, side.cover.footprint
+    frames = Frames(alignment.transform, side.level, prepared.level,
                     None if registration is None else registration.transform)
     detectors = {}
     full, threshold = settings.footprint.full, settings.matching.threshold
-    for name in sides.names:
-        truth_f, map_f = truth_found[name], map_found[name]
+    for name in settings.matching.detectors:
+        truth_f, map_f = prepared.features[name], side.features[name]
         if not full:  # truth features the map never saw are not missing
             truth_f = truth_f.counted_where(inside(truth_f, footprint, grid))
         detectors[name] = DetectorResult(truth_f, map_f,
@@ -305,19 +386,20 @@ def score(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap, setti
     if settings.noref.enabled:
         progress("no-reference figures")
         scale = alignment.transform.scale if settings.alignment.scale else 1.0
+        corners = harris_corners(truth, prepared.features, settings)
         noref = {"map": input_figures(loaded, settings.noref, scale=scale),
-                 "truth": input_figures(truth, settings.noref,
-                                        corners=harris_corners(truth, truth_found, settings))}
+                 "truth": input_figures(truth, settings.noref, corners=corners)}
     cloud_distances = None
     if registration is not None:
         progress("distances in 3D")
-        cloud_distances = distances_3d(source.points, truth.points,
+        cloud_distances = distances_3d(side.source.points, truth.points,
                                        settings.raster.cloud_resolution, settings.distances.taus)
-    return Result(map_path=Path(map_path), map_kind=source.kind, truth_path=Path(truth_path),
-                  truth_kind=truth.kind, grid=grid, alignment=alignment, overlap=cover,
-                  distances=distances(truth_occ, map_occ, footprint, grid,
-                                      settings.distances.taus, to_map),
+    return Result(map_path=Path(loaded.path), map_kind=side.source.kind,
+                  truth_path=Path(truth.path), truth_kind=truth.kind, grid=grid,
+                  alignment=alignment, overlap=side.cover,
+                  distances=distances(prepared.occupied, side.occupied, footprint, grid,
+                                      settings.distances.taus, side.to_map, prepared.to_truth),
                   registration_3d=registration, distances_3d=cloud_distances,
                   threshold=threshold, full=full, detectors=detectors,
                   footprint_rule=rule, frames=frames, settings=settings.to_dict(),
-                  truth_occupied=truth_occ, map_occupied=map_occ, noref=noref)
+                  truth_occupied=prepared.occupied, map_occupied=side.occupied, noref=noref)

@@ -45,15 +45,17 @@ def nearest_distance(target: np.ndarray, grid: MetricGrid) -> np.ndarray:
 
 def distances(truth_occ: np.ndarray, map_occ: np.ndarray, footprint: np.ndarray,
               grid: MetricGrid, taus: tuple[float, ...] = DEFAULT_TAUS,
-              to_map: np.ndarray | None = None) -> Distances:
+              to_map: np.ndarray | None = None,
+              to_truth: np.ndarray | None = None) -> Distances:
     """Distance metrics between the occupied cells of the aligned map and of the truth.
 
     truth_occ, map_occ, footprint: (rows, cols) bool on ``grid``. Completeness and recall only
-    count the truth cells inside ``footprint`` (the area the map observed). to_map: the
-    map's :func:`nearest_distance` field, when the caller already has it.
+    count the truth cells inside ``footprint`` (the area the map observed). to_map, to_truth:
+    the map's and the truth's :func:`nearest_distance` fields, when the caller has them.
     """
     to_map = nearest_distance(map_occ, grid) if to_map is None else to_map
-    acc = nearest_distance(truth_occ, grid)[map_occ]
+    to_truth = nearest_distance(truth_occ, grid) if to_truth is None else to_truth
+    acc = to_truth[map_occ]
     comp = to_map[truth_occ & footprint]
     return _summary(acc, comp, taus)
 
