@@ -45,7 +45,8 @@ def map_footprint_rule(source: OccupancyMap | PointMap, settings: Settings) -> s
     image = isinstance(source, OccupancyMap)
     try:
         return footprint_rule(settings.footprint.rule, source.state == UNKNOWN if image else None,
-                              source.grid.resolution if image else 0.0)
+                              source.grid.resolution if image else 0.0,
+                              views=not image and source.views is not None)
     except ValueError as err:
         raise InputError(f"{source.path}: {err}") from None
 
@@ -58,6 +59,7 @@ def map_raster(source: OccupancyMap | PointMap, map_xy: np.ndarray, transform: S
     :mod:`pcmapq.raster.footprint`), both bool."""
     image = isinstance(source, OccupancyMap)
     rule = map_footprint_rule(source, settings) if rule is None else rule
+    views = None
     if image:
         state = warp_state(source.state, source.grid, transform, grid)
         occupied, known = state == OCCUPIED, state != UNKNOWN
@@ -68,10 +70,12 @@ def map_raster(source: OccupancyMap | PointMap, map_xy: np.ndarray, transform: S
     else:
         occupied = points_to_grid(transform.apply(map_xy), grid, min_hits(source, settings))
         known = None
+        if source.views is not None:
+            views = transform.apply(source.views.reshape(-1, 2)).reshape(source.views.shape)
         (x0, y0), (x1, y1) = map_xy.min(axis=0), map_xy.max(axis=0)
         corners = np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]])
     footprint = map_footprint(rule, occupied, grid, settings.footprint.margin, known=known,
-                              rectangle=transform.apply(corners))
+                              rectangle=transform.apply(corners), views=views)
     return occupied, footprint
 
 

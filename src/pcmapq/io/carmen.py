@@ -24,6 +24,7 @@ from __future__ import annotations
 import gzip
 import warnings
 import zlib
+from dataclasses import dataclass
 from pathlib import Path
 from typing import NoReturn
 
@@ -75,14 +76,32 @@ def load_carmen(path: str | Path, max_range: float = DEFAULT_MAX_RANGE) -> Point
     return PointMap(path, points, is_3d=False, kind="carmen")
 
 
-def read_flaser(path: str | Path) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The scans of a CARMEN log's ``FLASER`` lines, in log order.
+@dataclass(frozen=True)
+class LaserScans:
+    """The scans of a CARMEN log's ``FLASER`` lines, in log order: ``poses`` (K, 3) laser pose
+    x, y (metres) and theta (radians) in the world frame; ``ranges`` (K, B) metres and
+    ``angles`` (K, B) radians in the laser frame, B the largest beam count, NaN where there is
+    no reading (see :func:`read_flaser`); ``stamps`` (K,) the lines' timestamps, seconds."""
 
-    Returns ``poses`` (K, 3): laser pose x, y (metres) and theta (radians) in the world frame;
-    ``ranges`` (K, B) metres and ``angles`` (K, B) radians in the laser frame, B the largest
-    beam count. A reading with no return (the log's "no return" code, a non-positive or
-    non-finite range) and the padding of a scan with fewer than B beams are NaN in ``ranges``.
+    poses: np.ndarray
+    ranges: np.ndarray
+    angles: np.ndarray
+    stamps: np.ndarray
+
+
+def read_flaser(path: str | Path) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The poses, ranges and angles of :func:`read_laser_scans`.
+
+    A reading with no return (the log's "no return" code, a non-positive or non-finite range)
+    and the padding of a scan with fewer than B beams are NaN in ``ranges``.
     """
+    scans = read_laser_scans(path)
+    return scans.poses, scans.ranges, scans.angles
+
+
+def read_laser_scans(path: str | Path) -> LaserScans:
+    """Every ``FLASER`` scan of a log with its pose and timestamp (:class:`LaserScans`);
+    InputError (one line naming the file, and the line) on a bad log."""
     path = Path(path)
     numbers, lines = flaser_lines(path)
     counts = _beam_counts(path, numbers, lines)
@@ -94,12 +113,14 @@ def read_flaser(path: str | Path) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
               for n, which in groups.items()}
     width = int(counts.max())
     poses = np.empty((len(lines), 3), dtype=np.float64)
+    stamps = np.empty(len(lines), dtype=np.float64)
     ranges = np.full((len(lines), width), np.nan)
     angles = np.full((len(lines), width), np.nan)
     for n, which in groups.items():
         table = tables[n]
         ranges[which, :n] = table[:, 1:n + 1]
         poses[which] = table[:, n + 1:n + 4]
+        stamps[which] = table[:, n + 7]
         angles[which, :n] = beam_angles(n)
     if not np.isfinite(poses).all():
         raise InputError(f"{path}: a FLASER pose is not a finite number")
@@ -108,7 +129,7 @@ def read_flaser(path: str | Path) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         code = no_return_range(ranges)
         if code is not None:
             ranges[ranges >= code * (1.0 - NO_RETURN_TOLERANCE)] = np.nan
-    return poses, ranges, angles
+    return LaserScans(poses, ranges, angles, stamps)
 
 
 def endpoints(poses: np.ndarray, ranges: np.ndarray, angles: np.ndarray,

@@ -46,12 +46,16 @@ class PointMap:
         (see the module's docstring) a read-only (N, 3) float32 or float64 array mapped onto the
         file: read it in chunks (``pcmapq.io.ply.CHUNK`` rows), never convert it whole.
     is_3d: False when z is constant (a 2D cloud).
+    views: for a map made of scans with known poses, each scan's outline of the free space it
+        saw, (K, V, 2) metres in the map's x, y (see
+        :func:`pcmapq.raster.footprint.view_outlines`); None otherwise.
     """
 
     path: Path
     points: np.ndarray
     is_3d: bool
     kind: str = "cloud"
+    views: np.ndarray | None = None
 
 
 def load_cloud(path: Path, memory_limit: int | None = None) -> PointMap:

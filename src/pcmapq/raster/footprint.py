@@ -8,8 +8,13 @@ Rules (``--footprint``, documented in docs/method.md):
   room whose walls were seen is observed, open ground beyond the outermost walls is not. A
   point cloud's rule, and a binary image's (black walls on white: no unknown value, so no
   evidence of what was not observed);
+- ``seen``: a map made of scans with known poses (``pcmapq track``'s maps) observed the free
+  space its scans swept: the union of their views, each the outline from the scanner through
+  its readings in angular order (a beam with no return cuts the view back to the scanner), so
+  a room the robot looked into is observed and one behind a wall it never passed is not;
 - ``all``: the map's whole rectangle (an image's extent, a cloud's bounding box, in its frame);
-- ``auto`` (default): ``known`` for an image with unknown regions, ``walls`` otherwise. An
+- ``auto`` (default): ``known`` for an image with unknown regions, ``seen`` for a map with
+  views, ``walls`` otherwise. An
   unknown region is what remains of the unknown cells after an opening by a disc of
   ``UNKNOWN_WIDTH`` metres (so anti-aliased wall edges, a thin grey border, stray pixels do not
   count); an image has them when they make up at least ``UNKNOWN_SHARE`` of it.
@@ -25,10 +30,10 @@ from scipy import ndimage
 
 from pcmapq.grid import MetricGrid
 from pcmapq.morphology import disc, distance_to
-from pcmapq.raster.draw import polygon_cells
+from pcmapq.raster.draw import polygon_cells, view_cells
 
 #: The footprint rules, ``auto`` first (the default).
-FOOTPRINT_RULES = ("auto", "known", "walls", "all")
+FOOTPRINT_RULES = ("auto", "known", "walls", "seen", "all")
 #: Unknown cells count as an unknown region when they are part of a patch at least this wide,
 #: metres: an opening by a disc of this diameter.
 UNKNOWN_WIDTH = 0.5
@@ -82,17 +87,22 @@ def unknown_regions(unknown: np.ndarray, resolution: float,
     return (opened & padded)[pad:-pad, pad:-pad]
 
 
-def footprint_rule(requested: str, unknown: np.ndarray | None, resolution: float) -> str:
+def footprint_rule(requested: str, unknown: np.ndarray | None, resolution: float,
+                   views: bool = False) -> str:
     """The rule a map's footprint follows: ``requested`` (one of FOOTPRINT_RULES), with
     ``auto`` resolved. ``unknown``: the image's unknown cells (None for a point cloud);
-    ``resolution``: the image's metres per cell. Raises ValueError for ``known`` on a cloud."""
+    ``resolution``: the image's metres per cell; ``views``: the cloud has its scans' views.
+    Raises ValueError for ``known`` on a cloud, ``seen`` without views."""
     if requested not in FOOTPRINT_RULES:
         raise ValueError(f"unknown footprint rule {requested!r}; choose from "
                          f"{', '.join(FOOTPRINT_RULES)}")
+    if requested == "seen" and not views:
+        raise ValueError("footprint 'seen' needs the scans' poses (a map that 'pcmapq track' "
+                         "builds): 'walls' or 'all'")
     if unknown is None:
         if requested == "known":
             raise ValueError("a point cloud has no known cells: footprint 'walls' or 'all'")
-        return "walls" if requested == "auto" else requested
+        return ("seen" if views else "walls") if requested == "auto" else requested
     if requested != "auto":
         return requested
     if not unknown.any():
@@ -103,13 +113,17 @@ def footprint_rule(requested: str, unknown: np.ndarray | None, resolution: float
 
 def map_footprint(rule: str, occupied: np.ndarray, grid: MetricGrid, margin: float = 0.3,
                   known: np.ndarray | None = None,
-                  rectangle: np.ndarray | None = None) -> np.ndarray:
+                  rectangle: np.ndarray | None = None,
+                  views: np.ndarray | None = None) -> np.ndarray:
     """The map's footprint on the truth's grid (bool) under ``rule`` (resolved: ``known``,
-    ``walls`` or ``all``, see :func:`footprint_rule`): its known cells, the area its occupied
-    cells enclose, or its rectangle (``rectangle``: (4, 2) corners, truth frame, metres);
-    grown by ``margin`` metres."""
+    ``walls``, ``seen`` or ``all``, see :func:`footprint_rule`): its known cells, the area its
+    occupied cells enclose, its scans' views (``views``: (K, V, 2), truth frame, metres) or
+    its rectangle (``rectangle``: (4, 2) corners, truth frame, metres); grown by ``margin``
+    metres."""
     if rule == "known" and known is not None:
         area = known
+    elif rule == "seen" and views is not None:
+        area = view_cells(views, grid)
     elif rule == "all" and rectangle is not None:
         area = polygon_cells(rectangle, grid)
     elif rule == "walls":
@@ -118,3 +132,21 @@ def map_footprint(rule: str, occupied: np.ndarray, grid: MetricGrid, margin: flo
         raise ValueError(f"footprint rule {rule!r} needs what this map lacks")
     return grow(area | occupied, grid, margin)
 
+
+
+def view_outlines(origins: np.ndarray, points: np.ndarray, scan: np.ndarray,
+                  bins: int = 360) -> np.ndarray:
+    """The views of K scans, (K, bins, 2) metres: scan k's farthest reading in each of
+    ``bins`` equal angular sectors around its scanner at ``origins[k]`` (K, 2), in angular
+    order, or the scanner itself for a sector with no reading. ``points`` (N, 2) are the
+    readings in the same frame, ``scan`` (N,) the scan of each. A star-shaped polygon: the
+    free space the scan saw (:func:`pcmapq.raster.draw.view_cells` fills it)."""
+    origins = np.asarray(origins, dtype=np.float64).reshape(-1, 2)
+    offset = np.asarray(points, dtype=np.float64).reshape(-1, 2) - origins[scan]
+    angle = np.arctan2(offset[:, 1], offset[:, 0])
+    sector = np.minimum(((angle + np.pi) / (2 * np.pi) * bins).astype(np.int64), bins - 1)
+    reach = np.zeros((len(origins), bins))
+    np.maximum.at(reach, (scan, sector), np.hypot(offset[:, 0], offset[:, 1]))
+    centre = -np.pi + (np.arange(bins) + 0.5) * (2 * np.pi / bins)
+    return origins[:, None, :] + reach[..., None] * np.stack([np.cos(centre),
+                                                               np.sin(centre)], axis=-1)

@@ -38,7 +38,7 @@ h3 { font-size: 1em; margin: 0.8em 0 0.3em; }
 
 #: How each footprint rule reads in the report.
 FOOTPRINT_WORDS = {"known": "known cells", "walls": "enclosed by its walls",
-                   "all": "its whole rectangle"}
+                   "seen": "seen by its scans", "all": "its whole rectangle"}
 
 
 def _img(png: bytes, alt: str) -> str:

@@ -1,0 +1,153 @@
+"""A SLAM run as ``pcmapq track`` reads it: the scans, one estimated pose each, and the map of
+the first k scans, grown scan by scan.
+
+- a CARMEN log (:class:`LaserRun`): its laser endpoints at its ``FLASER`` poses, or at the
+  poses of a file given instead; a map of the first k scans is a prefix of the endpoints.
+- a scan sequence (:class:`ScanRun`): a folder of scans, a ROS bag or an MCAP file, placed at
+  given poses or at KISS-ICP's; the map grows in a voxel map (centroids of 0.1 m cells, as
+  ``pcmapq map``), one scan at a time.
+
+Each map carries its scans' views (:func:`~pcmapq.raster.footprint.view_outlines`, in the
+poses' x, y: a 3D map's levelling is not applied to them), so it is scored inside the area its
+scans saw (footprint rule ``seen``).
+
+Poses are (K, 4, 4) in the map's world frame, ``p_world = pose_k @ p_scanner``; metres.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterator, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from pcmapq.errors import InputError
+from pcmapq.io import PointMap
+from pcmapq.io.carmen import DEFAULT_MAX_RANGE, LaserScans, endpoints, is_carmen, read_laser_scans
+from pcmapq.mapping import ScanSequence, VoxelMap, build_map_kiss, open_scans, read_poses
+from pcmapq.mapping.reference import scans_for_poses
+from pcmapq.raster.footprint import view_outlines
+
+#: Cell of the voxel map a scan sequence grows into, metres (``pcmapq map``'s default).
+SCAN_VOXEL = 0.1
+#: Scanner readings kept, metres from the scanner (KISS-ICP's defaults).
+MIN_RANGE, MAX_RANGE = 0.0, 100.0
+
+
+def planar_poses(xyt: np.ndarray) -> np.ndarray:
+    """(K, 4, 4) poses of planar poses (K, 3): x, y metres, theta radians."""
+    xyt = np.asarray(xyt, dtype=np.float64).reshape(-1, 3)
+    c, s = np.cos(xyt[:, 2]), np.sin(xyt[:, 2])
+    poses = np.tile(np.eye(4), (len(xyt), 1, 1))
+    poses[:, 0, 0], poses[:, 0, 1], poses[:, 1, 0], poses[:, 1, 1] = c, -s, s, c
+    poses[:, :2, 3] = xyt[:, :2]
+    return poses
+
+
+def planar_of(poses: np.ndarray) -> np.ndarray:
+    """(K, 3) x, y (metres) and yaw (radians) of poses (K, 4, 4)."""
+    return np.column_stack([poses[:, 0, 3], poses[:, 1, 3],
+                            np.arctan2(poses[:, 1, 0], poses[:, 0, 0])])
+
+
+@dataclass(frozen=True)
+class LaserRun:
+    """A CARMEN log's scans at ``poses`` (K, 4, 4; the log's own or a file's), readings up to
+    ``max_range`` metres; ``stamps`` (K,) seconds."""
+
+    path: Path
+    scans: LaserScans
+    poses: np.ndarray
+    stamps: np.ndarray | None
+    max_range: float = DEFAULT_MAX_RANGE
+
+    def __len__(self) -> int:
+        return len(self.poses)
+
+    def maps(self, ends: Sequence[int],
+             tick: Callable[[int], None] = lambda done: None) -> Iterator[PointMap]:
+        """The 2D map of the first ``end`` scans for each of ``ends`` (increasing): every
+        endpoint is computed once, and each map is a prefix of them."""
+        xy = endpoints(planar_of(self.poses), self.scans.ranges, self.scans.angles,
+                       self.max_range)
+        with np.errstate(invalid="ignore"):
+            kept = (self.scans.ranges > 0) & (self.scans.ranges <= self.max_range) & \
+                np.isfinite(self.scans.angles)
+        counts = np.count_nonzero(kept, axis=1)
+        offsets = np.concatenate([[0], np.cumsum(counts)])
+        views = view_outlines(self.poses[:, :2, 3], xy, np.repeat(np.arange(len(self)), counts))
+        points = np.column_stack([xy, np.zeros(len(xy))])
+        for end in ends:
+            tick(int(end))
+            yield PointMap(self.path, points[:offsets[end]], is_3d=False, kind="carmen",
+                           views=views[:end])
+
+
+@dataclass(frozen=True)
+class ScanRun:
+    """A scan sequence at ``poses`` (K, 4, 4), grown into a voxel map of ``voxel`` metres."""
+
+    path: Path
+    sequence: ScanSequence
+    poses: np.ndarray
+    stamps: np.ndarray | None = None
+    voxel: float = SCAN_VOXEL
+
+    def __len__(self) -> int:
+        return len(self.poses)
+
+    def maps(self, ends: Sequence[int],
+             tick: Callable[[int], None] = lambda done: None) -> Iterator[PointMap]:
+        """The 3D map of the first ``end`` scans for each of ``ends`` (increasing): each scan
+        is placed and added to the voxel map once."""
+        grid, wanted, views = VoxelMap(self.voxel), list(ends), []
+        for index, (points, _) in enumerate(self.sequence):
+            ranges = np.linalg.norm(points, axis=1)
+            points = points[(ranges >= MIN_RANGE) & (ranges <= MAX_RANGE)]
+            pose = self.poses[index]
+            placed = points @ pose[:3, :3].T + pose[:3, 3]
+            grid.add(placed)
+            views.append(view_outlines(pose[None, :2, 3], placed[:, :2],
+                                       np.zeros(len(placed), dtype=np.int64))[0])
+            tick(index + 1)
+            if wanted and index + 1 == wanted[0]:
+                wanted.pop(0)
+                yield PointMap(self.path, grid.points(), is_3d=True, kind="scans",
+                               views=np.stack(views))
+            if not wanted:
+                return
+
+
+Run = LaserRun | ScanRun
+
+
+def open_run(source: Path, poses: Path | None = None, *,
+             progress: Callable[[int, int], None] | None = None) -> Run:
+    """The run at ``source`` (a CARMEN log, or scans) with the poses of ``poses`` (a KITTI or
+    TUM file, one pose per scan), else the log's own, else KISS-ICP's (``progress(done,
+    total)`` while it runs). InputError, one line, when the counts differ."""
+    estimate = None if poses is None else read_poses(poses)
+    if is_carmen(source):
+        scans = read_laser_scans(source)
+        if estimate is None:
+            estimate = planar_poses(scans.poses)
+        elif len(estimate) != len(scans.poses):
+            raise InputError(f"{poses}: {len(estimate)} poses for the {len(scans.poses)} "
+                             f"scans of {source} (one pose per scan)")
+        return LaserRun(source, scans, estimate, scans.stamps)
+    sequence = open_scans(source)
+    if estimate is None:
+        _, estimate = build_map_kiss(source, progress=progress)
+    sequence = scans_for_poses(sequence, len(estimate), poses_path=poses)
+    return ScanRun(source, sequence, estimate)
+
+
+def reference_poses_of(path: Path, count: int) -> np.ndarray:
+    """Reference poses (count, 4, 4) from a KITTI or TUM file, or a CARMEN log's FLASER poses;
+    InputError, one line, when there are not ``count`` of them (one per scan)."""
+    poses = planar_poses(read_laser_scans(path).poses) if is_carmen(path) else read_poses(path)
+    if len(poses) != count:
+        raise InputError(f"{path}: {len(poses)} reference poses for {count} scans (one per "
+                         "scan)")
+    return poses

@@ -1,0 +1,196 @@
+"""Score a run's map as it grows: one evaluation per step against a truth prepared once.
+
+Each step scores the map of the scans so far inside its footprint (the partial-map rules), with
+the settings of ``pcmapq eval``. The first step searches for the map's pose in the truth (or
+starts from ``--init``); every later one starts ICP from the pose the step before found, and
+searches again only when that pose no longer fits (a confidence below the minimum). A step the
+method cannot score (too few walls yet, a place it does not recognise) is kept, with no
+figures and the reason.
+
+Besides the figures of ``pcmapq eval`` a step holds ``slide_m``: how far the alignment moved
+the positions of the first scored step's scans since that step, RMS metres; a map that drifts
+drags the alignment of the whole map along, and the first part slides away from where it fitted.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from pcmapq.config import Settings
+from pcmapq.errors import EvaluationError, InputError
+from pcmapq.frames import Frames
+from pcmapq.pipeline import PreparedTruth, score_prepared
+from pcmapq.report.summary import summary_row
+from pcmapq.result import Result
+from pcmapq.track.runs import Run
+from pcmapq.track.steps import travelled
+from pcmapq.trajectory import ape, rpe
+from pcmapq.transform import Similarity2D
+
+#: The summary columns a step does not repeat (they name the inputs or a batch's outcome).
+NOT_PER_STEP = ("name", "map", "truth", "gates", "exit_code", "error")
+#: A fall smaller than this is no drop (the band a good run's curves stay within).
+MIN_DROP = 0.05
+#: Positions of the first scored step that measure the slide (an even sample of them).
+SLIDE_POINTS = 2000
+
+
+@dataclass(frozen=True)
+class PoseOptions:
+    """How the trajectory errors compare the estimate with the reference, as evo's options:
+    ``align`` (-a, SE(3) Umeyama), ``correct_scale`` (-s), RPE's ``delta`` in frames."""
+
+    align: bool = False
+    correct_scale: bool = False
+    delta: int = 1
+
+
+@dataclass(frozen=True)
+class Step:
+    """One step: the map of the first ``scans`` scans; ``time_s`` since the first scan (None
+    without timestamps) and ``distance_m`` travelled at its last scan; ``figures`` the flat
+    columns of :func:`~pcmapq.report.summary.summary_row` plus ``slide_m`` and the trajectory
+    errors (None when undefined); ``note`` why a step was not scored ("" when it was);
+    ``start`` the pose its ICP started from (None: the global search)."""
+
+    step: int
+    scans: int
+    time_s: float | None
+    distance_m: float
+    figures: dict[str, float | None]
+    note: str = ""
+    start: Similarity2D | None = None
+
+    @property
+    def scored(self) -> bool:
+        return not self.note
+
+
+def plane_points(xyz: np.ndarray, frames: Frames) -> np.ndarray:
+    """Map-frame points (N, 3) in the truth's plan, (N, 2) metres: levelled, then aligned."""
+    if frames.map_levelling is not None:
+        xyz = xyz @ frames.map_levelling.rotation.T
+    return frames.map_to_truth().apply(xyz[:, :2])
+
+
+def pose_errors(estimate: np.ndarray, reference: np.ndarray,
+                options: PoseOptions) -> dict[str, float | None]:
+    """APE (translation, metres) and RPE (translation, metres; rotation, degrees) RMSE of
+    the estimate (K, 4, 4) against the reference, as evo_ape and evo_rpe compute them."""
+    kw = {"align": options.align, "correct_scale": options.correct_scale}
+    if len(estimate) < 3 and options.align:
+        kw = {"align": False, "correct_scale": False}  # Umeyama needs three poses
+    return {"ape_rmse_m": ape(estimate, reference, **kw).stats.rmse,
+            "ape_max_m": ape(estimate, reference, **kw).stats.max,
+            "rpe_rmse_m": rpe(estimate, reference, options.delta, **kw).stats.rmse,
+            "rpe_rot_rmse_deg": rpe(estimate, reference, options.delta,
+                                    relation="rotation_angle_deg", **kw).stats.rmse}
+
+
+def figures_of(result: Result) -> dict[str, float | None]:
+    """A result's flat figures: :func:`summary_row` without the inputs and outcome, the
+    detectors' mean precision (``precision``: is what the map shows right? the figure whose
+    fall dates a fault) and the wall precision at each tau (``wall_precision@0.1m``: share of
+    the map's wall cells within tau of a truth wall)."""
+    row = summary_row("", result.to_dict())
+    figures = {k: v for k, v in row.items() if k not in NOT_PER_STEP}
+    precisions = [d.matching.precision for d in result.detectors.values()
+                  if d.matching.precision is not None]
+    figures["precision"] = float(np.mean(precisions)) if precisions else None
+    for f in result.distances.fscores:
+        figures[f"wall_precision@{f.tau_m:g}m"] = f.precision
+    return figures
+
+
+def score_step(source, prepared: PreparedTruth, settings: Settings,
+               start: Similarity2D | None) -> tuple[Result, Similarity2D | None]:
+    """Score one step's map, ICP from ``start`` (None: the global search); a start whose
+    result is refused is followed by a global search. The result and the start it used."""
+    option = settings.alignment
+    if start is None or not option.enabled:
+        return score_prepared(source, prepared, settings), option.init
+    try:
+        return score_prepared(source, prepared,
+                              replace(settings, alignment=replace(option, init=start))), start
+    except EvaluationError:
+        if option.force:
+            raise
+        return score_prepared(source, prepared, settings), None
+
+
+def track(run: Run, prepared: PreparedTruth, settings: Settings, ends: np.ndarray,
+          reference: np.ndarray | None = None, pose_options: PoseOptions = PoseOptions(),
+          tick: Callable[[int], None] = lambda done: None) -> list[Step]:
+    """Score the map of ``run`` after each of ``ends`` scans against ``prepared``.
+
+    reference: (K, 4, 4) reference poses, one per scan, for the trajectory errors of each
+    step. tick: ``tick(scans done)``."""
+    distance = travelled(run.poses)
+    stamps = run.stamps
+    steps: list[Step] = []
+    start, first = settings.alignment.init, None
+    for index, (end, source) in enumerate(zip(ends, run.maps(ends, tick), strict=True)):
+        end = int(end)
+        time_s = None if stamps is None else float(stamps[end - 1] - stamps[0])
+        extra = {} if reference is None else pose_errors(run.poses[:end], reference[:end],
+                                                         pose_options)
+        try:
+            result, used = score_step(source, prepared, settings, start)
+        except (EvaluationError, InputError) as err:
+            steps.append(Step(index, end, time_s, float(distance[end - 1]),
+                              {"slide_m": None, **extra}, str(err), start))
+            continue
+        positions = run.poses[:end, :3, 3]
+        if first is None:
+            first = positions[np.linspace(0, end - 1, min(end, SLIDE_POINTS)).astype(int)]
+            origin = plane_points(first, result.frames)
+        moved = plane_points(first, result.frames) - origin
+        slide = float(np.sqrt(np.mean(np.sum(moved**2, axis=1))))
+        steps.append(Step(index, end, time_s, float(distance[end - 1]),
+                          {**figures_of(result), "slide_m": slide, **extra}, "", used))
+        if settings.alignment.enabled:
+            start = result.transform
+    return steps
+
+
+def result_at(run: Run, prepared: PreparedTruth, settings: Settings, step: Step) -> Result:
+    """The full result of a scored step, computed again as :func:`track` computed it (the
+    same map, the same start: the same result)."""
+    source = next(run.maps([step.scans]))
+    if step.start is None or not settings.alignment.enabled:
+        return score_prepared(source, prepared, settings)
+    return score_prepared(source, prepared, replace(settings, alignment=replace(
+        settings.alignment, init=step.start)))
+
+
+@dataclass(frozen=True)
+class Drop:
+    """The worst fall of a figure along the steps: it peaked at step ``peak``, fell from step
+    ``start`` (the first step after the peak: where the map started to go wrong) to its lowest
+    at step ``low``, by ``size`` (peak value minus lowest value)."""
+
+    figure: str
+    peak: int
+    start: int
+    low: int
+    size: float
+
+
+def worst_drop(steps: list[Step], figure: str = "precision") -> Drop | None:
+    """The largest fall of ``figure`` from its highest value so far (the maximum drawdown) over
+    the scored steps; None with fewer than two, or when it is less than :data:`MIN_DROP`."""
+    scored = [s for s in steps if s.scored and s.figures.get(figure) is not None]
+    if len(scored) < 2:
+        return None
+    values = np.array([s.figures[figure] for s in scored])
+    peaks = np.maximum.accumulate(values)
+    low = int(np.argmax(peaks - values))
+    if peaks[low] - values[low] < MIN_DROP:
+        return None
+    peak = int(np.flatnonzero(values[:low + 1] == peaks[low])[-1])
+    start = min(peak + 1, low)
+    return Drop(figure, scored[peak].step, scored[start].step, scored[low].step,
+                float(peaks[low] - values[low]))
