@@ -21,6 +21,7 @@ from . import (
     lidar,
     noref,
     same_place,
+    track,
 )
 from .common import ROOT, Case, Section
 
@@ -30,7 +31,7 @@ COMMAND = "python -m bench.validation --write"
 SECTIONS: dict[str, ModuleType] = {
     "drawings": drawings, "fr79": fr79, "lidar": lidar, "kitti": kitti, "gazebo": gazebo,
     "halmstad": halmstad, "floorplans": floorplans, "carmen": carmen, "noref": noref,
-    "same_place": same_place,
+    "same_place": same_place, "track": track,
 }
 
 

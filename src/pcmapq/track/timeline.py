@@ -32,8 +32,9 @@ from pcmapq.transform import Similarity2D
 
 #: The summary columns a step does not repeat (they name the inputs or a batch's outcome).
 NOT_PER_STEP = ("name", "map", "truth", "gates", "exit_code", "error")
-#: A fall smaller than this is no drop (the band a good run's curves stay within).
-MIN_DROP = 0.05
+#: A fall smaller than this is no drop (the band a good run's curves stay within); a value
+#: within NOISE of the peak is still level with it.
+MIN_DROP, NOISE = 0.05, 0.025
 #: Positions of the first scored step that measure the slide (an even sample of them).
 SLIDE_POINTS = 2000
 
@@ -168,9 +169,9 @@ def result_at(run: Run, prepared: PreparedTruth, settings: Settings, step: Step)
 
 @dataclass(frozen=True)
 class Drop:
-    """The worst fall of a figure along the steps: it peaked at step ``peak``, fell from step
-    ``start`` (the first step after the peak: where the map started to go wrong) to its lowest
-    at step ``low``, by ``size`` (peak value minus lowest value)."""
+    """The worst fall of a figure along the steps: it peaked at step ``peak``, started to fall
+    at step ``start`` (the step after the last one still within :data:`NOISE` of the peak:
+    where the map went wrong) and was lowest at step ``low``, ``size`` below the peak."""
 
     figure: str
     peak: int
@@ -191,6 +192,7 @@ def worst_drop(steps: list[Step], figure: str = "precision") -> Drop | None:
     if peaks[low] - values[low] < MIN_DROP:
         return None
     peak = int(np.flatnonzero(values[:low + 1] == peaks[low])[-1])
-    start = min(peak + 1, low)
+    level = np.flatnonzero(values[peak:low + 1] >= peaks[low] - NOISE)
+    start = peak + int(level[-1]) + 1
     return Drop(figure, scored[peak].step, scored[start].step, scored[low].step,
                 float(peaks[low] - values[low]))
