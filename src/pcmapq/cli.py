@@ -701,14 +701,18 @@ def track_command(
             with OutputSet() as outputs:
                 write_atomic(Path(json_path), wrote[1].read_text(), outputs)
                 outputs.commit()
+    scored = sum(s.scored for s in tracked.steps)
     if json_path == "-":
         sys.stdout.write(wrote[1].read_text())
     elif not quiet:
         drop = tracked.drop
-        scored = sum(s.scored for s in tracked.steps)
         err.print(f"{len(tracked.steps)} steps ({scored} scored) of {len(run)} scans; "
                   + ("no drop" if drop is None else
                      f"worst drop of {drop.figure}: {drop.size:.3f} from step {drop.start} "
                      f"({tracked.steps[drop.start].distance_m:.0f} m travelled)")
                   + f"; wrote {out}/track.csv, track.json, track.png, track.html",
                   markup=False, highlight=False, soft_wrap=True)
+    if not scored:  # nothing to measure: said as such, and not a success
+        err.print(f"pcmapq: error: {run_path}: no step could be scored; the last: "
+                  f"{tracked.steps[-1].note}", markup=False, highlight=False, soft_wrap=True)
+        raise typer.Exit(1)

@@ -51,6 +51,11 @@ def timeline_figure(rows: list[dict], drop: dict | None) -> Figure:
     panels = [(title, [c for c in cols if any(r.get(c) is not None for r in rows)])
               for title, cols in FAMILIES]
     panels = [(t, cols) for t, cols in panels if cols]
+    if not panels:
+        fig = Figure(figsize=(WIDTH_IN, 1.5))
+        fig.text(0.5, 0.5, f"no step could be scored ({len(rows)} steps)", ha="center",
+                 va="center")
+        return fig
     fig = Figure(figsize=(WIDTH_IN, 2.0 * len(panels) + 0.6), layout="constrained")
     axes = fig.subplots(len(panels), 1, sharex=True, squeeze=False)[:, 0]
     for ax, (title, cols) in zip(axes, panels, strict=True):
