@@ -15,7 +15,7 @@ import pytest
 from typer.testing import CliRunner
 
 import pcmapq
-from pcmapq import cli
+from pcmapq import cli, terminal
 from pcmapq.plan import MAX_OCCUPIED_SHARE
 
 from .conftest import shared
@@ -96,7 +96,7 @@ def _foreign_lines(args: list[str], capfd: pytest.CaptureFixture[str],
             yield
         caught.extend(log)
 
-    monkeypatch.setattr(cli, "show_warnings", recorded)
+    monkeypatch.setattr(terminal, "show_warnings", recorded)
     capfd.readouterr()
     got = CliRunner().invoke(cli.app, args)
     outside = capfd.readouterr()

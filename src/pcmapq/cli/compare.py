@@ -1,0 +1,51 @@
+"""``pcmapq compare``: saved results side by side."""
+
+from __future__ import annotations
+
+import warnings
+from pathlib import Path
+from typing import Annotated
+
+import typer
+from rich.console import Console
+
+from pcmapq import terminal
+from pcmapq.cli.app import app
+from pcmapq.terminal import (
+    report_errors,
+)
+
+
+@app.command("compare")
+def compare_command(
+    results: Annotated[list[Path], typer.Argument(
+        metavar="RESULTS...", help="Saved results: JSON files of 'pcmapq eval --json' (or of "
+        "a batch), one row each.")],
+    out: Annotated[Path, typer.Option(
+        help="Folder to write table.csv, table.md and figure.png into (made if missing).")],
+    names: Annotated[str | None, typer.Option(
+        help="Comma-separated row names, one per result (default: each file's stem).")
+    ] = None,
+    allow_different_truths: Annotated[bool, typer.Option(
+        "--allow-different-truths", help="Compare results scored against different truths "
+        "(a warning instead of exit 2).")] = False,
+    quiet: Annotated[bool, typer.Option(
+        "--quiet", "-q", help="Print nothing but warnings and errors.")] = False,
+) -> None:
+    """Compare saved results side by side (like evo_res): a table and a figure of the
+    qualities, precisions, f1, coverage, alignment and wall distances (metres, degrees)."""
+    from pcmapq.compare import check_same_truth, read_results
+    from pcmapq.report.summary import print_summary, write_summary
+
+    err = Console(stderr=True)
+    with report_errors(err), terminal.show_warnings(err):
+        saved = read_results(results, None if names is None else names.split(","))
+        if (line := check_same_truth(saved, allow_different_truths)) is not None:
+            warnings.warn(line, stacklevel=1)
+        rows = [s.row for s in saved]
+        wrote = write_summary(rows, out)
+    if not quiet:
+        for path in wrote:
+            err.print(f"wrote {path}", markup=False, highlight=False, soft_wrap=True)
+        print_summary(rows, Console())
+

@@ -1,0 +1,109 @@
+"""``pcmapq inspect``: no-reference figures of one map."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+from typing import Annotated
+
+import numpy as np
+import typer
+from rich.console import Console
+
+from pcmapq import options, terminal
+from pcmapq.cli.app import app
+from pcmapq.config import (
+    NoRefConfig,
+)
+from pcmapq.inspect_map import inspect_map, summary_lines, to_json
+from pcmapq.io import PointMap, load_map
+from pcmapq.io.writers import OutputSet, write_atomic
+from pcmapq.mapping import (
+    posed_map,
+    read_pose_matrix,
+    read_poses,
+)
+from pcmapq.metrics.noref import DEPTH_RADIUS, LIDAR_RADIUS, MAX_NN, MIN_KNN
+from pcmapq.metrics.posed import place_subset, read_orthogonal_subset
+from pcmapq.terminal import (
+    report_errors,
+)
+
+
+@app.command("inspect")
+def inspect_command(
+    ctx: typer.Context,
+    map_path: Annotated[Path | None, typer.Argument(
+        metavar="[MAP]", help="Map to inspect: cloud (.ply/.pcd/.xyz/.npy/.bin), CARMEN log, or "
+        "image (.png/.pgm with its ROS YAML, or the YAML). Or --scans with --poses.",
+        show_default=False)] = None,
+    scans: Annotated[Path | None, typer.Option(
+        help="Inspect these scans placed at --poses instead: a folder of .bin/.ply/.pcd/.npy "
+        "scans, a ROS bag or an MCAP file.")] = None,
+    poses: Annotated[Path | None, typer.Option(
+        help="With --scans: one pose per scan, a KITTI or TUM file or a folder of 4x4 text "
+        "files (name order); the map is in the first scan's frame.")] = None,
+    radius: Annotated[float, typer.Option(
+        help=f"Neighbourhood radius of MME, MPV and MOM, metres ({LIDAR_RADIUS:g} for LiDAR "
+        f"maps, {DEPTH_RADIUS:g} for depth cameras).", min=1e-6,
+        callback=options.finite)] = LIDAR_RADIUS,
+    min_knn: Annotated[int, typer.Option(
+        help="A point counts when it has more than this many neighbours.", min=0)] = MIN_KNN,
+    max_nn: Annotated[int, typer.Option(
+        help="Nearest neighbours of the normals that pick MOM's orthogonal planes.", min=3)
+    ] = MAX_NN,
+    voxel: Annotated[float, typer.Option(
+        help="First reduce a 3D cloud to one point (the centroid) per cell of this size, "
+        "metres; 0: as it is, as map-metrics ('pcmapq eval' uses 0.1).", min=0.0,
+        callback=options.finite)] = 0.0,
+    orth_subset: Annotated[Path | None, typer.Option(
+        help="MOM's orthogonal planes (a map-metrics .npy or .npz) in the map's frame, or in "
+        "the frame of the scan at --orth-pose; otherwise pcmapq extracts them.")] = None,
+    orth_pose: Annotated[Path | None, typer.Option(
+        help="With --orth-subset: the 4x4 pose of the scan whose frame the planes are in "
+        "(with --poses, placed relative to the first pose, as the map).")] = None,
+    map_resolution: Annotated[float | None, typer.Option(
+        help="Metres per pixel of an image without YAML.", min=1e-6, callback=options.finite)
+    ] = None,
+    json_path: Annotated[str | None, typer.Option(
+        "--json", help="Write the figures as JSON to this path ('-' for stdout only).")] = None,
+    quiet: Annotated[bool, typer.Option(
+        "--quiet", "-q", help="Print nothing but warnings and errors.")] = False,
+) -> None:
+    """How good is a map without a ground truth: MME, MPV and MOM of a 3D cloud, occupancy
+    figures of a 2D map (docs/metrics.md)."""
+    err = Console(stderr=True)
+    with report_errors(err), terminal.show_warnings(err):
+        if (map_path is None) == (scans is None) or (scans is None) != (poses is None):
+            raise typer.BadParameter("give MAP, or --scans DIR with --poses FILE",
+                                     param_hint="MAP")
+        if orth_pose is not None and orth_subset is None:
+            raise typer.BadParameter("--orth-pose places --orth-subset: give both",
+                                     param_hint="--orth-pose")
+        options.check_outputs({"--json": json_path}, None,
+                              inputs=(map_path, scans, poses, orth_subset, orth_pose))
+        first = np.eye(4)
+        if scans is not None and poses is not None:
+            trajectory = read_poses(poses)
+            first = trajectory[0]
+            source = PointMap(scans, posed_map(scans, trajectory), True, kind="scans")
+        else:
+            source = load_map(map_path, map_resolution)
+        planes = None if orth_subset is None else read_orthogonal_subset(orth_subset)
+        if planes is not None and orth_pose is not None:
+            planes = place_subset(planes, read_pose_matrix(orth_pose), first)
+        config = NoRefConfig(radius=radius, min_knn=min_knn, max_nn=max_nn, voxel=voxel)
+        record = inspect_map(source, config, planes, options.command_line(ctx))
+        if json_path not in (None, "-"):
+            with OutputSet() as outputs:
+                write_atomic(Path(json_path), to_json(record), outputs)
+                outputs.commit()
+    if json_path == "-":
+        sys.stdout.write(to_json(record))
+    elif not quiet:
+        for line in summary_lines(record):
+            print(line)
+        if json_path is not None:
+            err.print(f"wrote {json_path}", markup=False, highlight=False, soft_wrap=True)
+
+

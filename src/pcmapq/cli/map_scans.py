@@ -1,0 +1,103 @@
+"""``pcmapq map``: a map from LiDAR scans (KISS-ICP or given poses)."""
+
+from __future__ import annotations
+
+import warnings
+from pathlib import Path
+from typing import Annotated
+
+import typer
+from rich.console import Console
+
+from pcmapq import options, terminal
+from pcmapq.cli.app import app
+from pcmapq.errors import InputError
+from pcmapq.io.writers import OutputSet, write_cloud
+from pcmapq.mapping import (
+    build_map_from_poses,
+    build_map_kiss,
+    describe_scans,
+    lidar_poses_from_camera,
+    moves_along_z,
+    open_scans,
+    read_calib,
+    read_poses,
+    scans_for_poses,
+    write_kitti_poses,
+    write_tum_poses,
+)
+from pcmapq.terminal import (
+    report_errors,
+    scan_bar,
+)
+
+
+@app.command("map")
+def map_command(
+    source: Annotated[Path, typer.Argument(
+        help="Scan sequence: a folder of KITTI .bin / .ply / .pcd / .npy scans, a ROS bag or "
+        "an MCAP file.")],
+    out: Annotated[Path, typer.Option(help="The map, .ply or .pcd (voxel centroids).")],
+    poses_out: Annotated[Path | None, typer.Option(
+        help="Write the scan poses in KITTI format (12 numbers a line), as evo reads them.")
+    ] = None,
+    tum_out: Annotated[Path | None, typer.Option(
+        help="Write the scan poses in TUM format (t x y z qx qy qz qw; t = scan index).")
+    ] = None,
+    poses: Annotated[Path | None, typer.Option(
+        help="Build the map from these poses (KITTI or TUM file) instead of running KISS-ICP.")
+    ] = None,
+    calib: Annotated[Path | None, typer.Option(
+        help="With --poses: scanner -> pose-frame transform T (12 or 16 numbers, or a KITTI "
+        "calib.txt with Tr:); the map is then built in the first scanner's frame, "
+        "inv(T) P_k T.")] = None,
+    max_scans: Annotated[int | None, typer.Option(help="Use only the first N scans.", min=1)
+                         ] = None,
+    voxel: Annotated[float, typer.Option(help="Cell of the output map, metres.", min=1e-4,
+                                         callback=options.finite)] = 0.1,
+    quiet: Annotated[bool, typer.Option(
+        "--quiet", "-q", help="Print nothing but warnings and errors.")] = False,
+) -> None:
+    """Build a map from LiDAR scans with KISS-ICP (or with given poses) and save it."""
+    err = Console(stderr=True)
+    with report_errors(err), terminal.show_warnings(err):
+        if calib is not None and poses is None:
+            raise InputError(f"{calib}: --calib places scans with --poses only (KISS-ICP's "
+                             "map is in the first scanner's frame already)")
+        options.check_outputs({"--out": out, "--poses-out": poses_out, "--tum-out": tum_out},
+                              None, inputs=(source, poses, calib))
+        with scan_bar(err, enabled=not quiet) as tick:
+            if poses is None:
+                points, trajectory = build_map_kiss(source, max_scans=max_scans, voxel=voxel,
+                                                    progress=tick)
+            else:
+                trajectory = read_poses(poses)
+                if calib is not None:
+                    trajectory = lidar_poses_from_camera(trajectory, read_calib(calib))
+                elif moves_along_z(trajectory):
+                    warnings.warn(f"{poses}: these poses move along their z axis, as a camera's "
+                                  "do (KITTI's are the left camera's); without --calib (KITTI's "
+                                  "Tr) the scans are placed as if they were the scanner's, and "
+                                  "the map smears", stacklevel=1)
+                every = open_scans(source)
+                scans = scans_for_poses(every, len(trajectory), max_scans=max_scans,
+                                        poses_path=poses)
+                if max_scans is not None and not quiet:
+                    err.print(f"mapping {describe_scans(scans, len(every))}", markup=False,
+                              highlight=False, soft_wrap=True)
+                trajectory = trajectory[:len(scans)]
+                points = build_map_from_poses(scans, trajectory, voxel=voxel, progress=tick)
+        with OutputSet() as outputs:  # the map and its poses: all or none
+            write_cloud(out, points, outputs)
+            wrote = [f"wrote {out}: {len(points)} points from {len(trajectory)} scans"]
+            if poses_out is not None:
+                write_kitti_poses(poses_out, trajectory, outputs)
+                wrote.append(f"wrote {poses_out}: {len(trajectory)} poses (KITTI)")
+            if tum_out is not None:
+                write_tum_poses(tum_out, trajectory, outputs=outputs)
+                wrote.append(f"wrote {tum_out}: {len(trajectory)} poses (TUM)")
+            outputs.commit()
+    if not quiet:
+        for line in wrote:
+            err.print(line, markup=False, highlight=False, soft_wrap=True)
+

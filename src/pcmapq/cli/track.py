@@ -1,0 +1,132 @@
+"""``pcmapq track``: a run's map scored as it grows."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+from typing import Annotated
+
+import typer
+from rich.console import Console
+
+from pcmapq import options, terminal
+from pcmapq.cli.app import DEFAULTS, app
+from pcmapq.errors import InputError
+from pcmapq.io.writers import OutputSet, write_atomic
+from pcmapq.raster.footprint import FOOTPRINT_RULES
+from pcmapq.terminal import (
+    report_errors,
+    scan_bar,
+    step_progress,
+)
+
+
+@app.command("track")
+def track_command(
+    ctx: typer.Context,
+    paths: Annotated[list[Path], typer.Argument(
+        metavar="RUN TRUTH", help="The run: a CARMEN log (.log/.log.gz), or scans (a folder of "
+        ".bin/.ply/.pcd/.npy scans, a ROS bag, an MCAP file); then the ground truth, as "
+        "eval's.")],
+    out: Annotated[Path, typer.Option(
+        help="Folder of the results: track.csv, track.json, track.png, track.html.")],
+    poses: Annotated[Path | None, typer.Option(
+        help="The run's estimated poses, one per scan (KITTI or TUM file); default: a log's "
+        "own, KISS-ICP's for scans.")] = None,
+    reference_poses: Annotated[Path | None, typer.Option(
+        help="Reference poses, one per scan (KITTI or TUM file, or a CARMEN log's): adds the "
+        "trajectory's APE and RPE at every step, as evo computes them.")] = None,
+    every: Annotated[int | None, typer.Option(
+        help="Score the map every N scans (default 20).", min=1, show_default=False)] = None,
+    every_m: Annotated[float | None, typer.Option(
+        help="Score the map every D metres travelled instead.", min=1e-6,
+        callback=options.finite)] = None,
+    step: Annotated[int | None, typer.Option(
+        help="The step the report shows (default: where the worst drop starts).", min=0,
+        show_default=False)] = None,
+    align_poses: Annotated[bool, typer.Option(
+        "--align-poses", help="APE/RPE: align the poses first (SE(3) Umeyama, evo's -a).")
+    ] = False,
+    correct_scale: Annotated[bool, typer.Option(
+        "--correct-scale", help="APE/RPE: correct the scale too (evo's -s).")] = False,
+    delta: Annotated[int, typer.Option(help="RPE: pairs this many scans apart.", min=1)] = 1,
+    truth_resolution: Annotated[float | None, typer.Option(
+        help="As eval's.", min=1e-6, callback=options.finite)] = None,
+    init: Annotated[str | None, typer.Option(
+        help="Initial guess x,y,yaw (m, m, deg), map -> truth, of the first step; skips the "
+        "global search.")] = None,
+    no_align: Annotated[bool, typer.Option(
+        "--no-align", help="Trust the run's frame: no alignment at any step.")] = False,
+    force: Annotated[bool, typer.Option(
+        help="Score every step, even one that does not seem to show the truth's place.")
+    ] = False,
+    threshold: Annotated[float, typer.Option(
+        help="Largest distance between matched features, metres.", min=1e-6,
+        callback=options.finite)] = DEFAULTS.matching.threshold,
+    detectors: Annotated[str, typer.Option(
+        metavar="<" + ",".join(DEFAULTS.matching.detectors) + ">",
+        help="As eval's.")] = ",".join(DEFAULTS.matching.detectors),
+    footprint: Annotated[str, typer.Option(
+        metavar="<" + "|".join(FOOTPRINT_RULES) + ">",
+        help="As eval's; 'auto' is 'seen': the area the scans so far saw.")
+    ] = DEFAULTS.footprint.rule,
+    tau: Annotated[str, typer.Option(
+        help="Distance thresholds of the F-score and wall precision, metres.")
+    ] = ",".join(f"{t:g}" for t in DEFAULTS.distances.taus),
+    json_path: Annotated[str | None, typer.Option(
+        "--json", help="Also write track.json to this path ('-' for stdout only).")] = None,
+    quiet: Annotated[bool, typer.Option(
+        "--quiet", "-q", help="Print nothing but warnings and errors.")] = False,
+) -> None:
+    """Score a SLAM run's map as it grows, every N scans or D metres, against the truth:
+    when did the map go wrong, and where was the robot then?"""
+    from pcmapq.track import PoseOptions, step_ends, track_run, travelled, write_track
+    from pcmapq.track.runs import open_run, reference_poses_of
+
+    if len(paths) != 2:
+        raise typer.BadParameter("give RUN and TRUTH", param_hint="RUN TRUTH")
+    run_path, truth_path = paths
+    settings = options.eval_settings(dict(
+        truth_resolution=truth_resolution, init=init, no_align=no_align, force=force,
+        threshold=threshold, detectors=detectors, footprint=footprint, tau=tau))
+    err = Console(stderr=True)
+    shown = not quiet and json_path != "-"
+    with report_errors(err), terminal.show_warnings(err), \
+            step_progress(err, enabled=shown) as progress:
+        if every is not None and every_m is not None:
+            raise typer.BadParameter("give one of --every and --every-m", param_hint="--every")
+        if out.exists() and not out.is_dir():
+            raise InputError(f"{out}: --out: not a folder")
+        options.check_outputs({"--json": json_path}, None, inputs=paths)
+        with scan_bar(err, enabled=shown) as tick:
+            run = open_run(run_path, poses, progress=tick)
+        reference = (None if reference_poses is None
+                     else reference_poses_of(reference_poses, len(run)))
+        ends = step_ends(len(run), (every or 20) if every_m is None else None, every_m,
+                         travelled(run.poses))
+        tracked = track_run(run, truth_path, settings, ends, reference=reference,
+                            pose_options=PoseOptions(align_poses, correct_scale, delta),
+                            show=step, progress=progress,
+                            tick=lambda done: progress(f"scoring: {done} of {len(run)} scans"))
+        rule = {"every_scans": None if every_m is not None else (every or 20),
+                "every_m": every_m}
+        wrote = write_track(tracked, out, rule, options.command_line(ctx))
+        if json_path not in (None, "-"):
+            with OutputSet() as outputs:
+                write_atomic(Path(json_path), wrote[1].read_text(), outputs)
+                outputs.commit()
+    scored = sum(s.scored for s in tracked.steps)
+    if json_path == "-":
+        sys.stdout.write(wrote[1].read_text())
+    elif not quiet:
+        drop = tracked.drop
+        err.print(f"{len(tracked.steps)} steps ({scored} scored) of {len(run)} scans; "
+                  + ("no drop" if drop is None else
+                     f"worst drop of {drop.figure}: {drop.size:.3f} from step {drop.start} "
+                     f"({tracked.steps[drop.start].distance_m:.0f} m travelled)")
+                  + f"; wrote {out}/track.csv, track.json, track.png, track.html",
+                  markup=False, highlight=False, soft_wrap=True)
+    if not scored:  # nothing to measure: said as such, and not a success
+        err.print(f"pcmapq: error: {run_path}: no step could be scored; the last: "
+                  f"{tracked.steps[-1].note}", markup=False, highlight=False, soft_wrap=True)
+        raise typer.Exit(1)
