@@ -117,7 +117,9 @@ def check_structure(path: Path, xy: np.ndarray) -> None:
 
 def distinct_cells(xy: np.ndarray) -> int:
     """How many distinct cells of memory.WORKING_CELL (metres) the points ``xy`` (metres) fill."""
-    return len(np.unique(np.floor(np.asarray(xy[:, :2]) / memory.WORKING_CELL), axis=0))
+    cells = np.floor(np.asarray(xy[:, :2]) / memory.WORKING_CELL).astype(np.int64)
+    cells -= cells.min(axis=0)  # one int64 per cell: a 1D unique, not a row-wise one
+    return len(np.unique(cells[:, 0] * (int(cells[:, 1].max()) + 1) + cells[:, 1]))
 
 
 def min_hits(cloud: PointMap, settings: Settings) -> int:

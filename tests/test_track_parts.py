@@ -1,0 +1,123 @@
+"""The pieces of ``pcmapq track`` with known answers: the scans' views and the ``seen``
+footprint, when steps fall, the worst drop."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from pcmapq import memory
+from pcmapq.grid import MetricGrid
+from pcmapq.plan import distinct_cells
+from pcmapq.raster.draw import view_cells
+from pcmapq.raster.footprint import footprint_rule, map_footprint, view_outlines
+from pcmapq.track.steps import step_ends, travelled
+from pcmapq.track.timeline import MIN_DROP, Step, worst_drop
+
+pytestmark = pytest.mark.unit
+
+GRID = MetricGrid(0.05, (0.0, 0.0, 0.0), (200, 300))  # 15 m x 10 m
+
+
+def _room_scan(origin: np.ndarray, box: tuple[float, float, float, float],
+               beams: int = 720) -> np.ndarray:
+    """Endpoints (beams, 2) of a 360-degree scan from ``origin`` inside the axis-aligned room
+    ``box`` (x0, y0, x1, y1), metres: the exact hits on its walls."""
+    a = np.linspace(-np.pi, np.pi, beams, endpoint=False) + 1e-3
+    d = np.stack([np.cos(a), np.sin(a)], axis=1)
+    with np.errstate(divide="ignore"):
+        tx = np.where(d[:, 0] > 0, (box[2] - origin[0]) / d[:, 0], (box[0] - origin[0]) / d[:, 0])
+        ty = np.where(d[:, 1] > 0, (box[3] - origin[1]) / d[:, 1], (box[1] - origin[1]) / d[:, 1])
+    return origin + np.minimum(tx, ty)[:, None] * d
+
+
+def test_views_of_a_room_seen_from_inside_cover_the_room():
+    """One 360-degree scan from inside a 6 m x 4 m room: its view is the room (up to the
+    sectors' chords, less than a cell at these distances), nothing outside it."""
+    box = (2.0, 3.0, 8.0, 7.0)
+    origin = np.array([4.0, 5.0])
+    hits = _room_scan(origin, box)
+    views = view_outlines(origin[None], hits, np.zeros(len(hits), dtype=np.int64))
+    assert views.shape == (1, 360, 2)
+    seen = view_cells(views, GRID)
+    centres = GRID.cell_centres(np.ones(GRID.shape, bool)).reshape(*GRID.shape, 2)
+    inside = ((centres[..., 0] > box[0] + 0.1) & (centres[..., 0] < box[2] - 0.1)
+              & (centres[..., 1] > box[1] + 0.1) & (centres[..., 1] < box[3] - 0.1))
+    outside = ((centres[..., 0] < box[0] - 0.1) | (centres[..., 0] > box[2] + 0.1)
+               | (centres[..., 1] < box[1] - 0.1) | (centres[..., 1] > box[3] + 0.1))
+    assert seen[inside].all()
+    assert not seen[outside].any()
+
+
+def test_a_sector_without_readings_is_not_seen():
+    """A half scan (readings only ahead, +x) sees the half of the room in front of it."""
+    box = (2.0, 3.0, 8.0, 7.0)
+    origin = np.array([5.0, 5.0])
+    hits = _room_scan(origin, box)
+    ahead = hits[hits[:, 0] > origin[0]]
+    seen = view_cells(view_outlines(origin[None], ahead, np.zeros(len(ahead), np.int64)), GRID)
+    xy = GRID.cell_centres(seen)
+    assert xy[:, 0].min() > origin[0] - 0.1
+    assert xy[:, 0].max() > box[2] - 0.1
+
+
+def test_views_are_a_union_over_scans():
+    """Two scans from two rooms see both rooms; the footprint 'seen' is that union grown by
+    the margin."""
+    a_box, b_box = (1.0, 1.0, 5.0, 5.0), (9.0, 2.0, 14.0, 8.0)
+    a, b = np.array([3.0, 3.0]), np.array([11.0, 5.0])
+    hits = np.vstack([_room_scan(a, a_box), _room_scan(b, b_box)])
+    scan = np.repeat([0, 1], 720)
+    views = view_outlines(np.stack([a, b]), hits, scan)
+    seen = view_cells(views, GRID)
+    one = view_cells(views[:1], GRID) | view_cells(views[1:], GRID)
+    assert (seen == one).all()
+    grown = map_footprint("seen", np.zeros(GRID.shape, bool), GRID, 0.3, views=views)
+    assert grown.sum() > seen.sum() and (grown | ~seen).all()
+
+
+def test_footprint_rule_seen_needs_views():
+    assert footprint_rule("auto", None, 0.0, views=True) == "seen"
+    assert footprint_rule("auto", None, 0.0) == "walls"
+    with pytest.raises(ValueError, match="'seen' needs the scans' poses"):
+        footprint_rule("seen", None, 0.0)
+
+
+def test_step_ends_every_scans_and_metres():
+    """Every 20 scans of 50: 20, 40 and the last; every 1 m along a straight path of 0.25 m
+    steps: the scans that reach 1, 2, 3 ... m."""
+    assert step_ends(50, every=20).tolist() == [20, 40, 50]
+    assert step_ends(40, every=20).tolist() == [20, 40]
+    poses = np.tile(np.eye(4), (13, 1, 1))
+    poses[:, 0, 3] = 0.25 * np.arange(13)  # 0 .. 3 m
+    distance = travelled(poses)
+    assert distance[-1] == pytest.approx(3.0)
+    assert step_ends(13, every_m=1.0, distance=distance).tolist() == [5, 9, 13]
+    with pytest.raises(ValueError):
+        step_ends(13, every=2, every_m=1.0, distance=distance)
+
+
+def _steps(values: list[float | None]) -> list[Step]:
+    return [Step(i, 10 * (i + 1), None, float(i), {"precision": v},
+                 "" if v is not None else "degenerate map") for i, v in enumerate(values)]
+
+
+def test_worst_drop_starts_after_the_last_step_level_with_the_peak():
+    """A plateau within the noise band, then a fall: the drop starts at the first step below
+    the band; a step that could not be scored is skipped."""
+    drop = worst_drop(_steps([None, 0.8, 0.9, 0.92, 0.91, 0.915, 0.84, 0.7, 0.6, 0.65]))
+    assert drop is not None
+    assert (drop.peak, drop.start, drop.low) == (3, 6, 8)
+    assert drop.size == pytest.approx(0.32)
+
+
+def test_no_drop_in_a_rising_run_or_below_the_band():
+    assert worst_drop(_steps([0.5, 0.6, 0.7, 0.8, 0.9, 1.0])) is None
+    assert worst_drop(_steps([0.9, 0.9 - 0.9 * MIN_DROP, 0.9])) is None
+    assert worst_drop(_steps([None, 0.9])) is None
+
+
+def test_distinct_cells_counts_cells_as_a_row_wise_unique():
+    rng = np.random.default_rng(3)
+    xy = np.vstack([rng.normal(size=(5000, 2)) * 3, rng.normal(size=(10, 2)) * 1e4])
+    assert distinct_cells(xy) == len(np.unique(np.floor(xy / memory.WORKING_CELL), axis=0))
