@@ -33,7 +33,7 @@ OTHER = ("#222222", "#aa3377", "#66ccee", "#ccbb44", "#bbbbbb")
 #: The least height of a panel in metres: centimetre noise stays flat.
 MIN_METRES = 0.1
 #: The path over the vectorial map.
-PATH_COLOUR = "#009988"
+PATH_COLOUR = "#08306b"
 
 
 def _colour(column: str, index: int) -> str:
@@ -84,7 +84,7 @@ def path_figure(result: Result, path_xy: np.ndarray) -> Figure:
     """The vectorial map of one step with the robot's path so far over it (``path_xy`` (K, 2),
     truth frame, metres) and its last position marked."""
     fig = vectorial_figure(result)
-    fig.suptitle("the robot's path so far: teal line, its last position: dot", fontsize=9)
+    fig.suptitle("the robot's path so far: dark blue line, its last position: dot", fontsize=9)
     for ax in fig.axes:
         if ax.get_title():
             ax.plot(path_xy[:, 0], path_xy[:, 1], color=PATH_COLOUR, lw=0.8, alpha=0.8)
