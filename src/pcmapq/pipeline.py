@@ -301,14 +301,12 @@ def prepare_truth(truth: OccupancyMap | PointMap, settings: Settings) -> Prepare
                          nearest_distance(occupied, grid))
 
 
-def map_side(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap,
-             truth_xy: np.ndarray, grid: MetricGrid, truth_occ: np.ndarray, settings: Settings,
-             sides: SideBySide, rule: str, progress: Progress = lambda step: None,
-             threads: int = 2) -> MapSide:
-    """Align ``source`` to the truth (plan points ``truth_xy``, metres), draw it on ``grid``,
-    measure the overlap with ``truth_occ`` and find its features with ``sides`` on
-    ``threads`` threads; a map that does not seem to show the truth's place is refused
-    (EvaluationError) unless ``--force``."""
+def place_map(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap,
+              truth_xy: np.ndarray, grid: MetricGrid, truth_occ: np.ndarray,
+              settings: Settings, rule: str, progress: Progress = lambda step: None) -> MapSide:
+    """Align ``source`` to the truth (plan points ``truth_xy``, metres), draw it on ``grid`` and
+    measure the overlap with ``truth_occ``: a :class:`MapSide` without features. A map that
+    does not seem to show the truth's place is refused (EvaluationError) unless ``--force``."""
     progress("aligning")
     source, registration = align_clouds_3d(source, truth, settings)
     map_xy, map_level = plan_points(source, settings)
@@ -322,9 +320,24 @@ def map_side(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap,
     if cover.confidence < option.min_confidence and not option.force:
         raise EvaluationError(refusal(source, truth.path, alignment, cover, settings, map_xy,
                                       truth_xy))
-    progress("drawing the walls' centre lines and detecting features")
     return MapSide(source, registration, map_xy, map_level, alignment, map_occ, to_map, cover,
-                   sides.features(map_occ, grid, threads=threads))
+                   {})
+
+
+def with_features(side: MapSide, grid: MetricGrid, sides: SideBySide,
+                  progress: Progress = lambda step: None, threads: int = 2) -> MapSide:
+    """``side`` with its features by detector, found with ``sides`` on ``threads`` threads."""
+    progress("drawing the walls' centre lines and detecting features")
+    return replace(side, features=sides.features(side.occupied, grid, threads=threads))
+
+
+def map_side(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap,
+             truth_xy: np.ndarray, grid: MetricGrid, truth_occ: np.ndarray, settings: Settings,
+             sides: SideBySide, rule: str, progress: Progress = lambda step: None,
+             threads: int = 2) -> MapSide:
+    """:func:`place_map`, then :func:`with_features` with ``sides`` on ``threads`` threads."""
+    side = place_map(source, truth, truth_xy, grid, truth_occ, settings, rule, progress)
+    return with_features(side, grid, sides, progress, threads)
 
 
 def score(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap, settings: Settings,
@@ -360,12 +373,26 @@ def score_prepared(source: OccupancyMap | PointMap, prepared: PreparedTruth,
                    settings: Settings, progress: Progress = lambda step: None) -> Result:
     """:func:`score` against a truth prepared once (:func:`prepare_truth`) with the same
     ``settings``: the same result, without the truth's work."""
+    return finish_prepared(source, place_prepared(source, prepared, settings, progress),
+                           prepared, settings, progress)
+
+
+def place_prepared(source: OccupancyMap | PointMap, prepared: PreparedTruth,
+                   settings: Settings, progress: Progress = lambda step: None) -> MapSide:
+    """The first half of :func:`score_prepared`: ``source`` aligned, drawn and checked
+    (:func:`place_map`), without features."""
     check_span(source, MAP_CROP)
-    rule = map_footprint_rule(source, settings)
+    return place_map(source, prepared.source, prepared.xy, prepared.grid, prepared.occupied,
+                     settings, map_footprint_rule(source, settings), progress)
+
+
+def finish_prepared(source: OccupancyMap | PointMap, side: MapSide, prepared: PreparedTruth,
+                    settings: Settings, progress: Progress = lambda step: None) -> Result:
+    """The second half of :func:`score_prepared`: the features of ``side`` (from
+    :func:`place_prepared`) matched against the prepared truth's, and the result."""
     sides = SideBySide(settings.matching.detectors, settings.matching.params)
-    side = map_side(source, prepared.source, prepared.xy, prepared.grid, prepared.occupied,
-                    settings, sides, rule, progress)
-    return assemble(source, side, prepared, settings, rule, progress)
+    return assemble(source, with_features(side, prepared.grid, sides, progress), prepared,
+                    settings, map_footprint_rule(source, settings), progress)
 
 
 def assemble(loaded: OccupancyMap | PointMap, side: MapSide, prepared: PreparedTruth,

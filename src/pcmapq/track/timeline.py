@@ -15,14 +15,21 @@ drags the alignment of the whole map along, and the first part slides away from 
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, replace
+from concurrent.futures import Future, ThreadPoolExecutor
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from pcmapq.config import Settings
 from pcmapq.errors import EvaluationError, InputError
 from pcmapq.frames import Frames
-from pcmapq.pipeline import PreparedTruth, score_prepared
+from pcmapq.pipeline import (
+    MapSide,
+    PreparedTruth,
+    finish_prepared,
+    place_prepared,
+    score_prepared,
+)
 from pcmapq.report.summary import summary_row
 from pcmapq.result import Result
 from pcmapq.track.runs import Run
@@ -55,7 +62,8 @@ class Step:
     without timestamps) and ``distance_m`` travelled at its last scan; ``figures`` the flat
     columns of :func:`~pcmapq.report.summary.summary_row` plus ``slide_m`` and the trajectory
     errors (None when undefined); ``note`` why a step was not scored ("" when it was);
-    ``start`` the pose its ICP started from (None: the global search)."""
+    ``start`` the pose its ICP started from (None: the global search); ``frames`` the frames
+    its result put the map and truth in (None when not scored)."""
 
     step: int
     scans: int
@@ -64,6 +72,7 @@ class Step:
     figures: dict[str, float | None]
     note: str = ""
     start: Similarity2D | None = None
+    frames: Frames | None = field(default=None, compare=False, repr=False)
 
     @property
     def scored(self) -> bool:
@@ -106,20 +115,28 @@ def figures_of(result: Result) -> dict[str, float | None]:
     return figures
 
 
-def score_step(source, prepared: PreparedTruth, settings: Settings,
-               start: Similarity2D | None) -> tuple[Result, Similarity2D | None]:
-    """Score one step's map, ICP from ``start`` (None: the global search); a start whose
-    result is refused is followed by a global search. The result and the start it used."""
+def place_step(source, prepared: PreparedTruth, settings: Settings,
+               start: Similarity2D | None) -> tuple[MapSide, Similarity2D | None]:
+    """Align and draw one step's map (:func:`~pcmapq.pipeline.place_prepared`), ICP from
+    ``start`` (None: the global search); a start whose pose is refused is followed by a global
+    search. The placed map and the start it used."""
     option = settings.alignment
     if start is None or not option.enabled:
-        return score_prepared(source, prepared, settings), option.init
+        return place_prepared(source, prepared, settings), option.init
     try:
-        return score_prepared(source, prepared,
+        return place_prepared(source, prepared,
                               replace(settings, alignment=replace(option, init=start))), start
     except EvaluationError:
         if option.force:
             raise
-        return score_prepared(source, prepared, settings), None
+        return place_prepared(source, prepared, settings), None
+
+
+def _settings_from(settings: Settings, start: Similarity2D | None) -> Settings:
+    """The settings a step was scored with: ICP from ``start`` (None: as given)."""
+    if start is None or not settings.alignment.enabled:
+        return settings
+    return replace(settings, alignment=replace(settings.alignment, init=start))
 
 
 def track(run: Run, prepared: PreparedTruth, settings: Settings, ends: np.ndarray,
@@ -128,33 +145,79 @@ def track(run: Run, prepared: PreparedTruth, settings: Settings, ends: np.ndarra
     """Score the map of ``run`` after each of ``ends`` scans against ``prepared``.
 
     reference: (K, 4, 4) reference poses, one per scan, for the trajectory errors of each
-    step. tick: ``tick(scans done)``."""
+    step. tick: ``tick(scans done)``.
+
+    Two stages overlap: this thread aligns and draws each step's map in turn (a step's ICP
+    starts from the pose the step before found), while up to :data:`FEATURE_THREADS` others
+    find the features of the steps already placed and score them. Each step's result depends
+    on its map and its start alone, so the steps are the same as one after the other."""
     distance = travelled(run.poses)
     stamps = run.stamps
-    steps: list[Step] = []
-    start, first = settings.alignment.init, None
-    for index, (end, source) in enumerate(zip(ends, run.maps(ends, tick), strict=True)):
-        end = int(end)
-        time_s = None if stamps is None else float(stamps[end - 1] - stamps[0])
-        extra = {} if reference is None else pose_errors(run.poses[:end], reference[:end],
-                                                         pose_options)
-        try:
-            result, used = score_step(source, prepared, settings, start)
-        except (EvaluationError, InputError) as err:
-            steps.append(Step(index, end, time_s, float(distance[end - 1]),
-                              {"slide_m": None, **extra}, str(err), start))
-            continue
-        positions = run.poses[:end, :3, 3]
-        if first is None:
-            first = positions[np.linspace(0, end - 1, min(end, SLIDE_POINTS)).astype(int)]
-            origin = plane_points(first, result.frames)
-        moved = plane_points(first, result.frames) - origin
-        slide = float(np.sqrt(np.mean(np.sum(moved**2, axis=1))))
-        steps.append(Step(index, end, time_s, float(distance[end - 1]),
-                          {**figures_of(result), "slide_m": slide, **extra}, "", used))
-        if settings.alignment.enabled:
-            start = result.transform
-    return steps
+    steps: list[Step | None] = [None] * len(ends)
+    pending: list[tuple[int, Future]] = []
+    start = settings.alignment.init
+
+    def collect(wait_for: int) -> None:
+        """Score the placed steps while more than ``wait_for`` are in flight."""
+        while len(pending) > wait_for:
+            index, job = pending.pop(0)
+            steps[index] = job.result()
+
+    with ThreadPoolExecutor(FEATURE_THREADS) as scorers:
+        for index, (end, source) in enumerate(zip(ends, run.maps(ends, tick), strict=True)):
+            end = int(end)
+            time_s = None if stamps is None else float(stamps[end - 1] - stamps[0])
+            extra = {} if reference is None else pose_errors(run.poses[:end], reference[:end],
+                                                             pose_options)
+            at = (index, end, time_s, float(distance[end - 1]))
+            try:
+                side, used = place_step(source, prepared, settings, start)
+            except (EvaluationError, InputError) as err:
+                steps[index] = Step(*at, {"slide_m": None, **extra}, str(err), start)
+                continue
+            if settings.alignment.enabled:
+                start = side.alignment.transform
+            pending.append((index, scorers.submit(
+                _finish, at, source, side, prepared, _settings_from(settings, used), used,
+                extra)))
+            collect(FEATURE_THREADS)
+        collect(0)
+    return _with_slide([s for s in steps if s is not None], run.poses)
+
+
+#: Threads finding the features of placed steps while the next step is placed.
+FEATURE_THREADS = 2
+
+
+def _finish(at: tuple, source, side: MapSide, prepared: PreparedTruth, settings: Settings,
+            used: Similarity2D | None, extra: dict) -> Step:
+    """A placed step's features matched and scored: its :class:`Step` (``slide_m`` unset)."""
+    try:
+        result = finish_prepared(source, side, prepared, settings)
+    except (EvaluationError, InputError) as err:
+        return Step(*at, {"slide_m": None, **extra}, str(err), used)
+    return Step(*at, {**figures_of(result), "slide_m": None, **extra}, "", used,
+                result.frames)
+
+
+def _with_slide(steps: list[Step], poses: np.ndarray) -> list[Step]:
+    """The steps with ``slide_m``: how far each scored step's alignment moves the positions
+    of the first scored step's scans from where that step put them, RMS metres."""
+    first = next((s for s in steps if s.scored), None)
+    if first is None:
+        return steps
+    positions = poses[:first.scans, :3, 3]
+    sample = positions[np.linspace(0, first.scans - 1,
+                                   min(first.scans, SLIDE_POINTS)).astype(int)]
+    origin = plane_points(sample, first.frames)
+    out = []
+    for s in steps:
+        if s.scored:
+            moved = plane_points(sample, s.frames) - origin
+            s = replace(s, figures={**s.figures,
+                                    "slide_m": float(np.sqrt(np.mean(np.sum(moved**2, axis=1))))})
+        out.append(s)
+    return out
 
 
 def result_at(run: Run, prepared: PreparedTruth, settings: Settings, step: Step) -> Result:
