@@ -11,6 +11,7 @@ import numpy as np
 
 from pcmapq import memory
 from pcmapq.align import Alignment, align
+from pcmapq.align.planar import RigidTarget
 from pcmapq.align.rigid3d import Registration3D, align_3d, apply
 from pcmapq.config import Settings
 from pcmapq.errors import EvaluationError, InputError
@@ -192,15 +193,16 @@ def check_scale_range(source: OccupancyMap | PointMap, map_xy: np.ndarray,
 
 
 def align_plan(source: OccupancyMap | PointMap, map_xy: np.ndarray, truth_xy: np.ndarray,
-               registration: Registration3D | None, settings: Settings) -> Alignment:
+               registration: Registration3D | None, settings: Settings,
+               target: RigidTarget | None = None) -> Alignment:
     """The 2D alignment of the map's plan points to the truth's (both (N, 2) metres, in their
-    own frames): the search and ICP of :func:`pcmapq.align.align`, or, after a 3D registration,
-    the plan scored as it is."""
+    own frames): the search and ICP of :func:`pcmapq.align.align` (``target``: the truth's
+    points prepared for it), or, after a 3D registration, the plan scored as it is."""
     option = settings.alignment
     if registration is None:
         check_scale_range(source, map_xy, truth_xy, settings)
         return align(map_xy, truth_xy, option.params, init=option.init, refine=option.enabled,
-                     scale=option.scale)
+                     scale=option.scale, target=target)
     return replace(align(map_xy, truth_xy, option.params, init=Similarity2D(), refine=False),
                    method="3d")
 
@@ -259,8 +261,9 @@ class PreparedTruth:
     """The truth as every score against it needs it, whatever the map: its plan points ``xy``
     (N, 2) metres with the ``level`` that made them, the ``grid`` everything is drawn on, its
     ``occupied`` cells, its ``features`` by detector and, when computed, ``to_truth``: each
-    cell's distance to the nearest truth wall, metres. Made once by :func:`prepare_truth` for
-    many maps (``pcmapq track``'s steps)."""
+    cell's distance to the nearest truth wall, metres; ``aligner``: its points prepared for
+    the rigid alignment (:class:`~pcmapq.align.planar.RigidTarget`). Made once by
+    :func:`prepare_truth` for many maps (``pcmapq track``'s steps)."""
 
     source: OccupancyMap | PointMap
     xy: np.ndarray
@@ -269,6 +272,7 @@ class PreparedTruth:
     occupied: np.ndarray
     features: dict[str, Features]
     to_truth: np.ndarray | None = None
+    aligner: RigidTarget | None = None
 
 
 @dataclass(frozen=True)
@@ -296,21 +300,26 @@ def prepare_truth(truth: OccupancyMap | PointMap, settings: Settings) -> Prepare
     truth_xy, level = plan_points(truth, settings)
     grid, occupied = truth_raster(truth, truth_xy, settings)
     sides = SideBySide(settings.matching.detectors, settings.matching.params)
+    option = settings.alignment
+    aligner = (RigidTarget(truth_xy, option.params) if option.enabled and not option.scale
+               else None)
     return PreparedTruth(truth, truth_xy, level, grid, occupied,
                          sides.features(occupied, grid, threads=2),
-                         nearest_distance(occupied, grid))
+                         nearest_distance(occupied, grid), aligner)
 
 
 def place_map(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap,
               truth_xy: np.ndarray, grid: MetricGrid, truth_occ: np.ndarray,
-              settings: Settings, rule: str, progress: Progress = lambda step: None) -> MapSide:
-    """Align ``source`` to the truth (plan points ``truth_xy``, metres), draw it on ``grid`` and
-    measure the overlap with ``truth_occ``: a :class:`MapSide` without features. A map that
-    does not seem to show the truth's place is refused (EvaluationError) unless ``--force``."""
+              settings: Settings, rule: str, progress: Progress = lambda step: None,
+              target: RigidTarget | None = None) -> MapSide:
+    """Align ``source`` to the truth (plan points ``truth_xy``, metres; ``target``: them
+    prepared for the rigid alignment), draw it on ``grid`` and measure the overlap with
+    ``truth_occ``: a :class:`MapSide` without features. A map that does not seem to show the
+    truth's place is refused (EvaluationError) unless ``--force``."""
     progress("aligning")
     source, registration = align_clouds_3d(source, truth, settings)
     map_xy, map_level = plan_points(source, settings)
-    alignment = align_plan(source, map_xy, truth_xy, registration, settings)
+    alignment = align_plan(source, map_xy, truth_xy, registration, settings, target)
 
     progress("rasterising")
     map_occ, footprint = map_raster(source, map_xy, alignment.transform, grid, settings, rule)
@@ -383,7 +392,8 @@ def place_prepared(source: OccupancyMap | PointMap, prepared: PreparedTruth,
     (:func:`place_map`), without features."""
     check_span(source, MAP_CROP)
     return place_map(source, prepared.source, prepared.xy, prepared.grid, prepared.occupied,
-                     settings, map_footprint_rule(source, settings), progress)
+                     settings, map_footprint_rule(source, settings), progress,
+                     prepared.aligner)
 
 
 def finish_prepared(source: OccupancyMap | PointMap, side: MapSide, prepared: PreparedTruth,

@@ -86,9 +86,30 @@ def score(map_xy: np.ndarray, truth_xy: np.ndarray, tf: Similarity2D,
     return _score_tree(np.asarray(map_xy, dtype=np.float64).reshape(-1, 2), tree, tf, tolerance)
 
 
+class RigidTarget:
+    """The truth prepared once for the rigid alignment of many maps (``pcmapq track``'s
+    steps): its points thinned as :func:`align` thins them, their KD-tree, the point-to-line
+    target (whose line normals, each depending on its point alone, are kept as they are
+    computed) and the point-to-point clouds by voxel. Aligning with it gives what aligning
+    with the truth's points gives. Not for two threads at once."""
+
+    def __init__(self, truth_xy: np.ndarray, params: AlignParams = AlignParams()) -> None:
+        """truth_xy: (M, 2) metres, truth frame; params: those of the alignments to come."""
+        self.voxel, self.max_points = params.voxel, params.max_points
+        self.points, _ = _thinned(np.asarray(truth_xy, dtype=np.float64).reshape(-1, 2),
+                                  params.voxel, TRUTH_POINTS * params.max_points)
+        self.tree = cKDTree(self.points) if len(self.points) else None
+        self.lines = LineTarget(self.points, self.tree) if len(self.points) else None
+        self.clouds: dict = {}
+
+    def fits(self, params: AlignParams) -> bool:
+        """Whether this target serves alignments with ``params``."""
+        return (params.voxel, params.max_points) == (self.voxel, self.max_points)
+
+
 def align(map_xy: np.ndarray, truth_xy: np.ndarray, params: AlignParams = AlignParams(), *,
           init: Similarity2D | None = None, refine: bool = True,
-          scale: bool = False) -> Alignment:
+          scale: bool = False, target: RigidTarget | None = None) -> Alignment:
     """Align a map to the truth with no initial guess needed; never fails on a bad match (an
     empty map or truth gives fitness 0).
 
@@ -99,15 +120,19 @@ def align(map_xy: np.ndarray, truth_xy: np.ndarray, params: AlignParams = AlignP
     there (its scale dropped unless ``scale``). refine: False with no ``init`` scores the
     identity ("none"); False with ``init`` scores ``init`` as it is ("init").
     scale: also estimate the scale, for a map in an unknown unit (see :func:`align_similarity`).
+    target: these truth points prepared by :class:`RigidTarget` (used without ``scale``, when
+    it fits ``params``): the same result, without the truth's work.
     """
     map_xy = np.asarray(map_xy, dtype=np.float64).reshape(-1, 2)
     truth_xy = np.asarray(truth_xy, dtype=np.float64).reshape(-1, 2)
     if scale:
         return align_similarity(map_xy, truth_xy, params, init=init, refine=refine)
-    return _align_rigid(map_xy, truth_xy, params, init, refine)
+    if target is None or not target.fits(params):
+        target = RigidTarget(truth_xy, params)
+    return _align_rigid(map_xy, target, params, init, refine)
 
 
-def _align_rigid(map_xy: np.ndarray, truth_xy: np.ndarray, params: AlignParams,
+def _align_rigid(map_xy: np.ndarray, target: RigidTarget, params: AlignParams,
                  init: Similarity2D | None, refine: bool) -> Alignment:
     """:func:`align` with scale 1: the search of :func:`~pcmapq.align.coarse.coarse_search`,
     Open3D point-to-point ICP stages (:data:`~pcmapq.align.point_to_point.DEFAULT_SCHEDULE`,
@@ -115,11 +140,10 @@ def _align_rigid(map_xy: np.ndarray, truth_xy: np.ndarray, params: AlignParams,
     then point-to-line on the winner."""
     voxel, tolerance = params.voxel, params.tolerance
     map_ds, map_voxel = _thinned(map_xy, voxel, params.max_points)
-    truth_ds, _ = _thinned(truth_xy, voxel, TRUTH_POINTS * params.max_points)
+    truth_ds, tree = target.points, target.tree
     start = Similarity2D() if init is None else init
     if len(map_ds) == 0 or len(truth_ds) == 0:
         return Alignment(start, 0.0, 0.0, tolerance, "none")
-    tree = cKDTree(truth_ds)
 
     def scored(tf: Similarity2D) -> Alignment:
         return _scored(map_ds, tree, tf, tolerance)
@@ -137,16 +161,15 @@ def _align_rigid(map_xy: np.ndarray, truth_xy: np.ndarray, params: AlignParams,
         first_dist = max(first_dist, 2 * search.cell)
     icp_map, schedule = _icp_inputs(map_ds, map_voxel > voxel,
                                     ((first_dist, first_voxel), *fine_stages))
-    target = IcpTarget(truth_ds, schedule)
+    icp = IcpTarget(truth_ds, schedule, target.clouds)
     best = refine_best(
         _starts(search, start),
-        lambda tf: refine_point_to_point(icp_map, target, tf, stages=slice(1)),
-        lambda tf: refine_point_to_point(icp_map, target, tf, stages=slice(1, None)), scored,
+        lambda tf: refine_point_to_point(icp_map, icp, tf, stages=slice(1)),
+        lambda tf: refine_point_to_point(icp_map, icp, tf, stages=slice(1, None)), scored,
         params.finalists_for(scale=False))
     # Point-to-line on the winner only: finishing both finalists (as with the scale free) moved
     # no bench_align pose by over 1e-7 m and took 18 % more CPU time there.
-    tf = refine_point_to_line(map_ds, LineTarget(truth_ds, tree), best.transform,
-                              fine_stages[-1][0])
+    tf = refine_point_to_line(map_ds, target.lines, best.transform, fine_stages[-1][0])
     return _labelled(scored(tf), search, "coarse+icp")
 
 

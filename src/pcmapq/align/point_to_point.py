@@ -48,11 +48,16 @@ class IcpTarget:
     one downsampled cloud per distinct voxel of the schedule."""
 
     def __init__(self, truth_xy: np.ndarray,
-                 schedule: tuple[tuple[float, float], ...] = DEFAULT_SCHEDULE) -> None:
-        """truth_xy: (N, 2) metres, truth frame; schedule: (max distance, voxel) pairs, metres."""
+                 schedule: tuple[tuple[float, float], ...] = DEFAULT_SCHEDULE,
+                 clouds: dict[float, o3d.geometry.PointCloud] | None = None) -> None:
+        """truth_xy: (N, 2) metres, truth frame; schedule: (max distance, voxel) pairs, metres;
+        clouds: downsampled clouds of these points by voxel, shared with other targets (those
+        missing are made and added)."""
         self.schedule = schedule
-        clouds = {voxel: _cloud(voxel_centroids(truth_xy, voxel))
-                  for voxel in dict.fromkeys(voxel for _, voxel in schedule)}
+        clouds = {} if clouds is None else clouds
+        for voxel in dict.fromkeys(voxel for _, voxel in schedule):
+            if voxel not in clouds:
+                clouds[voxel] = _cloud(voxel_centroids(truth_xy, voxel))
         self.clouds = [clouds[voxel] for _, voxel in schedule]
 
 
