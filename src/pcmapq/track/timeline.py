@@ -63,7 +63,9 @@ class Step:
     columns of :func:`~pcmapq.report.summary.summary_row` plus ``slide_m`` and the trajectory
     errors (None when undefined); ``note`` why a step was not scored ("" when it was);
     ``start`` the pose its ICP started from (None: the global search); ``frames`` the frames
-    its result put the map and truth in (None when not scored)."""
+    its result put the map and truth in (None when not scored); ``result`` its full result,
+    while the steps' rasters fit in :data:`KEEP_BYTES` (None otherwise: :func:`result_at`
+    scores it again)."""
 
     step: int
     scans: int
@@ -73,6 +75,7 @@ class Step:
     note: str = ""
     start: Similarity2D | None = None
     frames: Frames | None = field(default=None, compare=False, repr=False)
+    result: Result | None = field(default=None, compare=False, repr=False)
 
     @property
     def scored(self) -> bool:
@@ -157,11 +160,20 @@ def track(run: Run, prepared: PreparedTruth, settings: Settings, ends: np.ndarra
     pending: list[tuple[int, Future]] = []
     start = settings.alignment.init
 
+    held = [0]  # bytes of the results kept, or -1 once they no longer fit
+
     def collect(wait_for: int) -> None:
-        """Score the placed steps while more than ``wait_for`` are in flight."""
+        """Score the placed steps while more than ``wait_for`` are in flight; keep their
+        results while they fit in :data:`KEEP_BYTES`."""
         while len(pending) > wait_for:
             index, job = pending.pop(0)
-            steps[index] = job.result()
+            step = job.result()
+            if step.result is not None and held[0] >= 0:
+                held[0] += step.result.map_occupied.nbytes + step.result.overlap.footprint.nbytes
+                if held[0] > KEEP_BYTES:
+                    held[0] = -1
+                    steps[:] = [s if s is None else replace(s, result=None) for s in steps]
+            steps[index] = step if held[0] >= 0 else replace(step, result=None)
 
     with ThreadPoolExecutor(FEATURE_THREADS) as scorers:
         for index, (end, source) in enumerate(zip(ends, run.maps(ends, tick), strict=True)):
@@ -197,7 +209,12 @@ def _finish(at: tuple, source, side: MapSide, prepared: PreparedTruth, settings:
     except (EvaluationError, InputError) as err:
         return Step(*at, {"slide_m": None, **extra}, str(err), used)
     return Step(*at, {**figures_of(result), "slide_m": None, **extra}, "", used,
-                result.frames)
+                result.frames, result)
+
+
+#: The steps' full results are kept while their map rasters and footprints take at most this
+#: many bytes in all (the truth's raster is shared); beyond it none is.
+KEEP_BYTES = 512 * 2**20
 
 
 def _with_slide(steps: list[Step], poses: np.ndarray) -> list[Step]:
@@ -221,8 +238,10 @@ def _with_slide(steps: list[Step], poses: np.ndarray) -> list[Step]:
 
 
 def result_at(run: Run, prepared: PreparedTruth, settings: Settings, step: Step) -> Result:
-    """The full result of a scored step, computed again as :func:`track` computed it (the
-    same map, the same start: the same result)."""
+    """The full result of a scored step: the one :func:`track` kept, else computed again as
+    it computed it (the same map, the same start: the same result)."""
+    if step.result is not None:
+        return step.result
     source = next(run.maps([step.scans]))
     if step.start is None or not settings.alignment.enabled:
         return score_prepared(source, prepared, settings)
