@@ -17,6 +17,7 @@ source calls ``run(`` end-to-end.
 from __future__ import annotations
 
 import csv
+import html
 import io
 import json
 import math
@@ -331,6 +332,27 @@ def test_csv_and_json_hold_the_same_steps(runs: Runs) -> None:
         for key, value in mine.figures.items():
             want = None if value is None else round(value, 6) + 0.0
             assert step[key] == pytest.approx(want, abs=2e-6), (mine.step, key)
+
+
+def test_outputs_name_the_inputs_and_the_step_shown(runs: Runs) -> None:
+    """track.json names the run, its poses (the log's own here), the truth and the reference
+    poses with how they were compared; the report says so too, and names the step it shows:
+    where the worst drop starts by default, the step asked with ``--step``."""
+    got, out = runs.tracked_cli_run("cli")
+    assert got.code == 0, got.stderr
+    doc = json.loads((out / "track.json").read_text())
+    assert doc["run"] == str(runs.data.drifted) and doc["truth"] == str(runs.data.corrected)
+    assert doc["poses"] == "the log's own FLASER poses"
+    assert doc["reference_poses"] == str(runs.data.corrected)
+    assert doc["pose_errors"] == {"align": False, "correct_scale": False, "delta": 1}
+    page = (out / "track.html").read_text()
+    start = doc["worst_drop"]["start"]
+    assert f"Step {start} (where the worst drop starts)" in page
+    assert html.escape(str(runs.data.corrected)) + "; not aligned, RPE over 1 scan" in page
+    assert f"fall starts at step {start}" in page
+    asked, folder = runs.tracked_cli_run("cli-step", "--step", "2")
+    assert asked.code == 0, asked.stderr
+    assert "Step 2 (the step asked)" in (folder / "track.html").read_text()
 
 
 @pytest.mark.e2e

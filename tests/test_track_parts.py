@@ -11,6 +11,8 @@ from pcmapq.grid import MetricGrid
 from pcmapq.plan import distinct_cells
 from pcmapq.raster.draw import view_cells
 from pcmapq.raster.footprint import footprint_rule, map_footprint, view_outlines
+from pcmapq.report.timeline import timeline_html
+from pcmapq.track.outputs import step_rows
 from pcmapq.track.steps import step_ends, travelled
 from pcmapq.track.timeline import MIN_DROP, Step, worst_drop
 
@@ -121,3 +123,15 @@ def test_distinct_cells_counts_cells_as_a_row_wise_unique():
     rng = np.random.default_rng(3)
     xy = np.vstack([rng.normal(size=(5000, 2)) * 3, rng.normal(size=(10, 2)) * 1e4])
     assert distinct_cells(xy) == len(np.unique(np.floor(xy / memory.WORKING_CELL), axis=0))
+
+
+def test_the_report_of_a_run_without_a_drop_says_so():
+    """No drop: the report shows the last step, says there was none and that the step could
+    not be scored when it could not; the inputs are named."""
+    rows = step_rows(_steps([0.8, 0.82, None]))
+    page = timeline_html(rows, None, 2, None, None, command=None,
+                         inputs={"run": "run.log", "poses": "est.txt", "truth": "truth.png"})
+    assert "Step 2 (the last step; no drop): 30 of 30 scans" in page
+    assert "no drop of precision (none of at least 0.05)" in page
+    assert "not scored: degenerate map" in page
+    assert "<td>poses</td><td>est.txt</td>" in page

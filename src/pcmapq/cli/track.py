@@ -106,7 +106,7 @@ def track_command(
                          travelled(run.poses))
         tracked = track_run(run, truth_path, settings, ends, reference=reference,
                             pose_options=PoseOptions(align_poses, correct_scale, delta),
-                            show=step, progress=progress,
+                            reference_path=reference_poses, show=step, progress=progress,
                             tick=lambda done: progress(f"scoring: {done} of {len(run)} scans"))
         rule = {"every_scans": None if every_m is not None else (every or 20),
                 "every_m": every_m}

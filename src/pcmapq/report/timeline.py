@@ -26,14 +26,23 @@ FAMILIES = (
                                   "wall_precision@0.2m")),
     ("wall distances [m]", ("accuracy_mean_m", "completeness_mean_m")),
     ("alignment: slide of the first part [m]", ("slide_m",)),
-    ("trajectory error [m]", ("ape_rmse_m", "rpe_rmse_m")),
+    ("absolute pose error, APE [m]", ("ape_rmse_m", "ape_max_m")),
+    ("relative pose error, RPE: translation [m]", ("rpe_rmse_m",)),
+    ("relative pose error, RPE: rotation [deg]", ("rpe_rot_rmse_deg",)),
 )
 #: Colours of the columns that are not a detector's.
 OTHER = ("#222222", "#aa3377", "#66ccee", "#ccbb44", "#bbbbbb")
-#: The least height of a panel in metres: centimetre noise stays flat.
-MIN_METRES = 0.1
-#: The path over the vectorial map.
-PATH_COLOUR = "#08306b"
+#: The least height of a panel in metres (degrees): centimetre (tenth-degree) noise stays flat.
+MIN_METRES, MIN_DEGREES = 0.1, 0.5
+#: The path over the vectorial map, drawn over a white edge above every marker.
+PATH_COLOUR, PATH_Z = "#08306b", 10
+#: The inputs' table reads left to right.
+FACTS_STYLE = ".facts td { text-align: left; }\n"
+#: The columns of the report's table of steps, those the rows have, and their decimals.
+TABLE = {"step": 0, "scans": 0, "distance_m": 1, "harris_quality": 3, "hough_quality": 3,
+         "sift_quality": 3, "precision": 3, "wall_precision@0.1m": 3, "coverage": 3,
+         "accuracy_mean_m": 3, "slide_m": 3, "ape_rmse_m": 3, "rpe_rmse_m": 3,
+         "rpe_rot_rmse_deg": 2}
 
 
 def _colour(column: str, index: int) -> str:
@@ -43,10 +52,22 @@ def _colour(column: str, index: int) -> str:
     return OTHER[index % len(OTHER)]
 
 
-def timeline_figure(rows: list[dict], drop: dict | None) -> Figure:
+def drop_words(rows: list[dict], drop: dict | None) -> str:
+    """The worst drop in words: how far the figure fell, from which step to which, and where
+    the fall started; or that there was none."""
+    if drop is None:
+        return "no drop of precision (none of at least 0.05)"
+    figure, peak, low, start = drop["figure"], drop["peak"], drop["low"], drop["start"]
+    return (f"{figure} fell {drop['size']:.3f}, from {rows[peak][figure]:.3f} at step {peak} "
+            f"to {rows[low][figure]:.3f} at step {low}; the fall starts at step {start} "
+            f"({rows[start]['distance_m']:.0f} m)")
+
+
+def timeline_figure(rows: list[dict], drop: dict | None, title: str = "") -> Figure:
     """The figures of the rows against ``distance_m``, one panel per family that has data; a
     gap where a step was not scored; the worst drop (``drop``: peak, start, low step indices)
-    shaded from its peak to its lowest step, a line where it starts."""
+    shaded from its peak to its lowest step, a line where it starts; ``title`` above (the
+    run)."""
     distance = np.array([r["distance_m"] for r in rows], dtype=float)
     panels = [(title, [c for c in cols if any(r.get(c) is not None for r in rows)])
               for title, cols in FAMILIES]
@@ -58,15 +79,15 @@ def timeline_figure(rows: list[dict], drop: dict | None) -> Figure:
         return fig
     fig = Figure(figsize=(WIDTH_IN, 2.0 * len(panels) + 0.6), layout="constrained")
     axes = fig.subplots(len(panels), 1, sharex=True, squeeze=False)[:, 0]
-    for ax, (title, cols) in zip(axes, panels, strict=True):
+    for ax, (panel, cols) in zip(axes, panels, strict=True):
         for i, column in enumerate(cols):
             values = np.array([np.nan if r.get(column) is None else r[column] for r in rows])
             ax.plot(distance, values, marker=".", lw=1.2, label=column,
                     color=_colour(column, i), ls="--" if column == "precision" else "-")
-        ax.set_title(title, fontsize=9, loc="left")
+        ax.set_title(panel, fontsize=9, loc="left")
         top = np.nanmax([r.get(c) or 0.0 for r in rows for c in cols] + [0.0])
-        ax.set_ylim(0.0, max(1.02, top * 1.05) if "[m]" not in title else
-                    max(MIN_METRES, top * 1.1))
+        least = (MIN_METRES if "[m]" in panel else MIN_DEGREES if "[deg]" in panel else None)
+        ax.set_ylim(0.0, max(1.02, top * 1.05) if least is None else max(least, top * 1.1))
         ax.grid(alpha=0.3)
         ax.legend(fontsize=7, loc="center left", bbox_to_anchor=(1.0, 0.5), frameon=False)
         if drop is not None:
@@ -74,48 +95,75 @@ def timeline_figure(rows: list[dict], drop: dict | None) -> Figure:
                        alpha=0.12, lw=0)
             ax.axvline(distance[drop["start"]], color="#ee6677", lw=1.2)
     axes[-1].set_xlabel("distance travelled [m]")
-    if drop is not None:
-        fig.suptitle(f"worst drop of {drop['figure']}: {drop['size']:.3f}, starting at step "
-                     f"{drop['start']} ({distance[drop['start']]:.0f} m)", fontsize=10)
+    marks = ("" if drop is None else
+             "\nshaded: from the peak to the lowest step; red line: where the fall starts")
+    fig.suptitle((f"{title}\n" if title else "") + drop_words(rows, drop) + marks,
+                 fontsize=9)
     return fig
 
 
 def path_figure(result: Result, path_xy: np.ndarray) -> Figure:
     """The vectorial map of one step with the robot's path so far over it (``path_xy`` (K, 2),
-    truth frame, metres) and its last position marked."""
+    truth frame, metres), its first position a square, its last a dot, above every marker."""
+    from matplotlib import patheffects
+
     fig = vectorial_figure(result)
-    fig.suptitle("the robot's path so far: dark blue line, its last position: dot", fontsize=9)
+    edge = [patheffects.withStroke(linewidth=3.2, foreground="white")]
     for ax in fig.axes:
         if ax.get_title():
-            ax.plot(path_xy[:, 0], path_xy[:, 1], color=PATH_COLOUR, lw=0.8, alpha=0.8)
-            ax.plot(*path_xy[-1], marker="o", color=PATH_COLOUR, ms=5)
+            ax.plot(path_xy[:, 0], path_xy[:, 1], color=PATH_COLOUR, lw=1.4,
+                    zorder=PATH_Z, path_effects=edge)
+            ax.plot(*path_xy[0], marker="s", color=PATH_COLOUR, ms=6, mec="white",
+                    zorder=PATH_Z + 1)
+            ax.plot(*path_xy[-1], marker="o", color=PATH_COLOUR, ms=7, mec="white",
+                    zorder=PATH_Z + 1)
+    fig.suptitle("the robot's path so far (estimated poses, aligned with the map): dark blue "
+                 "line from its first position (square) to its last (dot)", fontsize=9)
     return fig
 
 
 def timeline_html(rows: list[dict], drop: dict | None, shown: int, result: Result | None,
-                  path_xy: np.ndarray | None, *, run: str, truth: str,
-                  command: str | None) -> str:
-    """The report: inputs, the curves, the step ``shown`` (its vectorial map with the path, or
-    why it was not scored) and a table of every step."""
+                  path_xy: np.ndarray | None, *, inputs: dict[str, str],
+                  command: str | None, asked: bool = False) -> str:
+    """The report: the inputs (``inputs``: what each is, in words, by name: run, poses, truth,
+    reference poses, step rule), the curves, the step ``shown`` (its vectorial map with the
+    path, or why it was not scored; ``asked``: chosen with ``--step``) and a table of every
+    step."""
     step = rows[shown]
-    parts = [f"<h1>pcmapq track</h1><p class='sub'>{html.escape(run)} against "
-             f"{html.escape(truth)}</p>",
+    scored = sum(bool(r["scored"]) for r in rows)
+    facts = "".join(f"<tr><td>{html.escape(k)}</td><td>{html.escape(v)}</td></tr>"
+                    for k, v in inputs.items())
+    parts = [f"<h1>pcmapq track</h1><p class='sub'>{html.escape(inputs.get('run', ''))}"
+             f" against {html.escape(inputs.get('truth', ''))}: {len(rows)} steps, {scored} "
+             f"scored, of {rows[-1]['scans']} scans</p>",
+             f"<table class='facts'>{facts}</table>",
              f"<p>command: <code>{html.escape(command or '(called from Python)')}</code></p>",
              "<h2>Quality over the run</h2>",
+             f"<p>{html.escape(drop_words(rows, drop))}.</p>",
              _img(png_bytes(timeline_figure(rows, drop)), "figures against distance")]
-    what = "the worst drop" if drop is not None and drop["start"] == shown else "the step asked"
-    parts.append(f"<h2>Step {shown} ({what}): {step['scans']} scans, "
+    what = ("the step asked" if asked else "where the worst drop starts"
+            if drop is not None and drop["start"] == shown else "the last step; no drop")
+    parts.append(f"<h2>Step {shown} ({what}): {step['scans']} of {rows[-1]['scans']} scans, "
                  f"{step['distance_m']:.0f} m travelled</h2>")
     if result is not None and path_xy is not None:
         parts.append(_img(png_bytes(path_figure(result, path_xy)),
                           f"vectorial map at step {shown}"))
     else:
         parts.append(f"<p class='note'>not scored: {html.escape(str(step['note']))}</p>")
-    columns = ["step", "scans", "distance_m", "harris_quality", "hough_quality",
-               "sift_quality", "precision", "coverage", "accuracy_mean_m", "slide_m"]
-    columns = [c for c in columns if c in step]
+    columns = [c for c in TABLE if c in step]
+    marks = {shown: " (shown)"} | ({} if drop is None else
+                                   {drop["peak"]: " (peak)", drop["start"]: " (fall starts)",
+                                    drop["low"]: " (lowest)"})
     parts.append("<h2>Steps</h2>" + _table(columns, [
-        [number(r[c]) if isinstance(r[c], float) else ("" if r[c] is None else str(r[c]))
+        [_cell(r[c], TABLE[c]) + (marks.get(r["step"], "") if c == "step" else "")
          for c in columns] for r in rows]))
-    return ("<!DOCTYPE html><html><head><meta charset='utf-8'><title>pcmapq track</title>"
-            f"<style>{STYLE}</style></head><body>{''.join(parts)}</body></html>\n")
+    return ("<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'><meta "
+            "name='viewport' content='width=device-width, initial-scale=1'><title>pcmapq "
+            f"track</title><style>{STYLE}{FACTS_STYLE}</style></head><body>{''.join(parts)}</body></html>\n")
+
+
+def _cell(value: object, digits: int) -> str:
+    """A table cell: the number with ``digits`` decimals, '-' for none."""
+    if isinstance(value, float):
+        return number(value, digits)
+    return "-" if value is None else str(value)

@@ -43,8 +43,9 @@ FILES = ("track.csv", "track.json", "track.png", "track.html")
 @dataclass(frozen=True)
 class Tracked:
     """A tracked run: its steps, the worst drop (None with fewer than two scored steps), the
-    step shown in the report (its index) with its full result and the robot's path in the
-    truth frame up to it (None when that step was not scored)."""
+    step shown in the report (its index; ``asked``: chosen by the caller) with its full result
+    and the robot's path in the truth frame up to it (None when that step was not scored);
+    ``reference``: the file of the reference poses, ``pose_options`` how they compare."""
 
     run: Run
     truth: PreparedTruth
@@ -54,15 +55,20 @@ class Tracked:
     shown: int
     result: Result | None
     path_xy: np.ndarray | None
+    asked: bool = False
+    reference: Path | None = None
+    pose_options: PoseOptions = PoseOptions()
 
 
 def track_run(run: Run, truth_path: Path, settings: Settings, ends: np.ndarray, *,
               reference: np.ndarray | None = None, pose_options: PoseOptions = PoseOptions(),  # noqa: B008 (frozen)
-              show: int | None = None, progress: Callable[[str], None] = lambda s: None,
+              reference_path: Path | None = None, show: int | None = None,
+              progress: Callable[[str], None] = lambda s: None,
               tick: Callable[[int], None] = lambda done: None) -> Tracked:
     """Score ``run`` after each of ``ends`` scans against the truth at ``truth_path`` (the
-    no-reference figures are left out: they do not change with the map's pose); ``show``: the
-    step the report shows (default: where the worst drop starts, else the last)."""
+    no-reference figures are left out: they do not change with the map's pose); ``reference``:
+    reference poses (K, 4, 4) from ``reference_path``; ``show``: the step the report shows
+    (default: where the worst drop starts, else the last)."""
     settings = replace(settings, noref=replace(settings.noref, enabled=False))
     progress("preparing the truth")
     truth = prepare_truth(load_input(truth_path, settings.truth, TRUTH_CROP), settings)
@@ -76,7 +82,28 @@ def track_run(run: Run, truth_path: Path, settings: Settings, ends: np.ndarray, 
         progress("drawing the step shown")
         result = result_at(run, truth, settings, steps[shown])
         path = plane_points(run.poses[:steps[shown].scans, :3, 3], result.frames)
-    return Tracked(run, truth, settings, steps, drop, shown, result, path)
+    return Tracked(run, truth, settings, steps, drop, shown, result, path, show is not None,
+                   reference_path if reference is not None else None, pose_options)
+
+
+def inputs_of(tracked: Tracked, every: dict) -> dict[str, str]:
+    """What a tracked run scored, in words, by name: the run, its poses, the truth, the
+    reference poses and how they compare, the step rule."""
+    run, options = tracked.run, tracked.pose_options
+    words = {"run": str(run.path), "poses": run.poses_source,
+             "truth": str(tracked.truth.source.path)}
+    if tracked.reference is not None:
+        how = [name for name, on in (("aligned (SE(3) Umeyama)", options.align and
+                                      not options.correct_scale),
+                                     ("aligned with scale (Sim(3) Umeyama)",
+                                      options.correct_scale),
+                                     ("not aligned", not options.align and
+                                      not options.correct_scale)) if on]
+        words["reference poses"] = (f"{tracked.reference}; {how[0]}, RPE over "
+                                    f"{options.delta} scan{'s' * (options.delta > 1)}")
+    words["steps"] = (f"every {every['every_scans']} scans" if every.get("every_scans")
+                      else f"every {every['every_m']:g} m travelled") + ", and the last"
+    return words
 
 
 def write_track(tracked: Tracked, out: Path, every: dict, command: str | None) -> list[Path]:
@@ -86,18 +113,20 @@ def write_track(tracked: Tracked, out: Path, every: dict, command: str | None) -
 
     rows = step_rows(tracked.steps)
     drop = None if tracked.drop is None else asdict(tracked.drop)
-    run, truth = str(tracked.run.path), str(tracked.truth.source.path)
+    inputs = inputs_of(tracked, every)
     out.mkdir(parents=True, exist_ok=True)
     paths = [out / name for name in FILES]
     with OutputSet() as outputs:
         write_atomic(paths[0], track_csv(rows), outputs)
-        write_atomic(paths[1], track_json(rows, tracked.drop, run=tracked.run.path,
-                                          truth=tracked.truth.source.path,
-                                          settings=tracked.settings.to_dict(), every=every,
-                                          command=command), outputs)
-        write_atomic(paths[2], png_bytes(timeline_figure(rows, drop)), outputs)
+        write_atomic(paths[1], track_json(
+            rows, tracked.drop, run=tracked.run.path, poses=tracked.run.poses_source,
+            truth=tracked.truth.source.path, reference=tracked.reference,
+            pose_options=asdict(tracked.pose_options), settings=tracked.settings.to_dict(),
+            every=every, command=command), outputs)
+        title = f"{tracked.run.path.name} against {tracked.truth.source.path.name}"
+        write_atomic(paths[2], png_bytes(timeline_figure(rows, drop, title)), outputs)
         write_atomic(paths[3], timeline_html(rows, drop, tracked.shown, tracked.result,
-                                             tracked.path_xy, run=run, truth=truth,
-                                             command=command), outputs)
+                                             tracked.path_xy, inputs=inputs, command=command,
+                                             asked=tracked.asked), outputs)
         outputs.commit()
     return paths

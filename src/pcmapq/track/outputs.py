@@ -57,13 +57,17 @@ def _rounded(value: object) -> object:
     return value
 
 
-def track_json(rows: list[dict[str, object]], drop: Drop | None, *, run: Path, truth: Path,
-               settings: dict, every: dict, command: str | None) -> str:
-    """The JSON document of a tracked run: inputs, step rule, settings, the worst drop and
-    every step (floats rounded to DECIMALS)."""
+def track_json(rows: list[dict[str, object]], drop: Drop | None, *, run: Path, poses: str,
+               truth: Path, reference: Path | None, pose_options: dict, settings: dict,
+               every: dict, command: str | None) -> str:
+    """The JSON document of a tracked run: its inputs (``poses``: the file of the run's poses
+    or where they come from, in words; ``reference_poses`` and how they were compared, null
+    without), step rule, settings, the worst drop and every step (floats rounded to
+    DECIMALS)."""
     doc = {"pcmapq": {"version": __version__, "command": command},
-           "run": str(run), "truth": str(truth), "every": every,
+           "run": str(run), "poses": poses, "truth": str(truth),
+           "reference_poses": None if reference is None else str(reference),
+           "pose_errors": None if reference is None else pose_options, "every": every,
            "worst_drop": None if drop is None else asdict(drop),
            "settings": settings, "steps": rows}
     return json.dumps(_rounded(doc), indent=2, allow_nan=False) + "\n"
-

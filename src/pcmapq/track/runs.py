@@ -54,13 +54,15 @@ def planar_of(poses: np.ndarray) -> np.ndarray:
 @dataclass(frozen=True)
 class LaserRun:
     """A CARMEN log's scans at ``poses`` (K, 4, 4; the log's own or a file's), readings up to
-    ``max_range`` metres; ``stamps`` (K,) seconds."""
+    ``max_range`` metres; ``stamps`` (K,) seconds; ``poses_source``: where the poses come
+    from, in words."""
 
     path: Path
     scans: LaserScans
     poses: np.ndarray
     stamps: np.ndarray | None
     max_range: float = DEFAULT_MAX_RANGE
+    poses_source: str = "the log's own FLASER poses"
 
     def __len__(self) -> int:
         return len(self.poses)
@@ -86,13 +88,15 @@ class LaserRun:
 
 @dataclass(frozen=True)
 class ScanRun:
-    """A scan sequence at ``poses`` (K, 4, 4), grown into a voxel map of ``voxel`` metres."""
+    """A scan sequence at ``poses`` (K, 4, 4), grown into a voxel map of ``voxel`` metres;
+    ``poses_source``: where the poses come from, in words."""
 
     path: Path
     sequence: ScanSequence
     poses: np.ndarray
     stamps: np.ndarray | None = None
     voxel: float = SCAN_VOXEL
+    poses_source: str = ""
 
     def __len__(self) -> int:
         return len(self.poses)
@@ -135,12 +139,14 @@ def open_run(source: Path, poses: Path | None = None, *,
         elif len(estimate) != len(scans.poses):
             raise InputError(f"{poses}: {len(estimate)} poses for the {len(scans.poses)} "
                              f"scans of {source} (one pose per scan)")
-        return LaserRun(source, scans, estimate, scans.stamps)
+        return LaserRun(source, scans, estimate, scans.stamps,
+                        **({} if poses is None else {"poses_source": str(poses)}))
     sequence = open_scans(source)
     if estimate is None:
         _, estimate = build_map_kiss(source, progress=progress)
     sequence = scans_for_poses(sequence, len(estimate), poses_path=poses)
-    return ScanRun(source, sequence, estimate)
+    return ScanRun(source, sequence, estimate,
+                   poses_source="KISS-ICP's poses" if poses is None else str(poses))
 
 
 def reference_poses_of(path: Path, count: int) -> np.ndarray:
