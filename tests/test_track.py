@@ -38,7 +38,7 @@ from pcmapq.plan import TRUTH_CROP, load_input
 from pcmapq.track import Tracked, open_run, step_ends, track_run, travelled
 from pcmapq.track.outputs import HEAD
 from pcmapq.track.runs import reference_poses_of
-from pcmapq.track.timeline import MIN_DROP, figures_of
+from pcmapq.track.timeline import MIN_DROP, figures_of, track
 
 PLAN = synth.building_plan(0)
 #: The path: from the corridor's west end on its centre line (the corridor lies between
@@ -496,4 +496,31 @@ def test_every_and_every_m_together_is_a_usage_error(runs: Runs) -> None:
                        "--out", out)
     assert got.code == 2, got.stderr
     assert "--every" in got.stderr and "Traceback" not in got.stderr
+    assert not out.exists()
+
+
+def test_steps_scored_one_at_a_time_equal_those_scored_at_once(runs: Runs) -> None:
+    """With memory for one map at a time (``prepared.maps`` 1: no step is scored while the
+    next is placed) the steps are those of the default run (three at once), figure for
+    figure and start for start."""
+    tracked = runs.track_run("drifted")
+    run = open_run(runs.data.drifted)
+    alone = track(run, replace(tracked.truth, maps=1), tracked.settings, runs.ends(),
+                  reference_poses_of(runs.data.corrected, len(run)))
+    assert tracked.truth.maps == 3
+    assert [(s.figures, s.note, s.start) for s in alone] == \
+        [(s.figures, s.note, s.start) for s in tracked.steps]
+
+
+def test_a_run_over_the_memory_limit_stops_in_one_line(runs: Runs) -> None:
+    """``--max-memory`` below what even one map at a time needs: exit 2, one line naming the
+    truth and the limit, no outputs."""
+    d = runs.data
+    out = d.folder / "memory"
+    got = runs.cli_run("track", d.drifted, d.corrected, "--every", str(EVERY), "--out", out,
+                       "--max-memory", "0.05")
+    assert got.code == 2, got.stderr
+    lines = got.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith(f"pcmapq: error: {d.corrected} with 1 map")
+    assert "--max-memory" in lines[0]
     assert not out.exists()

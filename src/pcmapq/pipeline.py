@@ -262,7 +262,8 @@ class PreparedTruth:
     (N, 2) metres with the ``level`` that made them, the ``grid`` everything is drawn on, its
     ``occupied`` cells, its ``features`` by detector and, when computed, ``to_truth``: each
     cell's distance to the nearest truth wall, metres; ``aligner``: its points prepared for
-    the rigid alignment (:class:`~pcmapq.align.planar.RigidTarget`). Made once by
+    the rigid alignment (:class:`~pcmapq.align.planar.RigidTarget`); ``maps``: how many maps
+    may be scored on its grid at once in the memory allowed. Made once by
     :func:`prepare_truth` for many maps (``pcmapq track``'s steps)."""
 
     source: OccupancyMap | PointMap
@@ -273,6 +274,7 @@ class PreparedTruth:
     features: dict[str, Features]
     to_truth: np.ndarray | None = None
     aligner: RigidTarget | None = None
+    maps: int = 1
 
 
 @dataclass(frozen=True)
@@ -293,11 +295,30 @@ class MapSide:
     features: dict[str, Features]
 
 
-def prepare_truth(truth: OccupancyMap | PointMap, settings: Settings) -> PreparedTruth:
+def prepare_truth(truth: OccupancyMap | PointMap, settings: Settings,
+                  memory_limit: int | None = None,
+                  maps: tuple[int, ...] = (1,)) -> PreparedTruth:
     """Everything of the truth that does not depend on the map: plan points, raster, features
-    (on two threads) and distance field; see :class:`PreparedTruth`."""
+    (on two threads) and distance field; see :class:`PreparedTruth`.
+
+    maps: how many maps the caller would score on its grid at once, most wanted first; the
+    first whose estimated memory fits in ``memory_limit`` bytes (None: the default) is kept as
+    ``PreparedTruth.maps``; InputError (one line) when none fits."""
     check_span(truth, TRUTH_CROP)
     truth_xy, level = plan_points(truth, settings)
+    grid = truth_grid(truth, truth_xy, settings)
+    cells = int(np.prod(grid.shape))
+    extent = cells * grid.resolution**2
+    image = int(np.prod(truth.grid.shape)) if isinstance(truth, OccupancyMap) else 0
+    points = len(truth.points) if isinstance(truth, PointMap) else 0
+    one_map = memory.needed_bytes(0, cells, extent, 0) - memory.BASE
+    need = {n: memory.needed_bytes(image, cells, extent, points) + n * one_map for n in maps}
+    limit = memory.default_limit() if memory_limit is None else memory_limit
+    fits = [n for n in maps if need[n] <= limit]
+    least = min(maps)
+    memory.guard(need[fits[0] if fits else least], memory_limit,
+                 f"{truth.path} with {least} map{'s' * (least > 1)} scored on its grid",
+                 lambda: hint(truth, TRUTH_CROP, grid.resolution))
     grid, occupied = truth_raster(truth, truth_xy, settings)
     sides = SideBySide(settings.matching.detectors, settings.matching.params)
     option = settings.alignment
@@ -305,7 +326,8 @@ def prepare_truth(truth: OccupancyMap | PointMap, settings: Settings) -> Prepare
                else None)
     return PreparedTruth(truth, truth_xy, level, grid, occupied,
                          sides.features(occupied, grid, threads=2),
-                         nearest_distance(occupied, grid), aligner)
+                         nearest_distance(occupied, grid), aligner,
+                         fits[0] if fits else least)
 
 
 def place_map(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap,

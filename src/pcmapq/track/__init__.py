@@ -24,6 +24,7 @@ from pcmapq.track.outputs import step_rows, track_csv, track_json
 from pcmapq.track.runs import Run, open_run, planar_of, planar_poses
 from pcmapq.track.steps import step_ends, travelled
 from pcmapq.track.timeline import (
+    FEATURE_THREADS,
     Drop,
     PoseOptions,
     Step,
@@ -64,14 +65,20 @@ def track_run(run: Run, truth_path: Path, settings: Settings, ends: np.ndarray, 
               reference: np.ndarray | None = None, pose_options: PoseOptions = PoseOptions(),  # noqa: B008 (frozen)
               reference_path: Path | None = None, show: int | None = None,
               progress: Callable[[str], None] = lambda s: None,
-              tick: Callable[[int], None] = lambda done: None) -> Tracked:
+              tick: Callable[[int], None] = lambda done: None,
+              memory_limit: int | None = None) -> Tracked:
     """Score ``run`` after each of ``ends`` scans against the truth at ``truth_path`` (the
     no-reference figures are left out: they do not change with the map's pose); ``reference``:
     reference poses (K, 4, 4) from ``reference_path``; ``show``: the step the report shows
-    (default: where the worst drop starts, else the last)."""
+    (default: where the worst drop starts, else the last). As many steps are scored at once
+    as fit in ``memory_limit`` bytes (None: :func:`pcmapq.memory.default_limit`), at most
+    three; InputError (one line) when not even one does. The results kept for the report
+    (at most :data:`~pcmapq.track.timeline.KEEP_BYTES`) are not counted."""
     settings = replace(settings, noref=replace(settings.noref, enabled=False))
     progress("preparing the truth")
-    truth = prepare_truth(load_input(truth_path, settings.truth, TRUTH_CROP), settings)
+    truth = prepare_truth(load_input(truth_path, settings.truth, TRUTH_CROP,
+                                     memory_limit=memory_limit), settings, memory_limit,
+                          maps=tuple(range(FEATURE_THREADS + 1, 0, -1)))
     progress("scoring the steps")
     steps = track(run, truth, settings, ends, reference, pose_options, tick)
     drop = worst_drop(steps)

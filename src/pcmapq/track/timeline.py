@@ -152,7 +152,8 @@ def track(run: Run, prepared: PreparedTruth, settings: Settings, ends: np.ndarra
 
     Two stages overlap: this thread aligns and draws each step's map in turn (a step's ICP
     starts from the pose the step before found), while up to :data:`FEATURE_THREADS` others
-    find the features of the steps already placed and score them. Each step's result depends
+    (fewer when the memory allows fewer maps at once: ``prepared.maps``) find the features of
+    the steps already placed and score them. Each step's result depends
     on its map and its start alone, so the steps are the same as one after the other."""
     distance = travelled(run.poses)
     stamps = run.stamps
@@ -175,7 +176,8 @@ def track(run: Run, prepared: PreparedTruth, settings: Settings, ends: np.ndarra
                     steps[:] = [s if s is None else replace(s, result=None) for s in steps]
             steps[index] = step if held[0] >= 0 else replace(step, result=None)
 
-    with ThreadPoolExecutor(FEATURE_THREADS) as scorers:
+    scoring = min(FEATURE_THREADS, prepared.maps - 1)  # steps scored while one is placed
+    with ThreadPoolExecutor(max(scoring, 1)) as scorers:
         for index, (end, source) in enumerate(zip(ends, run.maps(ends, tick), strict=True)):
             end = int(end)
             time_s = None if stamps is None else float(stamps[end - 1] - stamps[0])
@@ -192,7 +194,7 @@ def track(run: Run, prepared: PreparedTruth, settings: Settings, ends: np.ndarra
             pending.append((index, scorers.submit(
                 _finish, at, source, side, prepared, _settings_from(settings, used), used,
                 extra)))
-            collect(FEATURE_THREADS)
+            collect(scoring)
         collect(0)
     return _with_slide([s for s in steps if s is not None], run.poses)
 
