@@ -278,6 +278,21 @@ def test_drift_at_a_known_scan_is_dated_by_the_worst_drop(runs: Runs) -> None:
     assert values(corrected.steps, "precision")[-1] >= 0.95
 
 
+@pytest.mark.e2e
+def test_the_newest_part_of_a_drifting_map_lies_off_the_truth(runs: Runs) -> None:
+    """``local_offset_m``: the readings since the step before, aligned alone, move less than
+    1 cm at the corrected poses and before the drift; from the first drifted step on they lie
+    farther off the truth than any error of the poses can explain away: above 5 cm at every
+    step. The whole map's alignment meanwhile keeps its older, larger part fitted (``slide_m``
+    under 1 cm)."""
+    corrected, drifted = runs.track_run("corrected"), runs.track_run("drifted")
+    k_step = runs.k_step()
+    assert (values(corrected.steps, "local_offset_m") < 0.01).all()
+    assert (values(drifted.steps[:k_step], "local_offset_m") < 0.01).all()
+    assert (values(drifted.steps[k_step:], "local_offset_m") > 0.05).all()
+    assert (values(drifted.steps, "slide_m") < 0.01).all()
+
+
 # --- 2. the files -----------------------------------------------------------------------------
 
 def _number(cell: str) -> float | None:
@@ -301,7 +316,7 @@ def test_csv_and_json_hold_the_same_steps(runs: Runs) -> None:
     header = text.splitlines()[0].split(",")
     assert header[:len(HEAD)] == list(HEAD) == ["step", "scans", "time_s", "distance_m", "scored"]
     assert header[-1] == "note"
-    assert set(FIGURES) | set(TRAJECTORY) | {"slide_m"} <= set(header)
+    assert set(FIGURES) | set(TRAJECTORY) | {"slide_m", "local_offset_m"} <= set(header)
     rows = list(csv.DictReader(io.StringIO(text)))
     assert [int(r["step"]) for r in rows] == list(range(len(runs.ends())))
     assert [int(r["scans"]) for r in rows] == runs.ends().tolist()
@@ -426,7 +441,8 @@ def test_a_step_equals_a_from_scratch_evaluation(runs: Runs, which: str, tmp_pat
         settings = replace(settings, alignment=replace(settings.alignment, init=step.start))
     result = score(source, load_input(runs.data.corrected, settings.truth, TRUTH_CROP), settings)
     got = figures_of(result)
-    want = {k: v for k, v in step.figures.items() if k != "slide_m" and k not in TRAJECTORY}
+    want = {k: v for k, v in step.figures.items()
+            if k not in ("slide_m", "local_offset_m") and k not in TRAJECTORY}
     assert list(got) == list(want)
     for key, value in want.items():
         if value is None or got[key] is None:

@@ -31,9 +31,10 @@ EVERY = 20
 LEVEL = 0.02
 START_SHARE = 0.5
 #: The figures compared: the detectors' mean precision (the worst drop's), each detector's
-#: quality, and the share of the map's walls within 0.1 m of the truth's.
+#: quality, the share of the map's walls within 0.1 m of the truth's, and how far the newest
+#: part of the map lies off the truth.
 FIGURES = ("precision", "harris_quality", "hough_quality", "sift_quality",
-           "wall_precision@0.1m")
+           "wall_precision@0.1m", "local_offset_m")
 
 
 @dataclass(frozen=True)
@@ -176,7 +177,14 @@ def section(data: Path, record: Record) -> Section:
                  "precision at 0.1 m stays at or above 0.95 from "
                  f"{_min_after(c, 'wall_precision@0.1m', 0.95)}, the detectors' mean "
                  f"precision from {_min_after(c, 'precision', 0.95)} and Harris's quality "
-                 f"from {_min_after(c, 'harris_quality', 0.95)}.", "",
+                 f"from {_min_after(c, 'harris_quality', 0.95)}. The newest part of the map "
+                 "lies at most "
+                 f"{np.nanmax(c.values(c.corrected, 'local_offset_m')):.3f} m off the truth "
+                 "at the corrected poses, at most "
+                 f"{np.nanmax(c.values(c.drifted, 'local_offset_m')[:c.k_step]):.3f} m at the "
+                 "drifted ones before the drift and at least "
+                 f"{np.nanmin(c.values(c.drifted, 'local_offset_m')[c.k_step:]):.3f} m from "
+                 "the first drifted step on.", "",
                  table(c), ""]
         files[f"img/track-{stem}.png"] = picture(c)
     return Section("\n".join(text), files)

@@ -25,7 +25,8 @@ FAMILIES = (
     ("coverage, wall precision", ("coverage", "wall_precision@0.05m", "wall_precision@0.1m",
                                   "wall_precision@0.2m")),
     ("wall distances [m]", ("accuracy_mean_m", "completeness_mean_m")),
-    ("alignment: slide of the first part [m]", ("slide_m",)),
+    ("alignment [m]: offset of the newest part, slide of the first", ("local_offset_m",
+                                                                        "slide_m")),
     ("absolute pose error, APE [m]", ("ape_rmse_m", "ape_max_m")),
     ("relative pose error, RPE: translation [m]", ("rpe_rmse_m",)),
     ("relative pose error, RPE: rotation [deg]", ("rpe_rot_rmse_deg",)),
@@ -41,7 +42,7 @@ FACTS_STYLE = ".facts td { text-align: left; }\n"
 #: The columns of the report's table of steps, those the rows have, and their decimals.
 TABLE = {"step": 0, "scans": 0, "distance_m": 1, "harris_quality": 3, "hough_quality": 3,
          "sift_quality": 3, "precision": 3, "wall_precision@0.1m": 3, "coverage": 3,
-         "accuracy_mean_m": 3, "slide_m": 3, "ape_rmse_m": 3, "rpe_rmse_m": 3,
+         "accuracy_mean_m": 3, "local_offset_m": 3, "slide_m": 3, "ape_rmse_m": 3, "rpe_rmse_m": 3,
          "rpe_rot_rmse_deg": 2}
 
 

@@ -69,8 +69,14 @@ class LaserRun:
 
     def maps(self, ends: Sequence[int],
              tick: Callable[[int], None] = lambda done: None) -> Iterator[PointMap]:
-        """The 2D map of the first ``end`` scans for each of ``ends`` (increasing): every
-        endpoint is computed once, and each map is a prefix of them."""
+        """The 2D map of the first ``end`` scans for each of ``ends`` (increasing)."""
+        return (m for m, _ in self.steps(ends, tick))
+
+    def steps(self, ends: Sequence[int], tick: Callable[[int], None] = lambda done: None
+              ) -> Iterator[tuple[PointMap, np.ndarray]]:
+        """For each of ``ends`` (increasing): the 2D map of the first ``end`` scans, and the
+        readings (N, 3; z = 0) of the scans since the step before. Every endpoint is computed
+        once, and each map is a prefix of them."""
         xy = endpoints(planar_of(self.poses), self.scans.ranges, self.scans.angles,
                        self.max_range)
         with np.errstate(invalid="ignore"):
@@ -80,10 +86,12 @@ class LaserRun:
         offsets = np.concatenate([[0], np.cumsum(counts)])
         views = view_outlines(self.poses[:, :2, 3], xy, np.repeat(np.arange(len(self)), counts))
         points = np.column_stack([xy, np.zeros(len(xy))])
+        before = 0
         for end in ends:
             tick(int(end))
-            yield PointMap(self.path, points[:offsets[end]], is_3d=False, kind="carmen",
-                           views=views[:end])
+            yield (PointMap(self.path, points[:offsets[end]], is_3d=False, kind="carmen",
+                            views=views[:end]), points[offsets[before]:offsets[end]])
+            before = end
 
 
 @dataclass(frozen=True)
@@ -103,22 +111,31 @@ class ScanRun:
 
     def maps(self, ends: Sequence[int],
              tick: Callable[[int], None] = lambda done: None) -> Iterator[PointMap]:
-        """The 3D map of the first ``end`` scans for each of ``ends`` (increasing): each scan
-        is placed and added to the voxel map once."""
+        """The 3D map of the first ``end`` scans for each of ``ends`` (increasing)."""
+        return (m for m, _ in self.steps(ends, tick))
+
+    def steps(self, ends: Sequence[int], tick: Callable[[int], None] = lambda done: None
+              ) -> Iterator[tuple[PointMap, np.ndarray]]:
+        """For each of ``ends`` (increasing): the 3D map of the first ``end`` scans, and the
+        scans since the step before (N, 3; their own voxel map's points). Each scan is placed
+        and added to the voxel maps once."""
         grid, wanted, views = VoxelMap(self.voxel), list(ends), []
+        recent = VoxelMap(self.voxel)
         for index, (points, _) in enumerate(self.sequence):
             ranges = np.linalg.norm(points, axis=1)
             points = points[(ranges >= MIN_RANGE) & (ranges <= MAX_RANGE)]
             pose = self.poses[index]
             placed = points @ pose[:3, :3].T + pose[:3, 3]
             grid.add(placed)
+            recent.add(placed)
             views.append(view_outlines(pose[None, :2, 3], placed[:, :2],
                                        np.zeros(len(placed), dtype=np.int64))[0])
             tick(index + 1)
             if wanted and index + 1 == wanted[0]:
                 wanted.pop(0)
-                yield PointMap(self.path, grid.points(), is_3d=True, kind="scans",
-                               views=np.stack(views))
+                yield (PointMap(self.path, grid.points(), is_3d=True, kind="scans",
+                                views=np.stack(views)), recent.points())
+                recent = VoxelMap(self.voxel)
             if not wanted:
                 return
 

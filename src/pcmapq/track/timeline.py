@@ -8,8 +8,12 @@ method cannot score (too few walls yet, a place it does not recognise) is kept, 
 figures and the reason.
 
 Besides the figures of ``pcmapq eval`` a step holds ``slide_m``: how far the alignment moved
-the positions of the first scored step's scans since that step, RMS metres; a map that drifts
-drags the alignment of the whole map along, and the first part slides away from where it fitted.
+the positions of the first scored step's scans since that step, RMS metres (a map that drifts
+may drag the alignment of the whole map along, and its first part slide away from where it
+fitted); and ``local_offset_m``: how far the readings of the scans since the step before lie
+off the truth where the map's alignment puts them, RMS metres (they alone are aligned to the
+truth, ICP from the map's pose, and moved that much): the part of the map the robot has just
+made, off the truth by drift even while the alignment of the whole map holds still.
 """
 
 from __future__ import annotations
@@ -20,6 +24,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from pcmapq.align import align
 from pcmapq.config import Settings
 from pcmapq.errors import EvaluationError, InputError
 from pcmapq.frames import Frames
@@ -178,7 +183,8 @@ def track(run: Run, prepared: PreparedTruth, settings: Settings, ends: np.ndarra
 
     scoring = min(FEATURE_THREADS, prepared.maps - 1)  # steps scored while one is placed
     with ThreadPoolExecutor(max(scoring, 1)) as scorers:
-        for index, (end, source) in enumerate(zip(ends, run.maps(ends, tick), strict=True)):
+        for index, (end, (source, recent)) in enumerate(zip(ends, run.steps(ends, tick),
+                                                            strict=True)):
             end = int(end)
             time_s = None if stamps is None else float(stamps[end - 1] - stamps[0])
             extra = {} if reference is None else pose_errors(run.poses[:end], reference[:end],
@@ -187,16 +193,39 @@ def track(run: Run, prepared: PreparedTruth, settings: Settings, ends: np.ndarra
             try:
                 side, used = place_step(source, prepared, settings, start)
             except (EvaluationError, InputError) as err:
-                steps[index] = Step(*at, {"slide_m": None, **extra}, str(err), start)
+                steps[index] = Step(*at, {"slide_m": None, "local_offset_m": None, **extra},
+                                    str(err), start)
                 continue
             if settings.alignment.enabled:
                 start = side.alignment.transform
+            extra = {"local_offset_m": local_offset(recent, side, prepared, settings), **extra}
             pending.append((index, scorers.submit(
                 _finish, at, source, side, prepared, _settings_from(settings, used), used,
                 extra)))
             collect(scoring)
         collect(0)
     return _with_slide([s for s in steps if s is not None], run.poses)
+
+
+def local_offset(recent: np.ndarray, side: MapSide, prepared: PreparedTruth,
+                 settings: Settings) -> float | None:
+    """How far the readings ``recent`` (N, 3, map frame, metres) lie off the truth where the
+    placed map ``side`` puts them: aligned alone to the truth (ICP from the map's pose, rigid),
+    their RMS displacement, metres. A 3D map's readings are levelled and cut to its wall band
+    as the map is. None for fewer than 3 readings or with the scale estimated."""
+    level, transform = side.level, side.alignment.transform
+    if level is not None:
+        levelled = np.asarray(recent) @ np.asarray(level.rotation).T
+        height = levelled[:, 2] - level.floor_z_m
+        recent = levelled[(height >= settings.raster.band_low)
+                          & (height <= settings.raster.band_high)]
+    xy = np.asarray(recent, dtype=np.float64)[:, :2]
+    if len(xy) < 3 or settings.alignment.scale:
+        return None
+    fitted = align(xy, prepared.xy, settings.alignment.params, init=transform,
+                   target=prepared.aligner).transform
+    moved = fitted.apply(xy) - transform.apply(xy)
+    return float(np.sqrt(np.mean(np.sum(moved**2, axis=1))))
 
 
 #: Threads finding the features of placed steps while the next step is placed.
