@@ -41,6 +41,7 @@ from pcmapq.track.runs import Run
 from pcmapq.track.steps import travelled
 from pcmapq.trajectory import ape, rpe
 from pcmapq.transform import Similarity2D
+from pcmapq.voxels import evenly, voxel_centroids
 
 #: The summary columns a step does not repeat (they name the inputs or a batch's outcome).
 NOT_PER_STEP = ("name", "map", "truth", "gates", "exit_code", "error")
@@ -207,11 +208,17 @@ def track(run: Run, prepared: PreparedTruth, settings: Settings, ends: np.ndarra
     return _with_slide([s for s in steps if s is not None], run.poses)
 
 
+#: The newest readings are aligned through this many of their voxel centroids at most (evenly
+#: spread): a pose is as sure from a few thousand wall points, and a 3D run's scans hold many.
+LOCAL_POINTS = 5000
+
+
 def local_offset(recent: np.ndarray, side: MapSide, prepared: PreparedTruth,
                  settings: Settings) -> float | None:
     """How far the readings ``recent`` (N, 3, map frame, metres) lie off the truth where the
-    placed map ``side`` puts them: aligned alone to the truth (ICP from the map's pose, rigid),
-    their RMS displacement, metres. A 3D map's readings are levelled and cut to its wall band
+    placed map ``side`` puts them: aligned alone to the truth (ICP from the map's pose, rigid,
+    through at most :data:`LOCAL_POINTS` of their voxel centroids), their RMS displacement,
+    metres. A 3D map's readings are levelled and cut to its wall band
     as the map is. None for fewer than 3 readings or with the scale estimated."""
     level, transform = side.level, side.alignment.transform
     if level is not None:
@@ -222,8 +229,9 @@ def local_offset(recent: np.ndarray, side: MapSide, prepared: PreparedTruth,
     xy = np.asarray(recent, dtype=np.float64)[:, :2]
     if len(xy) < 3 or settings.alignment.scale:
         return None
-    fitted = align(xy, prepared.xy, settings.alignment.params, init=transform,
-                   target=prepared.aligner).transform
+    params = settings.alignment.params
+    fitted = align(evenly(voxel_centroids(xy, params.voxel), LOCAL_POINTS), prepared.xy,
+                   params, init=transform, target=prepared.aligner).transform
     moved = fitted.apply(xy) - transform.apply(xy)
     return float(np.sqrt(np.mean(np.sum(moved**2, axis=1))))
 
