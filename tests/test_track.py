@@ -368,6 +368,9 @@ def test_outputs_name_the_inputs_and_the_step_shown(runs: Runs) -> None:
     asked, folder = runs.tracked_cli_run("cli-step", "--step", "2")
     assert asked.code == 0, asked.stderr
     assert "Step 2 (the step asked)" in (folder / "track.html").read_text()
+    beyond, folder = runs.tracked_cli_run("cli-beyond", "--step", str(len(runs.ends())))
+    assert beyond.code == 2 and not folder.exists()
+    assert f"the run has {len(runs.ends())} steps" in beyond.stderr
 
 
 @pytest.mark.e2e

@@ -108,6 +108,9 @@ def track_command(
                      else reference_poses_of(reference_poses, len(run)))
         ends = step_ends(len(run), (every or 20) if every_m is None else None, every_m,
                          travelled(run.poses))
+        if step is not None and step >= len(ends):
+            raise typer.BadParameter(f"{step}: the run has {len(ends)} steps, 0 to "
+                                     f"{len(ends) - 1}", param_hint="--step")
         tracked = track_run(run, truth_path, settings, ends, reference=reference,
                             pose_options=PoseOptions(align_poses, correct_scale, delta),
                             reference_path=reference_poses, show=step, progress=progress,
