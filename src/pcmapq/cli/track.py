@@ -42,7 +42,8 @@ def track_command(
         help="Score the map every D metres travelled instead.", min=1e-6,
         callback=options.finite)] = None,
     step: Annotated[int | None, typer.Option(
-        help="The step the report shows (default: where the worst drop starts).", min=0,
+        help="The step the report shows (default: where the worst drop starts, else the "
+        "last).", min=0,
         show_default=False)] = None,
     align_poses: Annotated[bool, typer.Option(
         "--align-poses", help="APE/RPE: align the poses first (SE(3) Umeyama, evo's -a).")
