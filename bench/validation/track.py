@@ -97,13 +97,15 @@ def cases(data: Path) -> list[Case]:
 
 
 def picture(c: Curves) -> bytes:
-    """Precision and wall precision of both runs against distance, k and the drop marked."""
+    """Precision, wall precision and the newest part's offset of both runs against distance,
+    k and the drop marked."""
     from matplotlib.figure import Figure
 
-    fig = Figure(figsize=(9, 4.2), layout="constrained")
-    axes = fig.subplots(1, 2, sharex=True)
+    fig = Figure(figsize=(12, 4.2), layout="constrained")
+    axes = fig.subplots(1, 3, sharex=True)
     distance = np.array([s.distance_m for s in c.corrected])
-    for ax, figure in zip(axes, ("precision", "wall_precision@0.1m"), strict=True):
+    for ax, figure in zip(axes, ("precision", "wall_precision@0.1m", "local_offset_m"),
+                          strict=True):
         ax.plot(distance, c.values(c.corrected, figure), ".-", label="corrected poses")
         ax.plot(distance, c.values(c.drifted, figure), ".-", label=f"{100 * LEVEL:g} % gain "
                 f"error after scan {c.k}")
@@ -112,8 +114,8 @@ def picture(c: Curves) -> bytes:
         if c.drop is not None:
             ax.axvline(c.drifted[c.drop.start].distance_m, color="#ee6677", lw=1.2,
                        label="worst drop starts")
-        ax.set_ylim(0, 1.02)
-        ax.set_title(figure, fontsize=9)
+        ax.set_ylim(0, 1.02 if figure != "local_offset_m" else None)
+        ax.set_title(figure + (" [m]" if figure.endswith("_m") else ""), fontsize=9)
         ax.set_xlabel("distance travelled [m]")
         ax.grid(alpha=0.3)
     axes[0].legend(fontsize=7, loc="lower left")
