@@ -50,6 +50,14 @@ NOT_PER_STEP = ("name", "map", "truth", "gates", "exit_code", "error")
 MIN_DROP, NOISE = 0.05, 0.025
 #: Positions of the first scored step that measure the slide (an even sample of them).
 SLIDE_POINTS = 2000
+#: The newest readings are aligned through this many of their voxel centroids at most (evenly
+#: spread): a pose is as sure from a few thousand wall points, and a 3D run's scans hold many.
+LOCAL_POINTS = 5000
+#: Threads finding the features of placed steps while the next step is placed.
+FEATURE_THREADS = 2
+#: The steps' full results are kept while their map rasters and footprints take at most this
+#: many bytes in all (the truth's raster is shared); beyond it none is.
+KEEP_BYTES = 512 * 2**20
 
 
 @dataclass(frozen=True)
@@ -66,8 +74,9 @@ class PoseOptions:
 class Step:
     """One step: the map of the first ``scans`` scans; ``time_s`` since the first scan (None
     without timestamps) and ``distance_m`` travelled at its last scan; ``figures`` the flat
-    columns of :func:`~pcmapq.report.summary.summary_row` plus ``slide_m`` and the trajectory
-    errors (None when undefined); ``note`` why a step was not scored ("" when it was);
+    columns of :func:`~pcmapq.report.summary.summary_row` plus ``slide_m``,
+    ``local_offset_m`` and the trajectory errors (None when undefined); ``note`` why a step
+    was not scored ("" when it was);
     ``start`` the pose its ICP started from (None: the global search); ``frames`` the frames
     its result put the map and truth in (None when not scored); ``result`` its full result,
     while the steps' rasters fit in :data:`KEEP_BYTES` (None otherwise: :func:`result_at`
@@ -159,28 +168,29 @@ def track(run: Run, prepared: PreparedTruth, settings: Settings, ends: np.ndarra
     Two stages overlap: this thread aligns and draws each step's map in turn (a step's ICP
     starts from the pose the step before found), while up to :data:`FEATURE_THREADS` others
     (fewer when the memory allows fewer maps at once: ``prepared.maps``) find the features of
-    the steps already placed and score them. Each step's result depends
-    on its map and its start alone, so the steps are the same as one after the other."""
+    the steps already placed and score them. Each step's result depends on its map and its
+    start alone, so the steps are the same as one after the other."""
     distance = travelled(run.poses)
     stamps = run.stamps
     steps: list[Step | None] = [None] * len(ends)
     pending: list[tuple[int, Future]] = []
     start = settings.alignment.init
 
-    held = [0]  # bytes of the results kept, or -1 once they no longer fit
+    held: int | None = 0  # bytes of the results kept; None once they no longer fit
 
     def collect(wait_for: int) -> None:
         """Score the placed steps while more than ``wait_for`` are in flight; keep their
         results while they fit in :data:`KEEP_BYTES`."""
+        nonlocal held
         while len(pending) > wait_for:
             index, job = pending.pop(0)
             step = job.result()
-            if step.result is not None and held[0] >= 0:
-                held[0] += step.result.map_occupied.nbytes + step.result.overlap.footprint.nbytes
-                if held[0] > KEEP_BYTES:
-                    held[0] = -1
+            if step.result is not None and held is not None:
+                held += step.result.map_occupied.nbytes + step.result.overlap.footprint.nbytes
+                if held > KEEP_BYTES:
+                    held = None
                     steps[:] = [s if s is None else replace(s, result=None) for s in steps]
-            steps[index] = step if held[0] >= 0 else replace(step, result=None)
+            steps[index] = step if held is not None else replace(step, result=None)
 
     scoring = min(FEATURE_THREADS, prepared.maps - 1)  # steps scored while one is placed
     with ThreadPoolExecutor(max(scoring, 1)) as scorers:
@@ -208,18 +218,13 @@ def track(run: Run, prepared: PreparedTruth, settings: Settings, ends: np.ndarra
     return _with_slide([s for s in steps if s is not None], run.poses)
 
 
-#: The newest readings are aligned through this many of their voxel centroids at most (evenly
-#: spread): a pose is as sure from a few thousand wall points, and a 3D run's scans hold many.
-LOCAL_POINTS = 5000
-
-
 def local_offset(recent: np.ndarray, side: MapSide, prepared: PreparedTruth,
                  settings: Settings) -> float | None:
     """How far the readings ``recent`` (N, 3, map frame, metres) lie off the truth where the
     placed map ``side`` puts them: aligned alone to the truth (ICP from the map's pose, rigid,
     through at most :data:`LOCAL_POINTS` of their voxel centroids), their RMS displacement,
-    metres. A 3D map's readings are levelled and cut to its wall band
-    as the map is. None for fewer than 3 readings or with the scale estimated."""
+    metres. A 3D map's readings are levelled and cut to its wall band as the map is. None for
+    fewer than 3 readings or with the scale estimated."""
     level, transform = side.level, side.alignment.transform
     if level is not None:
         levelled = np.asarray(recent) @ np.asarray(level.rotation).T
@@ -236,10 +241,6 @@ def local_offset(recent: np.ndarray, side: MapSide, prepared: PreparedTruth,
     return float(np.sqrt(np.mean(np.sum(moved**2, axis=1))))
 
 
-#: Threads finding the features of placed steps while the next step is placed.
-FEATURE_THREADS = 2
-
-
 def _finish(at: tuple, source, side: MapSide, prepared: PreparedTruth, settings: Settings,
             used: Similarity2D | None, extra: dict) -> Step:
     """A placed step's features matched and scored: its :class:`Step` (``slide_m`` unset)."""
@@ -249,11 +250,6 @@ def _finish(at: tuple, source, side: MapSide, prepared: PreparedTruth, settings:
         return Step(*at, {"slide_m": None, **extra}, str(err), used)
     return Step(*at, {**figures_of(result), "slide_m": None, **extra}, "", used,
                 result.frames, result)
-
-
-#: The steps' full results are kept while their map rasters and footprints take at most this
-#: many bytes in all (the truth's raster is shared); beyond it none is.
-KEEP_BYTES = 512 * 2**20
 
 
 def _with_slide(steps: list[Step], poses: np.ndarray) -> list[Step]:
