@@ -100,14 +100,12 @@ def inputs_of(tracked: Tracked, every: dict) -> dict[str, str]:
     words = {"run": str(run.path), "poses": run.poses_source,
              "truth": str(tracked.truth.source.path)}
     if tracked.reference is not None:
-        how = [name for name, on in (("aligned (SE(3) Umeyama)", options.align and
-                                      not options.correct_scale),
-                                     ("aligned with scale (Sim(3) Umeyama)",
-                                      options.correct_scale),
-                                     ("not aligned", not options.align and
-                                      not options.correct_scale)) if on]
-        words["reference poses"] = (f"{tracked.reference}; {how[0]}, RPE over "
-                                    f"{options.delta} scan{'s' * (options.delta > 1)}")
+        how = {(True, True): "aligned with scale (Sim(3) Umeyama)",
+               (True, False): "aligned (SE(3) Umeyama)",
+               (False, True): "scale corrected, not aligned",
+               (False, False): "not aligned"}[options.align, options.correct_scale]
+        words["reference poses"] = (f"{tracked.reference}; {how}, RPE over {options.delta} "
+                                    f"scan{'s' * (options.delta > 1)}")
     words["steps"] = (f"every {every['every_scans']} scans" if every.get("every_scans")
                       else f"every {every['every_m']:g} m travelled") + ", and the last"
     return words
