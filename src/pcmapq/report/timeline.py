@@ -160,7 +160,8 @@ def timeline_html(rows: list[dict], drop: dict | None, shown: int, result: Resul
          for c in columns] for r in rows]))
     return ("<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'><meta "
             "name='viewport' content='width=device-width, initial-scale=1'><title>pcmapq "
-            f"track</title><style>{STYLE}{FACTS_STYLE}</style></head><body>{''.join(parts)}</body></html>\n")
+            f"track</title><style>{STYLE}{FACTS_STYLE}</style></head><body>{''.join(parts)}"
+            "</body></html>\n")
 
 
 def _cell(value: object, digits: int) -> str:
