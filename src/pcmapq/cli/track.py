@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import sys
+from dataclasses import asdict
 from pathlib import Path
 from typing import Annotated
 
@@ -85,7 +86,9 @@ def track_command(
 ) -> None:
     """Score a SLAM run's map as it grows, every N scans or D metres, against the truth:
     when did the map go wrong, and where was the robot then?"""
+    from pcmapq.report.timeline import drop_words
     from pcmapq.track import PoseOptions, step_ends, track_run, travelled, write_track
+    from pcmapq.track.outputs import step_rows
     from pcmapq.track.runs import open_run, reference_poses_of
 
     if len(paths) != 2:
@@ -128,13 +131,11 @@ def track_command(
     if json_path == "-":
         sys.stdout.write(wrote[1].read_text())
     elif not quiet:
-        drop = tracked.drop
+        drop = None if tracked.drop is None else asdict(tracked.drop)
         err.print(f"{len(tracked.steps)} steps ({scored} scored) of {len(run)} scans; "
-                  + ("no drop" if drop is None else
-                     f"worst drop of {drop.figure}: {drop.size:.3f} from step {drop.start} "
-                     f"({tracked.steps[drop.start].distance_m:.0f} m travelled)")
-                  + f"; wrote {out}/track.csv, track.json, track.png, track.html",
-                  markup=False, highlight=False, soft_wrap=True)
+                  f"{drop_words(step_rows(tracked.steps), drop)}; wrote {out}/track.csv, "
+                  "track.json, track.png, track.html", markup=False, highlight=False,
+                  soft_wrap=True)
     if not scored:  # nothing to measure: said as such, and not a success
         err.print(f"pcmapq: error: {run_path}: no step could be scored; the last: "
                   f"{tracked.steps[-1].note}", markup=False, highlight=False, soft_wrap=True)
