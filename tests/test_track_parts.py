@@ -8,11 +8,13 @@ import pytest
 
 from pcmapq import memory
 from pcmapq.grid import MetricGrid
+from pcmapq.io.carmen import beam_angles
 from pcmapq.plan import distinct_cells
 from pcmapq.raster.draw import view_cells
 from pcmapq.raster.footprint import footprint_rule, map_footprint, view_outlines
 from pcmapq.report.timeline import timeline_html
 from pcmapq.track.outputs import step_rows
+from pcmapq.track.runs import dense_reach
 from pcmapq.track.steps import step_ends, travelled
 from pcmapq.track.timeline import MIN_DROP, Step, worst_drop
 
@@ -76,6 +78,36 @@ def test_views_are_a_union_over_scans():
     assert (seen == one).all()
     grown = map_footprint("seen", np.zeros(GRID.shape, bool), GRID, 0.3, views=views)
     assert grown.sum() > seen.sum() and (grown | ~seen).all()
+
+
+def test_a_view_reaches_no_farther_than_max_reach():
+    """The room scan's view capped at 1 m: every vertex within 1 m of the scanner, its cells a
+    disc of 1 m inside the room (the walls are 1.5 m away or more); a cap beyond the walls
+    changes nothing."""
+    box = (2.0, 3.0, 8.0, 7.0)
+    origin = np.array([4.0, 5.0])
+    hits = _room_scan(origin, box)
+    scan = np.zeros(len(hits), dtype=np.int64)
+    capped = view_outlines(origin[None], hits, scan, max_reach=1.0)
+    assert np.hypot(*(capped[0] - origin).T).max() == pytest.approx(1.0)
+    xy = GRID.cell_centres(view_cells(capped, GRID))
+    assert np.hypot(*(xy - origin).T).max() <= 1.0 + GRID.resolution
+    # the fill takes the cells its outline crosses too: half a cell beyond it
+    assert len(xy) * GRID.resolution**2 == pytest.approx(
+        np.pi * (1.0 + GRID.resolution / 2) ** 2, rel=0.02)
+    assert (view_outlines(origin[None], hits, scan, max_reach=50.0) ==
+            view_outlines(origin[None], hits, scan)).all()
+
+
+def test_dense_reach_of_a_laser_is_where_its_readings_stop_joining():
+    """CARMEN's 180 beams over 180 degrees are 1 degree apart: readings 0.2 m apart (twice
+    the wall image's closing) at 0.2 / (pi / 180) = 11.46 m; padding (NaN) is ignored; one
+    beam bounds nothing."""
+    angles = np.tile(beam_angles(180), (3, 1))
+    assert dense_reach(angles) == pytest.approx(0.2 / np.radians(1.0))
+    padded = np.column_stack([angles, np.full((3, 5), np.nan)])
+    assert dense_reach(padded) == dense_reach(angles)
+    assert dense_reach(angles[:, :1]) == np.inf
 
 
 def test_footprint_rule_seen_needs_views():

@@ -56,6 +56,9 @@ TILE, HALO = 2048, 4.0
 THICKEST = 2.0
 #: Threads drawing tiles, at most.
 THREADS = 4
+#: The closing's radius, metres (module docstring, 2): readings of a wall up to about twice this
+#: apart join into one line.
+CLOSING = 0.1
 
 def _overlap_matrix(n_out: int, out_size: float, n_in: int, in_size: float) -> sparse.csr_array:
     """(n_out, n_in) weights of 1D area averaging: the fraction of output cell ``i`` (length
@@ -206,7 +209,7 @@ class WallImage:
 
 
 def wall_image(occupied: np.ndarray, grid: MetricGrid, resolution: float = 0.05,
-               closing: float = 0.1, width: float = 0.15, spur: float = 0.25,
+               closing: float = CLOSING, width: float = 0.15, spur: float = 0.25,
                small: float = 1.0, tile: int = TILE) -> WallImage:
     """The walls as the detectors see them: their centre lines drawn ``width`` metres wide.
 

@@ -135,18 +135,20 @@ def map_footprint(rule: str, occupied: np.ndarray, grid: MetricGrid, margin: flo
 
 
 def view_outlines(origins: np.ndarray, points: np.ndarray, scan: np.ndarray,
-                  bins: int = 360) -> np.ndarray:
+                  bins: int = 360, max_reach: float = np.inf) -> np.ndarray:
     """The views of K scans, (K, bins, 2) metres: scan k's farthest reading in each of
     ``bins`` equal angular sectors around its scanner at ``origins[k]`` (K, 2), in angular
-    order, or the scanner itself for a sector with no reading. ``points`` (N, 2) are the
-    readings in the same frame, ``scan`` (N,) the scan of each. A star-shaped polygon: the
-    free space the scan saw (:func:`pcmapq.raster.draw.view_cells` fills it)."""
+    order, but no farther than ``max_reach`` metres from it, or the scanner itself for a
+    sector with no reading. ``points`` (N, 2) are the readings in the same frame, ``scan``
+    (N,) the scan of each. A star-shaped polygon: the free space the scan saw
+    (:func:`pcmapq.raster.draw.view_cells` fills it)."""
     origins = np.asarray(origins, dtype=np.float64).reshape(-1, 2)
     offset = np.asarray(points, dtype=np.float64).reshape(-1, 2) - origins[scan]
     angle = np.arctan2(offset[:, 1], offset[:, 0])
     sector = np.minimum(((angle + np.pi) / (2 * np.pi) * bins).astype(np.int64), bins - 1)
     reach = np.zeros((len(origins), bins))
     np.maximum.at(reach, (scan, sector), np.hypot(offset[:, 0], offset[:, 1]))
+    np.minimum(reach, max_reach, out=reach)
     centre = -np.pi + (np.arange(bins) + 0.5) * (2 * np.pi / bins)
     return origins[:, None, :] + reach[..., None] * np.stack([np.cos(centre),
                                                                np.sin(centre)], axis=-1)
