@@ -142,8 +142,7 @@ def place_step(source, prepared: PreparedTruth, settings: Settings,
     if start is None or not option.enabled:
         return place_prepared(source, prepared, settings), option.init
     try:
-        return place_prepared(source, prepared,
-                              replace(settings, alignment=replace(option, init=start))), start
+        return place_prepared(source, prepared, _settings_from(settings, start)), start
     except EvaluationError:
         if option.force:
             raise
@@ -277,11 +276,8 @@ def result_at(run: Run, prepared: PreparedTruth, settings: Settings, step: Step)
     it computed it (the same map, the same start: the same result)."""
     if step.result is not None:
         return step.result
-    source = next(run.maps([step.scans]))
-    if step.start is None or not settings.alignment.enabled:
-        return score_prepared(source, prepared, settings)
-    return score_prepared(source, prepared, replace(settings, alignment=replace(
-        settings.alignment, init=step.start)))
+    return score_prepared(next(run.maps([step.scans])), prepared,
+                          _settings_from(settings, step.start))
 
 
 @dataclass(frozen=True)
