@@ -6,7 +6,7 @@ from typing import Annotated
 
 import typer
 
-from pcmapq import __version__
+from pcmapq import __version__, options
 from pcmapq.config import Settings
 from pcmapq.terminal import HELP_WIDTH, OneLineUsageErrors
 
@@ -50,4 +50,13 @@ FailOver = Annotated[str | None, typer.Option(
     metavar="<KEY=VALUE,...>",
     help="CI gate for distances: exit 3 when a figure is above its bound, e.g. "
     "accuracy.mean=0.05 (metres).")]
+#: The memory limit of eval and track, in GB (:func:`memory_limit` in bytes).
+MaxMemory = Annotated[float | None, typer.Option(
+    help="Stop (exit 2) before a run estimated to need more than this many GB "
+    "(default: 75 % of this machine's memory).", min=0.0, show_default=False,
+    callback=options.finite)]
 
+
+def memory_limit(max_memory: float | None) -> int | None:
+    """``--max-memory`` GB in bytes; None (the default limit) without it."""
+    return None if max_memory is None else int(max_memory * 1e9)

@@ -11,7 +11,7 @@ import typer
 from rich.console import Console
 
 from pcmapq import gates, options, terminal
-from pcmapq.cli.app import DEFAULTS, FailOver, FailUnder, app
+from pcmapq.cli.app import DEFAULTS, FailOver, FailUnder, MaxMemory, app, memory_limit
 from pcmapq.config import (
     DETECTOR_NAMES,
     Settings,
@@ -135,10 +135,7 @@ def eval_command(
     full: Annotated[bool, typer.Option(
         "--full", help="Score against the whole truth, not only the part the map covers.")
     ] = False,
-    max_memory: Annotated[float | None, typer.Option(
-        help="Stop (exit 2) before a run estimated to need more than this many GB "
-        "(default: 75 % of this machine's memory).", min=0.0, show_default=False,
-        callback=options.finite)] = None,
+    max_memory: MaxMemory = None,
     aligned: Annotated[Path | None, typer.Option(
         help="Write the map moved into the truth's frame: .ply/.pcd for a cloud map (a 3D "
         "cloud keeps its heights), .png/.pgm with its map_server YAML for an image map.")
@@ -199,7 +196,7 @@ def eval_command(
             progress("mapping the scans with KISS-ICP")
             points, _ = build_map_kiss(scans, max_scans=max_scans)
             map_path = PointMap(scans, points, True, kind="scans")
-        limit = None if max_memory is None else int(max_memory * 1e9)
+        limit = memory_limit(max_memory)
         result = replace(evaluate(map_path, truth_path, settings, progress, limit),
                          command=options.command_line(ctx))
         doc = result.to_dict() if rules else {}

@@ -11,7 +11,7 @@ import typer
 from rich.console import Console
 
 from pcmapq import options, terminal
-from pcmapq.cli.app import DEFAULTS, app
+from pcmapq.cli.app import DEFAULTS, MaxMemory, app, memory_limit
 from pcmapq.errors import InputError
 from pcmapq.io.writers import OutputSet, write_atomic
 from pcmapq.raster.footprint import FOOTPRINT_RULES
@@ -75,10 +75,7 @@ def track_command(
     tau: Annotated[str, typer.Option(
         help="Distance thresholds of the F-score and wall precision, metres.")
     ] = ",".join(f"{t:g}" for t in DEFAULTS.distances.taus),
-    max_memory: Annotated[float | None, typer.Option(
-        help="Stop (exit 2) before a run estimated to need more than this many GB "
-        "(default: 75 % of this machine's memory).", min=0.0, show_default=False,
-        callback=options.finite)] = None,
+    max_memory: MaxMemory = None,
     json_path: Annotated[str | None, typer.Option(
         "--json", help="Also write track.json to this path ('-' for stdout only).")] = None,
     quiet: Annotated[bool, typer.Option(
@@ -119,7 +116,7 @@ def track_command(
                             pose_options=PoseOptions(align_poses, correct_scale, delta),
                             reference_path=reference_poses, show=step, progress=progress,
                             tick=lambda done: progress(f"scoring: {done} of {len(run)} scans"),
-                            memory_limit=None if max_memory is None else int(max_memory * 1e9))
+                            memory_limit=memory_limit(max_memory))
         rule = {"every_scans": None if every_m is not None else (every or 20),
                 "every_m": every_m}
         wrote = write_track(tracked, out, rule, options.command_line(ctx))
