@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -233,16 +233,17 @@ def evaluate(map_path: str | Path | PointMap, truth_path: str | Path,
     return score(source, truth, settings, progress, memory_limit)
 
 
-def needed_memory(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap,
-                  truth_xy: np.ndarray, settings: Settings) -> int:
-    """Estimated peak memory, bytes, of scoring ``source`` against ``truth`` (whose plan points
-    are ``truth_xy``, metres): see :mod:`pcmapq.memory`."""
-    images = sum(int(np.prod(s.grid.shape)) for s in (source, truth)
-                 if isinstance(s, OccupancyMap))
-    points = sum(len(s.points) for s in (source, truth) if isinstance(s, PointMap))
-    grid = truth_grid(truth, truth_xy, settings)
+def needed_memory(inputs: Sequence[OccupancyMap | PointMap], grid: MetricGrid,
+                  more_maps: int = 0) -> int:
+    """Estimated peak memory, bytes, of scoring a map against a truth (``inputs``: both, or
+    the truth alone for what it needs whatever the map) on the truth's ``grid``, with
+    ``more_maps`` maps more scored on it at once: see :mod:`pcmapq.memory`."""
+    images = sum(int(np.prod(s.grid.shape)) for s in inputs if isinstance(s, OccupancyMap))
+    points = sum(len(s.points) for s in inputs if isinstance(s, PointMap))
     cells = int(np.prod(grid.shape))
-    return memory.needed_bytes(images, cells, cells * grid.resolution**2, points)
+    extent = cells * grid.resolution**2
+    one_map = memory.needed_bytes(0, cells, extent, 0) - memory.BASE
+    return memory.needed_bytes(images, cells, extent, points) + more_maps * one_map
 
 
 def harris_corners(truth: OccupancyMap | PointMap, found: dict[str, Features],
@@ -264,7 +265,7 @@ class PreparedTruth:
     cell's distance to the nearest truth wall, metres; ``aligner``: its points prepared for
     the rigid alignment (:class:`~pcmapq.align.planar.RigidTarget`); ``maps``: how many maps
     may be scored on its grid at once in the memory allowed. Made once by
-    :func:`prepare_truth` for many maps (``pcmapq track``'s steps)."""
+    :func:`pcmapq.prepared.prepare_truth` for many maps (``pcmapq track``'s steps)."""
 
     source: OccupancyMap | PointMap
     xy: np.ndarray
@@ -293,41 +294,6 @@ class MapSide:
     to_map: np.ndarray
     cover: Overlap
     features: dict[str, Features]
-
-
-def prepare_truth(truth: OccupancyMap | PointMap, settings: Settings,
-                  memory_limit: int | None = None,
-                  maps: tuple[int, ...] = (1,)) -> PreparedTruth:
-    """Everything of the truth that does not depend on the map: plan points, raster, features
-    (on two threads) and distance field; see :class:`PreparedTruth`.
-
-    maps: how many maps the caller would score on its grid at once, most wanted first; the
-    first whose estimated memory fits in ``memory_limit`` bytes (None: the default) is kept as
-    ``PreparedTruth.maps``; InputError (one line) when none fits."""
-    check_span(truth, TRUTH_CROP)
-    truth_xy, level = plan_points(truth, settings)
-    grid = truth_grid(truth, truth_xy, settings)
-    cells = int(np.prod(grid.shape))
-    extent = cells * grid.resolution**2
-    image = int(np.prod(truth.grid.shape)) if isinstance(truth, OccupancyMap) else 0
-    points = len(truth.points) if isinstance(truth, PointMap) else 0
-    one_map = memory.needed_bytes(0, cells, extent, 0) - memory.BASE
-    need = {n: memory.needed_bytes(image, cells, extent, points) + n * one_map for n in maps}
-    limit = memory.default_limit() if memory_limit is None else memory_limit
-    fits = [n for n in maps if need[n] <= limit]
-    least = min(maps)
-    memory.guard(need[fits[0] if fits else least], memory_limit,
-                 f"{truth.path} with {least} map{'s' * (least > 1)} scored on its grid",
-                 lambda: hint(truth, TRUTH_CROP, grid.resolution))
-    grid, occupied = truth_raster(truth, truth_xy, settings)
-    sides = SideBySide(settings.matching.detectors, settings.matching.params)
-    option = settings.alignment
-    aligner = (RigidTarget(truth_xy, option.params) if option.enabled and not option.scale
-               else None)
-    return PreparedTruth(truth, truth_xy, level, grid, occupied,
-                         sides.features(occupied, grid, threads=2),
-                         nearest_distance(occupied, grid), aligner,
-                         fits[0] if fits else least)
 
 
 def place_map(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap,
@@ -381,10 +347,10 @@ def score(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap, setti
     check_span(source, MAP_CROP)
     rule = map_footprint_rule(source, settings)
     truth_xy, truth_level = plan_points(truth, settings)
-    cell = truth_grid(truth, truth_xy, settings).resolution
-    memory.guard(needed_memory(source, truth, truth_xy, settings), memory_limit,
+    cell = truth_grid(truth, truth_xy, settings)
+    memory.guard(needed_memory((source, truth), cell), memory_limit,
                  f"{source.path} against {truth.path}",
-                 lambda: hint(truth, TRUTH_CROP, cell) or hint(source, MAP_CROP))
+                 lambda: hint(truth, TRUTH_CROP, cell.resolution) or hint(source, MAP_CROP))
     grid, truth_occ = truth_raster(truth, truth_xy, settings)
     sides = SideBySide(settings.matching.detectors, settings.matching.params)
     with ThreadPoolExecutor(1) as background:
@@ -398,33 +364,6 @@ def score(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap, setti
             sides.cancel()
             raise
     return assemble(source, side, prepared, settings, rule, progress)
-
-
-def score_prepared(source: OccupancyMap | PointMap, prepared: PreparedTruth,
-                   settings: Settings, progress: Progress = lambda step: None) -> Result:
-    """:func:`score` against a truth prepared once (:func:`prepare_truth`) with the same
-    ``settings``: the same result, without the truth's work."""
-    return finish_prepared(source, place_prepared(source, prepared, settings, progress),
-                           prepared, settings, progress)
-
-
-def place_prepared(source: OccupancyMap | PointMap, prepared: PreparedTruth,
-                   settings: Settings, progress: Progress = lambda step: None) -> MapSide:
-    """The first half of :func:`score_prepared`: ``source`` aligned, drawn and checked
-    (:func:`place_map`), without features."""
-    check_span(source, MAP_CROP)
-    return place_map(source, prepared.source, prepared.xy, prepared.grid, prepared.occupied,
-                     settings, map_footprint_rule(source, settings), progress,
-                     prepared.aligner)
-
-
-def finish_prepared(source: OccupancyMap | PointMap, side: MapSide, prepared: PreparedTruth,
-                    settings: Settings, progress: Progress = lambda step: None) -> Result:
-    """The second half of :func:`score_prepared`: the features of ``side`` (from
-    :func:`place_prepared`) matched against the prepared truth's, and the result."""
-    sides = SideBySide(settings.matching.detectors, settings.matching.params)
-    return assemble(source, with_features(side, prepared.grid, sides, progress), prepared,
-                    settings, map_footprint_rule(source, settings), progress)
 
 
 def assemble(loaded: OccupancyMap | PointMap, side: MapSide, prepared: PreparedTruth,

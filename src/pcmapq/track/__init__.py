@@ -17,8 +17,9 @@ import numpy as np
 
 from pcmapq.config import Settings
 from pcmapq.io.writers import OutputSet, write_atomic
-from pcmapq.pipeline import PreparedTruth, prepare_truth
+from pcmapq.pipeline import PreparedTruth
 from pcmapq.plan import TRUTH_CROP, load_input
+from pcmapq.prepared import prepare_truth
 from pcmapq.result import Result
 from pcmapq.track.outputs import step_rows, track_csv, track_json
 from pcmapq.track.runs import Run, open_run, planar_of, planar_poses

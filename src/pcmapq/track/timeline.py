@@ -28,13 +28,8 @@ from pcmapq.align import align
 from pcmapq.config import Settings
 from pcmapq.errors import EvaluationError, InputError
 from pcmapq.frames import Frames
-from pcmapq.pipeline import (
-    MapSide,
-    PreparedTruth,
-    finish_prepared,
-    place_prepared,
-    score_prepared,
-)
+from pcmapq.pipeline import MapSide, PreparedTruth
+from pcmapq.prepared import finish_prepared, place_prepared, score_prepared
 from pcmapq.report.summary import summary_row
 from pcmapq.result import Result
 from pcmapq.track.runs import Run
@@ -135,7 +130,7 @@ def figures_of(result: Result) -> dict[str, float | None]:
 
 def place_step(source, prepared: PreparedTruth, settings: Settings,
                start: Similarity2D | None) -> tuple[MapSide, Similarity2D | None]:
-    """Align and draw one step's map (:func:`~pcmapq.pipeline.place_prepared`), ICP from
+    """Align and draw one step's map (:func:`~pcmapq.prepared.place_prepared`), ICP from
     ``start`` (None: the global search); a start whose pose is refused is followed by a global
     search. The placed map and the start it used."""
     option = settings.alignment
