@@ -270,9 +270,9 @@ def test_drift_at_a_known_scan_is_dated_by_the_worst_drop(runs: Runs) -> None:
     assert drop.peak < k_step <= drop.low and drop.size >= 2 * MIN_DROP
     assert drifted.shown == drop.start and drifted.result is not None
 
-    # a partial map of a perfect run wavers too (measured: 0.93 -> 0.86 at step 3, a drop of
-    # 0.07), but less than the drift makes it fall
-    assert corrected.drop is None or corrected.drop.size < drop.size / 2
+    # a partial map of a perfect run wavers too (measured: 0.93 -> 0.86 at step 3, 0.07), but
+    # later steps make it up: no lasting drop
+    assert corrected.drop is None
     assert (values(corrected.steps, "wall_precision@0.1m") >= 0.99).all()
     assert (values(corrected.steps, "precision") >= 0.8).all()
     assert values(corrected.steps, "precision")[-1] >= 0.95

@@ -143,6 +143,20 @@ def test_worst_drop_starts_after_the_last_step_level_with_the_peak():
     assert drop is not None
     assert (drop.peak, drop.start, drop.low) == (3, 6, 8)
     assert drop.size == pytest.approx(0.32)
+    assert drop.lasting == pytest.approx(0.27)  # step 9 came back to 0.65
+
+
+def test_a_dip_the_map_recovers_from_is_no_drop():
+    """A fall of 0.1 that later steps make up is no drop; one made up only in part is a drop
+    of its full size, lasting what was never made up; the worst lasting one is reported."""
+    assert worst_drop(_steps([0.9, 0.93, 0.83, 0.9, 0.95, 1.0])) is None
+    drop = worst_drop(_steps([0.9, 0.9, 0.6, 0.7, 0.7]))
+    assert (drop.peak, drop.start, drop.low) == (1, 2, 2)
+    assert (drop.size, drop.lasting) == pytest.approx((0.3, 0.2))
+    # a deep dip made up, then a shallower fall that lasts
+    drop = worst_drop(_steps([0.9, 0.5, 0.9, 0.92, 0.8, 0.8]))
+    assert (drop.peak, drop.start, drop.low) == (3, 4, 4)
+    assert drop.lasting == pytest.approx(0.12)
 
 
 def test_no_drop_in_a_rising_run_or_below_the_band():
@@ -164,6 +178,6 @@ def test_the_report_of_a_run_without_a_drop_says_so():
     page = timeline_html(rows, None, 2, None, None, command=None,
                          inputs={"run": "run.log", "poses": "est.txt", "truth": "truth.png"})
     assert "Step 2 (the last step; no drop): 30 of 30 scans" in page
-    assert "no drop of precision (none of at least 0.05)" in page
+    assert "no lasting drop of precision (none of at least 0.05)" in page
     assert "not scored: degenerate map" in page
     assert "<td>poses</td><td>est.txt</td>" in page

@@ -54,13 +54,14 @@ def _colour(column: str, index: int) -> str:
 
 
 def drop_words(rows: list[dict], drop: dict | None) -> str:
-    """The worst drop in words: how far the figure fell, from which step to which, and where
-    the fall started; or that there was none."""
+    """The worst drop in words: how far the figure fell, from which step to which, how much
+    of it lasted, and where the fall started; or that there was none."""
     if drop is None:
-        return "no drop of precision (none of at least 0.05)"
+        return "no lasting drop of precision (none of at least 0.05)"
     figure, peak, low, start = drop["figure"], drop["peak"], drop["low"], drop["start"]
     return (f"{figure} fell {drop['size']:.3f}, from {rows[peak][figure]:.3f} at step {peak} "
-            f"to {rows[low][figure]:.3f} at step {low}; the fall starts at step {start} "
+            f"to {rows[low][figure]:.3f} at step {low}, and never came back within "
+            f"{drop['lasting']:.3f} of it; the fall starts at step {start} "
             f"({rows[start]['distance_m']:.0f} m)")
 
 

@@ -203,10 +203,9 @@ def track(run: Run, prepared: PreparedTruth, settings: Settings, ends: np.ndarra
                 continue
             if settings.alignment.enabled:
                 start = side.alignment.transform
-            extra = {"local_offset_m": local_offset(recent, side, prepared, settings), **extra}
             pending.append((index, scorers.submit(
-                _finish, at, source, side, prepared, _settings_from(settings, used), used,
-                extra)))
+                _finish, at, source, recent, side, prepared, _settings_from(settings, used),
+                used, extra)))
             collect(scoring)
         collect(0)
     return _with_slide([s for s in steps if s is not None], run.poses)
@@ -235,9 +234,11 @@ def local_offset(recent: np.ndarray, side: MapSide, prepared: PreparedTruth,
     return float(np.sqrt(np.mean(np.sum(moved**2, axis=1))))
 
 
-def _finish(at: tuple, source, side: MapSide, prepared: PreparedTruth, settings: Settings,
-            used: Similarity2D | None, extra: dict) -> Step:
-    """A placed step's features matched and scored: its :class:`Step` (``slide_m`` unset)."""
+def _finish(at: tuple, source, recent: np.ndarray, side: MapSide, prepared: PreparedTruth,
+            settings: Settings, used: Similarity2D | None, extra: dict) -> Step:
+    """A placed step's features matched and scored, and the offset of its ``recent`` readings
+    (:func:`local_offset`): its :class:`Step` (``slide_m`` unset)."""
+    extra = {"local_offset_m": local_offset(recent, side, prepared, settings), **extra}
     try:
         result = finish_prepared(source, side, prepared, settings)
     except (EvaluationError, InputError) as err:
@@ -277,30 +278,38 @@ def result_at(run: Run, prepared: PreparedTruth, settings: Settings, step: Step)
 
 @dataclass(frozen=True)
 class Drop:
-    """The worst fall of a figure along the steps: it peaked at step ``peak``, started to fall
-    at step ``start`` (the step after the last one still within :data:`NOISE` of the peak:
-    where the map went wrong) and was lowest at step ``low``, ``size`` below the peak."""
+    """The worst lasting fall of a figure along the steps: it peaked at step ``peak``, started
+    to fall at step ``start`` (the step after the last one still within :data:`NOISE` of the
+    peak: where the map went wrong) and was lowest at step ``low``, ``size`` below the peak;
+    no later step came back within ``lasting`` of the peak."""
 
     figure: str
     peak: int
     start: int
     low: int
     size: float
+    lasting: float
 
 
 def worst_drop(steps: list[Step], figure: str = "precision") -> Drop | None:
-    """The largest fall of ``figure`` from its highest value so far (the maximum drawdown) over
-    the scored steps; None with fewer than two, or when it is less than :data:`MIN_DROP`."""
+    """The largest fall of ``figure`` from its highest value so far that no later step makes
+    up (the maximum drawdown of the later steps' best), over the scored steps; None with fewer
+    than two, or when it is less than :data:`MIN_DROP`. A map keeps every scan it took, so a
+    part that went wrong stays in it and the figure stays down; a dip it recovers from (a
+    wall scored before the rest of it was seen) is no fault."""
     scored = [s for s in steps if s.scored and s.figures.get(figure) is not None]
     if len(scored) < 2:
         return None
     values = np.array([s.figures[figure] for s in scored])
     peaks = np.maximum.accumulate(values)
-    low = int(np.argmax(peaks - values))
-    if peaks[low] - values[low] < MIN_DROP:
+    later_best = np.maximum.accumulate(values[::-1])[::-1]
+    worst = int(np.argmax(peaks - later_best))
+    lasting = float(peaks[worst] - later_best[worst])
+    if lasting < MIN_DROP:
         return None
-    peak = int(np.flatnonzero(values[:low + 1] == peaks[low])[-1])
-    level = np.flatnonzero(values[peak:low + 1] >= peaks[low] - NOISE)
+    peak = int(np.flatnonzero(values[:worst + 1] == peaks[worst])[-1])
+    low = peak + int(np.argmin(values[peak:worst + 1]))
+    level = np.flatnonzero(values[peak:low + 1] >= peaks[worst] - NOISE)
     start = peak + int(level[-1]) + 1
     return Drop(figure, scored[peak].step, scored[start].step, scored[low].step,
-                float(peaks[low] - values[low]))
+                float(peaks[worst] - values[low]), lasting)
