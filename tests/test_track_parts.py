@@ -3,6 +3,8 @@ footprint, when steps fall, the worst drop."""
 
 from __future__ import annotations
 
+from dataclasses import asdict
+
 import numpy as np
 import pytest
 
@@ -12,7 +14,7 @@ from pcmapq.io.carmen import beam_angles
 from pcmapq.plan import distinct_cells
 from pcmapq.raster.draw import view_cells
 from pcmapq.raster.footprint import footprint_rule, map_footprint, view_outlines
-from pcmapq.report.timeline import timeline_html
+from pcmapq.report.timeline import drop_words, timeline_html
 from pcmapq.track.outputs import step_rows
 from pcmapq.track.runs import dense_reach
 from pcmapq.track.steps import step_ends, travelled
@@ -163,6 +165,16 @@ def test_no_drop_in_a_rising_run_or_below_the_band():
     assert worst_drop(_steps([0.5, 0.6, 0.7, 0.8, 0.9, 1.0])) is None
     assert worst_drop(_steps([0.9, 0.9 - 0.9 * MIN_DROP, 0.9])) is None
     assert worst_drop(_steps([None, 0.9])) is None
+
+
+def test_the_drop_in_words_says_how_far_later_steps_came_back():
+    steps = _steps([0.9, 0.9, 0.6, 0.7, 0.65])
+    words = drop_words(step_rows(steps), asdict(worst_drop(steps)))
+    assert words == ("precision fell 0.300, from 0.900 at step 1 to 0.600 at step 2, and no "
+                     "later step came back above 0.700; the fall starts at step 2 (2 m)")
+    steps = _steps([0.9, 0.9, 0.8, 0.7])
+    assert ("to 0.700 at step 3, the last step scored; the fall starts at step 2"
+            in drop_words(step_rows(steps), asdict(worst_drop(steps))))
 
 
 def test_distinct_cells_counts_cells_as_a_row_wise_unique():

@@ -54,15 +54,17 @@ def _colour(column: str, index: int) -> str:
 
 
 def drop_words(rows: list[dict], drop: dict | None) -> str:
-    """The worst drop in words: how far the figure fell, from which step to which, how much
-    of it lasted, and where the fall started; or that there was none."""
+    """The worst drop in words: how far the figure fell, from which step to which, how far
+    later steps came back, and where the fall started; or that there was none."""
     if drop is None:
         return "no lasting drop of precision (none of at least 0.05)"
     figure, peak, low, start = drop["figure"], drop["peak"], drop["low"], drop["start"]
+    later = [r[figure] for r in rows[low + 1:] if r.get(figure) is not None]
+    after = (f", and no later step came back above {max(later):.3f}" if later else
+             ", the last step scored")
     return (f"{figure} fell {drop['size']:.3f}, from {rows[peak][figure]:.3f} at step {peak} "
-            f"to {rows[low][figure]:.3f} at step {low}, and never came back within "
-            f"{drop['lasting']:.3f} of it; the fall starts at step {start} "
-            f"({rows[start]['distance_m']:.0f} m)")
+            f"to {rows[low][figure]:.3f} at step {low}{after}; the fall starts at step "
+            f"{start} ({rows[start]['distance_m']:.0f} m)")
 
 
 def timeline_figure(rows: list[dict], drop: dict | None, title: str = "") -> Figure:
