@@ -52,15 +52,9 @@ from pcmapq.features.base import (
     no_candidates,
     sorted_features,
 )
+from pcmapq.features.merging import merge
 from pcmapq.features.ridges import pieces, ridges
-from pcmapq.features.segments import (
-    away,
-    directions,
-    inside_runs,
-    merge,
-    near_pairs,
-    wall_test,
-)
+from pcmapq.features.segments import away, directions, inside_runs, near_pairs, wall_test
 from pcmapq.features.walls import WallImage
 
 
