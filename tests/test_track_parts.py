@@ -12,17 +12,24 @@ from pcmapq import memory
 from pcmapq.grid import MetricGrid
 from pcmapq.io.carmen import beam_angles
 from pcmapq.plan import distinct_cells
-from pcmapq.raster.draw import view_cells
 from pcmapq.raster.footprint import footprint_rule, map_footprint, view_outlines
+from pcmapq.raster.seen import NO_VIEW, add_views, seen_on
 from pcmapq.report.timeline import drop_words, timeline_html
 from pcmapq.track.outputs import step_rows
 from pcmapq.track.runs import dense_reach
 from pcmapq.track.steps import step_ends, travelled
 from pcmapq.track.timeline import MIN_DROP, Step, worst_drop
+from pcmapq.transform import Similarity2D
 
 pytestmark = pytest.mark.unit
 
 GRID = MetricGrid(0.05, (0.0, 0.0, 0.0), (200, 300))  # 15 m x 10 m
+
+
+def view_cells(views: np.ndarray, transform: Similarity2D | None = None) -> np.ndarray:
+    """GRID's cells the views (K, V, 2, map frame) cover, the map placed by ``transform``
+    (default: as it is)."""
+    return seen_on(add_views(NO_VIEW, views), transform or Similarity2D(), GRID)
 
 
 def _room_scan(origin: np.ndarray, box: tuple[float, float, float, float],
@@ -45,7 +52,7 @@ def test_views_of_a_room_seen_from_inside_cover_the_room():
     hits = _room_scan(origin, box)
     views = view_outlines(origin[None], hits, np.zeros(len(hits), dtype=np.int64))
     assert views.shape == (1, 360, 2)
-    seen = view_cells(views, GRID)
+    seen = view_cells(views)
     centres = GRID.cell_centres(np.ones(GRID.shape, bool)).reshape(*GRID.shape, 2)
     inside = ((centres[..., 0] > box[0] + 0.1) & (centres[..., 0] < box[2] - 0.1)
               & (centres[..., 1] > box[1] + 0.1) & (centres[..., 1] < box[3] - 0.1))
@@ -61,7 +68,7 @@ def test_a_sector_without_readings_is_not_seen():
     origin = np.array([5.0, 5.0])
     hits = _room_scan(origin, box)
     ahead = hits[hits[:, 0] > origin[0]]
-    seen = view_cells(view_outlines(origin[None], ahead, np.zeros(len(ahead), np.int64)), GRID)
+    seen = view_cells(view_outlines(origin[None], ahead, np.zeros(len(ahead), np.int64)))
     xy = GRID.cell_centres(seen)
     assert xy[:, 0].min() > origin[0] - 0.1
     assert xy[:, 0].max() > box[2] - 0.1
@@ -75,11 +82,39 @@ def test_views_are_a_union_over_scans():
     hits = np.vstack([_room_scan(a, a_box), _room_scan(b, b_box)])
     scan = np.repeat([0, 1], 720)
     views = view_outlines(np.stack([a, b]), hits, scan)
-    seen = view_cells(views, GRID)
-    one = view_cells(views[:1], GRID) | view_cells(views[1:], GRID)
+    seen = view_cells(views)
+    one = view_cells(views[:1]) | view_cells(views[1:])
     assert (seen == one).all()
-    grown = map_footprint("seen", np.zeros(GRID.shape, bool), GRID, 0.3, views=views)
+    grown = map_footprint("seen", np.zeros(GRID.shape, bool), GRID, 0.3, seen=seen)
     assert grown.sum() > seen.sum() and (grown | ~seen).all()
+
+
+def test_views_added_step_by_step_fill_what_they_fill_at_once():
+    """The lattice grown one view at a time (each growing it: the second room lies beyond
+    the first's cells) holds exactly the cells of both views filled at once."""
+    a, b = np.array([3.0, 3.0]), np.array([11.0, 5.0])
+    hits = np.vstack([_room_scan(a, (1.0, 1.0, 5.0, 5.0)), _room_scan(b, (9.0, 2.0, 14.0, 8.0))])
+    views = view_outlines(np.stack([a, b]), hits, np.repeat([0, 1], 720))
+    first = add_views(NO_VIEW, views[:1])
+    both, once = add_views(first, views[1:]), add_views(NO_VIEW, views)
+    assert both.corner == once.corner and np.array_equal(both.cells, once.cells)
+    assert first.cells.sum() < both.cells.sum()  # the first is not changed
+    assert np.array_equal(add_views(first, views[1:]).cells, both.cells)
+
+
+def test_the_seen_area_moves_with_the_map():
+    """A room seen in the map's frame, the map turned by 90 degrees and shifted: the cells the
+    truth's grid draws are those of the room where the transform puts it, up to a cell at its
+    border."""
+    box = (-3.0, -2.0, 3.0, 2.0)
+    hits = _room_scan(np.array([-1.0, 0.5]), box)
+    views = view_outlines(np.array([[-1.0, 0.5]]), hits, np.zeros(len(hits), np.int64))
+    moved = view_cells(views, Similarity2D(7.5, 5.0, np.pi / 2))
+    centres = GRID.cell_centres(np.ones(GRID.shape, bool)).reshape(*GRID.shape, 2)
+    x, y = centres[..., 0] - 7.5, centres[..., 1] - 5.0  # the room is 4 m wide in x, 6 m in y
+    inside = (np.abs(x) < 2.0 - 0.1) & (np.abs(y) < 3.0 - 0.1)
+    outside = (np.abs(x) > 2.0 + 0.1) | (np.abs(y) > 3.0 + 0.1)
+    assert moved[inside].all() and not moved[outside].any()
 
 
 def test_a_view_reaches_no_farther_than_max_reach():
@@ -92,7 +127,7 @@ def test_a_view_reaches_no_farther_than_max_reach():
     scan = np.zeros(len(hits), dtype=np.int64)
     capped = view_outlines(origin[None], hits, scan, max_reach=1.0)
     assert np.hypot(*(capped[0] - origin).T).max() == pytest.approx(1.0)
-    xy = GRID.cell_centres(view_cells(capped, GRID))
+    xy = GRID.cell_centres(view_cells(capped))
     assert np.hypot(*(xy - origin).T).max() <= 1.0 + GRID.resolution
     # the fill takes the cells its outline crosses too: half a cell beyond it
     assert len(xy) * GRID.resolution**2 == pytest.approx(

@@ -35,6 +35,7 @@ from pcmapq.plan import (
 )
 from pcmapq.raster.draw import OCCUPIED, UNKNOWN, points_to_grid, warp_state
 from pcmapq.raster.footprint import footprint_rule, map_footprint
+from pcmapq.raster.seen import seen_on
 from pcmapq.result import DetectorResult, Overlap, Result
 from pcmapq.transform import Similarity2D
 
@@ -47,7 +48,7 @@ def map_footprint_rule(source: OccupancyMap | PointMap, settings: Settings) -> s
     try:
         return footprint_rule(settings.footprint.rule, source.state == UNKNOWN if image else None,
                               source.grid.resolution if image else 0.0,
-                              views=not image and source.views is not None)
+                              views=not image and source.seen is not None)
     except ValueError as err:
         raise InputError(f"{source.path}: {err}") from None
 
@@ -60,7 +61,7 @@ def map_raster(source: OccupancyMap | PointMap, map_xy: np.ndarray, transform: S
     :mod:`pcmapq.raster.footprint`), both bool."""
     image = isinstance(source, OccupancyMap)
     rule = map_footprint_rule(source, settings) if rule is None else rule
-    views = None
+    seen = None
     if image:
         state = warp_state(source.state, source.grid, transform, grid)
         occupied, known = state == OCCUPIED, state != UNKNOWN
@@ -71,12 +72,12 @@ def map_raster(source: OccupancyMap | PointMap, map_xy: np.ndarray, transform: S
     else:
         occupied = points_to_grid(transform.apply(map_xy), grid, min_hits(source, settings))
         known = None
-        if source.views is not None:
-            views = transform.apply(source.views.reshape(-1, 2)).reshape(source.views.shape)
+        if rule == "seen" and source.seen is not None:
+            seen = seen_on(source.seen, transform, grid)
         (x0, y0), (x1, y1) = map_xy.min(axis=0), map_xy.max(axis=0)
         corners = np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]])
     footprint = map_footprint(rule, occupied, grid, settings.footprint.margin, known=known,
-                              rectangle=transform.apply(corners), views=views)
+                              rectangle=transform.apply(corners), seen=seen)
     return occupied, footprint
 
 

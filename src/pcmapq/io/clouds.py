@@ -37,6 +37,21 @@ FLAT_TOLERANCE = 1e-6
 MAP_POINTS = CHUNK
 
 
+#: Side of the cells of :class:`SeenCells`, metres (the map's frame).
+SEEN_CELL = 0.05
+
+
+@dataclass(frozen=True)
+class SeenCells:
+    """The area a map's scans saw, as cells of a lattice of :data:`SEEN_CELL` squares in the
+    map's own frame (:mod:`pcmapq.raster.seen` fills and draws it): ``cells`` (rows, cols)
+    bool, whose row r and column c is the lattice cell (``corner[0] + c``, ``corner[1] + r``),
+    which covers ``[i, i + 1) x [j, j + 1)`` cells from the frame's origin (x right, y up)."""
+
+    cells: np.ndarray
+    corner: tuple[int, int]
+
+
 @dataclass(frozen=True)
 class PointMap:
     """A point-cloud map.
@@ -46,16 +61,15 @@ class PointMap:
         (see the module's docstring) a read-only (N, 3) float32 or float64 array mapped onto the
         file: read it in chunks (``pcmapq.io.ply.CHUNK`` rows), never convert it whole.
     is_3d: False when z is constant (a 2D cloud).
-    views: for a map made of scans with known poses, each scan's outline of the free space it
-        saw, (K, V, 2) metres in the map's x, y (see
-        :func:`pcmapq.raster.footprint.view_outlines`); None otherwise.
+    seen: for a map made of scans with known poses, the area its scans saw (the union of
+        their views, see :mod:`pcmapq.raster.seen`); None otherwise.
     """
 
     path: Path
     points: np.ndarray
     is_3d: bool
     kind: str = "cloud"
-    views: np.ndarray | None = None
+    seen: SeenCells | None = None
 
 
 def load_cloud(path: Path, memory_limit: int | None = None) -> PointMap:

@@ -40,20 +40,6 @@ def polygon_cells(polygons: np.ndarray, grid: MetricGrid) -> np.ndarray:
     return area.astype(bool)
 
 
-def view_cells(views: np.ndarray, grid: MetricGrid) -> np.ndarray:
-    """The cells of ``grid`` (bool) inside any of the scans' views: (K, V, 2) star-shaped
-    polygons, metres, in the grid's frame, each the scanner's outline of free space (see
-    :func:`pcmapq.raster.footprint.view_outlines`). Filled one scan at a time, as
-    :func:`polygon_cells`."""
-    shift = 8
-    views = np.asarray(views, dtype=np.float64)
-    uv = grid.xy_to_pixels(views.reshape(-1, 2)).reshape(views.shape)
-    area = np.zeros(grid.shape, np.uint8)
-    for poly in np.round(uv * (1 << shift)).astype(np.int32):
-        cv2.fillPoly(area, [poly], 1, lineType=cv2.LINE_8, shift=shift)
-    return area.astype(bool)
-
-
 def points_to_grid(xy: np.ndarray, grid: MetricGrid, min_hits: int = 1) -> np.ndarray:
     """Occupied cells: those holding at least ``min_hits`` of the points (N, 2, metres). Bool."""
     return hit_counts(xy, grid) >= min_hits

@@ -30,7 +30,7 @@ from scipy import ndimage
 
 from pcmapq.grid import MetricGrid
 from pcmapq.morphology import disc, distance_to
-from pcmapq.raster.draw import polygon_cells, view_cells
+from pcmapq.raster.draw import polygon_cells
 
 #: The footprint rules, ``auto`` first (the default).
 FOOTPRINT_RULES = ("auto", "known", "walls", "seen", "all")
@@ -114,16 +114,16 @@ def footprint_rule(requested: str, unknown: np.ndarray | None, resolution: float
 def map_footprint(rule: str, occupied: np.ndarray, grid: MetricGrid, margin: float = 0.3,
                   known: np.ndarray | None = None,
                   rectangle: np.ndarray | None = None,
-                  views: np.ndarray | None = None) -> np.ndarray:
+                  seen: np.ndarray | None = None) -> np.ndarray:
     """The map's footprint on the truth's grid (bool) under ``rule`` (resolved: ``known``,
     ``walls``, ``seen`` or ``all``, see :func:`footprint_rule`): its known cells, the area its
-    occupied cells enclose, its scans' views (``views``: (K, V, 2), truth frame, metres) or
-    its rectangle (``rectangle``: (4, 2) corners, truth frame, metres); grown by ``margin``
-    metres."""
+    occupied cells enclose, the cells its scans saw (``seen``, bool, see
+    :func:`pcmapq.raster.seen.seen_on`) or its rectangle (``rectangle``: (4, 2) corners,
+    truth frame, metres); grown by ``margin`` metres."""
     if rule == "known" and known is not None:
         area = known
-    elif rule == "seen" and views is not None:
-        area = view_cells(views, grid)
+    elif rule == "seen" and seen is not None:
+        area = seen
     elif rule == "all" and rectangle is not None:
         area = polygon_cells(rectangle, grid)
     elif rule == "walls":
@@ -141,7 +141,7 @@ def view_outlines(origins: np.ndarray, points: np.ndarray, scan: np.ndarray,
     order, but no farther than ``max_reach`` metres from it, or the scanner itself for a
     sector with no reading. ``points`` (N, 2) are the readings in the same frame, ``scan``
     (N,) the scan of each. A star-shaped polygon: the free space the scan saw
-    (:func:`pcmapq.raster.draw.view_cells` fills it)."""
+    (:func:`pcmapq.raster.seen.add_views` fills it)."""
     origins = np.asarray(origins, dtype=np.float64).reshape(-1, 2)
     offset = np.asarray(points, dtype=np.float64).reshape(-1, 2) - origins[scan]
     angle = np.arctan2(offset[:, 1], offset[:, 0])

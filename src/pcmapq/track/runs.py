@@ -7,9 +7,10 @@ the first k scans, grown scan by scan.
   given poses or at KISS-ICP's; the map grows in a voxel map (centroids of 0.1 m cells, as
   ``pcmapq map``), one scan at a time.
 
-Each map carries its scans' views (:func:`~pcmapq.raster.footprint.view_outlines`, in the
-poses' x, y: a 3D map's levelling is not applied to them), so it is scored inside the area its
-scans saw (footprint rule ``seen``). A laser's views reach no farther than its readings draw a
+Each map carries the area its scans saw (their views,
+:func:`~pcmapq.raster.footprint.view_outlines`, in the poses' x, y: a 3D map's levelling is not
+applied to them), filled once as the map grows (:mod:`~pcmapq.raster.seen`), so it is scored
+inside it (footprint rule ``seen``). A laser's views reach no farther than its readings draw a
 wall (:func:`dense_reach`: 11.5 m for 1-degree beams); a 3D scanner's, whose readings lie a
 few tenths of a degree apart in bearing, are not cut.
 
@@ -31,6 +32,7 @@ from pcmapq.io.carmen import DEFAULT_MAX_RANGE, LaserScans, endpoints, is_carmen
 from pcmapq.mapping import ScanSequence, VoxelMap, build_map_kiss, open_scans, read_poses
 from pcmapq.mapping.reference import scans_for_poses
 from pcmapq.raster.footprint import view_outlines
+from pcmapq.raster.seen import NO_VIEW, add_views
 
 #: Cell of the voxel map a scan sequence grows into, metres (``pcmapq map``'s default).
 SCAN_VOXEL = 0.1
@@ -101,11 +103,12 @@ class LaserRun:
         views = view_outlines(self.poses[:, :2, 3], xy, np.repeat(np.arange(len(self)), counts),
                               max_reach=dense_reach(self.scans.angles))
         points = np.column_stack([xy, np.zeros(len(xy))])
-        before = 0
+        before, seen = 0, NO_VIEW
         for end in ends:
             tick(int(end))
+            seen = add_views(seen, views[before:end])
             yield (PointMap(self.path, points[:offsets[end]], is_3d=False, kind="carmen",
-                            views=views[:end]), points[offsets[before]:offsets[end]])
+                            seen=seen), points[offsets[before]:offsets[end]])
             before = end
 
 
@@ -134,7 +137,7 @@ class ScanRun:
         """For each of ``ends`` (increasing): the 3D map of the first ``end`` scans, and the
         scans since the step before (N, 3; their own voxel map's points). Each scan is placed
         and added to the voxel maps once."""
-        grid, wanted, views = VoxelMap(self.voxel), list(ends), []
+        grid, wanted, views, seen = VoxelMap(self.voxel), list(ends), [], NO_VIEW
         recent = VoxelMap(self.voxel)
         for index, (points, _) in enumerate(self.sequence):
             ranges = np.linalg.norm(points, axis=1)
@@ -148,8 +151,9 @@ class ScanRun:
             tick(index + 1)
             if wanted and index + 1 == wanted[0]:
                 wanted.pop(0)
-                yield (PointMap(self.path, grid.points(), is_3d=True, kind="scans",
-                                views=np.stack(views)), recent.points())
+                seen, views = add_views(seen, np.stack(views)), []
+                yield (PointMap(self.path, grid.points(), is_3d=True, kind="scans", seen=seen),
+                       recent.points())
                 recent = VoxelMap(self.voxel)
             if not wanted:
                 return

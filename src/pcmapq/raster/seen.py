@@ -1,0 +1,61 @@
+"""The area a run's scans saw, filled once in the map's own frame (the ``seen`` footprint).
+
+Each scan's view (:func:`pcmapq.raster.footprint.view_outlines`) is filled into a lattice of
+:data:`~pcmapq.io.clouds.SEEN_CELL` squares in the map's frame
+(:class:`~pcmapq.io.clouds.SeenCells`) as the scan is taken, so a map grown scan by scan
+fills each view once; the lattice is then drawn into the truth's grid under the map's
+alignment, one warp per evaluation. Vertices are placed on the lattice in whole 1/256 cells,
+so a view fills the same cells whatever part of the lattice is held.
+"""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+
+from pcmapq.grid import MetricGrid
+from pcmapq.io.clouds import SEEN_CELL, SeenCells
+from pcmapq.transform import Similarity2D
+
+#: Fractional bits of the vertices given to OpenCV's polygon filling.
+SHIFT = 8
+#: Nothing seen yet.
+NO_VIEW = SeenCells(np.zeros((0, 0), bool), (0, 0))
+
+
+def add_views(seen: SeenCells, views: np.ndarray) -> SeenCells:
+    """``seen`` with the views (K, V, 2; metres, map frame; star-shaped polygons) filled in,
+    the lattice grown to hold them. The cells ``seen`` holds are not changed."""
+    views = np.asarray(views, dtype=np.float64).reshape(-1, np.shape(views)[-2], 2)
+    if views.size == 0:
+        return seen
+    fixed = np.round(views * ((1 << SHIFT) / SEEN_CELL)).astype(np.int64) - (1 << (SHIFT - 1))
+    low = fixed.reshape(-1, 2).min(axis=0) >> SHIFT
+    high = (fixed.reshape(-1, 2).max(axis=0) >> SHIFT) + 1
+    if seen.cells.size:
+        low = np.minimum(low, seen.corner)
+        high = np.maximum(high, np.add(seen.corner, seen.cells.shape[::-1]) - 1)
+    cells = np.zeros((int(high[1] - low[1]) + 1, int(high[0] - low[0]) + 1), np.uint8)
+    if seen.cells.size:
+        x, y = np.subtract(seen.corner, low)
+        rows, cols = seen.cells.shape
+        cells[y:y + rows, x:x + cols] = seen.cells
+    shifted = (fixed - (low << SHIFT)).astype(np.int32)
+    for polygon in shifted:  # one at a time: filled together, overlaps would cancel
+        cv2.fillPoly(cells, [polygon], 1, lineType=cv2.LINE_8, shift=SHIFT)
+    return SeenCells(cells.view(bool), (int(low[0]), int(low[1])))
+
+
+def seen_on(seen: SeenCells, transform: Similarity2D, grid: MetricGrid) -> np.ndarray:
+    """The cells of ``grid`` (truth frame, bool) whose centres the map's ``transform``
+    (``p_truth = transform(p_map)``) puts on a seen lattice cell: the nearest one."""
+    if seen.cells.size == 0:
+        return np.zeros(grid.shape, bool)
+    to_lattice = np.array([[1 / SEEN_CELL, 0.0, -0.5 - seen.corner[0]],
+                           [0.0, 1 / SEEN_CELL, -0.5 - seen.corner[1]], [0.0, 0.0, 1.0]])
+    m = to_lattice @ transform.inverse().matrix @ grid.pixel_to_xy_matrix()
+    rows, cols = grid.shape
+    drawn = cv2.warpAffine(seen.cells.view(np.uint8), m[:2], (cols, rows),
+                           flags=cv2.INTER_NEAREST | cv2.WARP_INVERSE_MAP,
+                           borderMode=cv2.BORDER_CONSTANT, borderValue=0)
+    return drawn.view(bool)
