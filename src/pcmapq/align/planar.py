@@ -91,7 +91,8 @@ class RigidTarget:
     steps): its points thinned as :func:`align` thins them, their KD-tree, the point-to-line
     target (whose line normals, each depending on its point alone, are kept as they are
     computed) and the point-to-point clouds by voxel. Aligning with it gives what aligning
-    with the truth's points gives. Not for two threads at once."""
+    with the truth's points gives, from several threads at once (its caches hold what any
+    thread would compute)."""
 
     def __init__(self, truth_xy: np.ndarray, params: AlignParams = AlignParams()) -> None:
         """truth_xy: (M, 2) metres, truth frame; params: those of the alignments to come."""

@@ -3,6 +3,8 @@ point-to-point ICP locks onto the lattice of two gridded clouds; it finishes eve
 
 from __future__ import annotations
 
+from threading import Lock
+
 import numpy as np
 from scipy.spatial import cKDTree
 
@@ -32,14 +34,17 @@ class LineTarget:
         self.points = np.asarray(truth_xy, dtype=np.float64).reshape(-1, 2)
         self.tree = cKDTree(self.points) if tree is None else tree
         self._normals = np.full((len(self.points), 2), np.nan)
+        self._computing = Lock()
 
     def normals(self, index: np.ndarray) -> np.ndarray:
         """Unit line normals (K, 2) of the truth points ``index`` (K,), as
-        :func:`line_normals`; none is computed twice. Needs at least 3 truth points."""
-        missing = np.unique(index[np.isnan(self._normals[index, 0])])
-        if len(missing):
-            self._normals[missing] = line_normals(self.tree, missing)
-        return self._normals[index]
+        :func:`line_normals`; none is computed twice. Needs at least 3 truth points. Safe
+        from several threads at once."""
+        with self._computing:
+            missing = np.unique(index[np.isnan(self._normals[index, 0])])
+            if len(missing):
+                self._normals[missing] = line_normals(self.tree, missing)
+            return self._normals[index]
 
 
 def refine_point_to_line(map_xy: np.ndarray, target: LineTarget, init: Similarity2D,

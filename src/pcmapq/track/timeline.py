@@ -203,10 +203,9 @@ def track(run: Run, prepared: PreparedTruth, settings: Settings, ends: np.ndarra
                 continue
             if settings.alignment.enabled:
                 start = side.alignment.transform
-            extra = {"local_offset_m": local_offset(recent, side, prepared, settings), **extra}
             pending.append((index, scorers.submit(
-                _finish, at, source, side, prepared, _settings_from(settings, used), used,
-                extra)))
+                _finish, at, source, recent, side, prepared, _settings_from(settings, used),
+                used, extra)))
             collect(scoring)
         collect(0)
     return _with_slide([s for s in steps if s is not None], run.poses)
@@ -235,9 +234,11 @@ def local_offset(recent: np.ndarray, side: MapSide, prepared: PreparedTruth,
     return float(np.sqrt(np.mean(np.sum(moved**2, axis=1))))
 
 
-def _finish(at: tuple, source, side: MapSide, prepared: PreparedTruth, settings: Settings,
-            used: Similarity2D | None, extra: dict) -> Step:
-    """A placed step's features matched and scored: its :class:`Step` (``slide_m`` unset)."""
+def _finish(at: tuple, source, recent: np.ndarray, side: MapSide, prepared: PreparedTruth,
+            settings: Settings, used: Similarity2D | None, extra: dict) -> Step:
+    """A placed step's features matched and scored, and the offset of its ``recent`` readings
+    (:func:`local_offset`): its :class:`Step` (``slide_m`` unset)."""
+    extra = {"local_offset_m": local_offset(recent, side, prepared, settings), **extra}
     try:
         result = finish_prepared(source, side, prepared, settings)
     except (EvaluationError, InputError) as err:
