@@ -19,7 +19,7 @@ from pcmapq.features import Features, SideBySide, default_params
 from pcmapq.frames import Frames, Levelling
 from pcmapq.grid import MetricGrid
 from pcmapq.io import OccupancyMap, PointMap
-from pcmapq.io.extent import check_span, far_points, hint
+from pcmapq.io.extent import check_span, hint
 from pcmapq.match import match
 from pcmapq.metrics.distances import distances, distances_3d, nearest_distance
 from pcmapq.noref_figures import input_figures
@@ -37,6 +37,7 @@ from pcmapq.raster.draw import OCCUPIED, UNKNOWN, points_to_grid, warp_state
 from pcmapq.raster.footprint import footprint_rule, map_footprint
 from pcmapq.raster.seen import seen_on
 from pcmapq.result import DetectorResult, Overlap, Result
+from pcmapq.same_place import OVERSIZE, overlap, radius, refusal
 from pcmapq.transform import Similarity2D
 
 Progress = Callable[[str], None]
@@ -81,81 +82,6 @@ def map_raster(source: OccupancyMap | PointMap, map_xy: np.ndarray, transform: S
     return occupied, footprint
 
 
-#: Confidence terms (see :func:`confidence`): the distinctiveness worth full confidence, the
-#: truth recalls and the agreements worth none and full confidence.
-FULL_DISTINCT = 0.2
-RECALL_NONE, RECALL_FULL = 0.4, 0.8
-AGREE_NONE, AGREE_FULL = 0.7, 0.9
-#: A map whose radius exceeds the truth's by this factor cannot be a part of it (a scale).
-OVERSIZE = 1.5
-
-
-def confidence(distinct: float | None, recall: float, agreement: float = 0.0) -> float:
-    """That the map shows the truth's place, [0, 1]: the smaller of distinct / FULL_DISTINCT
-    and (recall - RECALL_NONE) / (RECALL_FULL - RECALL_NONE), clipped. ``distinct``: the global
-    search's distinctiveness of the final pose (None without a search: ``--init``,
-    ``--no-align``, a 3D registration; then the recall term alone); ``recall``: share of the
-    covered truth walls near the map. 0.5 is distinctiveness 0.1 and recall 0.6.
-
-    A map that lies on the truth both ways is the truth's place even when the place is
-    symmetric (a round room, a square hall: the pose is ambiguous, the scores are not), so
-    ``agreement`` (fitness x recall) gives confidence on its own:
-    (agreement - AGREE_NONE) / (AGREE_FULL - AGREE_NONE), 0.5 at 0.8; the larger one counts."""
-    terms = [(recall - RECALL_NONE) / (RECALL_FULL - RECALL_NONE)]
-    if distinct is not None:
-        terms.append(distinct / FULL_DISTINCT)
-    agreed = (agreement - AGREE_NONE) / (AGREE_FULL - AGREE_NONE)
-    return float(np.clip(max(min(terms), agreed), 0.0, 1.0))
-
-
-def overlap(truth_occ: np.ndarray, to_map: np.ndarray, footprint: np.ndarray,
-            alignment: Alignment) -> Overlap:
-    """How much of the truth the map covers, how well the two agree there, and the confidence
-    that they show one place; ``to_map`` is each cell's distance to the nearest map wall,
-    metres."""
-    seen = truth_occ & footprint
-    coverage = float(seen.sum() / truth_occ.sum()) if truth_occ.any() else 0.0
-    tolerance = alignment.tolerance_m
-    recall = float((to_map[seen] <= tolerance).mean()) if seen.any() else 0.0
-    agreement = alignment.fitness * recall
-    return Overlap(footprint, coverage, recall, agreement,
-                   confidence(alignment.distinctiveness, recall, agreement))
-
-
-def _radius(xy: np.ndarray) -> float:
-    """Largest distance of points (N, 2) from their centroid, in their unit."""
-    return float(np.sqrt(((xy - xy.mean(axis=0)) ** 2).sum(axis=1).max()))
-
-
-def refusal(source: OccupancyMap | PointMap, truth_path: Path, alignment: Alignment,
-            cover: Overlap, settings: Settings, map_xy: np.ndarray, truth_xy: np.ndarray) -> str:
-    """One line: why the map seems not to show the truth's place, and the likely cause with the
-    option that addresses it."""
-    map_path = source.path
-    distinct = alignment.distinctiveness
-    why = (f"{cover.truth_recall:.0%} of the truth it covers lies near the map" +
-           ("" if distinct is None else
-            f", the best pose scores {distinct:.0%} above the best one elsewhere"))
-    size = _radius(map_xy) / max(_radius(truth_xy), 1e-12)
-    option = settings.alignment
-    far = far_points(source, MAP_CROP)
-    if far:
-        cause = far
-    elif option.init is not None or not option.enabled:
-        cause = ("the given frame: a wrong --init guess or --no-align; drop them for a "
-                 "global search")
-    elif not option.scale and size > OVERSIZE:
-        cause = (f"a scale that differs: the map spans {size:.1f} times the truth; try "
-                 "--scale auto")
-    elif not option.scale:
-        cause = "a map of another place, or of another scale (--scale auto)"
-    else:
-        cause = f"a map of another place (best scale found {alignment.transform.scale:.3g})"
-    return (f"{map_path}: does not seem to show the place of {truth_path}: confidence "
-            f"{cover.confidence:.2f} < {option.min_confidence} ({why}); likely cause: "
-            f"{cause}; --force scores it anyway")
-
-
 def inside(features: Features, area: np.ndarray, grid: MetricGrid) -> np.ndarray:
     """(N,) bool: which features lie in the cells where ``area`` is true."""
     uv = np.floor(grid.xy_to_pixels(features.xy) + 0.5).astype(int)
@@ -185,7 +111,7 @@ def check_scale_range(source: OccupancyMap | PointMap, map_xy: np.ndarray,
     if not option.scale or option.init is not None or not option.enabled:
         return
     lowest = option.params.scale_range[0]
-    size = lowest * _radius(map_xy) / max(_radius(truth_xy), 1e-12)
+    size = lowest * radius(map_xy) / max(radius(truth_xy), 1e-12)
     if size > OVERSIZE:
         why = hint(source, MAP_CROP) or "a map of a larger place, or in another unit"
         raise EvaluationError(f"{source.path}: at the lowest scale --scale auto tries "

@@ -64,7 +64,7 @@ class Overlap:
     coverage: share of the truth's occupied cells inside the footprint, [0, 1].
     truth_recall: share of those within the fit tolerance of a map occupied cell, [0, 1].
     agreement: alignment fitness times truth_recall.
-    confidence: that the map shows the truth's place, [0, 1] (see pipeline.confidence); below
+    confidence: that the map shows the truth's place, [0, 1] (see same_place.confidence); below
         0.5 a map of another place.
     """
 

@@ -1,0 +1,90 @@
+"""Does the map show the truth's place? How much of the truth it covers and how well the two
+agree there (:func:`overlap`), the confidence that they show one place (:func:`confidence`),
+and the one line that says why not and what to try (:func:`refusal`)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from pcmapq.align import Alignment
+from pcmapq.config import Settings
+from pcmapq.io import OccupancyMap, PointMap
+from pcmapq.io.extent import far_points
+from pcmapq.plan import MAP_CROP
+from pcmapq.result import Overlap
+
+#: Confidence terms (see :func:`confidence`): the distinctiveness worth full confidence, the
+#: truth recalls and the agreements worth none and full confidence.
+FULL_DISTINCT = 0.2
+RECALL_NONE, RECALL_FULL = 0.4, 0.8
+AGREE_NONE, AGREE_FULL = 0.7, 0.9
+#: A map whose radius exceeds the truth's by this factor cannot be a part of it (a scale).
+OVERSIZE = 1.5
+
+
+def confidence(distinct: float | None, recall: float, agreement: float = 0.0) -> float:
+    """That the map shows the truth's place, [0, 1]: the smaller of distinct / FULL_DISTINCT
+    and (recall - RECALL_NONE) / (RECALL_FULL - RECALL_NONE), clipped. ``distinct``: the global
+    search's distinctiveness of the final pose (None without a search: ``--init``,
+    ``--no-align``, a 3D registration; then the recall term alone); ``recall``: share of the
+    covered truth walls near the map. 0.5 is distinctiveness 0.1 and recall 0.6.
+
+    A map that lies on the truth both ways is the truth's place even when the place is
+    symmetric (a round room, a square hall: the pose is ambiguous, the scores are not), so
+    ``agreement`` (fitness x recall) gives confidence on its own:
+    (agreement - AGREE_NONE) / (AGREE_FULL - AGREE_NONE), 0.5 at 0.8; the larger one counts."""
+    terms = [(recall - RECALL_NONE) / (RECALL_FULL - RECALL_NONE)]
+    if distinct is not None:
+        terms.append(distinct / FULL_DISTINCT)
+    agreed = (agreement - AGREE_NONE) / (AGREE_FULL - AGREE_NONE)
+    return float(np.clip(max(min(terms), agreed), 0.0, 1.0))
+
+
+def overlap(truth_occ: np.ndarray, to_map: np.ndarray, footprint: np.ndarray,
+            alignment: Alignment) -> Overlap:
+    """How much of the truth the map covers, how well the two agree there, and the confidence
+    that they show one place; ``to_map`` is each cell's distance to the nearest map wall,
+    metres."""
+    seen = truth_occ & footprint
+    coverage = float(seen.sum() / truth_occ.sum()) if truth_occ.any() else 0.0
+    tolerance = alignment.tolerance_m
+    recall = float((to_map[seen] <= tolerance).mean()) if seen.any() else 0.0
+    agreement = alignment.fitness * recall
+    return Overlap(footprint, coverage, recall, agreement,
+                   confidence(alignment.distinctiveness, recall, agreement))
+
+
+def radius(xy: np.ndarray) -> float:
+    """Largest distance of points (N, 2) from their centroid, in their unit."""
+    return float(np.sqrt(((xy - xy.mean(axis=0)) ** 2).sum(axis=1).max()))
+
+
+def refusal(source: OccupancyMap | PointMap, truth_path: Path, alignment: Alignment,
+            cover: Overlap, settings: Settings, map_xy: np.ndarray, truth_xy: np.ndarray) -> str:
+    """One line: why the map seems not to show the truth's place, and the likely cause with the
+    option that addresses it."""
+    map_path = source.path
+    distinct = alignment.distinctiveness
+    why = (f"{cover.truth_recall:.0%} of the truth it covers lies near the map" +
+           ("" if distinct is None else
+            f", the best pose scores {distinct:.0%} above the best one elsewhere"))
+    size = radius(map_xy) / max(radius(truth_xy), 1e-12)
+    option = settings.alignment
+    far = far_points(source, MAP_CROP)
+    if far:
+        cause = far
+    elif option.init is not None or not option.enabled:
+        cause = ("the given frame: a wrong --init guess or --no-align; drop them for a "
+                 "global search")
+    elif not option.scale and size > OVERSIZE:
+        cause = (f"a scale that differs: the map spans {size:.1f} times the truth; try "
+                 "--scale auto")
+    elif not option.scale:
+        cause = "a map of another place, or of another scale (--scale auto)"
+    else:
+        cause = f"a map of another place (best scale found {alignment.transform.scale:.3g})"
+    return (f"{map_path}: does not seem to show the place of {truth_path}: confidence "
+            f"{cover.confidence:.2f} < {option.min_confidence} ({why}); likely cause: "
+            f"{cause}; --force scores it anyway")
