@@ -162,7 +162,8 @@ def track(run: Run, prepared: PreparedTruth, settings: Settings, ends: np.ndarra
     Two stages overlap: this thread aligns and draws each step's map in turn (a step's ICP
     starts from the pose the step before found), while up to :data:`FEATURE_THREADS` others
     (fewer when the memory allows fewer maps at once: ``prepared.maps``) find the features of
-    the steps already placed and score them. Each step's result depends on its map and its
+    the steps already placed, score them and align their newest readings alone
+    (:func:`local_offset`). Each step's result depends on its map and its
     start alone, so the steps are the same as one after the other."""
     distance = travelled(run.poses)
     stamps = run.stamps
@@ -281,7 +282,7 @@ class Drop:
     """The worst lasting fall of a figure along the steps: it peaked at step ``peak``, started
     to fall at step ``start`` (the step after the last one still within :data:`NOISE` of the
     peak: where the map went wrong) and was lowest at step ``low``, ``size`` below the peak;
-    no later step came back within ``lasting`` of the peak."""
+    every later step stays at least ``lasting`` below the peak."""
 
     figure: str
     peak: int
