@@ -128,11 +128,11 @@ def path_figure(result: Result, path_xy: np.ndarray) -> Figure:
 
 def timeline_html(rows: list[dict], drop: dict | None, shown: int, result: Result | None,
                   path_xy: np.ndarray | None, *, inputs: dict[str, str],
-                  command: str | None, asked: bool = False) -> str:
+                  command: str | None, asked: bool = False, curves: bytes | None = None) -> str:
     """The report: the inputs (``inputs``: what each is, in words, by name: run, poses, truth,
-    reference poses, step rule), the curves, the step ``shown`` (its vectorial map with the
-    path, or why it was not scored; ``asked``: chosen with ``--step``) and a table of every
-    step."""
+    reference poses, step rule), the curves (``curves``: their PNG when already drawn by
+    :func:`timeline_figure`), the step ``shown`` (its vectorial map with the path, or why it
+    was not scored; ``asked``: chosen with ``--step``) and a table of every step."""
     step = rows[shown]
     scored = sum(bool(r["scored"]) for r in rows)
     facts = "".join(f"<tr><td>{html.escape(k)}</td><td>{html.escape(v)}</td></tr>"
@@ -144,7 +144,7 @@ def timeline_html(rows: list[dict], drop: dict | None, shown: int, result: Resul
              f"<p>command: <code>{html.escape(command or '(called from Python)')}</code></p>",
              "<h2>Quality over the run</h2>",
              f"<p>{html.escape(drop_words(rows, drop))}.</p>",
-             _img(png_bytes(timeline_figure(rows, drop)), "figures against distance")]
+             _img(curves or png_bytes(timeline_figure(rows, drop)), "figures against distance")]
     what = ("the step asked" if asked else "where the worst drop starts"
             if drop is not None and drop["start"] == shown else "the last step; no drop")
     parts.append(f"<h2>Step {shown} ({what}): {step['scans']} of {rows[-1]['scans']} scans, "

@@ -130,9 +130,10 @@ def write_track(tracked: Tracked, out: Path, every: dict, command: str | None) -
             pose_options=asdict(tracked.pose_options), settings=tracked.settings.to_dict(),
             every=every, command=command), outputs)
         title = f"{tracked.run.path.name} against {tracked.truth.source.path.name}"
-        write_atomic(paths[2], png_bytes(timeline_figure(rows, drop, title)), outputs)
+        curves = png_bytes(timeline_figure(rows, drop, title))
+        write_atomic(paths[2], curves, outputs)
         write_atomic(paths[3], timeline_html(rows, drop, tracked.shown, tracked.result,
                                              tracked.path_xy, inputs=inputs, command=command,
-                                             asked=tracked.asked), outputs)
+                                             asked=tracked.asked, curves=curves), outputs)
         outputs.commit()
     return paths
