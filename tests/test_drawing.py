@@ -87,6 +87,33 @@ def test_tiles_join_into_the_whole_image(resolution):
     np.testing.assert_array_equal(tiled.image, whole.image)
 
 
+@pytest.mark.parametrize("resolution", [0.05, 0.025])
+def test_the_walls_window_gives_the_whole_rasters_image(resolution):
+    """Only the walls' bounding box and its margin are drawn: the image equals the whole
+    raster's drawn at once, cell for cell, with walls of every drawing (one-cell walls along
+    the box's edges), noise and small objects in one part of a large empty raster turned by 20
+    degrees, some touching its border; at
+    0.025 m each working cell is two raster cells (the window starts on whole ones)."""
+    from pcmapq.features.walls import CLOSING, _band
+
+    plan = np.vstack([synth.campus(2, 2), synth.clutter(PLAN, 6, seed=3)])
+    turned = synth.plan_grid(plan, resolution)
+    rows, cols = turned.shape
+    grid = MetricGrid(resolution, (*turned.origin[:2], np.radians(20.0)), (3 * rows, 2 * cols))
+    occ = np.zeros(grid.shape, dtype=bool)
+    part = synth.render(plan, turned, 0.3) == synth.OCCUPIED
+    part |= synth.faces(synth.render(plan + 0.4, turned, 0.15) == synth.OCCUPIED)
+    part ^= np.random.default_rng(0).random(part.shape) < 0.002
+    part[0], part[:, 0] = True, True  # one-cell walls along the box's edges: bands beyond it
+    occ[rows + 7:2 * rows + 7, cols + 3:] = part[:, :cols - 3]  # cut by the right border
+    whole = _band(occ, grid, 0.05, CLOSING, 0.15, 0.25, 1.0)
+    drawn = wall_image(occ, grid)
+    assert drawn.grid == grid.resampled(0.05)
+    assert (whole > 0).sum() > 10_000
+    np.testing.assert_array_equal(drawn.image, whole)
+    assert not wall_image(np.zeros_like(occ), grid).image.any()
+
+
 def test_ridges_by_strips_equal_the_whole():
     """Hough's ridge lines computed strip by strip (each with its halo) equal the whole
     image's, mask and direction, cell for cell."""

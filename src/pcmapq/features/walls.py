@@ -27,10 +27,13 @@ thin one has none). So the detectors never see the cells as drawn. They see the 
 
 What the detectors see then depends on where the walls are, not on how many cells paint them.
 
-A large raster is drawn tile by tile (:data:`TILE` working cells a side, each with a halo of
-:data:`HALO` metres that is drawn and dropped), on as many threads as there are cores (at most
-4): every step looks no farther than the halo, so the tiles join into the image the whole raster
-would give, in a bounded memory.
+Only the window of the raster that holds walls is drawn (their bounding box and
+:data:`MARGIN` metres of empty cells around it; the rest is 0): beyond the walls every step sees
+empty cells only, and none reaches farther into them than the margin (the closing's 0.1 m, the
+band's half width), so the window gives the image the whole raster would. A window larger than
+:data:`TILE` working cells a side is drawn tile by tile (each with a halo of :data:`HALO` metres
+that is drawn and dropped), on as many threads as there are cores (at most 4): every step looks
+no farther than the halo, so the tiles join into the same image, in a bounded memory.
 """
 
 from __future__ import annotations
@@ -52,6 +55,9 @@ from pcmapq.morphology import disc, distance_to
 #: Working cells a side of a tile of a large raster, and the halo drawn around each, metres:
 #: more than any step looks (a small object's 1 m, a spur's 0.25 m, the closing's 0.1 m).
 TILE, HALO = 2048, 4.0
+#: Empty margin kept around the walls' bounding box, metres: more than any step reaches into
+#: empty cells (the closing's disc, the band's half width and a cell).
+MARGIN = 0.5
 #: The thickest wall, metres: thicker occupied areas are filled regions (module docstring, 3).
 THICKEST = 2.0
 #: Threads drawing tiles, at most.
@@ -233,38 +239,55 @@ def wall_image(occupied: np.ndarray, grid: MetricGrid, resolution: float = 0.05,
     The :class:`WallImage` on a grid of ``resolution`` metres.
     """
     k = int(round(resolution / grid.resolution))
-    if k < 1 or abs(resolution - k * grid.resolution) > 1e-9 * resolution or \
-            max(grid.shape) <= tile * k:
+    if k < 1 or abs(resolution - k * grid.resolution) > 1e-9 * resolution:
         return WallImage(_band(occupied, grid, resolution, closing, width, spur, small),
                          grid.resampled(resolution))
     return _tiled(occupied, grid, resolution, k, tile,
-                  lambda crop, sub: _band(crop, sub, resolution, closing, width, spur, small))
+                  lambda crop, sub: _band(crop, sub, resolution, closing, width, spur, small),
+                  _window(occupied, k, k * int(np.ceil(MARGIN / resolution))))
+
+
+def _window(occupied: np.ndarray, k: int, margin: int) -> tuple[int, int, int, int]:
+    """Rows (counted from the bottom) and columns ``lo, hi, left, right`` of the raster's
+    cells that hold walls, widened by ``margin`` cells and to whole working cells of ``k``
+    raster cells from the lower-left corner, within the raster; empty when none does."""
+    rows = np.flatnonzero(occupied[::-1].any(axis=1))
+    cols = np.flatnonzero(occupied.any(axis=0))
+    if not len(rows):
+        return 0, 0, 0, 0
+    def widened(first: int, last: int, size: int) -> tuple[int, int]:
+        return max(0, (first - margin) // k * k), min(size, -(-(last + 1 + margin) // k) * k)
+
+    return (*widened(rows[0], rows[-1], occupied.shape[0]),
+            *widened(cols[0], cols[-1], occupied.shape[1]))
 
 
 def _tiled(occupied: np.ndarray, grid: MetricGrid, resolution: float, k: int, tile: int,
-           band) -> WallImage:
-    """:func:`wall_image` tile by tile: ``band(crop, crop_grid)`` draws one haloed crop; the
-    working cell is ``k`` raster cells. Rows are counted from the bottom here, where the working
-    grid is anchored (the grid's origin is the image's lower-left corner)."""
-    rows, cols = occupied.shape
+           band, window: tuple[int, int, int, int]) -> WallImage:
+    """:func:`wall_image` of the cells within ``window`` (see :func:`_window`; the others
+    are empty), tile by tile: ``band(crop, crop_grid)`` draws one haloed crop, cut to the
+    window; the working cell is ``k`` raster cells. Rows are counted from the bottom here,
+    where the working grid is anchored (the grid's origin is the image's lower-left corner)."""
+    rows = occupied.shape[0]
     work = grid.resampled(resolution)
     halo = k * int(np.ceil(HALO / resolution))
     step = tile * k
     below = occupied[::-1]  # row 0 at the bottom
     out = np.zeros(work.shape, np.float32)[::-1]
+    bottom, top_row, first, last = window
 
     def draw(p: int, c: int) -> None:
-        lo, hi = max(0, p - halo), min(rows, p + step + halo)
-        left, right = max(0, c - halo), min(cols, c + step + halo)
+        lo, hi = max(bottom, p - halo), min(top_row, p + step + halo)
+        left, right = max(first, c - halo), min(last, c + step + halo)
         corner = grid.pixels_to_xy(np.array([[left - 0.5, rows - lo - 0.5]]))[0]
         sub = MetricGrid(grid.resolution, (float(corner[0]), float(corner[1]), grid.origin[2]),
                          (hi - lo, right - left))
         got = band(np.ascontiguousarray(below[lo:hi, left:right][::-1]), sub)[::-1]
-        top, end = -(-min(rows, p + step) // k), -(-min(cols, c + step) // k)
+        top, end = -(-min(top_row, p + step) // k), -(-min(last, c + step) // k)
         out[p // k:top, c // k:end] = got[(p - lo) // k:(p - lo) // k + top - p // k,
                                           (c - left) // k:(c - left) // k + end - c // k]
 
-    starts = [(p, c) for p in range(0, rows, step) for c in range(0, cols, step)]
+    starts = [(p, c) for p in range(bottom, top_row, step) for c in range(first, last, step)]
     with ThreadPoolExecutor(min(THREADS, os.cpu_count() or 1)) as pool:
         list(pool.map(lambda pc: draw(*pc), starts))
     return WallImage(np.ascontiguousarray(out[::-1]), work)
