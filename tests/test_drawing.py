@@ -129,6 +129,27 @@ def test_ridges_by_strips_equal_the_whole():
         np.testing.assert_array_equal(a, b)
 
 
+def test_strips_computed_only_near_walls_equal_the_whole():
+    """Harris's response and Hough's ridge lines computed only within their reach of the walls
+    (the rest as for an empty image) equal the whole image's, cell for cell: walls in one
+    part of a large empty image, touching its left border; and an empty image."""
+    from pcmapq.features.base import by_strips
+    from pcmapq.features.harris import response
+    from pcmapq.features.ridges import ridges
+
+    grid = synth.plan_grid(synth.campus(2, 2), 0.05)
+    walls = wall_image(synth.render(synth.campus(2, 2), grid) == synth.OCCUPIED, grid).image
+    image = np.zeros((walls.shape[0] + 300, walls.shape[1] + 200), np.float32)
+    image[250:250 + walls.shape[0], :walls.shape[1]] = walls
+    for fn, halo in ((lambda s: ridges(s, 2.0, 0.1), 10),
+                     (lambda s: (response(s, 0.05, 0.1, 0.2, 0.05),), 26)):
+        for im in (image, np.zeros_like(image)):
+            whole, near = fn(im), by_strips(im, halo, fn, rows=64)
+            for a, b in zip(whole, near, strict=True):
+                np.testing.assert_array_equal(a, b)
+    assert ridges(image, 2.0, 0.1)[0].sum() > 5000
+
+
 @pytest.mark.unit
 def test_cores_on_the_rows_and_columns_of_objects_equal_the_whole_image():
     """cores() drops the rows and columns without objects: every object's depth and core are

@@ -142,11 +142,31 @@ STRIP_CELLS = 1 << 21
 
 def by_strips(image: np.ndarray, halo: int, fn: Callable[[np.ndarray], tuple[np.ndarray, ...]],
               rows: int | None = None) -> tuple[np.ndarray, ...]:
-    """``fn(image)`` computed on strips of ``rows`` rows (by default :data:`STRIP_CELLS` cells,
-    at least four halos), each with ``halo`` rows of the image above and below it, and joined:
-    the same arrays, cell for cell, when ``fn`` looks no farther than ``halo`` rows (reflected
-    borders stay the image's own), in the memory of one strip. ``fn`` returns arrays of the
-    strip's shape."""
+    """``fn(image)`` for an ``fn`` that looks no farther than ``halo`` cells (reflected borders
+    stay the image's own): the same arrays, cell for cell, computed on the window of cells
+    within ``halo`` of a nonzero cell only (the others get what ``fn`` gives an all-zero image),
+    in strips of ``rows`` rows (by default :data:`STRIP_CELLS` cells, at least four halos),
+    each with ``halo`` rows above and below it, in the memory of one strip. ``fn`` returns
+    arrays of the shape of its input."""
+    held_rows, held_cols = np.flatnonzero(image.any(axis=1)), np.flatnonzero(image.any(axis=0))
+    if len(held_rows) and held_rows[0] <= halo and held_rows[-1] >= image.shape[0] - 1 - halo \
+            and held_cols[0] <= halo and held_cols[-1] >= image.shape[1] - 1 - halo:
+        return _strips(image, halo, fn, rows)
+    blank = tuple(a[halo, halo] for a in fn(np.zeros((2 * halo + 1,) * 2, image.dtype)))
+    out = tuple(np.full(image.shape, value, value.dtype) for value in blank)
+    if len(held_rows):
+        lo, hi = max(0, held_rows[0] - halo), min(image.shape[0], held_rows[-1] + 1 + halo)
+        left = max(0, held_cols[0] - halo)
+        right = min(image.shape[1], held_cols[-1] + 1 + halo)
+        for whole, part in zip(out, _strips(image[lo:hi, left:right], halo, fn, rows),
+                               strict=True):
+            whole[lo:hi, left:right] = part
+    return out
+
+
+def _strips(image: np.ndarray, halo: int, fn: Callable[[np.ndarray], tuple[np.ndarray, ...]],
+            rows: int | None) -> tuple[np.ndarray, ...]:
+    """:func:`by_strips` over the whole of ``image``."""
     if rows is None:
         rows = max(4 * halo, STRIP_CELLS // max(image.shape[1], 1))
     if image.shape[0] <= rows + 2 * halo:
