@@ -231,8 +231,9 @@ def wall_image(occupied: np.ndarray, grid: MetricGrid, resolution: float = 0.05,
     small : an object at most this wide and high, metres (a pillar, a box), is drawn as its
         core instead, ``width`` across: a ring of thin walls and a solid block of thick ones
         are the same object.
-    tile : working cells a side of the tiles a raster larger than that is drawn in, when the
-        working cell is a whole number of raster cells (otherwise drawn whole).
+    tile : working cells a side of the tiles a window of walls larger than that is drawn in,
+        when the working cell is a whole number of raster cells (otherwise the raster is drawn
+        whole, without a window).
 
     Returns
     -------
@@ -255,6 +256,7 @@ def _window(occupied: np.ndarray, k: int, margin: int) -> tuple[int, int, int, i
     cols = np.flatnonzero(occupied.any(axis=0))
     if not len(rows):
         return 0, 0, 0, 0
+
     def widened(first: int, last: int, size: int) -> tuple[int, int]:
         return max(0, (first - margin) // k * k), min(size, -(-(last + 1 + margin) // k) * k)
 
@@ -274,20 +276,21 @@ def _tiled(occupied: np.ndarray, grid: MetricGrid, resolution: float, k: int, ti
     step = tile * k
     below = occupied[::-1]  # row 0 at the bottom
     out = np.zeros(work.shape, np.float32)[::-1]
-    bottom, top_row, first, last = window
+    from_row, to_row, from_col, to_col = window
 
     def draw(p: int, c: int) -> None:
-        lo, hi = max(bottom, p - halo), min(top_row, p + step + halo)
-        left, right = max(first, c - halo), min(last, c + step + halo)
+        lo, hi = max(from_row, p - halo), min(to_row, p + step + halo)
+        left, right = max(from_col, c - halo), min(to_col, c + step + halo)
         corner = grid.pixels_to_xy(np.array([[left - 0.5, rows - lo - 0.5]]))[0]
         sub = MetricGrid(grid.resolution, (float(corner[0]), float(corner[1]), grid.origin[2]),
                          (hi - lo, right - left))
         got = band(np.ascontiguousarray(below[lo:hi, left:right][::-1]), sub)[::-1]
-        top, end = -(-min(top_row, p + step) // k), -(-min(last, c + step) // k)
+        top, end = -(-min(to_row, p + step) // k), -(-min(to_col, c + step) // k)
         out[p // k:top, c // k:end] = got[(p - lo) // k:(p - lo) // k + top - p // k,
                                           (c - left) // k:(c - left) // k + end - c // k]
 
-    starts = [(p, c) for p in range(bottom, top_row, step) for c in range(first, last, step)]
+    starts = [(p, c) for p in range(from_row, to_row, step)
+              for c in range(from_col, to_col, step)]
     with ThreadPoolExecutor(min(THREADS, os.cpu_count() or 1)) as pool:
         list(pool.map(lambda pc: draw(*pc), starts))
     return WallImage(np.ascontiguousarray(out[::-1]), work)
