@@ -10,9 +10,9 @@ from pathlib import Path
 import numpy as np
 
 from pcmapq import memory
-from pcmapq.align import Alignment, align
+from pcmapq.align import Alignment
 from pcmapq.align.planar import RigidTarget
-from pcmapq.align.rigid3d import Registration3D, align_3d, apply
+from pcmapq.align.rigid3d import Registration3D
 from pcmapq.config import Settings
 from pcmapq.errors import EvaluationError, InputError
 from pcmapq.features import Features, SideBySide, default_params
@@ -23,6 +23,7 @@ from pcmapq.io.extent import check_span, hint
 from pcmapq.match import match
 from pcmapq.metrics.distances import distances, distances_3d, nearest_distance
 from pcmapq.noref_figures import input_figures
+from pcmapq.placing import align_clouds_3d, align_plan
 from pcmapq.plan import (
     MAP_CROP,
     TRUTH_CROP,
@@ -37,7 +38,7 @@ from pcmapq.raster.draw import OCCUPIED, UNKNOWN, points_to_grid, warp_state
 from pcmapq.raster.footprint import footprint_rule, map_footprint
 from pcmapq.raster.seen import seen_on
 from pcmapq.result import DetectorResult, Overlap, Result
-from pcmapq.same_place import OVERSIZE, overlap, radius, refusal
+from pcmapq.same_place import overlap, refusal
 from pcmapq.transform import Similarity2D
 
 Progress = Callable[[str], None]
@@ -88,50 +89,6 @@ def inside(features: Features, area: np.ndarray, grid: MetricGrid) -> np.ndarray
     rows, cols = area.shape
     ok = (uv[:, 0] >= 0) & (uv[:, 0] < cols) & (uv[:, 1] >= 0) & (uv[:, 1] < rows)
     return ok & area[np.clip(uv[:, 1], 0, rows - 1), np.clip(uv[:, 0], 0, cols - 1)]
-
-
-def align_clouds_3d(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap,
-                    settings: Settings) -> tuple[OccupancyMap | PointMap, Registration3D | None]:
-    """When both sides are 3D clouds (and no guess or --no-align says otherwise), register them
-    in 3D first; returns the map moved into the truth frame and the registration."""
-    both_3d = all(isinstance(s, PointMap) and s.is_3d for s in (source, truth))
-    option = settings.alignment
-    if not (both_3d and option.enabled and option.init is None and not option.scale):
-        return source, None
-    reg = align_3d(source.points, truth.points, voxel=option.voxel_3d)
-    return replace(source, points=apply(reg.transform, source.points)), reg
-
-
-def check_scale_range(source: OccupancyMap | PointMap, map_xy: np.ndarray,
-                      truth_xy: np.ndarray, settings: Settings) -> None:
-    """EvaluationError (one line) when ``--scale auto`` searches for a map's scale that even its
-    lowest scale leaves :data:`OVERSIZE` times larger than the truth: another unit, or a much
-    larger place."""
-    option = settings.alignment
-    if not option.scale or option.init is not None or not option.enabled:
-        return
-    lowest = option.params.scale_range[0]
-    size = lowest * radius(map_xy) / max(radius(truth_xy), 1e-12)
-    if size > OVERSIZE:
-        why = hint(source, MAP_CROP) or "a map of a larger place, or in another unit"
-        raise EvaluationError(f"{source.path}: at the lowest scale --scale auto tries "
-                              f"({lowest:g}), the map is still {size:.0f} times the size of "
-                              f"the truth; {why}")
-
-
-def align_plan(source: OccupancyMap | PointMap, map_xy: np.ndarray, truth_xy: np.ndarray,
-               registration: Registration3D | None, settings: Settings,
-               target: RigidTarget | None = None) -> Alignment:
-    """The 2D alignment of the map's plan points to the truth's (both (N, 2) metres, in their
-    own frames): the search and ICP of :func:`pcmapq.align.align` (``target``: the truth's
-    points prepared for it), or, after a 3D registration, the plan scored as it is."""
-    option = settings.alignment
-    if registration is None:
-        check_scale_range(source, map_xy, truth_xy, settings)
-        return align(map_xy, truth_xy, option.params, init=option.init, refine=option.enabled,
-                     scale=option.scale, target=target)
-    return replace(align(map_xy, truth_xy, option.params, init=Similarity2D(), refine=False),
-                   method="3d")
 
 
 def evaluate(map_path: str | Path | PointMap, truth_path: str | Path,
