@@ -16,16 +16,15 @@ from pcmapq import synth
 from pcmapq.config import MatchingConfig, Settings
 from pcmapq.grid import MetricGrid
 from pcmapq.pipeline import evaluate
+from pcmapq.report.heatmap import distance_heatmap, wall_distances
 from pcmapq.report.html import report_html
 from pcmapq.report.plot import (
-    distance_heatmap,
     extent,
     overlay,
     png_bytes,
     shade,
     thinned,
     vectorial_figure,
-    wall_distances,
 )
 from pcmapq.report.style import ARROW_SCALE, DPI, FIGURE_WIDTH_PX, MAP_LIGHT
 from pcmapq.report.text import number

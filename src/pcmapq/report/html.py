@@ -10,7 +10,8 @@ import json
 import numpy as np
 
 from pcmapq import __version__
-from pcmapq.report.plot import distance_heatmap, png_bytes, vectorial_figure
+from pcmapq.report.heatmap import distance_heatmap
+from pcmapq.report.plot import png_bytes, vectorial_figure
 from pcmapq.report.style import ARROW_SCALE, FIGURE_WIDTH_PX
 from pcmapq.report.text import number, score
 from pcmapq.report.viewer import STYLE as VIEWER_STYLE

@@ -1,5 +1,6 @@
-"""Pictures of a Result: the vectorial map per detector, and the distance heatmaps (accuracy:
-map -> truth, completeness: truth -> map).
+"""Pictures of a Result: the vectorial map per detector, what every picture shares (frame,
+extent, pooling to display resolution) and the figure files (the distance heatmaps are
+:mod:`pcmapq.report.heatmap`).
 
 Everything is drawn in the truth frame, axes in metres (matplotlib, headless Agg backend). The
 truth's walls are drawn dark over the aligned map's, light and one pixel wider, so both show
@@ -32,16 +33,13 @@ import cv2  # noqa: E402
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.axes import Axes  # noqa: E402
-from matplotlib.cm import ScalarMappable  # noqa: E402
 from matplotlib.collections import LineCollection  # noqa: E402
-from matplotlib.colors import Normalize  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
 from matplotlib.legend import Legend  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
 from mpl_toolkits.axes_grid1.anchored_artists import AnchoredSizeBar  # noqa: E402
 
-from pcmapq.morphology import distance_to  # noqa: E402
-from pcmapq.raster.pool import max_pool, mean_pool, min_pool  # noqa: E402
+from pcmapq.raster.pool import max_pool, mean_pool  # noqa: E402
 from pcmapq.report.style import (  # noqa: E402
     ARROW_SCALE,
     DPI,
@@ -66,8 +64,6 @@ WIDTH_IN = FIGURE_WIDTH_PX / DPI
 #: Shade of a pixel with any occupied cell in a density picture (so a lone hit shows), and
 #: of the truth over the map.
 DENSITY_FLOOR, TRUTH_ALPHA = 0.3, 0.9
-#: Grey of the walls under a heatmap's coloured cells.
-UNDER_GREY = (0.8, 0.8, 0.8)
 
 
 def _nice(value: float) -> float:
@@ -110,7 +106,7 @@ def pooling(fig: Figure, axes: Sequence[Axes], shape: tuple[int, int]) -> tuple[
     return factor, pixel_m
 
 
-def _frame(ax: Axes, result: Result) -> None:
+def frame(ax: Axes, result: Result) -> None:
     """Axes in metres over the truth grid's extent, one metre as long across as down."""
     left, right, bottom, top = extent(result)
     ax.set_xlim(left, right)
@@ -269,7 +265,7 @@ def vectorial_figure(result: Result, arrow_scale: float = ARROW_SCALE) -> Figure
                   "axes and arrows in metres", grid.flat[-1] if spare else None)
     for ax, name in zip(axes, names, strict=True):
         _title(ax, result, name)
-        _frame(ax, result)
+        frame(ax, result)
     factor, pixel_m = pooling(fig, axes, result.grid.shape)
     image = overlay(shade(result.truth_occupied, factor, as_density),
                     grown(shade(result.map_occupied, factor, as_density)))
@@ -277,70 +273,6 @@ def vectorial_figure(result: Result, arrow_scale: float = ARROW_SCALE) -> Figure
     for ax, name in zip(axes, names, strict=True):
         _panel(ax, result, factor, image, footprint, result.detectors[name], arrow_scale,
                thin_px * pixel_m)
-    return fig
-
-
-def wall_distances(target: np.ndarray, source: np.ndarray, resolution: float,
-                   factor: int) -> np.ndarray:
-    """Per block of ``factor`` x ``factor`` cells, the smallest distance, metres, from the
-    ``source`` wall cells in it to the nearest ``target`` wall cell: target, source (rows, cols)
-    bool wall masks of cells of ``resolution`` metres -> (ceil(rows / factor),
-    ceil(cols / factor)) float64, NaN where the block holds no source wall. Accuracy: the
-    map's walls to the truth's; completeness: the truth's to the map's.
-
-    The distances are the full grid's (a float32 transform, 4 bytes a cell), so each shown value
-    is one the statistics count; a transform on the pooled target would be cheaper but off by
-    up to a pooled cell's diagonal (24 mm on the Gazebo truth, pooled 9-fold; 1 to 1.5 s and
-    0.3 GB saved there). The smallest, because a block's distance to the target is that of its
-    nearest wall cell, as a cell's is; the block's other wall cells are at most its diagonal
-    farther.
-    """
-    cells = distance_to(target)
-    np.copyto(cells, np.float32(np.nan), where=~source)
-    return np.multiply(min_pool(cells, factor), resolution, dtype=np.float64)
-
-
-def _heat_panel(ax: Axes, result: Result, factor: int, under: np.ndarray, shown: np.ndarray,
-                colours: ScalarMappable, title: str) -> None:
-    """``under`` (pooled bool) in grey, then ``shown`` (pooled distances, NaN where none)
-    coloured by ``colours``, each coloured pixel grown by one pixel so lone cells show."""
-    base = np.ones((*under.shape, 3))
-    base[under] = UNDER_GREY
-    ax.imshow(base, extent=extent(result, factor), origin="upper", interpolation="nearest")
-    near = -cv2.dilate(np.nan_to_num(-shown, nan=-np.inf).astype(np.float32),
-                       np.ones((3, 3), np.uint8), borderType=cv2.BORDER_REPLICATE)
-    ax.imshow(np.where(np.isfinite(near), np.minimum(near, colours.norm.vmax), np.nan),
-              extent=extent(result, factor), origin="upper", cmap=colours.cmap,
-              norm=colours.norm, interpolation="nearest")
-    ax.set_title(title, fontsize=TITLE_PT)
-
-
-def distance_heatmap(result: Result, clip: float = 0.5) -> Figure:
-    """Two panels: accuracy (each occupied cell of the aligned map coloured by its distance to
-    the nearest truth wall, the truth's walls grey beneath) and completeness (each truth wall
-    cell the scores count, inside the footprint unless scored against the whole truth,
-    coloured by its distance to the nearest map wall, the map's walls grey beneath); metres,
-    clipped at ``clip``. Pooled to display resolution (:func:`wall_distances`)."""
-    width, height = result.grid.size_m
-    panel_w = WIDTH_IN / 2
-    fig, axes = plt.subplots(1, 2, figsize=(WIDTH_IN, float(np.clip(
-        panel_w * height / width, 2.5, 9.0)) + 1.4), layout="constrained")
-    colours = ScalarMappable(Normalize(0, clip), "viridis")
-    bar = fig.colorbar(colours, ax=list(axes), location="bottom", shrink=0.6, aspect=40)
-    bar.set_label(f"distance to the nearest wall of the other side [m] (clipped at {clip:g})",
-                  fontsize=TEXT_PT)
-    bar.ax.tick_params(labelsize=TEXT_PT)
-    for ax in axes:
-        _frame(ax, result)
-    factor, _ = pooling(fig, list(axes), result.grid.shape)
-    truth, walls, res = result.truth_occupied, result.map_occupied, result.grid.resolution
-    counted = truth if result.full else truth & result.overlap.footprint
-    _heat_panel(axes[0], result, factor, max_pool(truth, factor),
-                wall_distances(truth, walls, res, factor), colours,
-                "accuracy: map walls to the truth")
-    _heat_panel(axes[1], result, factor, max_pool(walls, factor),
-                wall_distances(walls, counted, res, factor), colours,
-                "completeness: truth walls to the map")
     return fig
 
 
