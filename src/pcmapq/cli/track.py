@@ -85,7 +85,6 @@ def track_command(
     when did the map go wrong, and where was the robot then?"""
     from pcmapq.report.timeline import drop_words
     from pcmapq.track import PoseOptions, step_ends, track_run, travelled, write_track
-    from pcmapq.track.outputs import step_rows
     from pcmapq.track.runs import open_run, reference_poses_of
 
     if len(paths) != 2:
@@ -130,7 +129,7 @@ def track_command(
     elif not quiet:
         drop = None if tracked.drop is None else asdict(tracked.drop)
         err.print(f"{len(tracked.steps)} steps ({scored} scored) of {len(run)} scans; "
-                  f"{drop_words(step_rows(tracked.steps), drop)}; wrote {out}/track.csv, "
+                  f"{drop_words(tracked.rows, drop)}; wrote {out}/track.csv, "
                   "track.json, track.png, track.html", markup=False, highlight=False,
                   soft_wrap=True)
     if not scored:  # nothing to measure: said as such, and not a success

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, replace
+from functools import cached_property
 from pathlib import Path
 
 import numpy as np
@@ -60,6 +61,12 @@ class Tracked:
     asked: bool = False
     reference: Path | None = None
     pose_options: PoseOptions = PoseOptions()
+
+    @cached_property
+    def rows(self) -> list[dict[str, object]]:
+        """The steps as the rows of ``track.csv`` and ``track.json``
+        (:func:`~pcmapq.track.outputs.step_rows`), built once."""
+        return step_rows(self.steps)
 
 
 def track_run(run: Run, truth_path: Path, settings: Settings, ends: np.ndarray, *,
@@ -117,7 +124,7 @@ def write_track(tracked: Tracked, out: Path, every: dict, command: str | None) -
     from pcmapq.report.plot import png_bytes
     from pcmapq.report.timeline import timeline_figure, timeline_html
 
-    rows = step_rows(tracked.steps)
+    rows = tracked.rows
     drop = None if tracked.drop is None else asdict(tracked.drop)
     inputs = inputs_of(tracked, every)
     out.mkdir(parents=True, exist_ok=True)
