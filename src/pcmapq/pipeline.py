@@ -231,10 +231,10 @@ def score(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap, setti
     check_span(source, MAP_CROP)
     rule = map_footprint_rule(source, settings)
     truth_xy, truth_level = plan_points(truth, settings)
-    cell = truth_grid(truth, truth_xy, settings)
-    memory.guard(needed_memory((source, truth), cell), memory_limit,
+    planned = truth_grid(truth, truth_xy, settings)
+    memory.guard(needed_memory((source, truth), planned), memory_limit,
                  f"{source.path} against {truth.path}",
-                 lambda: hint(truth, TRUTH_CROP, cell.resolution) or hint(source, MAP_CROP))
+                 lambda: hint(truth, TRUTH_CROP, planned.resolution) or hint(source, MAP_CROP))
     grid, truth_occ = truth_raster(truth, truth_xy, settings)
     sides = SideBySide(settings.matching.detectors, settings.matching.params)
     with ThreadPoolExecutor(1) as background:
