@@ -36,9 +36,10 @@ from pcmapq.io.writers import write_ros_map
 from pcmapq.pipeline import score
 from pcmapq.plan import TRUTH_CROP, load_input
 from pcmapq.track import Tracked, open_run, step_ends, track_run, travelled
+from pcmapq.track.drop import MIN_DROP
 from pcmapq.track.outputs import HEAD
 from pcmapq.track.runs import reference_poses_of
-from pcmapq.track.timeline import MIN_DROP, figures_of, track
+from pcmapq.track.timeline import figures_of, track
 
 PLAN = synth.building_plan(0)
 #: The path: from the corridor's west end on its centre line (the corridor lies between

@@ -15,10 +15,11 @@ from pcmapq.plan import distinct_cells
 from pcmapq.raster.footprint import footprint_rule, map_footprint, view_outlines
 from pcmapq.raster.seen import NO_VIEW, add_views, seen_on
 from pcmapq.report.timeline import drop_words, timeline_html
+from pcmapq.track.drop import MIN_DROP, worst_drop
 from pcmapq.track.outputs import step_rows
 from pcmapq.track.runs import dense_reach
 from pcmapq.track.steps import step_ends, travelled
-from pcmapq.track.timeline import MIN_DROP, Step, worst_drop
+from pcmapq.track.timeline import Step
 from pcmapq.transform import Similarity2D
 
 pytestmark = pytest.mark.unit

@@ -20,7 +20,8 @@ import numpy as np
 
 from pcmapq.config import Settings
 from pcmapq.track import open_run, planar_of, planar_poses, step_ends, track_run, travelled
-from pcmapq.track.timeline import Drop, Step
+from pcmapq.track.drop import Drop
+from pcmapq.track.timeline import Step
 
 from .common import Case, Record, Section
 from .drift import increments, integrate

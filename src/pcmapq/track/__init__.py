@@ -5,7 +5,8 @@ truth prepared once, and :func:`write_track` writes ``track.csv``, ``track.json`
 ``track.png`` and ``track.html`` (the curves, and the vectorial map at the worst drop with the
 robot's path). Modules: :mod:`~pcmapq.track.runs` (the scans and poses of a run, and its growing
 map), :mod:`~pcmapq.track.steps` (when to score), :mod:`~pcmapq.track.timeline` (the scoring
-loop and the worst drop), :mod:`~pcmapq.track.outputs` (the files)."""
+loop), :mod:`~pcmapq.track.drop` (the worst drop), :mod:`~pcmapq.track.outputs` (the
+files)."""
 
 from __future__ import annotations
 
@@ -22,18 +23,17 @@ from pcmapq.pipeline import PreparedTruth
 from pcmapq.plan import TRUTH_CROP, load_input
 from pcmapq.prepared import prepare_truth
 from pcmapq.result import Result
+from pcmapq.track.drop import Drop, worst_drop
 from pcmapq.track.outputs import step_rows, track_csv, track_json
 from pcmapq.track.runs import Run, open_run, planar_of, planar_poses
 from pcmapq.track.steps import step_ends, travelled
 from pcmapq.track.timeline import (
     FEATURE_THREADS,
-    Drop,
     PoseOptions,
     Step,
     plane_points,
     result_at,
     track,
-    worst_drop,
 )
 
 __all__ = ["PoseOptions", "Step", "Tracked", "open_run", "planar_of", "planar_poses",

@@ -10,7 +10,8 @@ from pathlib import Path
 
 from pcmapq import __version__
 from pcmapq.result import DECIMALS
-from pcmapq.track.timeline import Drop, Step
+from pcmapq.track.drop import Drop
+from pcmapq.track.timeline import Step
 
 #: The columns every step has, before its figures.
 HEAD = ("step", "scans", "time_s", "distance_m", "scored")
