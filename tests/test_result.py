@@ -63,6 +63,12 @@ def test_counts_add_up(result: Result):
         assert sum(c["map"] for c in counted) == det["matched_map"]
 
 
+def test_the_figures_alone_are_the_document_without_its_feature_lists(result: Result):
+    whole, figures = result.to_dict(), result.to_dict(features=False)
+    assert all(whole[key] for key in ("matches", "missing", "extra"))
+    assert figures == {**whole, "matches": [], "missing": [], "extra": []}
+
+
 def test_the_frame_chain_is_reported(result: Result):
     """The sample scan is a level 3D cloud: its plan comes from levelling it, with no tilt; the
     truth is an image (no levelling); the planar transform is the reported alignment."""

@@ -126,8 +126,11 @@ class Result:
         return [f"{name}: n/a: {note}" for name in self.detectors
                 if (note := self.note(name)) is not None]
 
-    def to_dict(self) -> dict:
-        """The JSON document (see README): plain types, floats rounded to DECIMALS."""
+    def to_dict(self, features: bool = True) -> dict:
+        """The JSON document (see README): plain types, floats rounded to DECIMALS.
+        ``features=False``: the figures alone, with the lists of matched, missing and extra
+        features left empty (a figures row needs none of them; Intel's final map has about
+        3000, and rounding them was most of the work)."""
         tf = self.transform
         x0, y0, yaw0 = self.grid.origin
         doc = {
@@ -171,6 +174,8 @@ class Result:
                 "threshold_m": self.threshold,
                 "displacement_m": det.displacement_stats().to_dict(),
             }
+            if not features:
+                continue
             doc["matches"] += [
                 {"detector": name, "truth_xy_m": t, "map_xy_m": p, "displacement_m": d,
                  "counted": {"truth": ts, "map": ms}}

@@ -115,7 +115,7 @@ def figures_of(result: Result) -> dict[str, float | None]:
     detectors' mean precision (``precision``: is what the map shows right? the figure whose
     fall dates a fault) and the wall precision at each tau (``wall_precision@0.1m``: share of
     the map's wall cells within tau of a truth wall)."""
-    row = summary_row("", result.to_dict())
+    row = summary_row("", result.to_dict(features=False))
     figures = {k: v for k, v in row.items() if k not in NOT_PER_STEP}
     precisions = [d.matching.precision for d in result.detectors.values()
                   if d.matching.precision is not None]
