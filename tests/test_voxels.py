@@ -4,8 +4,12 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+from hypothesis.extra import numpy as hnp
 
 from pcmapq import voxels
+from pcmapq.bounds import bounds
 from pcmapq.voxels import VoxelMap, evenly, voxel_centroids, voxel_count, voxel_index, voxel_keys
 
 
@@ -60,3 +64,17 @@ def test_evenly_spreads_over_the_order() -> None:
     points = np.arange(20.0).reshape(10, 2)
     np.testing.assert_array_equal(evenly(points, 4), points[[0, 3, 6, 9]])
     assert evenly(points, 10) is points and evenly(points, 50) is points
+
+
+
+SHAPES = hnp.array_shapes(min_dims=2, max_dims=2, min_side=1, max_side=60).map(
+    lambda s: (s[0], min(s[1], 3)))
+
+
+@given(st.one_of(hnp.arrays(np.float64, SHAPES, elements=st.floats(allow_nan=True)),
+                 hnp.arrays(np.int64, SHAPES)))
+def test_bounds_are_numpys_over_axis_0(points):
+    lo, hi = bounds(points)
+    np.testing.assert_array_equal(lo, points.min(axis=0))
+    np.testing.assert_array_equal(hi, points.max(axis=0))
+    assert lo.dtype == hi.dtype == points.dtype

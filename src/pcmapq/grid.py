@@ -12,6 +12,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from pcmapq.bounds import bounds
+
 
 @dataclass(frozen=True)
 class MetricGrid:
@@ -72,7 +74,8 @@ class MetricGrid:
     def covering(cls, xy: np.ndarray, resolution: float, margin: float = 1.0) -> MetricGrid:
         """An axis-aligned grid (yaw 0) that covers points ``xy`` (N, 2, metres) plus a margin."""
         xy = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
-        lo = np.floor((xy.min(axis=0) - margin) / resolution) * resolution
-        hi = xy.max(axis=0) + margin
+        low, high = bounds(xy)
+        lo = np.floor((low - margin) / resolution) * resolution
+        hi = high + margin
         cols, rows = np.ceil((hi - lo) / resolution).astype(int) + 1
         return cls(float(resolution), (float(lo[0]), float(lo[1]), 0.0), (int(rows), int(cols)))

@@ -13,6 +13,7 @@ from pcmapq import memory
 from pcmapq.align import Alignment
 from pcmapq.align.planar import RigidTarget
 from pcmapq.align.rigid3d import Registration3D
+from pcmapq.bounds import bounds
 from pcmapq.config import Settings
 from pcmapq.errors import EvaluationError, InputError
 from pcmapq.features import Features, SideBySide, default_params
@@ -76,7 +77,7 @@ def map_raster(source: OccupancyMap | PointMap, map_xy: np.ndarray, transform: S
         known = None
         if rule == "seen" and source.seen is not None:
             seen = seen_on(source.seen, transform, grid)
-        (x0, y0), (x1, y1) = map_xy.min(axis=0), map_xy.max(axis=0)
+        (x0, y0), (x1, y1) = bounds(map_xy)
         corners = np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]])
     footprint = map_footprint(rule, occupied, grid, settings.footprint.margin, known=known,
                               rectangle=transform.apply(corners), seen=seen)

@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from pcmapq import memory
+from pcmapq.bounds import bounds
 from pcmapq.config import Settings, SourceConfig
 from pcmapq.errors import EvaluationError, InputError
 from pcmapq.frames import Levelling
@@ -118,7 +119,7 @@ def check_structure(path: Path, xy: np.ndarray) -> None:
 def distinct_cells(xy: np.ndarray) -> int:
     """How many distinct cells of memory.WORKING_CELL (metres) the points ``xy`` (metres) fill."""
     cells = np.floor(np.asarray(xy[:, :2]) / memory.WORKING_CELL).astype(np.int64)
-    cells -= cells.min(axis=0)  # one int64 per cell: a 1D unique, not a row-wise one
+    cells -= bounds(cells)[0]  # one int64 per cell: a 1D unique, not a row-wise one
     return len(np.unique(cells[:, 0] * (int(cells[:, 1].max()) + 1) + cells[:, 1]))
 
 

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from pcmapq.bounds import bounds
 from pcmapq.errors import InputError
 
 __all__ = ["VoxelMap", "evenly", "voxel_centroids", "voxel_count"]
@@ -124,8 +125,8 @@ def _dense_groups(index: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
     indices' bounding box; None when that box is too large (DENSE_PER_POINT, DENSE_CELLS)."""
     if len(index) == 0:
         return None
-    lo = index.min(axis=0)
-    span = index.max(axis=0) - lo + 1
+    lo, hi = bounds(index)
+    span = hi - lo + 1
     cells = int(np.prod(span.astype(object)))
     if cells > min(DENSE_PER_POINT * len(index) + 4096, DENSE_CELLS):
         return None

@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
+from pcmapq.bounds import bounds
 from pcmapq.grid import MetricGrid
 from pcmapq.morphology import distance_to
 from pcmapq.raster.draw import hit_counts
@@ -255,7 +256,7 @@ def similarity_search(map_xy: np.ndarray, truth_xy: np.ndarray, *,
     fgrid = MetricGrid.covering(truth_xy, resolution, margin=(half_max + 1) * resolution)
     field = likelihood_field(truth_xy, fgrid, resolution)
     (u0, v0), (u1, v1) = np.round(fgrid.xy_to_pixels(
-        np.array([truth_xy.min(axis=0), truth_xy.max(axis=0)]))).astype(int)
+        np.array(bounds(truth_xy)))).astype(int)
     baseline = float(field[v1:v0 + 1, u0:u1 + 1].mean())
     rows = []
     for scale in scales:

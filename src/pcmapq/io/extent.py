@@ -12,6 +12,7 @@ from dataclasses import replace
 
 import numpy as np
 
+from pcmapq.bounds import bounds
 from pcmapq.cells import OCCUPIED, UNKNOWN
 from pcmapq.errors import InputError
 from pcmapq.grid import MetricGrid
@@ -49,7 +50,7 @@ def span(source: OccupancyMap | PointMap) -> tuple[float, float]:
     """Width and height of the input, metres: the image's size, the box of a cloud's x, y."""
     if isinstance(source, OccupancyMap):
         return source.grid.size_m
-    lo, hi = np.min(source.points[:, :2], axis=0), np.max(source.points[:, :2], axis=0)
+    lo, hi = bounds(source.points[:, :2])
     with np.errstate(over="ignore"):
         return float(hi[0]) - float(lo[0]), float(hi[1]) - float(lo[1])
 
@@ -78,8 +79,8 @@ def main_group(xy: np.ndarray) -> Box | None:
     if keep.all():
         return None
     inside = xy[keep]
-    (x0, y0), (x1, y1) = (np.floor((inside.min(axis=0) - BIN) * 10) / 10,
-                          np.ceil((inside.max(axis=0) + BIN) * 10) / 10)
+    lo, hi = bounds(inside)
+    (x0, y0), (x1, y1) = np.floor((lo - BIN) * 10) / 10, np.ceil((hi + BIN) * 10) / 10
     return float(x0), float(y0), float(x1), float(y1)
 
 

@@ -24,6 +24,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.spatial import cKDTree
 
+from pcmapq.bounds import bounds
 from pcmapq.metrics.ballsums import CHUNK_POINTS, ball_sums, moments
 
 #: map-metrics' presets (metres, neighbour counts): ``LidarConfig`` and ``DepthConfig``.
@@ -182,7 +183,8 @@ def query_covariances(points: np.ndarray, queries: np.ndarray,
     if len(q) == 0:
         return np.zeros(0, dtype=np.int64), np.zeros((0, 3, 3))
     r = strict_radius(radius)
-    lo, hi = q.min(axis=0) - radius, q.max(axis=0) + radius
+    lo, hi = bounds(q)
+    lo, hi = lo - radius, hi + radius
     near = pts[np.all((pts >= lo) & (pts <= hi), axis=1)]
     origin = q.mean(axis=0)
     if len(near) == 0:
