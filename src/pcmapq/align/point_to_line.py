@@ -60,7 +60,8 @@ def refine_point_to_line(map_xy: np.ndarray, target: LineTarget, init: Similarit
     tf = init if with_scale else Similarity2D(init.tx, init.ty, init.yaw)
     for _ in range(iterations):
         p = tf.apply(map_xy)
-        dist, j = tree.query(p, distance_upper_bound=max_distance, workers=-1)
+        # one thread, as planar._score_tree's: threads started for each of up to 30 queries
+        dist, j = tree.query(p, distance_upper_bound=max_distance, workers=1)
         ok = np.isfinite(dist)
         if ok.sum() < 3:
             break
