@@ -72,7 +72,8 @@ def _score_tree(map_xy: np.ndarray, tree: cKDTree, tf: Similarity2D,
     if len(map_xy) == 0:
         return 0.0, 0.0
     # one thread: SciPy starts and joins threads for each query, which costs more than the
-    # query of a thinned map saves; a tracked run's steps keep the cores busy (Intel's 7 % faster)
+    # query of a thinned map saves, and a tracked run's steps keep the cores busy
+    # (docs/benchmarks.md, "Quality over a run")
     dist, _ = tree.query(tf.apply(map_xy), distance_upper_bound=tolerance, workers=1)
     inliers = dist[np.isfinite(dist)]
     rmse = float(np.sqrt(np.mean(inliers**2))) if len(inliers) else 0.0
