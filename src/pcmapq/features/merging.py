@@ -13,6 +13,7 @@ import math
 import numba
 import numpy as np
 
+from pcmapq.bounds import bounds
 from pcmapq.features.segments import WallTest, directions
 
 #: Regroup-and-refit rounds of one merged segment.
@@ -79,10 +80,10 @@ def _tiles(seg: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndar
     midpoint: the segments in tile order, each filled tile's first position in it and count,
     its centre (F, 2, metres), and the tile's side, metres."""
     mid = 0.5 * (seg[:, :2] + seg[:, 2:])
-    lo = mid.min(axis=0)
-    size = max(float(np.ptp(mid, axis=0).max()) / TILES, 1e-9)
+    lo, hi = bounds(mid)
+    size = max(float((hi - lo).max()) / TILES, 1e-9)
     cell = np.floor((mid - lo) / size).astype(np.int64)
-    shape = cell.max(axis=0) + 1
+    shape = bounds(cell)[1] + 1
     tile = cell[:, 0] * shape[1] + cell[:, 1]
     order = np.argsort(tile, kind="stable")
     counts = np.bincount(tile, minlength=int(np.prod(shape)))

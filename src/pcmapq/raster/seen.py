@@ -13,6 +13,7 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
+from pcmapq.bounds import bounds
 from pcmapq.grid import MetricGrid
 from pcmapq.io.clouds import SEEN_CELL, SeenCells
 from pcmapq.transform import Similarity2D
@@ -30,8 +31,8 @@ def add_views(seen: SeenCells, views: np.ndarray) -> SeenCells:
     if views.size == 0:
         return seen
     fixed = np.round(views * ((1 << SHIFT) / SEEN_CELL)).astype(np.int64) - (1 << (SHIFT - 1))
-    low = fixed.reshape(-1, 2).min(axis=0) >> SHIFT
-    high = (fixed.reshape(-1, 2).max(axis=0) >> SHIFT) + 1
+    low, high = bounds(fixed.reshape(-1, 2))
+    low, high = low >> SHIFT, (high >> SHIFT) + 1
     if seen.cells.size:
         low = np.minimum(low, seen.corner)
         high = np.maximum(high, np.add(seen.corner, seen.cells.shape[::-1]) - 1)
