@@ -180,3 +180,39 @@ def test_cli_footprint_option(plan, truth_png, tmp_path):
     res = runner.invoke(app, ["eval", cloud, str(truth_png), "--footprint", "known"])
     assert res.exit_code == 2 and "Traceback" not in res.output
     assert "cloud.npy: a point cloud has no known cells" in res.output
+
+
+def test_seen_footprint_counts_no_map_feature_outside_it(plan, truth_png):
+    """A map of the whole plan that saw only its west half (a ``seen`` lattice): a box of
+    clutter the truth lacks counts as extra inside the half it saw, and not at all in the half
+    it did not (outside, its cells are not in the footprint); ``walls`` counts both."""
+    from pcmapq.io import PointMap
+    from pcmapq.raster.seen import NO_VIEW, add_views
+
+    west = np.array([[[-1.0, -1.0], [11.0, -1.0], [11.0, 17.0], [-1.0, 17.0]]])
+    seen = add_views(NO_VIEW, west)
+    walls = synth.wall_points(plan, 0.02, noise=0.01, seed=3)
+
+    def scored(boxes: list[tuple[float, float]], rule: str):
+        corners = [np.array([[x - 0.3, y - 0.3], [x + 0.3, y - 0.3], [x + 0.3, y + 0.3],
+                             [x - 0.3, y + 0.3]]) for x, y in boxes]
+        sides = [np.column_stack([c, np.roll(c, -1, axis=0)]) for c in corners]
+        points = np.concatenate([walls] + [synth.wall_points(s, 0.02) for s in sides])
+        cloud = PointMap(truth_png, np.column_stack([points, np.zeros(len(points))]), False,
+                         seen=seen)
+        settings = Settings(alignment=AlignmentConfig(enabled=False),
+                            footprint=FootprintConfig(rule=rule))
+        return {name: d.matching for name, d in evaluate(cloud, truth_png, settings)
+                .detectors.items()}
+
+    inside, outside = (2.5, 2.0), (16.0, 2.0)  # in a room of each half, over 1.3 m from walls
+    bare = scored([], "seen")
+    for name, far in scored([outside], "seen").items():
+        assert (far.map_features, far.matched_map) == (bare[name].map_features,
+                                                       bare[name].matched_map), name
+    near = scored([inside], "seen")
+    assert sum(m.map_features - m.matched_map for m in near.values()) > \
+        sum(m.map_features - m.matched_map for m in bare.values())
+    counted = scored([], "walls")
+    assert sum(m.map_features for m in scored([outside], "walls").values()) > \
+        sum(m.map_features for m in counted.values())

@@ -12,12 +12,16 @@ from pcmapq import memory
 from pcmapq.grid import MetricGrid
 from pcmapq.io.carmen import beam_angles
 from pcmapq.plan import distinct_cells
-from pcmapq.raster.footprint import footprint_rule, map_footprint, view_outlines
+from pcmapq.raster.footprint import (
+    footprint_rule,
+    joined_readings,
+    map_footprint,
+    view_outlines,
+)
 from pcmapq.raster.seen import NO_VIEW, add_views, seen_on
 from pcmapq.report.timeline import drop_words, timeline_html
 from pcmapq.track.drop import MIN_DROP, worst_drop
 from pcmapq.track.outputs import step_rows
-from pcmapq.track.runs import dense_reach
 from pcmapq.track.steps import step_ends, travelled
 from pcmapq.track.timeline import Step
 from pcmapq.transform import Similarity2D
@@ -118,34 +122,42 @@ def test_the_seen_area_moves_with_the_map():
     assert moved[inside].all() and not moved[outside].any()
 
 
-def test_a_view_reaches_no_farther_than_max_reach():
-    """The room scan's view capped at 1 m: every vertex within 1 m of the scanner, its cells a
-    disc of 1 m inside the room (the walls are 1.5 m away or more); a cap beyond the walls
-    changes nothing."""
-    box = (2.0, 3.0, 8.0, 7.0)
-    origin = np.array([4.0, 5.0])
-    hits = _room_scan(origin, box)
-    scan = np.zeros(len(hits), dtype=np.int64)
-    capped = view_outlines(origin[None], hits, scan, max_reach=1.0)
-    assert np.hypot(*(capped[0] - origin).T).max() == pytest.approx(1.0)
-    xy = GRID.cell_centres(view_cells(capped))
-    assert np.hypot(*(xy - origin).T).max() <= 1.0 + GRID.resolution
-    # the fill takes the cells its outline crosses too: half a cell beyond it
-    assert len(xy) * GRID.resolution**2 == pytest.approx(
-        np.pi * (1.0 + GRID.resolution / 2) ** 2, rel=0.02)
-    assert (view_outlines(origin[None], hits, scan, max_reach=50.0) ==
-            view_outlines(origin[None], hits, scan)).all()
+def test_joined_readings_are_those_drawing_a_wall_as_a_line():
+    """CARMEN's 1-degree beams on a wall facing the scanner: at 5 m readings land 0.087 m
+    apart and all but the two ends are joined; at 15 m (0.26 m apart, beyond 0.2 / (pi / 180)
+    = 11.46 m) none is; along a wall 1 m to the side, readings more than 0.2 m apart are not.
+    A scan's first reading is not joined to the previous scan's last."""
+    angles = beam_angles(180)
+    ahead = angles[np.abs(angles) < np.radians(20)]
+    for distance, joined in ((5.0, True), (15.0, False)):
+        hits = np.column_stack([np.full(len(ahead), distance), distance * np.tan(ahead)])
+        got = joined_readings(hits, np.zeros(len(hits), np.int64), 0.2)
+        assert not got[0] and not got[-1] and (got[1:-1] == joined).all()
+    side = angles[(angles > np.radians(5)) & (angles < np.radians(80))]
+    hits = np.column_stack([1.0 / np.tan(side), np.ones(len(side))])  # the wall y = 1
+    gaps = np.hypot(*np.diff(hits, axis=0).T)
+    got = joined_readings(hits, np.zeros(len(hits), np.int64), 0.2)
+    assert (got[1:-1] == ((gaps[:-1] <= 0.2) & (gaps[1:] <= 0.2))).all()
+    assert got.any() and not got.all()
+    hits = np.column_stack([np.full(len(ahead), 5.0), 5.0 * np.tan(ahead)])
+    two = np.concatenate([hits, hits])
+    scan = np.repeat([0, 1], len(hits))
+    assert np.array_equal(joined_readings(two, scan, 0.2),
+                          np.tile(joined_readings(hits, scan[:len(hits)], 0.2), 2))
 
 
-def test_dense_reach_of_a_laser_is_where_its_readings_stop_joining():
-    """CARMEN's 180 beams over 180 degrees are 1 degree apart: readings 0.2 m apart (twice
-    the wall image's closing) at 0.2 / (pi / 180) = 11.46 m; padding (NaN) is ignored; one
-    beam bounds nothing."""
-    angles = np.tile(beam_angles(180), (3, 1))
-    assert dense_reach(angles) == pytest.approx(0.2 / np.radians(1.0))
-    padded = np.column_stack([angles, np.full((3, 5), np.nan)])
-    assert dense_reach(padded) == dense_reach(angles)
-    assert dense_reach(angles[:, :1]) == np.inf
+def test_the_seen_footprint_leaves_out_the_cells_of_readings_that_drew_no_wall():
+    """Occupied cells outside the seen area (dots no view reaches) stay out of a ``seen``
+    footprint, while ``walls`` and ``all`` take every occupied cell in."""
+    seen = np.zeros(GRID.shape, bool)
+    seen[50:100, 50:100] = True
+    occupied = np.zeros(GRID.shape, bool)
+    occupied[150, 250] = occupied[75, 100] = True
+    footprint = map_footprint("seen", occupied, GRID, 0.3, seen=seen)
+    assert not footprint[150, 250] and footprint[75, 100]
+    assert footprint.sum() == map_footprint("seen", np.zeros_like(occupied), GRID, 0.3,
+                                            seen=seen).sum()
+    assert map_footprint("walls", occupied, GRID, 0.3)[150, 250]
 
 
 def test_footprint_rule_seen_needs_views():

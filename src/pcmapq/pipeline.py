@@ -266,6 +266,8 @@ def assemble(loaded: OccupancyMap | PointMap, side: MapSide, prepared: PreparedT
         truth_f, map_f = prepared.features[name], side.features[name]
         if not full:  # truth features the map never saw are not missing
             truth_f = truth_f.counted_where(inside(truth_f, footprint, grid))
+            if rule == "seen":  # nor are the features of walls its scans only dotted extra
+                map_f = map_f.counted_where(inside(map_f, footprint, grid))
         detectors[name] = DetectorResult(truth_f, map_f,
                                          match(name, truth_f, map_f, threshold,
                                                settings.matching.params.get(name)))

@@ -11,15 +11,18 @@ Rules (``--footprint``, documented in docs/method.md):
 - ``seen``: a map made of scans with known poses (``pcmapq track``'s maps) observed the free
   space its scans swept: the union of their views, each the outline from the scanner through
   its readings in angular order (a beam with no return cuts the view back to the scanner), so
-  a room the robot looked into is observed and one behind a wall it never passed is not;
+  a room the robot looked into is observed and one behind a wall it never passed is not. The
+  map's cells outside it (readings that drew no wall, see :func:`joined_readings`) are not
+  added to it, and their features are not counted (``pipeline.assemble``);
 - ``all``: the map's whole rectangle (an image's extent, a cloud's bounding box, in its frame);
 - ``auto`` (default): ``known`` for an image with unknown regions, ``seen`` for a map with
   views, ``walls`` otherwise. An
   unknown region is what remains of the unknown cells after an opening by a disc of
   ``UNKNOWN_WIDTH`` metres (so anti-aliased wall edges, a thin grey border, stray pixels do not
   count); an image has them when they make up at least ``UNKNOWN_SHARE`` of it.
-Whatever the rule, the footprint is then grown by ``margin`` metres, so truth features on the
-border of what the map saw (a wall the map ends on) count as inside.
+Whatever the rule, the footprint (with the map's occupied cells, but for ``seen``) is then
+grown by ``margin`` metres, so truth features on the border of what the map saw (a wall the
+map ends on) count as inside.
 """
 
 from __future__ import annotations
@@ -119,7 +122,8 @@ def map_footprint(rule: str, occupied: np.ndarray, grid: MetricGrid, margin: flo
     ``walls``, ``seen`` or ``all``, see :func:`footprint_rule`): its known cells, the area its
     occupied cells enclose, the cells its scans saw (``seen``, bool, see
     :func:`pcmapq.raster.seen.seen_on`) or its rectangle (``rectangle``: (4, 2) corners,
-    truth frame, metres); grown by ``margin`` metres."""
+    truth frame, metres), with the ``occupied`` cells (but for ``seen``: the readings that drew
+    no wall stay out); grown by ``margin`` metres."""
     if rule == "known" and known is not None:
         area = known
     elif rule == "seen" and seen is not None:
@@ -130,25 +134,36 @@ def map_footprint(rule: str, occupied: np.ndarray, grid: MetricGrid, margin: flo
         area = enclosed_area(occupied, grid)
     else:
         raise ValueError(f"footprint rule {rule!r} needs what this map lacks")
-    return grow(area | occupied, grid, margin)
+    return grow(area if rule == "seen" else area | occupied, grid, margin)
 
+
+
+def joined_readings(points: np.ndarray, scan: np.ndarray, gap: float) -> np.ndarray:
+    """(N,) bool: the readings that draw a wall as a line: those whose neighbours on both
+    sides, the readings before and after them in the same scan, lie within ``gap`` metres.
+    ``points`` (N, 2, metres) are the readings of each scan in beam order, ``scan`` (N,) the
+    scan of each. A wall far away or seen at a grazing angle is a row of dots instead (1-degree
+    beams land 0.2 m apart at 11.5 m facing the wall, farther apart along it)."""
+    points = np.asarray(points, dtype=np.float64).reshape(-1, 2)
+    scan = np.asarray(scan)
+    gaps = np.hypot(*np.diff(points, axis=0).T)
+    near = (scan[1:] == scan[:-1]) & (gaps <= gap)
+    return np.concatenate([[False], near]) & np.concatenate([near, [False]])
 
 
 def view_outlines(origins: np.ndarray, points: np.ndarray, scan: np.ndarray,
-                  bins: int = 360, max_reach: float = np.inf) -> np.ndarray:
+                  bins: int = 360) -> np.ndarray:
     """The views of K scans, (K, bins, 2) metres: scan k's farthest reading in each of
     ``bins`` equal angular sectors around its scanner at ``origins[k]`` (K, 2), in angular
-    order, but no farther than ``max_reach`` metres from it, or the scanner itself for a
-    sector with no reading. ``points`` (N, 2) are the readings in the same frame, ``scan``
-    (N,) the scan of each. A star-shaped polygon: the free space the scan saw
-    (:func:`pcmapq.raster.seen.add_views` fills it)."""
+    order, or the scanner itself for a sector with no reading. ``points`` (N, 2) are the
+    readings in the same frame, ``scan`` (N,) the scan of each. A star-shaped polygon: the
+    free space the scan saw (:func:`pcmapq.raster.seen.add_views` fills it)."""
     origins = np.asarray(origins, dtype=np.float64).reshape(-1, 2)
     offset = np.asarray(points, dtype=np.float64).reshape(-1, 2) - origins[scan]
     angle = np.arctan2(offset[:, 1], offset[:, 0])
     sector = np.minimum(((angle + np.pi) / (2 * np.pi) * bins).astype(np.int64), bins - 1)
     reach = np.zeros((len(origins), bins))
     np.maximum.at(reach, (scan, sector), np.hypot(offset[:, 0], offset[:, 1]))
-    np.minimum(reach, max_reach, out=reach)
     centre = -np.pi + (np.arange(bins) + 0.5) * (2 * np.pi / bins)
     return origins[:, None, :] + reach[..., None] * np.stack([np.cos(centre),
                                                                np.sin(centre)], axis=-1)

@@ -11,8 +11,9 @@ Each map carries the area its scans saw (their views,
 :func:`~pcmapq.raster.footprint.view_outlines`, in the poses' x, y: a 3D map's levelling is not
 applied to them), filled once as the map grows (:mod:`~pcmapq.raster.seen`), so it is scored
 inside it (footprint rule ``seen``). A laser's views reach no farther than its readings draw a
-wall (:func:`dense_reach`: 11.5 m for 1-degree beams); a 3D scanner's, whose readings lie a
-few tenths of a degree apart in bearing, are not cut.
+wall: only the readings within twice the wall image's closing of their neighbours on both sides
+make them (:func:`~pcmapq.raster.footprint.joined_readings`); a 3D scanner's, whose readings
+lie a few tenths of a degree apart in bearing, are not cut.
 
 Poses are (K, 4, 4) in the map's world frame, ``p_world = pose_k @ p_scanner``; metres.
 """
@@ -31,24 +32,13 @@ from pcmapq.io import PointMap
 from pcmapq.io.carmen import DEFAULT_MAX_RANGE, LaserScans, endpoints, is_carmen, read_laser_scans
 from pcmapq.mapping import ScanSequence, VoxelMap, build_map_kiss, open_scans, read_poses
 from pcmapq.mapping.reference import scans_for_poses
-from pcmapq.raster.footprint import view_outlines
+from pcmapq.raster.footprint import joined_readings, view_outlines
 from pcmapq.raster.seen import NO_VIEW, add_views
 
 #: Cell of the voxel map a scan sequence grows into, metres (``pcmapq map``'s default).
 SCAN_VOXEL = 0.1
 #: Scanner readings kept, metres from the scanner (KISS-ICP's defaults).
 MIN_RANGE, MAX_RANGE = 0.0, 100.0
-
-
-def dense_reach(angles: np.ndarray) -> float:
-    """How far, metres, a laser whose beams are ``angles`` (K, B) radians apart (NaN for none)
-    draws a wall with its readings no farther apart than the wall image joins into one line
-    (twice :data:`~pcmapq.features.walls.CLOSING`; a wall facing the scanner): the reach of a
-    scan's view. 11.5 m for CARMEN's 1-degree beams; unbounded with fewer than two beams."""
-    with np.errstate(invalid="ignore"):
-        steps = np.abs(np.diff(angles, axis=1))
-    steps = steps[np.isfinite(steps) & (steps > 0)]
-    return float(2 * CLOSING / np.median(steps)) if len(steps) else np.inf
 
 
 def planar_poses(xyt: np.ndarray) -> np.ndarray:
@@ -100,8 +90,9 @@ class LaserRun:
                 np.isfinite(self.scans.angles)
         counts = np.count_nonzero(kept, axis=1)
         offsets = np.concatenate([[0], np.cumsum(counts)])
-        views = view_outlines(self.poses[:, :2, 3], xy, np.repeat(np.arange(len(self)), counts),
-                              max_reach=dense_reach(self.scans.angles))
+        scan = np.repeat(np.arange(len(self)), counts)
+        joined = joined_readings(xy, scan, 2 * CLOSING)
+        views = view_outlines(self.poses[:, :2, 3], xy[joined], scan[joined])
         points = np.column_stack([xy, np.zeros(len(xy))])
         before, seen = 0, NO_VIEW
         for end in ends:
