@@ -144,6 +144,9 @@ def test_joined_readings_are_those_drawing_a_wall_as_a_line():
     scan = np.repeat([0, 1], len(hits))
     assert np.array_equal(joined_readings(two, scan, 0.2),
                           np.tile(joined_readings(hits, scan[:len(hits)], 0.2), 2))
+    for count in (0, 1):  # no neighbour, nothing joined
+        assert not joined_readings(hits[:count], scan[:count], 0.2).any()
+        assert len(joined_readings(hits[:count], scan[:count], 0.2)) == count
 
 
 def test_the_seen_footprint_leaves_out_the_cells_of_readings_that_drew_no_wall():

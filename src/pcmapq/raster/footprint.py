@@ -137,7 +137,6 @@ def map_footprint(rule: str, occupied: np.ndarray, grid: MetricGrid, margin: flo
     return grow(area if rule == "seen" else area | occupied, grid, margin)
 
 
-
 def joined_readings(points: np.ndarray, scan: np.ndarray, gap: float) -> np.ndarray:
     """(N,) bool: the readings that draw a wall as a line: those whose neighbours on both
     sides, the readings before and after them in the same scan, lie within ``gap`` metres.
@@ -146,9 +145,9 @@ def joined_readings(points: np.ndarray, scan: np.ndarray, gap: float) -> np.ndar
     beams land 0.2 m apart at 11.5 m facing the wall, farther apart along it)."""
     points = np.asarray(points, dtype=np.float64).reshape(-1, 2)
     scan = np.asarray(scan)
-    gaps = np.hypot(*np.diff(points, axis=0).T)
-    near = (scan[1:] == scan[:-1]) & (gaps <= gap)
-    return np.concatenate([[False], near]) & np.concatenate([near, [False]])
+    near = np.zeros(len(points) + 1, bool)  # near[i]: readings i - 1 and i are joined
+    near[1:-1] = (scan[1:] == scan[:-1]) & (np.hypot(*np.diff(points, axis=0).T) <= gap)
+    return near[:-1] & near[1:]
 
 
 def view_outlines(origins: np.ndarray, points: np.ndarray, scan: np.ndarray,
