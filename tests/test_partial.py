@@ -12,8 +12,10 @@ import pytest
 from pcmapq import synth
 from pcmapq.config import AlignmentConfig, FootprintConfig, MatchingConfig, Settings
 from pcmapq.errors import InputError
+from pcmapq.io import PointMap
 from pcmapq.io.writers import write_ros_map
 from pcmapq.pipeline import evaluate
+from pcmapq.raster.seen import NO_VIEW, add_views
 from pcmapq.transform import Similarity2D
 
 from .conftest import in_map_frame, write_cloud_map
@@ -186,18 +188,12 @@ def test_seen_footprint_counts_no_map_feature_outside_it(plan, truth_png):
     """A map of the whole plan that saw only its west half (a ``seen`` lattice): a box of
     clutter the truth lacks counts as extra inside the half it saw, and not at all in the half
     it did not (outside, its cells are not in the footprint); ``walls`` counts both."""
-    from pcmapq.io import PointMap
-    from pcmapq.raster.seen import NO_VIEW, add_views
-
     west = np.array([[[-1.0, -1.0], [11.0, -1.0], [11.0, 17.0], [-1.0, 17.0]]])
     seen = add_views(NO_VIEW, west)
     walls = synth.wall_points(plan, 0.02, noise=0.01, seed=3)
 
     def scored(boxes: list[tuple[float, float]], rule: str):
-        corners = [np.array([[x - 0.3, y - 0.3], [x + 0.3, y - 0.3], [x + 0.3, y + 0.3],
-                             [x - 0.3, y + 0.3]]) for x, y in boxes]
-        sides = [np.column_stack([c, np.roll(c, -1, axis=0)]) for c in corners]
-        points = np.concatenate([walls] + [synth.wall_points(s, 0.02) for s in sides])
+        points = np.concatenate([walls, synth.wall_points(synth.boxes(boxes, 0.6), 0.02)])
         cloud = PointMap(truth_png, np.column_stack([points, np.zeros(len(points))]), False,
                          seen=seen)
         settings = Settings(alignment=AlignmentConfig(enabled=False),

@@ -161,6 +161,8 @@ def test_the_seen_footprint_leaves_out_the_cells_of_readings_that_drew_no_wall()
     assert footprint.sum() == map_footprint("seen", np.zeros_like(occupied), GRID, 0.3,
                                             seen=seen).sum()
     assert map_footprint("walls", occupied, GRID, 0.3)[150, 250]
+    corner = np.array([[1.0, 1.0], [2.0, 1.0], [2.0, 2.0], [1.0, 2.0]])
+    assert map_footprint("all", occupied, GRID, 0.3, rectangle=corner)[150, 250]
 
 
 def test_footprint_rule_seen_needs_views():

@@ -120,16 +120,20 @@ def drop_walls(segments: np.ndarray, fraction: float, seed: int = 0) -> np.ndarr
     return np.delete(segments, gone, axis=0)
 
 
+def boxes(centres: np.ndarray, size: float = 0.5) -> np.ndarray:
+    """The sides (4K, 4: x0, y0, x1, y1, metres) of square boxes of side ``size`` metres
+    around ``centres`` (K, 2, metres), axis-aligned."""
+    h = size / 2
+    corners = np.array([[-h, -h], [h, -h], [h, h], [-h, h]])
+    boxes = np.asarray(centres, dtype=np.float64).reshape(-1, 2)[:, None, :] + corners[None]
+    return np.concatenate([boxes, np.roll(boxes, -1, axis=1)], axis=2).reshape(-1, 4)
+
+
 def clutter(segments: np.ndarray, count: int, seed: int = 0, size: float = 0.5) -> np.ndarray:
     """Add ``count`` small square boxes (side ``size`` m) at random places inside the plan."""
     rng = np.random.default_rng(seed)
     lo, hi = segments.reshape(-1, 2).min(axis=0) + 1.0, segments.reshape(-1, 2).max(axis=0) - 1.0
-    centres = rng.uniform(lo, hi, size=(count, 2))
-    h = size / 2
-    corners = np.array([[-h, -h], [h, -h], [h, h], [-h, h]])
-    boxes = centres[:, None, :] + corners[None]  # (count, 4, 2)
-    sides = np.concatenate([boxes, np.roll(boxes, -1, axis=1)], axis=2).reshape(-1, 4)
-    return np.vstack([segments, sides])
+    return np.vstack([segments, boxes(rng.uniform(lo, hi, size=(count, 2)), size)])
 
 
 def wall_quads(segments: np.ndarray, thickness: float) -> np.ndarray:
