@@ -8,6 +8,7 @@ import pytest
 from pcmapq import synth
 from pcmapq.align import Alignment, AlignParams, align, score
 from pcmapq.align.coarse import coarse_search
+from pcmapq.align.planar import refine_best
 from pcmapq.transform import Similarity2D
 from pcmapq.voxels import voxel_centroids
 
@@ -99,6 +100,30 @@ def test_init_skips_global_search(truth, scan):
     result = align(map_xy, truth, init=init)
     dxy, dyaw = pose_error(t_true, result.transform)
     assert result.method == "init+icp" and dxy < 0.05 and dyaw < 0.2 and result.fitness > 0.9
+
+
+def test_refine_best_scores_only_to_choose():
+    """One start is refined without a score (nothing to choose); several are ranked by
+    fitness, then RMSE, and the best finalist wins."""
+    calls = []
+
+    def scored(tf: Similarity2D) -> Alignment:
+        calls.append(tf)
+        return Alignment(tf, fitness=1.0 - abs(tf.tx - 2.0) / 10, rmse_m=0.0,
+                         tolerance_m=0.2, method="")
+
+    def rough(tf: Similarity2D) -> Similarity2D:
+        return Similarity2D(tf.tx + 1.0, tf.ty, tf.yaw)
+
+    def fine(tf: Similarity2D) -> Similarity2D:
+        return Similarity2D(tf.tx, tf.ty + 1.0, tf.yaw)
+
+    assert refine_best([Similarity2D(5.0, 0.0, 0.0)], rough, fine, scored, 2) == \
+        Similarity2D(6.0, 1.0, 0.0)
+    assert calls == []
+    starts = [Similarity2D(x, 0.0, 0.0) for x in (7.0, 1.0, -3.0)]
+    assert refine_best(starts, rough, fine, scored, 2) == Similarity2D(2.0, 1.0, 0.0)
+    assert len(calls) == 3 + 2
 
 
 def test_no_refine_scores_identity(truth, scan):

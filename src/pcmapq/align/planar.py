@@ -173,7 +173,7 @@ def _align_rigid(map_xy: np.ndarray, target: RigidTarget, params: AlignParams,
         params.finalists_for(scale=False))
     # Point-to-line on the winner only: finishing both finalists (as with the scale free) moved
     # no bench_align pose by over 1e-7 m and took 18 % more CPU time there.
-    tf = refine_point_to_line(map_ds, target.lines, best.transform, fine_stages[-1][0])
+    tf = refine_point_to_line(map_ds, target.lines, best, fine_stages[-1][0])
     return _labelled(scored(tf), search, "coarse+icp")
 
 
@@ -234,15 +234,19 @@ def align_similarity(map_xy: np.ndarray, truth_xy: np.ndarray,
 
     best = refine_best(_starts(search, start), lambda tf: refine_similarity(map_xy, rough, tf),
                        finish, scored, params.finalists_for(scale=True))
-    return _labelled(best, search, "similarity+icp")
+    return _labelled(scored(best), search, "similarity+icp")
 
 
 def refine_best(starts: Sequence[Similarity2D], rough: Refine, fine: Refine,
-                scored: Callable[[Similarity2D], Alignment], finalists: int) -> Alignment:
+                scored: Callable[[Similarity2D], Alignment], finalists: int) -> Similarity2D:
     """Every start refined by ``rough``; the ``finalists`` best of those (highest fitness, then
-    lowest RMSE, by ``scored``) refined by ``fine``; the best of these, scored."""
+    lowest RMSE, by ``scored``) refined by ``fine``; the best of these. A single start (an
+    ``init``, every step of ``pcmapq track``) is refined without scoring: there is no choice
+    to make."""
+    if len(starts) == 1:
+        return fine(rough(starts[0]))
     firsts = sorted((scored(rough(s)) for s in starts), key=_rank)
-    return min((scored(fine(r.transform)) for r in firsts[:finalists]), key=_rank)
+    return min((scored(fine(r.transform)) for r in firsts[:finalists]), key=_rank).transform
 
 
 def _starts(search: Search | None, init: Similarity2D) -> list[Similarity2D]:
