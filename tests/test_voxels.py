@@ -9,7 +9,7 @@ from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
 
 from pcmapq import voxels
-from pcmapq.bounds import bounds
+from pcmapq.bounds import bounds, nonzero_window
 from pcmapq.voxels import VoxelMap, evenly, voxel_centroids, voxel_count, voxel_index, voxel_keys
 
 
@@ -78,3 +78,20 @@ def test_bounds_are_numpys_over_axis_0(points):
     np.testing.assert_array_equal(lo, points.min(axis=0))
     np.testing.assert_array_equal(hi, points.max(axis=0))
     assert lo.dtype == hi.dtype == points.dtype
+
+
+@given(hnp.arrays(bool, hnp.array_shapes(min_dims=2, max_dims=2, min_side=1, max_side=30)),
+       st.integers(0, 5))
+def test_nonzero_window_is_the_grown_box_of_nonzero_cells(image, margin):
+    window = nonzero_window(image, margin)
+    if not image.any():
+        assert window is None
+        return
+    lo, hi, left, right = window
+    rows, cols = np.nonzero(image)
+    grown = np.zeros_like(image)
+    grown[max(0, rows.min() - margin):rows.max() + 1 + margin,
+          max(0, cols.min() - margin):cols.max() + 1 + margin] = True
+    expected = np.zeros_like(image)
+    expected[lo:hi, left:right] = True
+    np.testing.assert_array_equal(expected, grown)

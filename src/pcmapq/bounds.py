@@ -1,4 +1,4 @@
-"""The bounding box of many points, column by column.
+"""Bounding boxes: of many points, column by column, and of the nonzero cells of an image.
 
 NumPy reduces an (N, d) array over axis 0 with a strided inner loop: for 158,000 points of
 three columns about 4 ms, against 0.16 ms for the columns one at a time. The box is the same.
@@ -16,3 +16,15 @@ def bounds(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     columns = [points[:, i] for i in range(points.shape[1])]
     return (np.array([c.min() for c in columns], dtype=points.dtype),
             np.array([c.max() for c in columns], dtype=points.dtype))
+
+
+def nonzero_window(image: np.ndarray, margin: int = 0) -> tuple[int, int, int, int] | None:
+    """The box of the nonzero cells of ``image`` (rows, cols) grown by ``margin`` cells and cut
+    to the image: ``lo, hi, left, right``, rows ``lo:hi`` and columns ``left:right`` (in the
+    array's own order); None when every cell is zero."""
+    rows = np.flatnonzero(image.any(axis=1))
+    if not len(rows):
+        return None
+    cols = np.flatnonzero(image.any(axis=0))
+    return (max(0, int(rows[0]) - margin), min(image.shape[0], int(rows[-1]) + 1 + margin),
+            max(0, int(cols[0]) - margin), min(image.shape[1], int(cols[-1]) + 1 + margin))

@@ -125,8 +125,8 @@ def boxes(centres: np.ndarray, size: float = 0.5) -> np.ndarray:
     around ``centres`` (K, 2, metres), axis-aligned."""
     h = size / 2
     corners = np.array([[-h, -h], [h, -h], [h, h], [-h, h]])
-    boxes = np.asarray(centres, dtype=np.float64).reshape(-1, 2)[:, None, :] + corners[None]
-    return np.concatenate([boxes, np.roll(boxes, -1, axis=1)], axis=2).reshape(-1, 4)
+    squares = np.asarray(centres, dtype=np.float64).reshape(-1, 2)[:, None, :] + corners[None]
+    return np.concatenate([squares, np.roll(squares, -1, axis=1)], axis=2).reshape(-1, 4)
 
 
 def clutter(segments: np.ndarray, count: int, seed: int = 0, size: float = 0.5) -> np.ndarray:

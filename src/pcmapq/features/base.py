@@ -17,6 +17,7 @@ import cv2
 import numpy as np
 from scipy.spatial import cKDTree
 
+from pcmapq.bounds import nonzero_window
 from pcmapq.errors import InputError
 from pcmapq.features.walls import WallImage
 
@@ -148,16 +149,13 @@ def by_strips(image: np.ndarray, halo: int, fn: Callable[[np.ndarray], tuple[np.
     in strips of ``rows`` rows (by default :data:`STRIP_CELLS` cells, at least four halos),
     each with ``halo`` rows above and below it, in the memory of one strip. ``fn`` returns
     arrays of the shape of its input."""
-    held_rows, held_cols = np.flatnonzero(image.any(axis=1)), np.flatnonzero(image.any(axis=0))
-    if len(held_rows) and held_rows[0] <= halo and held_rows[-1] >= image.shape[0] - 1 - halo \
-            and held_cols[0] <= halo and held_cols[-1] >= image.shape[1] - 1 - halo:
+    window = nonzero_window(image, halo)
+    if window == (0, image.shape[0], 0, image.shape[1]):
         return _strips(image, halo, fn, rows)
     blank = tuple(a[halo, halo] for a in fn(np.zeros((2 * halo + 1,) * 2, image.dtype)))
     out = tuple(np.full(image.shape, value, value.dtype) for value in blank)
-    if len(held_rows):
-        lo, hi = max(0, held_rows[0] - halo), min(image.shape[0], held_rows[-1] + 1 + halo)
-        left = max(0, held_cols[0] - halo)
-        right = min(image.shape[1], held_cols[-1] + 1 + halo)
+    if window is not None:
+        lo, hi, left, right = window
         for whole, part in zip(out, _strips(image[lo:hi, left:right], halo, fn, rows),
                                strict=True):
             whole[lo:hi, left:right] = part

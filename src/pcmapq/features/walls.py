@@ -46,6 +46,7 @@ import cv2
 import numpy as np
 from skimage.morphology import skeletonize
 
+from pcmapq.bounds import nonzero_window
 from pcmapq.features.pixels import flat_index, neighbour_pairs
 from pcmapq.features.pixels import pieces as connected
 from pcmapq.features.resample import resample
@@ -208,16 +209,12 @@ def _window(occupied: np.ndarray, k: int, margin: int) -> tuple[int, int, int, i
     """Rows (counted from the bottom) and columns ``lo, hi, left, right`` of the raster's
     cells that hold walls, widened by ``margin`` cells and to whole working cells of ``k``
     raster cells from the lower-left corner, within the raster; empty when none does."""
-    rows = np.flatnonzero(occupied[::-1].any(axis=1))
-    cols = np.flatnonzero(occupied.any(axis=0))
-    if not len(rows):
+    window = nonzero_window(occupied[::-1], margin)
+    if window is None:
         return 0, 0, 0, 0
-
-    def widened(first: int, last: int, size: int) -> tuple[int, int]:
-        return max(0, (first - margin) // k * k), min(size, -(-(last + 1 + margin) // k) * k)
-
-    return (*widened(rows[0], rows[-1], occupied.shape[0]),
-            *widened(cols[0], cols[-1], occupied.shape[1]))
+    lo, hi, left, right = window
+    rows, cols = occupied.shape
+    return lo // k * k, min(rows, -(-hi // k) * k), left // k * k, min(cols, -(-right // k) * k)
 
 
 def _tiled(occupied: np.ndarray, grid: MetricGrid, resolution: float, k: int, tile: int,
