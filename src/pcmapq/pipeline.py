@@ -32,8 +32,8 @@ from pcmapq.plan import (
     load_input,
     min_hits,
     plan_points,
+    truth_cells,
     truth_grid,
-    truth_raster,
 )
 from pcmapq.raster.draw import OCCUPIED, UNKNOWN, points_to_grid, warp_state
 from pcmapq.raster.footprint import footprint_rule, map_footprint
@@ -236,7 +236,7 @@ def score(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap, setti
     memory.guard(needed_memory((source, truth), planned), memory_limit,
                  f"{source.path} against {truth.path}",
                  lambda: hint(truth, TRUTH_CROP, planned.resolution) or hint(source, MAP_CROP))
-    grid, truth_occ = truth_raster(truth, truth_xy, settings)
+    grid, truth_occ = planned, truth_cells(truth, truth_xy, planned, settings)
     sides = SideBySide(settings.matching.detectors, settings.matching.params)
     with ThreadPoolExecutor(1) as background:
         truth_side = background.submit(sides.features, truth_occ, grid)

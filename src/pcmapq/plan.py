@@ -145,6 +145,13 @@ def truth_raster(truth: OccupancyMap | PointMap, truth_xy: np.ndarray,
                  settings: Settings) -> tuple[MetricGrid, np.ndarray]:
     """The truth's grid (:func:`truth_grid`) and its occupied cells."""
     grid = truth_grid(truth, truth_xy, settings)
+    return grid, truth_cells(truth, truth_xy, grid, settings)
+
+
+def truth_cells(truth: OccupancyMap | PointMap, truth_xy: np.ndarray, grid: MetricGrid,
+                settings: Settings) -> np.ndarray:
+    """The truth's occupied cells (bool) on ``grid``, the one :func:`truth_grid` planned: an
+    image's own, a cloud's plan points ``truth_xy`` (metres) drawn."""
     if isinstance(truth, OccupancyMap):
-        return grid, truth.state == OCCUPIED
-    return grid, points_to_grid(truth_xy, grid, min_hits(truth, settings))
+        return truth.state == OCCUPIED
+    return points_to_grid(truth_xy, grid, min_hits(truth, settings))

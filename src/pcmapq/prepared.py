@@ -20,7 +20,7 @@ from pcmapq.pipeline import (
     place_map,
     with_features,
 )
-from pcmapq.plan import MAP_CROP, TRUTH_CROP, plan_points, truth_grid, truth_raster
+from pcmapq.plan import MAP_CROP, TRUTH_CROP, plan_points, truth_cells, truth_grid
 from pcmapq.result import Result
 
 
@@ -43,7 +43,7 @@ def prepare_truth(truth: OccupancyMap | PointMap, settings: Settings,
     memory.guard(need[fits[0] if fits else least], memory_limit,
                  f"{truth.path} with {least} map{'s' * (least > 1)} scored on its grid",
                  lambda: hint(truth, TRUTH_CROP, grid.resolution))
-    grid, occupied = truth_raster(truth, truth_xy, settings)
+    occupied = truth_cells(truth, truth_xy, grid, settings)
     sides = SideBySide(settings.matching.detectors, settings.matching.params)
     option = settings.alignment
     aligner = (RigidTarget(truth_xy, option.params) if option.enabled and not option.scale
