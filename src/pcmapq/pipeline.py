@@ -232,11 +232,11 @@ def score(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap, setti
     check_span(source, MAP_CROP)
     rule = map_footprint_rule(source, settings)
     truth_xy, truth_level = plan_points(truth, settings)
-    planned = truth_grid(truth, truth_xy, settings)
-    memory.guard(needed_memory((source, truth), planned), memory_limit,
+    grid = truth_grid(truth, truth_xy, settings)
+    memory.guard(needed_memory((source, truth), grid), memory_limit,
                  f"{source.path} against {truth.path}",
-                 lambda: hint(truth, TRUTH_CROP, planned.resolution) or hint(source, MAP_CROP))
-    grid, truth_occ = planned, truth_cells(truth, truth_xy, planned, settings)
+                 lambda: hint(truth, TRUTH_CROP, grid.resolution) or hint(source, MAP_CROP))
+    truth_occ = truth_cells(truth, truth_xy, grid, settings)
     sides = SideBySide(settings.matching.detectors, settings.matching.params)
     with ThreadPoolExecutor(1) as background:
         truth_side = background.submit(sides.features, truth_occ, grid)
