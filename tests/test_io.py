@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import json
 import os
+import warnings
 from pathlib import Path
 
 import cv2
@@ -109,8 +111,105 @@ def test_image_finds_yaml_beside_it(tmp_path: Path) -> None:
 def test_yaml_beside_an_image_may_name_another_file(tmp_path: Path) -> None:
     png = write_png(tmp_path / "copy.png", TRINARY)
     write_yaml(tmp_path / "copy.yaml", image="original.png", negate="true")
-    np.testing.assert_array_equal(load_map(png).state, [[FREE, UNKNOWN, UNKNOWN, UNKNOWN],
-                                                        [OCCUPIED, OCCUPIED, OCCUPIED, OCCUPIED]])
+    with pytest.warns(UserWarning, match=r"copy\.yaml: names image 'original\.png'"):
+        state = load_map(png).state
+    np.testing.assert_array_equal(state, [[FREE, UNKNOWN, UNKNOWN, UNKNOWN],
+                                          [OCCUPIED, OCCUPIED, OCCUPIED, OCCUPIED]])
+
+
+def test_yaml_beside_an_image_naming_another_image_is_warned_about(tmp_path: Path) -> None:
+    """a.png with a.yaml beside it saying ``image: b.png`` (b.png exists and differs): a.png is
+    read with a.yaml's numbers, and one warning names both files and the one read; the YAML
+    given reads b.png, as map_server does, and says nothing."""
+    a = write_png(tmp_path / "a.png", TRINARY)
+    write_png(tmp_path / "b.png", np.full((3, 5), 254))
+    yml = write_yaml(tmp_path / "a.yaml", image="b.png", resolution=0.25, origin=[3, 4, 0])
+    with pytest.warns(UserWarning) as warned:
+        m = load_map(a)
+    assert [str(w.message) for w in warned] == [
+        f"{yml}: names image 'b.png', not a.png; a.png read with this YAML's resolution, "
+        "origin and thresholds (give the YAML itself to read the image it names)"]
+    assert warned[0].filename.endswith("occupancy.py")  # pcmapq's: shown on the command line
+    assert m.path == a and m.grid == MetricGrid(0.25, (3.0, 4.0, 0.0), (2, 4))
+    np.testing.assert_array_equal(m.state, TRINARY_STATE)
+    with pytest.warns(UserWarning, match=r"a\.yaml: names image 'b\.png', not a\.png; a\.png "
+                      r"read with this YAML's origin and thresholds \("):
+        load_map(a, resolution=0.1)  # the resolution given is not the YAML's
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        given = load_map(yml)
+    assert given.path == yml and given.grid == MetricGrid(0.25, (3.0, 4.0, 0.0), (3, 5))
+    assert (given.state == FREE).all()
+
+
+@pytest.mark.parametrize("named", ["a.png", "./a.png", "../maps/a.png", "ABSOLUTE", "link.png"])
+def test_yaml_beside_an_image_naming_that_image_says_nothing(tmp_path: Path, named: str) -> None:
+    """The YAML's image is the image given, however written (relative, absolute, through a
+    link): no warning."""
+    (tmp_path / "maps").mkdir()
+    a = write_png(tmp_path / "maps" / "a.png", TRINARY)
+    (tmp_path / "maps" / "link.png").symlink_to(a)
+    write_yaml(tmp_path / "maps" / "a.yaml", image=str(a) if named == "ABSOLUTE" else named)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        m = load_map(a)
+        load_map(tmp_path / "maps" / "a.yaml")
+    np.testing.assert_array_equal(m.state, TRINARY_STATE)
+
+
+@pytest.mark.parametrize("quiet", [[], ["--quiet"]])
+def test_yaml_naming_another_image_warning_on_the_command_line(tmp_path: Path,
+                                                               quiet: list[str]) -> None:
+    """One line on stderr (--quiet too: it keeps warnings); stdout's --json - stays JSON."""
+    from .test_cli import SAMPLE, run
+
+    (tmp_path / "a.png").write_bytes((SAMPLE / "truth.png").read_bytes())
+    write_png(tmp_path / "b.png", 255 - cv2.imread(str(SAMPLE / "truth.png"), 0))
+    (tmp_path / "a.yaml").write_text((SAMPLE / "truth.yaml").read_text().replace(
+        "image: truth.png", "image: b.png"))
+    got = run("eval", str(tmp_path / "a.png"), str(SAMPLE / "truth.png"), "--detectors",
+              "hough", "--json", "-", *quiet)
+    assert got.returncode == 0, got.stderr
+    assert got.stderr.splitlines() == [
+        f"pcmapq: warning: {tmp_path / 'a.yaml'}: names image 'b.png', not a.png; a.png read "
+        "with this YAML's resolution, origin and thresholds (give the YAML itself to read the "
+        "image it names)"]
+    assert json.loads(got.stdout)["coverage"] == pytest.approx(1.0)  # a.png's walls, read
+
+
+def test_yaml_warning_is_not_swallowed_by_a_capture_on_another_thread(
+        tmp_path: Path, capfd: pytest.CaptureFixture[str]) -> None:
+    """The truth is read (its library's stderr captured) while the map is: the map's warning,
+    printed meanwhile, waits for that capture to end rather than landing in it."""
+    import threading
+    import time
+
+    from pcmapq.io.stderr import stderr_captured
+
+    a = write_png(tmp_path / "a.png", TRINARY)
+    write_png(tmp_path / "b.png", TRINARY)
+    write_yaml(tmp_path / "a.yaml", image="b.png")
+    capturing, captured = threading.Event(), []
+
+    def read_truth() -> None:
+        with stderr_captured() as lines:
+            capturing.set()
+            time.sleep(0.3)
+        captured.extend(lines)
+
+    def to_descriptor_2(message: Warning | str, *_: object) -> None:
+        os.write(2, f"pcmapq: warning: {message}\n".encode())
+
+    truth = threading.Thread(target=read_truth)
+    truth.start()
+    capturing.wait()
+    with warnings.catch_warnings():
+        warnings.simplefilter("always")
+        warnings.showwarning = to_descriptor_2
+        load_map(a)
+    truth.join()
+    assert captured == []
+    assert "a.yaml: names image 'b.png', not a.png" in capfd.readouterr().err
 
 
 def test_image_with_resolution_only(tmp_path: Path) -> None:

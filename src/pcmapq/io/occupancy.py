@@ -26,7 +26,7 @@ from pcmapq.cells import FREE, OCCUPIED, UNKNOWN
 from pcmapq.errors import InputError
 from pcmapq.grid import MetricGrid
 from pcmapq.io.image_header import check_image_size
-from pcmapq.io.stderr import stderr_captured
+from pcmapq.io.stderr import stderr_captured, stderr_uncaptured
 from pcmapq.io.writers import one_line
 
 IMAGE_SUFFIXES = (".png", ".pgm", ".jpg", ".jpeg", ".bmp")
@@ -122,19 +122,52 @@ def load_occupancy(path: Path, resolution: float | None = None,
 def _meta_beside(image: Path, resolution: float | None) -> MapMeta:
     """The map_server metadata of the YAML beside an image (same stem), or none. A YAML there
     that is not a map_server file (no ``image`` key, or not YAML at all: a results file) is
-    ignored with a warning when a ``resolution`` is given, and an error otherwise."""
+    ignored with a warning when a ``resolution`` is given, and an error otherwise. A YAML that
+    names another image is used all the same (the image given is read), with a warning."""
     beside = [image.with_suffix(s) for s in YAML_SUFFIXES if image.with_suffix(s).is_file()]
     if not beside:
         return MapMeta(resolution=None)
     try:
-        return read_yaml(beside[0])[0]
+        meta, named = read_yaml(beside[0])
     except InputError as error:
         if resolution is None or _is_map_yaml(beside[0]):
             raise
-        warnings.warn(f"{beside[0]}: ignored, not a map_server YAML ({_after_path(error)}); "
-                      f"{image.name} read with the resolution given, {resolution:g} m",
-                      stacklevel=2)
+        _warn(f"{beside[0]}: ignored, not a map_server YAML ({_after_path(error)}); "
+              f"{image.name} read with the resolution given, {resolution:g} m")
         return MapMeta(resolution=None)
+    if not _same_file(image, named):
+        used = "origin and thresholds" if resolution is not None else \
+            "resolution, origin and thresholds"
+        _warn(f"{beside[0]}: names image '{_as_written(named, beside[0])}', not {image.name}; "
+              f"{image.name} read with this YAML's {used} (give the YAML itself to read the "
+              "image it names)")
+    return meta
+
+
+def _warn(message: str) -> None:
+    """A warning of :func:`_meta_beside`, from :func:`load_occupancy`'s line; shown while no
+    other thread captures stderr (the truth is read while the map is), which would swallow it."""
+    with stderr_uncaptured():
+        warnings.warn(message, stacklevel=3)
+
+
+def _same_file(a: Path, b: Path) -> bool:
+    """Whether two paths name one file: the same path once resolved, or (both existing) the
+    same file on disk (a hard link)."""
+    if a.resolve() == b.resolve():
+        return True
+    try:
+        return a.samefile(b)
+    except OSError:
+        return False
+
+
+def _as_written(named: Path, yaml_path: Path) -> Path:
+    """The image a YAML names, as its ``image`` key gives it (relative to the YAML's folder)."""
+    try:
+        return named.relative_to(yaml_path.parent)
+    except ValueError:
+        return named
 
 
 def _is_map_yaml(path: Path) -> bool:

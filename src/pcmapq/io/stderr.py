@@ -11,7 +11,7 @@ import threading
 from collections.abc import Iterator
 from contextlib import contextmanager
 
-__all__ = ["stderr_captured"]
+__all__ = ["stderr_captured", "stderr_uncaptured"]
 
 #: One capture at a time: two threads swapping descriptor 2 at once (the map and the truth are
 #: read in parallel) would each restore the other's sink and leave stderr pointing at a file.
@@ -34,3 +34,12 @@ def stderr_captured() -> Iterator[list[str]]:
             os.close(saved)
             sink.seek(0)
             lines += sink.read().decode("utf-8", errors="replace").splitlines()
+
+
+@contextmanager
+def stderr_uncaptured() -> Iterator[None]:
+    """Descriptor 2 left as it is in the block: no capture in another thread meanwhile (one
+    under way is waited for). For a line meant for the user (a warning) while another thread
+    may be reading a file, whose capture would swallow it. Not inside a capture."""
+    with _ONE_AT_A_TIME:
+        yield
