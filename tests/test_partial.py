@@ -18,7 +18,7 @@ from pcmapq.pipeline import evaluate
 from pcmapq.raster.seen import NO_VIEW, add_views
 from pcmapq.transform import Similarity2D
 
-from .conftest import in_map_frame, write_cloud_map
+from .conftest import in_map_frame, write_cloud_map, write_image_map
 
 #: Sub-rectangles of the 24 m x 16 m plan (x0, y0, x1, y1, metres) and map poses.
 CUTS = [((-1, -1, 12.5, 17), Similarity2D(4.0, -6.0, np.radians(63.0))),      # west half
@@ -34,11 +34,29 @@ BINARY_CUTS = [((-1, -1, 7.8, 11.5), Similarity2D(-6.0, 5.0, np.radians(151.0)))
                ((-1, -1, 16.5, 14), Similarity2D(-2.0, -4.0, np.radians(230.0)))]  # 57 %
 
 
-def true_share(plan: np.ndarray, box) -> float:
-    """Share of the truth's wall cells inside ``box``."""
+#: Binary cuts of two plans that leave rooms open, off every wall as above: (plan seed, cut,
+#: map pose), the cut a box (x0, y0, x1, y1) or a polygon (corners in order, plan frame).
+OPEN_CUTS = [(0, (-1, -1, 10.5, 10.5), Similarity2D(2.0, 3.0, np.radians(40.0))),     # 34 %
+             (1, (10.4, 3.0, 25, 17), Similarity2D(3.0, -9.0, np.radians(288.0))),     # 35 %
+             (1, (-1, -1, 10.5, 8.0), Similarity2D(-3.0, 7.0, np.radians(322.0))),     # 25 %
+             (0, ((-1, -1), (14, -1), (2, 17), (-1, 17)),                              # 39 %
+              Similarity2D(7.0, 2.0, np.radians(138.0))),
+             (1, ((-1, -1), (14, -1), (14, 6), (6, 6), (6, 17), (-1, 17)),             # an L, 44 %
+              Similarity2D(-5.0, 4.0, np.radians(71.0))),
+             (0, ((-1, -1), (25, -1), (25, 7.8), (9, 7.8), (9, 2.5), (5.5, 2.5),       # a U, 49 %
+                  (5.5, 7.8), (-1, 7.8)), Similarity2D(6.0, 1.0, np.radians(197.0)))]
+
+
+def true_share(plan: np.ndarray, cut) -> float:
+    """Share of the truth's wall cells inside ``cut``: a box (x0, y0, x1, y1) or a polygon
+    ((M, 2) corners in order), plan frame, metres."""
+    from matplotlib.path import Path
+
     grid = synth.plan_grid(plan, 0.05)
     xy = grid.cell_centres(synth.render(plan, grid) == synth.OCCUPIED)
-    x0, y0, x1, y1 = box
+    if np.ndim(cut) == 2:
+        return float(np.mean(Path(np.asarray(cut, dtype=np.float64)).contains_points(xy)))
+    x0, y0, x1, y1 = cut
     return float(np.mean((xy[:, 0] >= x0) & (xy[:, 0] <= x1) & (xy[:, 1] >= y0) & (xy[:, 1] <= y1)))
 
 
@@ -56,8 +74,10 @@ def write_partial_image(plan, box, tf: Similarity2D, path):
 
 
 def write_binary_partial(plan, box, tf: Similarity2D, path):
-    """The plan's walls inside ``box`` (truth frame) seen in the map frame, black on white."""
-    img, grid = synth.binary_partial(plan, box, tf)
+    """The plan's walls inside ``box`` (truth frame; or a polygon, (M, 2) corners) seen in the
+    map frame, black on white."""
+    img, grid = (synth.binary_cut(plan, np.asarray(box), tf) if np.ndim(box) == 2 else
+                 synth.binary_partial(plan, box, tf))
     return write_ros_map(path, img, 0.05, grid.origin[:2])
 
 
@@ -116,6 +136,24 @@ def test_binary_partial_image_map(plan, truth_png, tmp_path, box, tf):
     assert abs(result.overlap.coverage - share) < 0.1, (result.overlap.coverage, share)
     for name, det in result.detectors.items():
         assert det.matching.quality >= 0.85, (name, det.matching.quality)
+
+
+@pytest.mark.parametrize(("seed", "cut", "tf"), OPEN_CUTS)
+def test_binary_cut_open_coverage_is_the_share_it_kept(seed, cut, tf, tmp_path):
+    """A binary map cut from a plan by a box or a polygon (an L, a U) through its rooms: the
+    area its walls enclose, closed and grown, ends at the cut, rooms cut open or not, so
+    coverage is the share of the truth's walls the cut kept, and each quality stays high."""
+    plan = synth.building_plan(seed)
+    truth = write_image_map(plan, tmp_path / "truth.png")
+    share = true_share(plan, cut)
+    assert 0.24 <= share <= 0.5
+    result = evaluate(write_binary_partial(plan, cut, tf, tmp_path / "part.png"), truth)
+    assert result.footprint_rule == "walls"
+    got = result.transform
+    assert np.hypot(got.tx - tf.tx, got.ty - tf.ty) < 0.1
+    assert abs(result.overlap.coverage - share) < 0.05, (result.overlap.coverage, share)
+    for name, det in result.detectors.items():
+        assert det.matching.quality >= 0.9, (name, det.matching.quality)
 
 
 def test_known_footprint_of_a_binary_map_counts_its_whole_rectangle(plan, truth_png, tmp_path):

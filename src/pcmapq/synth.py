@@ -188,14 +188,37 @@ def binary_partial(segments: np.ndarray, box: tuple[float, float, float, float],
     unknown value): the walls inside ``box`` (x0, y0, x1, y1, plan frame, metres), seen in a
     map frame where ``p_plan = tf(p_map)``. The image covers the box's bounding rectangle in
     the map frame plus ``margin`` metres. Returns the uint8 image (0 or 255) and its grid."""
+    x0, y0, x1, y1 = box
+    return _binary_within(segments, np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]]), tf,
+                          resolution, margin, convex=True)
+
+
+def binary_cut(segments: np.ndarray, polygon: np.ndarray, tf: Similarity2D,
+               resolution: float = 0.05, margin: float = 1.0) -> tuple[np.ndarray, MetricGrid]:
+    """:func:`binary_partial` cut by a polygon: the walls inside ``polygon`` ((M, 2) corners
+    in order, plan frame, metres; convex or not, an L or a U), black on white in the map frame
+    where ``p_plan = tf(p_map)``, on an image covering the polygon's bounding rectangle there
+    plus ``margin`` metres. Returns the uint8 image (0 or 255) and its grid."""
+    return _binary_within(segments, np.asarray(polygon, dtype=np.float64).reshape(-1, 2), tf,
+                          resolution, margin, convex=False)
+
+
+def _binary_within(segments: np.ndarray, corners: np.ndarray, tf: Similarity2D,
+                   resolution: float, margin: float,
+                   convex: bool) -> tuple[np.ndarray, MetricGrid]:
+    """The walls inside the polygon ``corners`` (plan frame) as a binary image in the map
+    frame; ``convex``: the polygon is convex (OpenCV's convex fill, else its general one)."""
     import cv2
 
-    x0, y0, x1, y1 = box
-    corners = tf.inverse().apply(np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]]))
+    corners = tf.inverse().apply(corners)
     grid = MetricGrid.covering(corners, resolution, margin)
     walls = render(transform_segments(segments, tf.inverse()), grid) == OCCUPIED
     inside = np.zeros(grid.shape, np.uint8)
-    cv2.fillConvexPoly(inside, np.round(grid.xy_to_pixels(corners)).astype(np.int32), 1)
+    pixels = np.round(grid.xy_to_pixels(corners)).astype(np.int32)
+    if convex:
+        cv2.fillConvexPoly(inside, pixels, 1)
+    else:
+        cv2.fillPoly(inside, [pixels], 1)
     return np.where(walls & (inside > 0), 0, 255).astype(np.uint8), grid
 
 
