@@ -29,3 +29,14 @@ def disc(radius: float) -> np.ndarray:
     OpenCV rasterises an ellipse, whose rows next to the centre row are as wide as it."""
     r = max(1, int(round(radius)))
     return cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * r + 1, 2 * r + 1))
+
+
+def outline(mask: np.ndarray, width: float) -> np.ndarray:
+    """The cells of ``mask`` (bool) within ``width`` cells of a cell outside it (a cell next to
+    one outside is 1 cell from it): a filled block becomes its band of that width, a wall up to
+    twice as thick stays whole. Cells at the image's border count as next to the outside. One
+    byte a cell: the mask less its erosion by :func:`disc` of ``width``."""
+    mask = np.asarray(mask, dtype=bool)
+    inner = cv2.erode(mask.view(np.uint8), disc(width), borderType=cv2.BORDER_CONSTANT,
+                      borderValue=0)
+    return mask & (inner == 0)

@@ -197,7 +197,7 @@ def place_map(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap,
     progress("rasterising")
     map_occ, footprint = map_raster(source, map_xy, alignment.transform, grid, settings, rule)
     to_map = nearest_distance(map_occ, grid)
-    cover = overlap(truth_occ, to_map, footprint, alignment)
+    cover = overlap(truth_occ, to_map, footprint, alignment, grid.resolution)
     option = settings.alignment
     if cover.confidence < option.min_confidence and not option.force:
         raise EvaluationError(refusal(source, truth.path, alignment, cover, settings, map_xy,

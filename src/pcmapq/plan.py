@@ -22,6 +22,7 @@ from pcmapq.frames import Levelling
 from pcmapq.grid import MetricGrid
 from pcmapq.io import OccupancyMap, PointMap, load_map
 from pcmapq.io.extent import crop
+from pcmapq.morphology import outline
 from pcmapq.raster.draw import OCCUPIED, points_to_grid
 from pcmapq.raster.slice import wall_band
 
@@ -40,6 +41,11 @@ MAX_OCCUPIED_SHARE = 0.5
 LINE_WIDTH = 0.5
 #: Plan points looked at by the structure checks (a stride through larger plans).
 SAMPLE = 100_000
+#: An image's plan points are its occupied cells within this many metres of free or unknown
+#: space: a block drawn filled (kitchen cabinets on an architect's plan, a pillar) is its
+#: outline, as a laser sees it, and cannot outscore walls where a map's clutter lies on it; a
+#: wall up to twice as thick stays whole.
+OUTLINE_M = 0.1
 
 
 def load_input(path: str | Path, config: SourceConfig, option: str,
@@ -59,13 +65,14 @@ def cropped(source: OccupancyMap | PointMap, config: SourceConfig,
 
 def plan_points(source: OccupancyMap | PointMap,
                 settings: Settings) -> tuple[np.ndarray, Levelling | None]:
-    """The 2D structure of an input, (N, 2) metres in its own plan frame: occupied cell centres
-    of an image, the wall band of a 3D cloud (with the levelling that made its plan), or a 2D
-    cloud as it is. Refused (EvaluationError) when it has nothing to align: see the module
-    docstring."""
+    """The 2D structure of an input, (N, 2) metres in its own plan frame: the centres of an
+    image's occupied cells within OUTLINE_M of free space, the wall band of a 3D cloud (with
+    the levelling that made its plan), or a 2D cloud as it is. Refused (EvaluationError)
+    when it has nothing to align: see the module docstring."""
     levelling = None
     if isinstance(source, OccupancyMap):
-        xy = source.grid.cell_centres(source.state == OCCUPIED)
+        occupied = source.state == OCCUPIED
+        xy = source.grid.cell_centres(outline(occupied, OUTLINE_M / source.grid.resolution))
     elif source.is_3d:
         try:
             xy, levelling = wall_band(source.points, settings.raster.band_low,
@@ -78,7 +85,7 @@ def plan_points(source: OccupancyMap | PointMap,
         raise InputError(f"{source.path}: no occupied cells or wall points")
     check_structure(source.path, xy)
     if isinstance(source, OccupancyMap):
-        check_occupied_share(source, len(xy))
+        check_occupied_share(source, int(np.count_nonzero(occupied)))
     return xy, levelling
 
 

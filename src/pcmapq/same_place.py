@@ -12,7 +12,8 @@ from pcmapq.align import Alignment
 from pcmapq.config import Settings
 from pcmapq.io import OccupancyMap, PointMap
 from pcmapq.io.extent import far_points
-from pcmapq.plan import MAP_CROP
+from pcmapq.morphology import outline
+from pcmapq.plan import MAP_CROP, OUTLINE_M
 from pcmapq.result import Overlap
 
 #: Confidence terms (see :func:`confidence`): the distinctiveness worth full confidence, the
@@ -43,14 +44,17 @@ def confidence(distinct: float | None, recall: float, agreement: float = 0.0) ->
 
 
 def overlap(truth_occ: np.ndarray, to_map: np.ndarray, footprint: np.ndarray,
-            alignment: Alignment) -> Overlap:
+            alignment: Alignment, resolution: float) -> Overlap:
     """How much of the truth the map covers, how well the two agree there, and the confidence
     that they show one place; ``to_map`` is each cell's distance to the nearest map wall,
-    metres."""
+    metres, on a grid of ``resolution`` metres. The recall counts the truth's walls by their
+    outline (:data:`~pcmapq.plan.OUTLINE_M`): a map sees a filled block's faces, not its
+    inside."""
     seen = truth_occ & footprint
     coverage = float(seen.sum() / truth_occ.sum()) if truth_occ.any() else 0.0
     tolerance = alignment.tolerance_m
-    recall = float((to_map[seen] <= tolerance).mean()) if seen.any() else 0.0
+    faces = outline(truth_occ, OUTLINE_M / resolution) & footprint
+    recall = float((to_map[faces] <= tolerance).mean()) if faces.any() else 0.0
     agreement = alignment.fitness * recall
     return Overlap(footprint, coverage, recall, agreement,
                    confidence(alignment.distinctiveness, recall, agreement))
