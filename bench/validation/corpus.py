@@ -678,6 +678,21 @@ def roc_table(records: list[Record], names: tuple[str, ...] = ("confidence",),
     return "\n".join(lines)
 
 
+def verdict_table(records: list[Record]) -> str:
+    """How many pairs of each kind got each verdict (where the result has one)."""
+    names = list(dict.fromkeys(str(r.alignment.get("verdict")) for r in records))
+    counts: dict[tuple[str, bool], dict[str, int]] = {}
+    for r in records:
+        tally = counts.setdefault((r.kind, r.same), dict.fromkeys(names, 0))
+        tally[str(r.alignment.get("verdict"))] += 1
+    kinds = list(KINDS)
+    lines = [header(["kind", "place", *names])]
+    for (kind, same), tally in sorted(counts.items(), key=lambda kv: (
+            not kv[0][1], kinds.index(kv[0][0]) if kv[0][0] in kinds else len(kinds))):
+        lines.append(row([kind, "same" if same else "other", *(str(tally[n]) for n in names)]))
+    return "\n".join(lines)
+
+
 def describe(r: Record) -> str:
     """'name (confidence c, distinctiveness d, recall r, fitness f)'."""
     a = r.alignment
@@ -730,6 +745,8 @@ def markdown(records: list[Record], names: tuple[str, ...] = ("confidence",)) ->
         lines += ["", "The same without the synthetic other places (plan i against plan j: "
                       "the plans share their outer walls, corridor, L-shaped wall and pillars, "
                       "most of their walls):", "", roc_table(real, names)]
+    if any("verdict" in r.alignment for r in records):
+        lines += ["", "### Verdicts (`alignment.verdict`) by kind", "", verdict_table(records)]
     if other:
         top = max(other, key=lambda r: value(r, "confidence") or 0.0)
         lines += ["", f"Worst other-place pair: {describe(top)}."]
