@@ -228,10 +228,11 @@ def test_legend_and_scale_bars_inside_the_canvas_and_off_the_data(moved_result, 
     fig.canvas.draw()
     renderer = fig.canvas.get_renderer()
     panels = [ax for ax in fig.axes if ax.images]
-    assert len(panels) == len(names)
+    assert len(result.consistency.points)  # the regions' panel follows the detectors'
+    assert len(panels) == len(names) + 1
     legends = fig.legends + [ax.get_legend() for ax in fig.axes if ax.get_legend()]
     bars = [a for ax in panels for a in ax.artists]
-    assert len(legends) == 1 and len(bars) == len(names)
+    assert len(legends) == 1 and len(bars) == len(names) + 1
     for artist in legends + bars:
         box = artist.get_window_extent(renderer)
         assert _inside(box, fig.bbox), (artist, box, fig.bbox)

@@ -131,7 +131,7 @@ def parse_footprint(text: str) -> str:
 
 
 #: What each output option writes, by extension (``--aligned``: see :func:`output_suffixes`).
-OUTPUT_SUFFIXES = {"--json": (".json",), "--vectors": (".csv",),
+OUTPUT_SUFFIXES = {"--json": (".json",), "--vectors": (".csv",), "--regions": (".csv",),
                    "--plot": (".png", ".svg", ".pdf"), "--report": (".html", ".htm"),
                    "--transform": (".txt",), "--distances": (".ply",),
                    "--out": (".ply", ".pcd"), "--poses-out": (".txt", ".kitti"),

@@ -11,7 +11,9 @@ import numpy as np
 
 from pcmapq import memory
 from pcmapq.align import Alignment
+from pcmapq.align.parts import place_parts
 from pcmapq.align.planar import RigidTarget
+from pcmapq.align.regions import Consistency, regions
 from pcmapq.align.rigid3d import Registration3D
 from pcmapq.bounds import bounds
 from pcmapq.config import Settings
@@ -38,8 +40,8 @@ from pcmapq.plan import (
 from pcmapq.raster.draw import OCCUPIED, UNKNOWN, points_to_grid, warp_state
 from pcmapq.raster.footprint import footprint_rule, map_footprint
 from pcmapq.raster.seen import seen_on
-from pcmapq.result import DetectorResult, Overlap, Result
-from pcmapq.same_place import overlap, refusal
+from pcmapq.result import OTHER, DetectorResult, Overlap, Result
+from pcmapq.same_place import overlap, refusal, verdict
 from pcmapq.transform import Similarity2D
 
 Progress = Callable[[str], None]
@@ -168,7 +170,8 @@ class MapSide:
     """One map aligned and drawn on the truth's grid: ``source`` (in the truth frame after a
     3D registration), its plan points ``xy`` (N, 2) metres in its own plan frame, the
     alignment, its ``occupied`` cells, ``to_map`` (each cell's distance to them, metres), the
-    overlap and its features by detector."""
+    overlap, its features by detector and its consistency map (each region aligned on its own;
+    None for a map of another place)."""
 
     source: OccupancyMap | PointMap
     registration: Registration3D | None
@@ -179,6 +182,7 @@ class MapSide:
     to_map: np.ndarray
     cover: Overlap
     features: dict[str, Features]
+    consistency: Consistency | None = None
 
 
 def place_map(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap,
@@ -190,20 +194,33 @@ def place_map(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap,
     ``truth_occ``: a :class:`MapSide` without features. A map that does not seem to show the
     truth's place is refused (EvaluationError) unless ``--force``."""
     progress("aligning")
+    option = settings.alignment
     source, registration = align_clouds_3d(source, truth, settings)
     map_xy, map_level = plan_points(source, settings)
+    if target is None or not target.fits(option.params):
+        target = RigidTarget(truth_xy, option.params)
     alignment = align_plan(source, map_xy, truth_xy, registration, settings, target)
 
     progress("rasterising")
     map_occ, footprint = map_raster(source, map_xy, alignment.transform, grid, settings, rule)
     to_map = nearest_distance(map_occ, grid)
     cover = overlap(truth_occ, to_map, footprint, alignment, grid.resolution)
-    option = settings.alignment
-    if cover.confidence < option.min_confidence and not option.force:
+    parts = ()
+    if cover.confidence < option.min_confidence and alignment.distinctiveness is not None:
+        progress("placing the map's parts on their own")
+        parts = tuple(place_parts(map_xy, truth_xy, alignment.transform, option.params, target))
+    cover = replace(cover, parts=parts,
+                    verdict=verdict(cover.confidence, option.min_confidence, parts))
+    if cover.verdict == OTHER and not option.force:
         raise EvaluationError(refusal(source, truth.path, alignment, cover, settings, map_xy,
                                       truth_xy))
+    consistency = None
+    if cover.verdict != OTHER and target.lines is not None:
+        progress("aligning the map's regions on their own")
+        consistency = regions(map_xy, alignment.transform, target.lines,
+                              alignment.tolerance_m)
     return MapSide(source, registration, map_xy, map_level, alignment, map_occ, to_map, cover,
-                   {})
+                   {}, consistency)
 
 
 def with_features(side: MapSide, grid: MetricGrid, sides: SideBySide,
@@ -291,4 +308,5 @@ def assemble(loaded: OccupancyMap | PointMap, side: MapSide, prepared: PreparedT
                   registration_3d=registration, distances_3d=cloud_distances,
                   threshold=threshold, full=full, detectors=detectors,
                   footprint_rule=rule, frames=frames, settings=settings.to_dict(),
-                  truth_occupied=prepared.occupied, map_occupied=side.occupied, noref=noref)
+                  truth_occupied=prepared.occupied, map_occupied=side.occupied, noref=noref,
+                  consistency=side.consistency)

@@ -21,10 +21,16 @@ from pcmapq.transform import Similarity2D
 
 if TYPE_CHECKING:  # the alignment modules load Open3D; a Result only holds their outputs
     from pcmapq.align import Alignment
+    from pcmapq.align.parts import Part
+    from pcmapq.align.regions import Consistency
     from pcmapq.align.rigid3d import Registration3D
 
 #: Decimals kept in saved numbers: micrometres, so reruns give byte-identical files.
 DECIMALS = 6
+#: The verdicts on whether a map shows the truth's place (see :mod:`pcmapq.same_place`): one
+#: pose fits it; it is of the truth's place but no single pose fits it whole (scored); it
+#: shows another place (refused unless ``--force``).
+SAME, INCONSISTENT, OTHER = "same place", "same place, inconsistent map", "another place"
 
 
 @dataclass(frozen=True)
@@ -64,8 +70,12 @@ class Overlap:
     coverage: share of the truth's occupied cells inside the footprint, [0, 1].
     truth_recall: share of those within the fit tolerance of a map occupied cell, [0, 1].
     agreement: alignment fitness times truth_recall.
-    confidence: that the map shows the truth's place, [0, 1] (see same_place.confidence); below
-        0.5 a map of another place.
+    confidence: that one pose places the map on the truth's place, [0, 1] (see
+        same_place.confidence).
+    verdict: SAME (confidence at least the minimum), INCONSISTENT (below it, but its parts
+        placed on their own agree with its pose) or OTHER.
+    parts: the map's parts placed on their own (:mod:`pcmapq.align.parts`); empty when the
+        confidence alone settled the verdict.
     """
 
     footprint: np.ndarray | None
@@ -73,6 +83,8 @@ class Overlap:
     truth_recall: float
     agreement: float
     confidence: float = 0.0
+    verdict: str = SAME
+    parts: tuple[Part, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -109,6 +121,7 @@ class Result:
     settings: dict | None = None
     command: str | None = None
     noref: dict | None = None
+    consistency: Consistency | None = None
 
     @property
     def transform(self) -> Similarity2D:
@@ -149,7 +162,11 @@ class Result:
                           "truth_recall": self.overlap.truth_recall,
                           "agreement": self.overlap.agreement,
                           "distinctiveness": self.alignment.distinctiveness,
-                          "confidence": self.overlap.confidence},
+                          "confidence": self.overlap.confidence,
+                          "verdict": self.overlap.verdict,
+                          "parts": [{**asdict(p), "centre_m": list(p.centre_m)}
+                                    for p in self.overlap.parts]},
+            "consistency": _consistency_dict(self.consistency),
             "frames": self.frames.to_dict(),
             "coverage": self.overlap.coverage,
             "footprint": self.footprint_rule,
@@ -222,6 +239,60 @@ class Result:
         return out.getvalue()
 
 
+    def regions_csv(self) -> str:
+        """One row per region of the consistency map (the JSON's ``consistency.regions``):
+        where the region is, the offset and turn that fit it to the truth on its own, its
+        points and its fitness before and after, truth frame, metres and degrees."""
+        out = io.StringIO()
+        out.write(",".join(REGION_COLUMNS) + "\n")
+        for row in _consistency_dict(self.consistency)["regions"]:
+            out.write(",".join(str(int(v)) if isinstance(v, bool | int) else f"{v:.{DECIMALS}f}"
+                               for v in (row[k] for k in REGION_COLUMNS)) + "\n")
+        return out.getvalue()
+
+
+#: The columns of a region, in the JSON and the regions CSV.
+REGION_COLUMNS = ("x_m", "y_m", "dx_m", "dy_m", "offset_m", "turn_deg", "points",
+                  "fitness_before", "fitness_after", "held")
+
+
+def _consistency_dict(c: Consistency | None) -> dict:
+    """The consistency map as JSON: the tile, the largest held offset and where, the map's
+    fitness at its pose and with each region aligned on its own, and the regions."""
+    if c is None:
+        return {"tile_m": None, "largest_offset_m": None, "largest_at_m": None,
+                "global_fitness": None, "local_fitness": None, "regions": []}
+    k = c.largest()
+    regions = [dict(zip(REGION_COLUMNS, (float(x), float(y), float(dx), float(dy), float(o),
+                                          float(t), int(n), float(b), float(a), bool(h)),
+                        strict=True))
+               for (x, y), (dx, dy), o, t, n, b, a, h in zip(
+                   c.centre, c.offset, c.offset_m, c.turn_deg, c.points, c.fit_before,
+                   c.fit_after, c.held, strict=True)]
+    return {"tile_m": c.tile_m, "largest_offset_m": None if k is None else float(c.offset_m[k]),
+            "largest_at_m": None if k is None else [float(v) for v in c.centre[k]],
+            "global_fitness": c.global_fitness(), "local_fitness": c.local_fitness(),
+            "regions": regions}
+
+
+def _consistency_of(doc: dict | None, tolerance: float) -> Consistency | None:
+    """The consistency map read back from its JSON (None when there was none)."""
+    from pcmapq.align.regions import Consistency
+
+    if not doc or doc.get("tile_m") is None:
+        return None
+    rows = doc["regions"]
+
+    def column(key: str, dtype=np.float64) -> np.ndarray:
+        return np.array([r[key] for r in rows], dtype=dtype)
+
+    return Consistency(doc["tile_m"], tolerance,
+                       np.column_stack([column("x_m"), column("y_m")]).reshape(-1, 2),
+                       np.column_stack([column("dx_m"), column("dy_m")]).reshape(-1, 2),
+                       column("turn_deg"), column("points", int), column("fitness_before"),
+                       column("fitness_after"), column("held", bool))
+
+
 def _distances_dict(d: Distances) -> dict:
     return {"accuracy_m": d.accuracy.to_dict(), "completeness_m": d.completeness.to_dict(),
             "chamfer_m": d.chamfer_m, "f_score": [asdict(f) for f in d.fscores]}
@@ -260,6 +331,7 @@ def _detector_of(doc: dict, matches: list[dict], missing: list[dict],
 def _from_dict(doc: dict) -> Result:
     """:meth:`Result.from_json` of a parsed document."""
     from pcmapq.align import Alignment  # runtime imports: reading a 3D result loads Open3D
+    from pcmapq.align.parts import Part
     from pcmapq.align.rigid3d import Registration3D
 
     a, t = doc["alignment"], doc["truth"]
@@ -280,7 +352,9 @@ def _from_dict(doc: dict) -> Result:
         alignment=Alignment(frames.planar, a["fitness"], a["rmse_m"], a["tolerance_m"],
                             a["method"], a["distinctiveness"]),
         overlap=Overlap(None, doc["coverage"], a["truth_recall"], a["agreement"],
-                        a["confidence"]),
+                        a["confidence"], a["verdict"],
+                        tuple(Part(**{**p, "centre_m": tuple(p["centre_m"])})
+                              for p in a["parts"])),
         distances=_distances_of(doc["distances"]),
         registration_3d=None if reg is None else Registration3D(
             np.asarray(reg["matrix"], dtype=np.float64), reg["fitness"], reg["rmse_m"]),
@@ -290,7 +364,8 @@ def _from_dict(doc: dict) -> Result:
         full=doc["scored_against"] == "whole truth", detectors=detectors,
         truth_occupied=None, map_occupied=None, frames=frames,
         footprint_rule=doc["footprint"], settings=doc["settings"],
-        command=doc["pcmapq"]["command"], noref=doc.get("noref"))
+        command=doc["pcmapq"]["command"], noref=doc.get("noref"),
+        consistency=_consistency_of(doc.get("consistency"), a["tolerance_m"]))
 
 
 def _rounded(value):

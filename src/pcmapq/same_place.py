@@ -1,20 +1,23 @@
 """Does the map show the truth's place? How much of the truth it covers and how well the two
-agree there (:func:`overlap`), the confidence that they show one place (:func:`confidence`),
-and the one line that says why not and what to try (:func:`refusal`)."""
+agree there (:func:`overlap`), the confidence that one pose places it there (:func:`confidence`),
+the verdict (:func:`verdict`: the same place; the same place, but a map no single pose fits
+whole; another place) and the one line that says why not and what to try (:func:`refusal`)."""
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
 
 from pcmapq.align import Alignment
+from pcmapq.align.parts import Part
 from pcmapq.config import Settings
 from pcmapq.io import OccupancyMap, PointMap
 from pcmapq.io.extent import far_points
 from pcmapq.morphology import outline
 from pcmapq.plan import MAP_CROP, OUTLINE_M
-from pcmapq.result import Overlap
+from pcmapq.result import INCONSISTENT, OTHER, SAME, Overlap
 
 #: Confidence terms (see :func:`confidence`): the distinctiveness worth full confidence, the
 #: truth recalls and the agreements worth none and full confidence.
@@ -23,6 +26,17 @@ RECALL_NONE, RECALL_FULL = 0.4, 0.8
 AGREE_NONE, AGREE_FULL = 0.7, 0.9
 #: A map whose radius exceeds the truth's by this factor cannot be a part of it (a scale).
 OVERSIZE = 1.5
+#: A map below the minimum confidence still shows the truth's place when at least this many of
+#: its four parts, each placed on its own, agree with its pose (:mod:`pcmapq.align.parts`).
+MIN_AGREEING = 2
+
+
+def verdict(confidence: float, min_confidence: float, parts: Sequence[Part]) -> str:
+    """SAME when the confidence reaches ``min_confidence``; else INCONSISTENT when at least
+    MIN_AGREEING of the map's ``parts`` agree with its pose; else OTHER."""
+    if confidence >= min_confidence:
+        return SAME
+    return INCONSISTENT if sum(p.agrees for p in parts) >= MIN_AGREEING else OTHER
 
 
 def confidence(distinct: float | None, recall: float, agreement: float = 0.0) -> float:
@@ -73,7 +87,10 @@ def refusal(source: OccupancyMap | PointMap, truth_path: Path, alignment: Alignm
     distinct = alignment.distinctiveness
     why = (f"{cover.truth_recall:.0%} of the truth it covers lies near the map" +
            ("" if distinct is None else
-            f", the best pose scores {distinct:.0%} above the best one elsewhere"))
+            f", the best pose scores {distinct:.0%} above the best one elsewhere") +
+           ("" if not cover.parts else
+            f", {sum(p.agrees for p in cover.parts)} of its {len(cover.parts)} parts placed "
+            "on their own land near that pose"))
     size = radius(map_xy) / max(radius(truth_xy), 1e-12)
     option = settings.alignment
     far = far_points(source, MAP_CROP)

@@ -113,6 +113,10 @@ def eval_command(
         help="Write the vectorial map as CSV: one row per matched pair of features (truth and "
         "map position, displacement, metres) and which of its two features are counted "
         "(truth_counted, map_counted: 1 or 0).")] = None,
+    regions: Annotated[Path | None, typer.Option(
+        help="Write the consistency map as CSV: one row per region of the map (truth frame, "
+        "metres), the offset and turn (degrees) that fit it to the truth on its own, its "
+        "points, its fitness before and after, and whether its walls hold it (held).")] = None,
     plot: Annotated[Path | None, typer.Option(
         help="Draw the vectorial map, one panel per detector, as PNG.")] = None,
     report: Annotated[Path | None, typer.Option(
@@ -187,7 +191,8 @@ def eval_command(
         rules = gates.parse_rules(fail_under, fail_over)
         options.check_eval_options(scans=scans, max_scans=max_scans, no_align=no_align,
                                    auto_scale=auto)
-        options.check_outputs({"--json": json_path, "--vectors": vectors, "--plot": plot,
+        options.check_outputs({"--json": json_path, "--vectors": vectors,
+                               "--regions": regions, "--plot": plot,
                                "--report": report, **exports}, None if scans else paths[0],
                               inputs=paths)
         if scans is None:
@@ -204,8 +209,8 @@ def eval_command(
         json_text = gates.to_json(gates.with_gates(doc, outcomes)) if rules else None
         progress("writing outputs")
         wrote = _write_outputs(result, map_path, settings, arrow_scale, json_path=json_path,
-                               vectors=vectors, plot=plot, report=report, exports=exports,
-                               json_text=json_text)
+                               vectors=vectors, regions=regions, plot=plot, report=report,
+                               exports=exports, json_text=json_text)
         if json_path == "-":
             sys.stdout.write(json_text or result.to_json())
     if not quiet:
@@ -221,7 +226,7 @@ def eval_command(
 
 def _write_outputs(result: Result, map_path: Path | PointMap, settings: Settings,
                    arrow_scale: float, *, json_path: str | None, vectors: Path | None,
-                   plot: Path | None, report: Path | None,
+                   regions: Path | None, plot: Path | None, report: Path | None,
                    exports: dict[str, Path | None], json_text: str | None = None) -> list[Path]:
     """Write the run's output files, all or nothing: each is produced into a temporary file
     beside its target, and all are renamed into place only once every one is produced
@@ -235,6 +240,9 @@ def _write_outputs(result: Result, map_path: Path | PointMap, settings: Settings
         if vectors is not None:
             write_atomic(vectors, result.vectors_csv(), outputs)
             wrote.append(vectors)
+        if regions is not None:
+            write_atomic(regions, result.regions_csv(), outputs)
+            wrote.append(regions)
         if plot is not None or report is not None:
             from pcmapq.report.html import report_html
             from pcmapq.report.plot import figure_bytes, vectorial_figure

@@ -205,6 +205,23 @@ def _panel(ax: Axes, result: Result, factor: int, image: np.ndarray,
     _scale_bar(ax, result)
 
 
+def _regions_panel(ax: Axes, result: Result, factor: int, image: np.ndarray,
+                   gain: float) -> None:
+    """The consistency map over ``image`` (pooled ``factor``-fold): at each region of the map,
+    the offset that fits it to the truth on its own, ``gain`` times its length; held regions
+    black, the others grey."""
+    c = result.consistency
+    ax.imshow(image, extent=extent(result, factor), origin="upper", interpolation="nearest")
+    for held, colour in ((False, "0.6"), (True, "black")):
+        k = c.held == held
+        if k.any():
+            ax.quiver(*c.centre[k].T, *c.offset[k].T, angles="xy", scale_units="xy",
+                      scale=1.0 / gain, color=colour, width=0.004, zorder=4)
+    if (largest := c.largest()) is not None:
+        ax.scatter(*c.centre[largest], s=90, facecolors="none", edgecolors=MISSING, zorder=5)
+    _scale_bar(ax, result)
+
+
 def _legend_handles(result: Result, gain: float, as_density: bool) -> list[Line2D]:
     what = "occupied share" if as_density else "walls"
     handles = [Line2D([], [], color=TRUTH_DARK, lw=4, label=f"truth {what}"),
@@ -216,7 +233,15 @@ def _legend_handles(result: Result, gain: float, as_density: bool) -> list[Line2
                Line2D([], [], color=EXTRA, marker="+", ls="", label="extra in the map")]
     if not result.full:
         handles.append(Line2D([], [], color=FOOTPRINT, lw=1, label="map footprint"))
+    if _has_regions(result):
+        handles.append(Line2D([], [], color=MISSING, marker="o", mfc="none", ls="",
+                              label="regions: largest offset (grey: not held)"))
     return handles
+
+
+def _has_regions(result: Result) -> bool:
+    """Whether the result has a consistency map to draw."""
+    return result.consistency is not None and len(result.consistency.points) > 0
 
 
 def fitted_legend(fig: Figure, handles: list[Line2D], note: str,
@@ -250,29 +275,36 @@ def vectorial_figure(result: Result, arrow_scale: float = ARROW_SCALE) -> Figure
     extra map features (thinned where crowded), the footprint outline."""
     names = list(result.detectors)
     width, height = result.grid.size_m
-    rows, cols = _grid_shape(len(names))
+    panels = len(names) + _has_regions(result)
+    rows, cols = _grid_shape(panels)
     panel_w = WIDTH_IN / cols
-    spare = rows * cols > len(names)
+    spare = rows * cols > panels
     panel_h = float(np.clip(panel_w * height / max(width, 1e-9), 2.5, 9.0)) + 0.6
     fig, grid = plt.subplots(rows, cols, figsize=(WIDTH_IN, rows * panel_h + (0 if spare else 1)),
                              squeeze=False, layout="constrained")
-    axes = list(grid.flat[:len(names)])
+    axes = list(grid.flat[:panels])
     as_density = density(result)
     thin_px = THIN_PX_DENSITY if as_density else THIN_PX
     fitted_legend(fig, _legend_handles(result, arrow_scale, as_density),
                   f"markers thinned to one per {thin_px} px square where crowded; "
                   f"{'shade: share of occupied cells per pixel; ' if as_density else ''}"
                   "axes and arrows in metres", grid.flat[-1] if spare else None)
-    for ax, name in zip(axes, names, strict=True):
+    for ax, name in zip(axes, names, strict=False):
         _title(ax, result, name)
+    if _has_regions(result):
+        axes[-1].set_title(f"regions: the offset that fits each on its own "
+                           f"({result.overlap.verdict})", fontsize=TITLE_PT)
+    for ax in axes:
         frame(ax, result)
     factor, pixel_m = pooling(fig, axes, result.grid.shape)
     image = overlay(shade(result.truth_occupied, factor, as_density),
                     grown(shade(result.map_occupied, factor, as_density)))
     footprint = None if result.full else max_pool(result.overlap.footprint, factor)
-    for ax, name in zip(axes, names, strict=True):
+    for ax, name in zip(axes, names, strict=False):
         _panel(ax, result, factor, image, footprint, result.detectors[name], arrow_scale,
                thin_px * pixel_m)
+    if _has_regions(result):
+        _regions_panel(axes[-1], result, factor, image, arrow_scale)
     return fig
 
 

@@ -69,12 +69,21 @@ def _summary(result: Result) -> list[tuple[str, list[str]]]:
                        f"scale {tf.scale:.4f}", f"map -> truth by {a.method}",
                        f"fitness {a.fitness:.3f} within {a.tolerance_m:g} m",
                        f"rmse {a.rmse_m:.3f} m",
-                       f"confidence {result.overlap.confidence:.2f}"]),
+                       f"confidence {result.overlap.confidence:.2f}",
+                       result.overlap.verdict]),
         ("footprint", [f"{result.footprint_rule}",
                        f"coverage {result.overlap.coverage:.3f}",
                        "scored against the whole truth" if result.full
                        else "truth features outside it not counted"]),
     ]
+    c = result.consistency
+    if c is not None and (k := c.largest()) is not None:
+        x, y = c.centre[k]
+        lines.append(("regions", [f"largest offset {c.offset_m[k]:.3f} m",
+                                  f"turn {abs(c.turn_deg[k]):.2f} deg at ({x:.1f}, {y:.1f}) m",
+                                  f"{len(c.points)} regions of {c.tile_m:g} m",
+                                  f"fitness {c.global_fitness():.3f} at the map's pose, "
+                                  f"{c.local_fitness():.3f} with each aligned on its own"]))
     if result.registration_3d is not None:
         reg = result.registration_3d
         lines.append(("3D", [f"registration fitness {reg.fitness:.3f}",

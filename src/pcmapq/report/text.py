@@ -6,7 +6,7 @@ from __future__ import annotations
 import re
 from collections.abc import Sequence
 
-from pcmapq.result import Result
+from pcmapq.result import INCONSISTENT, OTHER, Result
 
 #: What the terms of the table mean, in one short paragraph (their definitions:
 #: docs/metrics.md).
@@ -51,10 +51,28 @@ def alignment_words(result: Result) -> str:
         placed = f"aligned at an estimated scale of {result.transform.scale:.4f}"
     else:
         placed = "aligned"
-    if confidence < 0.5:
-        return (f"{placed}, but it may show another place (confidence {confidence:.2f} < 0.5, "
+    cover = result.overlap
+    if cover.verdict == INCONSISTENT:
+        agree = sum(p.agrees for p in cover.parts)
+        return (f"{placed}: a map of the truth's place that no single pose fits (confidence "
+                f"{confidence:.2f}; {agree} of its {len(cover.parts)} parts placed on their own "
+                f"land near its pose){breaks(result)}")
+    if cover.verdict == OTHER:
+        return (f"{placed}, but it may show another place (confidence {confidence:.2f}, "
                 "scored because of --force)")
     return f"{placed} with confidence {confidence:.2f}"
+
+
+def breaks(result: Result) -> str:
+    """Where the map breaks, as a clause: its region with the largest held offset (see
+    :mod:`pcmapq.align.regions`), metres, truth frame; '' without one."""
+    c = result.consistency
+    k = None if c is None else c.largest()
+    if k is None:
+        return ""
+    x, y = c.centre[k]
+    return (f"; it breaks most at ({x:.1f}, {y:.1f}) m, where a region fits the truth moved "
+            f"by {c.offset_m[k]:.2f} m and turned by {abs(c.turn_deg[k]):.1f} deg")
 
 
 def verdict(result: Result) -> str:

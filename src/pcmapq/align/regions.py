@@ -1,0 +1,143 @@
+"""Where a map breaks: each region of the map, already placed by the global alignment, aligned
+again on its own to the truth (point-to-line ICP of the region's walls from where the global
+pose put them). A consistent map needs no region to move; a map that drifted, bent or broke
+apart needs its regions moved by offsets that grow where it breaks.
+
+Regions are square tiles of the truth frame; each tile is aligned with the map points of a
+window twice its side around it (walls of neighbouring tiles hold a corridor in place along
+its length), and reported at the centroid of its own points. Frames: every position, offset and
+turn is in the truth frame, metres and degrees; ``offset`` takes the region's points from
+where the global pose put them to where they fit the truth."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from pcmapq.align.point_to_line import LineTarget, refine_point_to_line
+from pcmapq.transform import Similarity2D
+from pcmapq.voxels import voxel_centroids
+
+#: Map points are taken at this voxel, metres, before they are cut into regions.
+VOXEL = 0.15
+#: Regions at most this many tiles across the map's larger side (larger maps get larger tiles).
+MAX_TILES = 24
+#: A tile holding fewer points than this (at VOXEL: metres of wall / VOXEL) is no region.
+MIN_POINTS = 20
+#: ICP stages of a region: pairs within these distances, metres (wide first, then fine).
+STAGES = (1.0, 0.4)
+#: A region is held in place in both directions when its matched walls' normals spread so that
+#: the weaker direction has at least this share of the stronger one (a lone corridor does not),
+#: and at least MIN_FIT of its window's points lie on truth walls once it is aligned.
+MIN_SPREAD = 0.1
+MIN_FIT = 0.5
+
+
+@dataclass(frozen=True)
+class Consistency:
+    """The regions of one placed map, as arrays (K regions).
+
+    tile_m: a tile's side, metres. centre: (K, 2) centroid of each region's map points, truth
+    frame, metres. offset: (K, 2) the move that fits the region to the truth, metres. turn_deg:
+    (K,) its turn, degrees. points: (K,) the region's map points (at VOXEL). fit_before,
+    fit_after: (K,) share of its points within ``tolerance_m`` of a truth wall at the global
+    pose and after the region's own alignment. held: (K,) whether the region, aligned,
+    lies on truth walls that hold it in both directions (its offset is then sure; otherwise it
+    may slide along its walls, or fit none)."""
+
+    tile_m: float
+    tolerance_m: float
+    centre: np.ndarray
+    offset: np.ndarray
+    turn_deg: np.ndarray
+    points: np.ndarray
+    fit_before: np.ndarray
+    fit_after: np.ndarray
+    held: np.ndarray
+
+    @property
+    def offset_m(self) -> np.ndarray:
+        """(K,) length of each region's offset, metres."""
+        return np.hypot(self.offset[:, 0], self.offset[:, 1])
+
+    def largest(self) -> int | None:
+        """Index of the held region with the largest offset; None without one."""
+        held = np.flatnonzero(self.held)
+        return None if len(held) == 0 else int(held[np.argmax(self.offset_m[held])])
+
+    def local_fitness(self) -> float:
+        """Share of the regions' points within the tolerance of a truth wall once each region
+        is aligned on its own, [0, 1]."""
+        total = self.points.sum()
+        return float((self.fit_after * self.points).sum() / total) if total else 0.0
+
+    def global_fitness(self) -> float:
+        """Share of the regions' points within the tolerance of a truth wall at the global
+        pose, [0, 1]."""
+        total = self.points.sum()
+        return float((self.fit_before * self.points).sum() / total) if total else 0.0
+
+
+def _fitness(points: np.ndarray, target: LineTarget, tolerance: float) -> float:
+    dist, _ = target.tree.query(points, distance_upper_bound=tolerance, workers=1)
+    return float(np.isfinite(dist).mean())
+
+
+def _held(points: np.ndarray, target: LineTarget, tolerance: float) -> bool:
+    """Whether ``points`` (N, 2, truth frame) lie on truth walls (at least MIN_FIT of them
+    within ``tolerance``) that face two ways enough to hold a translation: the smaller
+    eigenvalue of the sum of their normals' outer products is at least MIN_SPREAD of the
+    larger."""
+    dist, j = target.tree.query(points, distance_upper_bound=tolerance, workers=1)
+    ok = np.isfinite(dist)
+    if ok.sum() < max(3, MIN_FIT * len(points)):
+        return False
+    n = target.normals(j[ok])
+    low, high = np.linalg.eigvalsh(n.T @ n)
+    return bool(low >= MIN_SPREAD * high)
+
+
+def regions(map_xy: np.ndarray, transform: Similarity2D, target: LineTarget,
+            tolerance: float = 0.2, tile_m: float = 4.0) -> Consistency:
+    """The regions of the map (N, 2, map frame) placed by ``transform`` (map -> truth), each
+    aligned on its own to the truth walls of ``target`` (truth frame, metres).
+
+    tile_m: a tile's side, metres (grown so that the map spans at most MAX_TILES tiles).
+    tolerance: the distance, metres, within which a point lies on a truth wall."""
+    placed = voxel_centroids(transform.apply(map_xy), VOXEL)
+    empty = np.zeros((0, 2))
+    if len(placed) == 0 or len(target.points) < 3:
+        return Consistency(tile_m, tolerance, empty, empty, np.zeros(0), np.zeros(0, int),
+                           np.zeros(0), np.zeros(0), np.zeros(0, bool))
+    span = float(np.ptp(placed, axis=0).max())
+    tile = max(tile_m, span / MAX_TILES)
+    keys = np.floor(placed / tile).astype(np.int64)
+    tiles, inverse, counts = np.unique(keys, axis=0, return_inverse=True, return_counts=True)
+    inverse = inverse.ravel()
+    order = np.argsort(inverse, kind="stable")
+    starts = np.concatenate([[0], np.cumsum(counts)])
+    rows = []
+    for k in np.flatnonzero(counts >= MIN_POINTS):
+        own = placed[order[starts[k]:starts[k + 1]]]
+        lo, hi = (tiles[k] - 0.5) * tile, (tiles[k] + 1.5) * tile
+        window = placed[np.all((placed >= lo) & (placed < hi), axis=1)]
+        local = Similarity2D()
+        for distance in STAGES:
+            local = refine_point_to_line(window, target, local, distance, iterations=15)
+        centre = own.mean(axis=0)
+        shift = local.apply(centre[None])[0] - centre
+        if np.hypot(*shift) > 2 * STAGES[0]:  # slid along its walls out of reach: not found
+            local, shift = Similarity2D(), np.zeros(2)
+        rows.append((*centre, *shift, np.degrees(local.yaw), len(own),
+                     _fitness(own, target, tolerance),
+                     _fitness(local.apply(own), target, tolerance),
+                     _held(local.apply(window), target, tolerance)))
+    if not rows:
+        return Consistency(tile, tolerance, empty, empty, np.zeros(0), np.zeros(0, int),
+                           np.zeros(0), np.zeros(0), np.zeros(0, bool))
+    # to the micrometre (and 1e-6 of a share or degree), as results are saved: the figures
+    # made from them are then the same read back from JSON
+    table = np.round(np.array(rows, dtype=np.float64), 6) + 0.0
+    return Consistency(tile, tolerance, table[:, :2], table[:, 2:4], table[:, 4],
+                       table[:, 5].astype(int), table[:, 6], table[:, 7], table[:, 8] > 0)

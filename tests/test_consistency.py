@@ -1,0 +1,137 @@
+"""Bad maps of the right place: scored, with the verdict that no single pose fits them and
+where they break. Known answers: maps bent or broken apart by a known amount; a map of another
+place still refused."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from pcmapq import synth
+from pcmapq.align import align
+from pcmapq.align.parts import Part, pieces
+from pcmapq.align.point_to_line import LineTarget
+from pcmapq.align.regions import regions
+from pcmapq.config import MatchingConfig, Settings
+from pcmapq.errors import EvaluationError
+from pcmapq.io import PointMap
+from pcmapq.pipeline import evaluate
+from pcmapq.result import INCONSISTENT, OTHER, SAME, Result
+from pcmapq.same_place import verdict
+from pcmapq.transform import Similarity2D
+from pcmapq.voxels import voxel_centroids
+
+from .conftest import write_image_map
+
+TRUE = Similarity2D(3.0, -2.0, np.radians(37.0))
+FAST = Settings(matching=MatchingConfig(detectors=()))
+
+
+def _part(agrees: bool) -> Part:
+    return Part(0.125, (0.0, 0.0), 0.0 if agrees else 9.0, 0.0, 0.5, agrees)
+
+
+def test_verdict_of_known_confidence_and_parts():
+    """The confidence settles it when it reaches the minimum; below it, two agreeing parts
+    make a map of the truth's place that no pose fits whole, one does not."""
+    assert verdict(0.5, 0.5, ()) == SAME
+    assert verdict(0.49, 0.5, [_part(True), _part(True)] + [_part(False)] * 6) == INCONSISTENT
+    assert verdict(0.49, 0.5, [_part(True)] + [_part(False)] * 7) == OTHER
+    assert verdict(0.0, 0.5, ()) == OTHER
+
+
+def test_pieces_cut_along_the_principal_axes():
+    """A long, turned cloud is cut into 4 x 2 pieces of equal count, the first index along
+    its length."""
+    rng = np.random.default_rng(0)
+    along = rng.uniform(-20, 20, 4000)
+    xy = np.column_stack([along, rng.uniform(-2, 2, 4000)]) @ np.array([[0.6, 0.8],
+                                                                         [-0.8, 0.6]])
+    index = pieces(xy, 4, 2)
+    assert np.bincount(index).tolist() == [500] * 8
+    for k in range(4):  # pieces 2k and 2k + 1 share a quarter of the length
+        assert np.ptp(along[index // 2 == k]) < 10.5
+
+
+def _broken(plan: np.ndarray, degrees: float) -> np.ndarray:
+    """Wall points of ``plan`` whose eastern half (x > 12 m) is turned by ``degrees`` about
+    (12, 8) m, in the map frame of TRUE."""
+    points = synth.wall_points(plan)
+    east = points[:, 0] > 12
+    pivot = np.array([12.0, 8.0])
+    points[east] = Similarity2D(0, 0, np.radians(degrees)).apply(points[east] - pivot) + pivot
+    return TRUE.inverse().apply(points)
+
+
+def _cloud(xy: np.ndarray, name: str = "map.npy") -> PointMap:
+    return PointMap(Path(name), np.column_stack([xy, np.zeros(len(xy))]), False)
+
+
+@pytest.mark.parametrize("seed", [0, 2])
+def test_a_map_broken_in_two_is_scored_and_says_where(seed, tmp_path):
+    """The eastern half of the map turned by 20 degrees: no pose fits it whole (confidence
+    0.24 and 0.29; it was refused as another place), its western parts placed on their own
+    agree with its pose, so it is scored, and it breaks most in the eastern half."""
+    plan = synth.building_plan(seed)
+    truth = write_image_map(plan, tmp_path / "truth.png")
+    result = evaluate(_cloud(_broken(plan, 20.0)), truth, FAST)
+    cover = result.overlap
+    assert cover.confidence < 0.5 and cover.verdict == INCONSISTENT
+    assert sum(p.agrees for p in cover.parts) >= 2
+    agreeing = np.array([p.centre_m for p in cover.parts if p.agrees])
+    assert (agreeing[:, 0] < 12).all()  # the parts that agree are western
+    c = result.consistency
+    k = c.largest()
+    assert c.centre[k][0] > 12 and c.offset_m[k] > 1.0
+    assert np.median(c.offset_m[c.centre[:, 0] < 10]) < 0.1  # the west needs no move
+
+
+def test_another_place_is_still_refused(tmp_path):
+    """Three round rooms against the building: no part lands near the pose; refused, and the
+    message counts the parts."""
+    ring = np.linspace(0, 2 * np.pi, 400, endpoint=False)
+    rooms = np.vstack([np.column_stack([cx + r * np.cos(ring), cy + r * np.sin(ring)])
+                       for cx, cy, r in ((6, 6, 5), (16, 8, 4), (11, 15, 3))])
+    truth = write_image_map(synth.building_plan(0), tmp_path / "truth.png")
+    with pytest.raises(EvaluationError, match=r"0 of its 8 parts|1 of its 8 parts"):
+        evaluate(_cloud(rooms), truth, FAST)
+
+
+@pytest.mark.parametrize("degrees_per_metre", [0.1, 0.2])
+def test_region_offsets_follow_a_bend(degrees_per_metre):
+    """A map bent like odometry drift (the far end 0.4 and 0.9 m off): each region's offset
+    correlates with the displacement that undoes the bend there (r >= 0.9 over x and y)."""
+    plan = synth.building_plan(0)
+    truth = voxel_centroids(synth.wall_points(plan), 0.05)
+    where = synth.wall_points(plan, seed=1)
+    drawn = TRUE.inverse().apply(synth.bend(where, degrees_per_metre))
+    pose = align(drawn, truth).transform
+    c = regions(drawn, pose, LineTarget(truth))
+    placed = pose.apply(drawn)
+    cell = np.floor(placed / c.tile_m).astype(int)
+    expected = np.array([(where - placed)[(cell == np.floor(centre / c.tile_m)).all(axis=1)]
+                         .mean(axis=0) for centre in c.centre])
+    held = c.held
+    assert held.sum() >= 20
+    r = np.corrcoef(expected[held].ravel(), c.offset[held].ravel())[0, 1]
+    assert r >= 0.9, r
+
+
+def test_consistency_in_json_csv_and_back(tmp_path):
+    """The regions and parts survive JSON; the regions CSV holds the JSON's rows."""
+    plan = synth.building_plan(0)
+    truth = write_image_map(plan, tmp_path / "truth.png")
+    result = evaluate(_cloud(_broken(plan, 20.0)), truth, FAST)
+    doc = json.loads(result.to_json())
+    assert doc["alignment"]["verdict"] == INCONSISTENT and len(doc["alignment"]["parts"]) == 8
+    regions_doc = doc["consistency"]["regions"]
+    assert len(regions_doc) == len(result.consistency.points) > 0
+    assert Result.from_json(result.to_json()).to_json() == result.to_json()
+    lines = result.regions_csv().splitlines()
+    assert lines[0].startswith("x_m,y_m,dx_m,dy_m,offset_m,turn_deg")
+    assert len(lines) == len(regions_doc) + 1
+    first = lines[1].split(",")
+    assert float(first[4]) == pytest.approx(regions_doc[0]["offset_m"], abs=1e-6)
