@@ -120,10 +120,14 @@ def report_html(result: Result, arrow_scale: float = ARROW_SCALE) -> str:
         ["x [m]", "y [m]", "yaw [deg]", "scale", "fitness", "inlier RMSE [m]", "method"],
         [[number(tf.tx), number(tf.ty), number(tf.yaw_deg, 2), number(tf.scale, 4),
           f"{number(a.fitness)} (within {a.tolerance_m:g} m)", number(a.rmse_m), a.method]])
+    c = result.consistency
+    k = None if c is None else c.largest()
     cover = _table(["coverage", "footprint", "truth recall in footprint", "confidence",
-                    "scored against"],
+                    "verdict", "largest region offset [m]", "scored against"],
                    [[number(o.coverage), FOOTPRINT_WORDS.get(result.footprint_rule, ""),
-                     number(o.truth_recall), number(o.confidence),
+                     number(o.truth_recall), number(o.confidence), o.verdict,
+                     "-" if k is None else f"{number(c.offset_m[k])} at "
+                     f"({c.centre[k][0]:.1f}, {c.centre[k][1]:.1f})",
                      "whole truth" if result.full else "the map's footprint"]])
     rows = []
     for name, det in result.detectors.items():

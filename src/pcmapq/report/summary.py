@@ -20,9 +20,9 @@ SCORES = ("quality", "precision", "f1")
 #: detector, then precision, then f1), coverage, the alignment, the wall distances (metres).
 HEAD = ("name", "map", "truth",
         *(f"{d}_{s}" for s in SCORES for d in DETECTOR_NAMES),
-        "coverage", "fitness", "confidence", "x_m", "y_m", "yaw_deg", "scale",
-        "accuracy_mean_m", "accuracy_median_m", "completeness_mean_m", "completeness_median_m",
-        "chamfer_m")
+        "coverage", "fitness", "confidence", "verdict", "x_m", "y_m", "yaw_deg", "scale",
+        "largest_offset_m", "accuracy_mean_m", "accuracy_median_m", "completeness_mean_m",
+        "completeness_median_m", "chamfer_m")
 #: Columns after the F-scores: the gates' verdict ("" without gates, "pass", or "fail: " and
 #: the failing keys) and how the evaluation ended (0 and "" when it finished).
 TAIL = ("gates", "exit_code", "error")
@@ -32,7 +32,8 @@ FSCORE = "f_score@{tau:g}m"
 HEADERS = {"name": "name", "map": "map", "truth": "truth",
            **{f"{d}_{s}": f"{d} {s}" for s in SCORES for d in DETECTOR_NAMES},
            "coverage": "coverage", "fitness": "fitness", "confidence": "confidence",
-           "x_m": "x (m)", "y_m": "y (m)", "yaw_deg": "yaw (deg)", "scale": "scale",
+           "verdict": "verdict", "x_m": "x (m)", "y_m": "y (m)", "yaw_deg": "yaw (deg)",
+           "scale": "scale", "largest_offset_m": "largest region offset (m)",
            "accuracy_mean_m": "accuracy mean (m)", "accuracy_median_m": "accuracy median (m)",
            "completeness_mean_m": "completeness mean (m)",
            "completeness_median_m": "completeness median (m)", "chamfer_m": "Chamfer (m)",
@@ -46,7 +47,8 @@ COLOURS = {"harris": "#4477aa", "hough": "#ee6677", "sift": "#228833"}
 def summary_row(name: str, result: dict) -> dict[str, object]:
     """One flat row of a result JSON document (``pcmapq eval --json``): the inputs' paths,
     each detector's quality, precision and f1 (None when undefined or not run), coverage, the
-    alignment (fitness, confidence, x, y metres, yaw degrees, scale), the wall distances
+    alignment (fitness, confidence, verdict, x, y metres, yaw degrees, scale), the largest
+    offset of a region of the consistency map (metres), the wall distances
     (metres), the F-score at each tau and the verdict of its gates (:func:`gates_verdict`);
     exit_code 0, error "". A document missing one of
     these is a ValueError naming the key."""
@@ -60,8 +62,10 @@ def summary_row(name: str, result: dict) -> dict[str, object]:
             row[f"{det}_{score}"] = (_number(detectors[det], score, f"detectors.{det}")
                                      if det in detectors else None)
     row["coverage"] = _number(result, "coverage")
-    for key in ("fitness", "confidence", "x_m", "y_m", "yaw_deg", "scale"):
-        row[key] = _number(align, key, "alignment")
+    for key in ("fitness", "confidence", "verdict", "x_m", "y_m", "yaw_deg", "scale"):
+        # a result written before verdicts and regions has neither: left empty
+        row[key] = align.get(key) if key == "verdict" else _number(align, key, "alignment")
+    row["largest_offset_m"] = (result.get("consistency") or {}).get("largest_offset_m")
     for side in ("accuracy", "completeness"):
         stats = _get(dist, f"{side}_m")
         for key in ("mean", "median"):
