@@ -121,6 +121,7 @@ def test_the_verdict_says_plainly_when_a_score_is_undefined():
     for m in doc["matches"]:
         m["counted"]["truth"] = m["counted"]["truth"] and m["detector"] != "harris"
     doc["alignment"]["confidence"] = 0.3
+    doc["alignment"]["verdict"] = "another place"
     line = verdict(sample_result(doc))
     assert "harris n/a (no strong truth feature inside the footprint)" in line
     assert "it may show another place (confidence 0.30 < 0.5, scored because of --force)" in line

@@ -29,9 +29,9 @@ OPTIONS = {UNDER: "--fail-under", OVER: "--fail-over"}
 #: A detector's scores, each in [0, 1].
 DETECTOR_FIELDS = ("quality", "precision", "f1")
 #: The top-level keys of the result's JSON (``alignment_3d``, ``distances_3d``: two 3D clouds).
-TOP_LEVEL = ("pcmapq", "settings", "map", "truth", "alignment", "frames", "coverage",
-             "footprint", "scored_against", "distances", "noref", "detectors", "matches", "missing",
-             "extra", "alignment_3d", "distances_3d")
+TOP_LEVEL = ("pcmapq", "settings", "map", "truth", "alignment", "consistency", "frames",
+             "coverage", "footprint", "scored_against", "distances", "noref", "detectors",
+             "matches", "missing", "extra", "alignment_3d", "distances_3d")
 #: The figures of ``alignment`` a short name reaches (they are their own JSON paths).
 ALIGNMENT_FIELDS = ("confidence", "fitness", "rmse_m", "truth_recall", "agreement",
                     "distinctiveness", "x_m", "y_m", "yaw_deg", "scale")

@@ -80,10 +80,11 @@ def _summary(result: Result) -> list[tuple[str, list[str]]]:
     if c is not None and (k := c.largest()) is not None:
         x, y = c.centre[k]
         lines.append(("regions", [f"largest offset {c.offset_m[k]:.3f} m",
-                                  f"turn {abs(c.turn_deg[k]):.2f} deg at ({x:.1f}, {y:.1f}) m",
+                                  f"turn {abs(c.turn_deg[k]):.2f} deg",
+                                  f"at ({x:.1f}, {y:.1f}) m",
                                   f"{len(c.points)} regions of {c.tile_m:g} m",
-                                  f"fitness {c.global_fitness():.3f} at the map's pose, "
-                                  f"{c.local_fitness():.3f} with each aligned on its own"]))
+                                  f"fitness {c.global_fitness():.3f} as placed",
+                                  f"{c.local_fitness():.3f} each fitted alone"]))
     if result.registration_3d is not None:
         reg = result.registration_3d
         lines.append(("3D", [f"registration fitness {reg.fitness:.3f}",

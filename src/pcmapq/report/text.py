@@ -58,7 +58,7 @@ def alignment_words(result: Result) -> str:
                 f"{confidence:.2f}; {agree} of its {len(cover.parts)} parts placed on their own "
                 f"land near its pose){breaks(result)}")
     if cover.verdict == OTHER:
-        return (f"{placed}, but it may show another place (confidence {confidence:.2f}, "
+        return (f"{placed}, but it may show another place (confidence {confidence:.2f} < 0.5, "
                 "scored because of --force)")
     return f"{placed} with confidence {confidence:.2f}"
 
