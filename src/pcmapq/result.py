@@ -164,8 +164,8 @@ class Result:
                           "distinctiveness": self.alignment.distinctiveness,
                           "confidence": self.overlap.confidence,
                           "verdict": self.overlap.verdict,
-                          "parts": [{**asdict(p), "centre_m": list(p.centre_m)}
-                                    for p in self.overlap.parts]},
+                          "parts": [{**asdict(p), "centre_m": list(p.centre_m),
+                                     "pose": p.pose.to_dict()} for p in self.overlap.parts]},
             "consistency": _consistency_dict(self.consistency),
             "frames": self.frames.to_dict(),
             "coverage": self.overlap.coverage,
@@ -353,7 +353,8 @@ def _from_dict(doc: dict) -> Result:
                             a["method"], a["distinctiveness"]),
         overlap=Overlap(None, doc["coverage"], a["truth_recall"], a["agreement"],
                         a["confidence"], a["verdict"],
-                        tuple(Part(**{**p, "centre_m": tuple(p["centre_m"])})
+                        tuple(Part(**{**p, "centre_m": tuple(p["centre_m"]),
+                                 "pose": Similarity2D.from_dict(p["pose"])})
                               for p in a["parts"])),
         distances=_distances_of(doc["distances"]),
         registration_3d=None if reg is None else Registration3D(

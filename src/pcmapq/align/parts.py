@@ -14,7 +14,7 @@ scale its pose found."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -41,7 +41,8 @@ class Part:
     share: its share of the map's points. centre_m: its centroid where the map's pose puts it,
     truth frame, metres. offset_m: how far its own pose puts that centroid from there, metres;
     turn_deg: how far its own pose turns it from the map's pose, degrees, in [0, 180].
-    fitness: its own alignment's fitness. agrees: within the agreement bounds."""
+    fitness: its own alignment's fitness. agrees: within the agreement bounds. pose: its own
+    map -> truth transform (at the map's scale)."""
 
     share: float
     centre_m: tuple[float, float]
@@ -49,6 +50,7 @@ class Part:
     turn_deg: float
     fitness: float
     agrees: bool
+    pose: Similarity2D = Similarity2D()
 
 
 def pieces(xy: np.ndarray, along: int = 2, across: int = 2) -> np.ndarray:
@@ -91,5 +93,6 @@ def place_parts(map_xy: np.ndarray, truth_xy: np.ndarray, pose: Similarity2D,
         offset = float(np.hypot(*(own.transform.apply(centre)[0] - placed)))
         turn = abs(float(np.degrees(np.angle(np.exp(1j * (own.transform.yaw - rigid.yaw))))))
         parts.append(Part(len(part) / len(scaled), (float(placed[0]), float(placed[1])),
-                          offset, turn, own.fitness, offset <= reach and turn <= AGREE_DEG))
+                          offset, turn, own.fitness, offset <= reach and turn <= AGREE_DEG,
+                          replace(own.transform, scale=pose.scale)))
     return parts

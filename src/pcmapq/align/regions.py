@@ -98,13 +98,32 @@ def _held(points: np.ndarray, target: LineTarget, tolerance: float) -> bool:
     return bool(low >= MIN_SPREAD * high)
 
 
+def _fit(window: np.ndarray, own: np.ndarray, target: LineTarget, start: Similarity2D,
+         tolerance: float) -> tuple[Similarity2D, float] | None:
+    """The window's points (truth frame) aligned from ``start`` (a move in the truth frame):
+    the move and the share of the region's ``own`` points it puts on truth walls; None when
+    the window slid more than twice the widest pairing distance away from ``start``."""
+    local = start
+    for distance in STAGES:
+        local = refine_point_to_line(window, target, local, distance, iterations=15)
+    centre = own.mean(axis=0, keepdims=True)
+    if np.hypot(*(local.apply(centre) - start.apply(centre))[0]) > 2 * STAGES[0]:
+        return None
+    return local, _fitness(local.apply(own), target, tolerance)
+
+
 def regions(map_xy: np.ndarray, transform: Similarity2D, target: LineTarget,
-            tolerance: float = 0.2, tile_m: float = 4.0) -> Consistency:
+            tolerance: float = 0.2, tile_m: float = 4.0,
+            starts: tuple[Similarity2D, ...] = ()) -> Consistency:
     """The regions of the map (N, 2, map frame) placed by ``transform`` (map -> truth), each
     aligned on its own to the truth walls of ``target`` (truth frame, metres).
 
     tile_m: a tile's side, metres (grown so that the map spans at most MAX_TILES tiles).
-    tolerance: the distance, metres, within which a point lies on a truth wall."""
+    tolerance: the distance, metres, within which a point lies on a truth wall.
+    starts: other map -> truth poses (the poses of the map's parts placed on their own, see
+    :mod:`pcmapq.align.parts`): each region is also aligned from each of them, and the fit that
+    puts most of its points on truth walls is kept (the map's own pose on a tie): a part that
+    broke off further than ICP reaches from the map's pose is fitted from its own."""
     placed = voxel_centroids(transform.apply(map_xy), VOXEL)
     empty = np.zeros((0, 2))
     if len(placed) == 0 or len(target.points) < 3:
@@ -116,22 +135,24 @@ def regions(map_xy: np.ndarray, transform: Similarity2D, target: LineTarget,
     tiles, inverse, counts = np.unique(keys, axis=0, return_inverse=True, return_counts=True)
     inverse = inverse.ravel()
     order = np.argsort(inverse, kind="stable")
-    starts = np.concatenate([[0], np.cumsum(counts)])
+    bounds_at = np.concatenate([[0], np.cumsum(counts)])
+    # each start as a move of the placed points, truth frame: start o transform^-1
+    moves = [Similarity2D()] + [s.compose(transform.inverse()) for s in starts]
     rows = []
     for k in np.flatnonzero(counts >= MIN_POINTS):
-        own = placed[order[starts[k]:starts[k + 1]]]
+        own = placed[order[bounds_at[k]:bounds_at[k + 1]]]
         lo, hi = (tiles[k] - 0.5) * tile, (tiles[k] + 1.5) * tile
         window = placed[np.all((placed >= lo) & (placed < hi), axis=1)]
-        local = Similarity2D()
-        for distance in STAGES:
-            local = refine_point_to_line(window, target, local, distance, iterations=15)
+        before = _fitness(own, target, tolerance)
+        local, after = Similarity2D(), before  # slid out of reach from every start: not moved
+        found = False
+        for move in moves:  # the map's own pose first: another start must fit better
+            fitted = _fit(window, own, target, move, tolerance)
+            if fitted is not None and (not found or fitted[1] > after + 1e-9):
+                (local, after), found = fitted, True
         centre = own.mean(axis=0)
         shift = local.apply(centre[None])[0] - centre
-        if np.hypot(*shift) > 2 * STAGES[0]:  # slid along its walls out of reach: not found
-            local, shift = Similarity2D(), np.zeros(2)
-        rows.append((*centre, *shift, np.degrees(local.yaw), len(own),
-                     _fitness(own, target, tolerance),
-                     _fitness(local.apply(own), target, tolerance),
+        rows.append((*centre, *shift, np.degrees(local.yaw), len(own), before, after,
                      _held(local.apply(window), target, tolerance)))
     if not rows:
         return Consistency(tile, tolerance, empty, empty, np.zeros(0), np.zeros(0, int),
