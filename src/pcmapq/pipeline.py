@@ -218,7 +218,8 @@ def place_map(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap,
     if cover.verdict != OTHER and target.lines is not None:
         progress("aligning the map's regions on their own")
         consistency = regions(map_xy, alignment.transform, target.lines,
-                              alignment.tolerance_m, starts=tuple(p.pose for p in parts))
+                              alignment.tolerance_m,
+                              starts=tuple((p.pose, p.centre_m) for p in parts if not p.agrees))
     return MapSide(source, registration, map_xy, map_level, alignment, map_occ, to_map, cover,
                    {}, consistency)
 

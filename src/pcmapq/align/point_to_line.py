@@ -49,11 +49,13 @@ class LineTarget:
 
 def refine_point_to_line(map_xy: np.ndarray, target: LineTarget, init: Similarity2D,
                          max_distance: float = 0.2, iterations: int = 30,
-                         with_scale: bool = False) -> Similarity2D:
+                         with_scale: bool = False, settled: float = 1e-6) -> Similarity2D:
     """2D point-to-line ICP (Gauss-Newton with Tukey weights) of the map (N, 2, metres, map
     frame) onto the truth (``target``), from ``init``; pairs farther apart than
-    ``max_distance`` metres are ignored. Returns the map -> truth transform: scale 1, or with
-    ``with_scale`` the scale refined too (the map then in any unit, starting at ``init``'s)."""
+    ``max_distance`` metres are ignored; it stops once a step moves less than ``settled``
+    metres (and a tenth of it in radians and scale). Returns the map -> truth transform: scale
+    1, or with ``with_scale`` the scale refined too (the map then in any unit, starting at
+    ``init``'s)."""
     if len(target.points) < 3:  # no lines to refine on
         return init
     truth_xy, tree = target.points, target.tree
@@ -81,6 +83,6 @@ def refine_point_to_line(map_xy: np.ndarray, target: LineTarget, init: Similarit
         else:
             tf = Similarity2D.from_matrix(Similarity2D(*step).matrix @ tf.matrix)
             tf = Similarity2D(tf.tx, tf.ty, tf.yaw)  # keep scale exactly 1
-        if np.abs(step[:2]).max() < 1e-6 and np.abs(step[2:]).max() < 1e-7:
+        if np.abs(step[:2]).max() < settled and np.abs(step[2:]).max() < 0.1 * settled:
             break
     return tf

@@ -27,6 +27,9 @@ MAX_TILES = 24
 MIN_POINTS = 20
 #: ICP stages of a region: pairs within these distances, metres (wide first, then fine).
 STAGES = (1.0, 0.4)
+#: A region's ICP stops once a step moves it less than this, metres (a tenth of a millimetre:
+#: offsets are reported to the centimetre).
+SETTLED = 1e-4
 #: A region is held in place in both directions when its matched walls' normals spread so that
 #: the weaker direction has at least this share of the stronger one (a lone corridor does not),
 #: and at least MIN_FIT of its window's points lie on truth walls once it is aligned.
@@ -105,7 +108,8 @@ def _fit(window: np.ndarray, own: np.ndarray, target: LineTarget, start: Similar
     the window slid more than twice the widest pairing distance away from ``start``."""
     local = start
     for distance in STAGES:
-        local = refine_point_to_line(window, target, local, distance, iterations=15)
+        local = refine_point_to_line(window, target, local, distance, iterations=15,
+                                     settled=SETTLED)
     centre = own.mean(axis=0, keepdims=True)
     if np.hypot(*(local.apply(centre) - start.apply(centre))[0]) > 2 * STAGES[0]:
         return None
@@ -114,16 +118,19 @@ def _fit(window: np.ndarray, own: np.ndarray, target: LineTarget, start: Similar
 
 def regions(map_xy: np.ndarray, transform: Similarity2D, target: LineTarget,
             tolerance: float = 0.2, tile_m: float = 4.0,
-            starts: tuple[Similarity2D, ...] = ()) -> Consistency:
+            starts: tuple[tuple[Similarity2D, tuple[float, float]], ...] = ()
+            ) -> Consistency:
     """The regions of the map (N, 2, map frame) placed by ``transform`` (map -> truth), each
     aligned on its own to the truth walls of ``target`` (truth frame, metres).
 
     tile_m: a tile's side, metres (grown so that the map spans at most MAX_TILES tiles).
     tolerance: the distance, metres, within which a point lies on a truth wall.
-    starts: other map -> truth poses (the poses of the map's parts placed on their own, see
-    :mod:`pcmapq.align.parts`): each region is also aligned from each of them, and the fit that
-    puts most of its points on truth walls is kept (the map's own pose on a tie): a part that
-    broke off further than ICP reaches from the map's pose is fitted from its own."""
+    starts: other map -> truth poses, each with where it applies (truth frame, metres): the
+    poses of the map's parts placed on their own and their centroids as the map's pose puts
+    them (see :mod:`pcmapq.align.parts`). Each region is also aligned from the pose whose place
+    is nearest, and the fit that puts more of its points on truth walls is kept (the map's own
+    pose on a tie): a part that broke off further than ICP reaches from the map's pose is
+    fitted from its own."""
     placed = voxel_centroids(transform.apply(map_xy), VOXEL)
     empty = np.zeros((0, 2))
     if len(placed) == 0 or len(target.points) < 3:
@@ -137,7 +144,8 @@ def regions(map_xy: np.ndarray, transform: Similarity2D, target: LineTarget,
     order = np.argsort(inverse, kind="stable")
     bounds_at = np.concatenate([[0], np.cumsum(counts)])
     # each start as a move of the placed points, truth frame: start o transform^-1
-    moves = [Similarity2D()] + [s.compose(transform.inverse()) for s in starts]
+    moves = [pose.compose(transform.inverse()) for pose, _ in starts]
+    places = np.array([where for _, where in starts], dtype=np.float64).reshape(-1, 2)
     rows = []
     for k in np.flatnonzero(counts >= MIN_POINTS):
         own = placed[order[bounds_at[k]:bounds_at[k + 1]]]
@@ -146,7 +154,9 @@ def regions(map_xy: np.ndarray, transform: Similarity2D, target: LineTarget,
         before = _fitness(own, target, tolerance)
         local, after = Similarity2D(), before  # slid out of reach from every start: not moved
         found = False
-        for move in moves:  # the map's own pose first: another start must fit better
+        nearest = np.argmin(np.hypot(*(places - own.mean(axis=0)).T)) if len(moves) else None
+        tries = [Similarity2D()] + ([] if nearest is None else [moves[nearest]])
+        for move in tries:  # the map's own pose first: another start must fit better
             fitted = _fit(window, own, target, move, tolerance)
             if fitted is not None and (not found or fitted[1] > after + 1e-9):
                 (local, after), found = fitted, True
