@@ -47,6 +47,8 @@ THINNED_TRUTH_VOXEL = 0.4
 #: below a wrong one (a plan's map under 800 boxes: 0.163 after the rough stage, 0.202 after
 #: the fine ones, against 0.186 for the pose turned by 180 degrees).
 CLOSE_FINALISTS = 0.9
+#: ... when it is another pose than every finalist's: farther than these, metres and degrees.
+SAME_POSE_M, SAME_POSE_DEG = 1.0, 5.0
 
 #: One refinement: a map -> truth transform in, the refined one out.
 Refine = Callable[[Similarity2D], Similarity2D]
@@ -246,16 +248,26 @@ def align_similarity(map_xy: np.ndarray, truth_xy: np.ndarray,
 def refine_best(starts: Sequence[Similarity2D], rough: Refine, fine: Refine,
                 scored: Callable[[Similarity2D], Alignment], finalists: int) -> Similarity2D:
     """Every start refined by ``rough``; the ``finalists`` best of those (highest fitness, then
-    lowest RMSE, by ``scored``), and any other within CLOSE_FINALISTS of the best fitness,
-    refined by ``fine``; the best of these. A single start (an
+    lowest RMSE, by ``scored``), and any other pose within CLOSE_FINALISTS of the best
+    fitness, refined by ``fine``; the best of these. A single start (an
     ``init``, every step of ``pcmapq track``) is refined without scoring: there is no choice
     to make."""
     if len(starts) == 1:
         return fine(rough(starts[0]))
     firsts = sorted((scored(rough(s)) for s in starts), key=_rank)
-    close = sum(r.fitness >= CLOSE_FINALISTS * firsts[0].fitness for r in firsts)
-    return min((scored(fine(r.transform)) for r in firsts[:max(finalists, close)]),
-               key=_rank).transform
+    chosen = firsts[:finalists]
+    for r in firsts[finalists:]:
+        if r.fitness >= CLOSE_FINALISTS * firsts[0].fitness and \
+                not any(_same_pose(r.transform, c.transform) for c in chosen):
+            chosen.append(r)
+    return min((scored(fine(r.transform)) for r in chosen), key=_rank).transform
+
+
+def _same_pose(a: Similarity2D, b: Similarity2D) -> bool:
+    """Whether two poses are one for the choice of finalists: within SAME_POSE_M of
+    translation and SAME_POSE_DEG of yaw."""
+    turn = abs(np.degrees(np.angle(np.exp(1j * (a.yaw - b.yaw)))))
+    return bool(np.hypot(a.tx - b.tx, a.ty - b.ty) < SAME_POSE_M and turn < SAME_POSE_DEG)
 
 
 def _starts(search: Search | None, init: Similarity2D) -> list[Similarity2D]:
