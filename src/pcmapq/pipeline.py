@@ -11,7 +11,7 @@ import numpy as np
 
 from pcmapq import memory
 from pcmapq.align import Alignment
-from pcmapq.align.parts import place_parts
+from pcmapq.align.parts import broken_off, place_parts
 from pcmapq.align.planar import RigidTarget
 from pcmapq.align.regions import Consistency, regions
 from pcmapq.align.rigid3d import Registration3D
@@ -219,7 +219,7 @@ def place_map(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap,
         progress("aligning the map's regions on their own")
         consistency = regions(map_xy, alignment.transform, target.lines,
                               alignment.tolerance_m,
-                              starts=tuple((p.pose, p.centre_m) for p in parts if not p.agrees))
+                              starts=broken_off(parts, map_xy, alignment.transform))
     return MapSide(source, registration, map_xy, map_level, alignment, map_occ, to_map, cover,
                    {}, consistency)
 

@@ -32,6 +32,10 @@ AGREE_DEG = 15.0
 PIECES = (4, 2)
 #: Parts with fewer points than this are not aligned (nothing to place them by).
 MIN_POINTS = 50
+#: A part that does not agree is taken as broken off, its own pose a start for the regions it
+#: holds (:func:`pcmapq.align.regions.regions`), when that pose moves it by at most this share
+#: of the map's radius and turns it by at most BROKEN_DEG; farther, it landed on other walls.
+BROKEN_RADIUS, BROKEN_DEG = 0.5, 45.0
 
 
 @dataclass(frozen=True)
@@ -79,8 +83,7 @@ def place_parts(map_xy: np.ndarray, truth_xy: np.ndarray, pose: Similarity2D,
     rigid = Similarity2D(pose.tx, pose.ty, pose.yaw)
     if target is None or not target.fits(params):
         target = RigidTarget(truth_xy, params)
-    radius = float(np.sqrt(((scaled - scaled.mean(axis=0)) ** 2).sum(axis=1).max()))
-    reach = max(AGREE_M, AGREE_RADIUS * radius)
+    reach = max(AGREE_M, AGREE_RADIUS * _radius(scaled))
     labels = pieces(scaled, *PIECES)
     parts = []
     for k in range(PIECES[0] * PIECES[1]):
@@ -96,3 +99,18 @@ def place_parts(map_xy: np.ndarray, truth_xy: np.ndarray, pose: Similarity2D,
                           offset, turn, own.fitness, offset <= reach and turn <= AGREE_DEG,
                           replace(own.transform, scale=pose.scale)))
     return parts
+
+
+def _radius(xy: np.ndarray) -> float:
+    return float(np.sqrt(((xy - xy.mean(axis=0)) ** 2).sum(axis=1).max()))
+
+
+def broken_off(parts: list[Part] | tuple[Part, ...], map_xy: np.ndarray,
+               pose: Similarity2D) -> tuple[tuple[Similarity2D, tuple[float, float]], ...]:
+    """The poses of the parts that broke off, each with its centroid as the map's ``pose``
+    puts it (truth frame, metres): parts that do not agree, moved by at most BROKEN_RADIUS of
+    the map's radius (map_xy (N, 2) in map units, scaled by ``pose``) and turned by at most
+    BROKEN_DEG."""
+    reach = BROKEN_RADIUS * pose.scale * _radius(np.asarray(map_xy, dtype=np.float64))
+    return tuple((p.pose, p.centre_m) for p in parts
+                 if not p.agrees and p.offset_m <= reach and p.turn_deg <= BROKEN_DEG)

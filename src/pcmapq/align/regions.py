@@ -27,6 +27,9 @@ MAX_TILES = 24
 MIN_POINTS = 20
 #: ICP stages of a region: pairs within these distances, metres (wide first, then fine).
 STAGES = (1.0, 0.4)
+#: A fit from a part's pose replaces the fit from the map's pose when it puts this much more of
+#: the region's points on truth walls.
+BETTER = 0.1
 #: A region's ICP stops once a step moves it less than this, metres (a tenth of a millimetre:
 #: offsets are reported to the centimetre).
 SETTLED = 1e-4
@@ -128,9 +131,9 @@ def regions(map_xy: np.ndarray, transform: Similarity2D, target: LineTarget,
     starts: other map -> truth poses, each with where it applies (truth frame, metres): the
     poses of the map's parts placed on their own and their centroids as the map's pose puts
     them (see :mod:`pcmapq.align.parts`). Each region is also aligned from the pose whose place
-    is nearest, and the fit that puts more of its points on truth walls is kept (the map's own
-    pose on a tie): a part that broke off further than ICP reaches from the map's pose is
-    fitted from its own."""
+    is nearest, and that fit replaces the one from the map's own pose when it puts BETTER more
+    of the region's points on truth walls: a part that broke off further than ICP reaches from
+    the map's pose is fitted from its own."""
     placed = voxel_centroids(transform.apply(map_xy), VOXEL)
     empty = np.zeros((0, 2))
     if len(placed) == 0 or len(target.points) < 3:
@@ -156,9 +159,9 @@ def regions(map_xy: np.ndarray, transform: Similarity2D, target: LineTarget,
         found = False
         nearest = np.argmin(np.hypot(*(places - own.mean(axis=0)).T)) if len(moves) else None
         tries = [Similarity2D()] + ([] if nearest is None else [moves[nearest]])
-        for move in tries:  # the map's own pose first: another start must fit better
+        for move in tries:  # the map's own pose first: another start must fit clearly better
             fitted = _fit(window, own, target, move, tolerance)
-            if fitted is not None and (not found or fitted[1] > after + 1e-9):
+            if fitted is not None and (not found or fitted[1] > after + BETTER):
                 (local, after), found = fitted, True
         centre = own.mean(axis=0)
         shift = local.apply(centre[None])[0] - centre

@@ -205,6 +205,14 @@ def _panel(ax: Axes, result: Result, factor: int, image: np.ndarray,
     _scale_bar(ax, result)
 
 
+def regions_gain(result: Result, arrow_scale: float) -> float:
+    """How many times its length a region's offset is drawn: ``arrow_scale``, less where the
+    largest offset would then be longer than a tile (drawn a tile long), at least 1."""
+    c = result.consistency
+    largest = float(c.offset_m.max()) if len(c.offset_m) else 0.0
+    return float(np.clip(c.tile_m / max(largest, 1e-9), 1.0, arrow_scale))
+
+
 def _regions_panel(ax: Axes, result: Result, factor: int, image: np.ndarray,
                    gain: float) -> None:
     """The consistency map over ``image`` (pooled ``factor``-fold): at each region of the map,
@@ -292,8 +300,9 @@ def vectorial_figure(result: Result, arrow_scale: float = ARROW_SCALE) -> Figure
     for ax, name in zip(axes, names, strict=False):
         _title(ax, result, name)
     if _has_regions(result):
-        axes[-1].set_title(f"regions: the offset that fits each on its own "
-                           f"({result.overlap.verdict})", fontsize=TITLE_PT)
+        gain = regions_gain(result, arrow_scale)
+        axes[-1].set_title(f"{result.overlap.verdict}: each region's fit\n"
+                           f"on its own, offsets x{gain:.3g}", fontsize=TITLE_PT)
     for ax in axes:
         frame(ax, result)
     factor, pixel_m = pooling(fig, axes, result.grid.shape)
@@ -304,7 +313,7 @@ def vectorial_figure(result: Result, arrow_scale: float = ARROW_SCALE) -> Figure
         _panel(ax, result, factor, image, footprint, result.detectors[name], arrow_scale,
                thin_px * pixel_m)
     if _has_regions(result):
-        _regions_panel(axes[-1], result, factor, image, arrow_scale)
+        _regions_panel(axes[-1], result, factor, image, gain)
     return fig
 
 
