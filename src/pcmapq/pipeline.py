@@ -13,7 +13,7 @@ from pcmapq import memory
 from pcmapq.align import Alignment
 from pcmapq.align.parts import broken_off, place_parts
 from pcmapq.align.planar import RigidTarget
-from pcmapq.align.regions import Consistency, regions
+from pcmapq.align.regions import regions
 from pcmapq.align.rigid3d import Registration3D
 from pcmapq.bounds import bounds
 from pcmapq.config import Settings
@@ -170,8 +170,8 @@ class MapSide:
     """One map aligned and drawn on the truth's grid: ``source`` (in the truth frame after a
     3D registration), its plan points ``xy`` (N, 2) metres in its own plan frame, the
     alignment, its ``occupied`` cells, ``to_map`` (each cell's distance to them, metres), the
-    overlap, its features by detector and its consistency map (each region aligned on its own;
-    None for a map of another place)."""
+    overlap, its features by detector and ``target``: the truth's points as its alignment
+    used them."""
 
     source: OccupancyMap | PointMap
     registration: Registration3D | None
@@ -182,7 +182,7 @@ class MapSide:
     to_map: np.ndarray
     cover: Overlap
     features: dict[str, Features]
-    consistency: Consistency | None = None
+    target: RigidTarget | None = None
 
 
 def place_map(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap,
@@ -214,14 +214,8 @@ def place_map(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap,
     if cover.verdict == OTHER and not option.force:
         raise EvaluationError(refusal(source, truth.path, alignment, cover, settings, map_xy,
                                       truth_xy))
-    consistency = None
-    if cover.verdict != OTHER and target.lines is not None:
-        progress("aligning the map's regions on their own")
-        consistency = regions(map_xy, alignment.transform, target.lines,
-                              alignment.tolerance_m,
-                              starts=broken_off(parts, map_xy, alignment.transform))
     return MapSide(source, registration, map_xy, map_level, alignment, map_occ, to_map, cover,
-                   {}, consistency)
+                   {}, target)
 
 
 def with_features(side: MapSide, grid: MetricGrid, sides: SideBySide,
@@ -289,6 +283,12 @@ def assemble(loaded: OccupancyMap | PointMap, side: MapSide, prepared: PreparedT
         detectors[name] = DetectorResult(truth_f, map_f,
                                          match(name, truth_f, map_f, threshold,
                                                settings.matching.params.get(name)))
+    consistency = None
+    if side.cover.verdict != OTHER and side.target is not None and side.target.lines is not None:
+        progress("aligning the map's regions on their own")
+        consistency = regions(side.xy, alignment.transform, side.target.lines,
+                              alignment.tolerance_m,
+                              starts=broken_off(side.cover.parts, side.xy, alignment.transform))
     noref = None
     if settings.noref.enabled:
         progress("no-reference figures")
@@ -310,4 +310,4 @@ def assemble(loaded: OccupancyMap | PointMap, side: MapSide, prepared: PreparedT
                   threshold=threshold, full=full, detectors=detectors,
                   footprint_rule=rule, frames=frames, settings=settings.to_dict(),
                   truth_occupied=prepared.occupied, map_occupied=side.occupied, noref=noref,
-                  consistency=side.consistency)
+                  consistency=consistency)

@@ -4,10 +4,11 @@ pose put them). A consistent map needs no region to move; a map that drifted, be
 apart needs its regions moved by offsets that grow where it breaks.
 
 Regions are square tiles of the truth frame; each tile is aligned with the map points of a
-window twice its side around it (walls of neighbouring tiles hold a corridor in place along
-its length), and reported at the centroid of its own points. Frames: every position, offset and
-turn is in the truth frame, metres and degrees; ``offset`` takes the region's points from
-where the global pose put them to where they fit the truth."""
+window around it, the tile grown by a quarter of its side on every side (walls of
+neighbouring tiles hold a corridor in place along its length), and reported at the centroid
+of its own points. Frames: every position, offset and turn is in the truth frame, metres
+and degrees; ``offset`` takes the region's points from where the global pose put them to
+where they fit the truth."""
 
 from __future__ import annotations
 
@@ -25,6 +26,9 @@ VOXEL = 0.15
 MAX_TILES = 24
 #: A tile holding fewer points than this (at VOXEL: metres of wall / VOXEL) is no region.
 MIN_POINTS = 20
+#: A region is aligned with the map points of its tile grown by this share of a side on each
+#: side (walls of the neighbouring tiles hold a corridor along its length).
+MARGIN = 0.25
 #: ICP stages of a region: pairs within these distances, metres (wide first, then fine).
 STAGES = (1.0, 0.4)
 #: A fit from a part's pose replaces the fit from the map's pose when it puts this much more of
@@ -152,7 +156,7 @@ def regions(map_xy: np.ndarray, transform: Similarity2D, target: LineTarget,
     rows = []
     for k in np.flatnonzero(counts >= MIN_POINTS):
         own = placed[order[bounds_at[k]:bounds_at[k + 1]]]
-        lo, hi = (tiles[k] - 0.5) * tile, (tiles[k] + 1.5) * tile
+        lo, hi = (tiles[k] - MARGIN) * tile, (tiles[k] + 1 + MARGIN) * tile
         window = placed[np.all((placed >= lo) & (placed < hi), axis=1)]
         before = _fitness(own, target, tolerance)
         local, after = Similarity2D(), before  # slid out of reach from every start: not moved
