@@ -1,12 +1,17 @@
-"""bench/validation/corpus.py: the ROC and acceptance analysis on hand-made records with known
-answers, and the corpus's make-up (listed, not measured)."""
+"""bench/validation/corpus.py: the ROC, acceptance and verdict analysis on hand-made records
+with known answers, the screening's shared walls, and the corpus's make-up (listed, not
+measured)."""
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 from bench.validation import corpus
 from bench.validation.common import DATA
+from pcmapq import synth
+
+from .test_confidence import round_rooms
 
 
 def record(name: str, same: bool, confidence: float | None, kind: str = "k",
@@ -72,7 +77,7 @@ def test_markdown_names_the_worst_other_place() -> None:
 
 def test_corpus_make_up() -> None:
     """At least 150 pairs with unique names and both labels, synthetic ones alone included;
-    nothing is built or scored."""
+    every synthetic other place, and only those, is screened; nothing is built or scored."""
     pairs = corpus.pairs(DATA)
     names = [p.name for p in pairs]
     assert len(pairs) >= 150 and len(set(names)) == len(names)
@@ -85,3 +90,104 @@ def test_corpus_make_up() -> None:
         ladder = [p for p in synthetic if p.kind == kind]
         assert len({p.level for p in ladder}) >= 3 and len(ladder) >= 9
     assert corpus.bend_rate(1.0) == pytest.approx(0.0828, abs=1e-4)
+    others = [p for p in pairs if not p.same]
+    assert {p.kind for p in others if p.screen} == set(corpus.SYNTHETIC_OTHER)
+    assert all((p.screen is not None) == (p.kind in corpus.SYNTHETIC_OTHER) for p in pairs)
+    assert "other synthetic" not in corpus.KINDS
+    # no synthetic other place sets a plan against another of its size
+    for p in others:
+        if p.screen is not None:
+            a, b = p.screen
+            assert a.rooms or b.rooms or (a.width, a.height) != (b.width, b.height), p.name
+
+
+def test_other_layouts_differ_from_the_plans() -> None:
+    """Each other layout against the plan it is set against: another outline, corridor walls
+    at other heights, room walls at other places along the corridor."""
+    def walls(segments: np.ndarray) -> tuple[set, set]:
+        flat = {round(y0, 2) for x0, y0, x1, y1 in segments if abs(y0 - y1) < 1e-9}
+        upright = {round(x0, 2) for x0, y0, x1, y1 in segments if abs(x0 - x1) < 1e-9}
+        return flat, upright
+
+    for p in corpus.synthetic_pairs():
+        if p.kind != "other layout":
+            continue
+        layout, plan = p.screen
+        assert (layout.width, layout.height) != (plan.width, plan.height)
+        (flat_a, up_a), (flat_b, up_b) = walls(layout.segments()), walls(plan.segments())
+        # building_plan's corridor: 2.2 m wide, its lower wall at 0.42 of the height
+        corridor_a = {round(0.42 * layout.height, 2), round(0.42 * layout.height + 2.2, 2)}
+        corridor_b = {round(0.42 * plan.height, 2), round(0.42 * plan.height + 2.2, 2)}
+        assert corridor_a <= flat_a and corridor_b <= flat_b
+        assert not corridor_a & flat_b and not corridor_b & flat_a, p.name
+        inner_a, inner_b = up_a - {0.0, layout.width}, up_b - {0.0, plan.width}
+        assert len(inner_a & inner_b) <= 2, p.name
+
+
+def test_round_rooms_are_those_of_the_confidence_tests() -> None:
+    np.testing.assert_array_equal(corpus.round_rooms(), round_rooms())
+
+
+def test_shared_walls() -> None:
+    """A plan shares all its walls with itself; plans 0 and 1 (one size) share most of theirs
+    where they lie (more than the screening allows); the round rooms little."""
+    plan0 = corpus.wall_samples(synth.building_plan(0))
+    assert corpus.shared(plan0, plan0) == 1.0
+    plan1 = corpus.wall_samples(synth.building_plan(1))
+    assert corpus.shared(plan0, plan1) > 0.8 > corpus.MAX_SHARED
+    assert corpus.shared(corpus.wall_samples(round_rooms()), plan0) < corpus.MAX_SHARED
+    assert corpus.Screened(0.4, 0.31, 1.0).dropped and not corpus.Screened(0.4, 0.3, 1.0).dropped
+
+
+def verdict(name: str, same: bool, kind: str, level: float | str | None, confidence: float,
+            said: str, agrees: int = 0, offset: float | None = None,
+            dropped: bool = False) -> corpus.Record:
+    parts = [{"agrees": k < agrees} for k in range(8)] if said != corpus.SAME else []
+    return corpus.Record(name, kind, level, same, "points",
+                         alignment={"confidence": confidence, "verdict": said, "parts": parts},
+                         consistency={"largest_offset_m": offset}, dropped=dropped,
+                         shared_walls=0.5 if dropped else None,
+                         layouts=["plan 0", "plan 10 30 x 12 m"] if dropped else None)
+
+
+#: A bend ladder (offsets growing), a same-place map refused, a real other place refused, a
+#: synthetic other place scored as inconsistent, and one dropped by the screening.
+VERDICTS = [
+    verdict("bend a 0.2", True, "bend", 0.2, 1.0, corpus.SAME, offset=0.1),
+    verdict("bend b 0.2", True, "bend", 0.2, 0.9, corpus.SAME, offset=0.2),
+    verdict("bend a 1", True, "bend", 1.0, 0.3, corpus.INCONSISTENT, 3, offset=0.8),
+    verdict("bend b 1", True, "bend", 1.0, 0.1, corpus.OTHER, 1),
+    verdict("carmen x vs y", False, "other carmen", None, 0.0, corpus.OTHER, 0),
+    verdict("layout p vs q", False, "other layout", "30 x 12 m", 0.2, corpus.INCONSISTENT, 2,
+            offset=0.5),
+    verdict("layout r vs s", False, "other layout", "30 x 12 m", 0.9, corpus.SAME,
+            dropped=True),
+]
+
+
+def test_verdict_groups() -> None:
+    groups = {(g.kind, g.level): g for g in corpus.verdict_groups(corpus.kept(VERDICTS))}
+    low, high = groups["bend", 0.2], groups["bend", 1.0]
+    assert (low.pairs, low.scored, low.inconsistent, low.accepted) == (2, 2, 0, 2)
+    assert low.offset == pytest.approx(0.15)
+    assert (high.pairs, high.scored, high.inconsistent, high.accepted) == (2, 1, 1, 0)
+    assert high.offset == 0.8 and high.share == 0.5
+    layout = groups["other layout", "30 x 12 m"]
+    assert (layout.pairs, layout.scored, layout.inconsistent) == (1, 1, 1)
+    assert corpus.rising([0.15, 0.8]) and not corpus.rising([0.15, None])
+    assert not corpus.rising([0.8, 0.15])
+
+
+def test_markdown_names_the_pairs_that_go_wrong() -> None:
+    text = corpus.markdown(VERDICTS)
+    assert text.startswith("## Same place, inconsistent map, or another place: a labelled "
+                           "corpus")
+    assert "6 pairs of a map and a truth" in text  # the dropped one left out
+    assert "1 of the 1 synthetic other-place pairs were dropped" in text
+    assert "Real other places scored: 0 of 1." in text
+    assert ("Same place refused (\"another place\"): 1 of 4:\n- bend b 1: \"another place\", "
+            "confidence 0.10, 1 of 8 parts agreeing") in text
+    assert ("Another place scored: 1 of 2:\n- layout p vs q: \"same place, inconsistent map\", "
+            "confidence 0.20, 2 of 8 parts agreeing, largest offset 0.50 m") in text
+    assert "bend: 0.15, 0.80 m at 0.2, 1 m of the far corner (grows with the level)" in text
+    assert "| bend | 1 | same | 2 | **1 (50 %)** | 1 | 0 | 0.20 | 0.80 |" in text

@@ -29,14 +29,26 @@ Same place:
 
 Another place: the 44 other-place pairs of :mod:`.same_place` (30 CARMEN buildings against each
 other, 12 Halmstad maps against the other layouts, Intel's and Freiburg's maps against each
-other's plan); synthetic plan i against plan j (i in 0-4, j = i + 1 and i + 2 modulo 5, points
-and images); each degradation's strongest level of plan i against plan (i + 1) mod 3.
+other's plan); synthetic layouts that differ from the 24 x 16 m plans (:data:`OTHER_SIZES`:
+``building_plan(seed, width, height)`` of other outlines, so other corridor heights, with seeds
+10-34, so other rooms) as maps against plans 0-4 (points and images); the three round rooms of
+``tests/test_confidence.py`` against plans 0-4; each degradation's strongest level of plans
+0-2 (the ladders' maps) against two of those other layouts.
+
+Plans of one size share much of their walls (85 % of plan 0's wall points lie within 0.1 m of
+plan 1's), so every synthetic other-place pair is screened (:func:`screen`): its two layouts,
+clean, are aligned by the same global search (the map's layout as points), and the pair is
+dropped, not scored, when at that best pose more than :data:`MAX_SHARED` of either layout's
+wall points lie within :data:`SHARED_M` of the other's walls.
 
 Every map and truth is built lazily (a callable given a scratch folder) and deterministically
 (seeded). ``run`` scores the pairs; ``roc``, ``acceptance`` and ``markdown`` analyse them.
 
     python -m bench.validation.corpus --out bench/results/corpus.jsonl [--data DIR]
-        [--only TEXT] [--fields confidence,truth_recall] [--records FILE]
+        [--only TEXT] [--fields confidence,truth_recall] [--records FILE] [--list]
+
+``python -m bench.validation --only corpus`` runs it as a section of docs/validation.md (its
+records in the system's temporary folder, ``pcmapq-corpus.jsonl``).
 """
 
 from __future__ import annotations
@@ -51,13 +63,15 @@ import tempfile
 import time
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import asdict, dataclass, field
-from functools import lru_cache
+from functools import lru_cache, partial
 from pathlib import Path
 
 import cv2
 import numpy as np
+from scipy.spatial import cKDTree
 
 from pcmapq import synth
+from pcmapq.align.parts import PIECES
 from pcmapq.config import Settings
 from pcmapq.io import PointMap
 from pcmapq.io.carmen import DEFAULT_MAX_RANGE, endpoints, read_flaser
@@ -65,10 +79,12 @@ from pcmapq.io.writers import write_ros_map
 from pcmapq.pipeline import evaluate
 from pcmapq.raster.draw import points_to_grid, polygon_cells
 from pcmapq.report.text import number
+from pcmapq.result import INCONSISTENT, OTHER, SAME
+from pcmapq.same_place import MIN_AGREEING
 from pcmapq.transform import Similarity2D
 
 from . import drift, same_place
-from .common import DATA, ROOT, Section, header, row
+from .common import DATA, ROOT, Case, Section, header, row
 from .common import Record as Figures
 
 #: Settings of every synthetic and CARMEN pair: both metric, forced, no detectors.
@@ -99,6 +115,20 @@ DRIFT_SCANS = 200
 DRIFT_SEED = 0
 #: The shipped sample's pose (tools/make_sample.py's SCAN_POSE): x, y metres, yaw degrees.
 SAMPLE_POSE = (6.0, 8.0, 37.0)
+#: Other places: building plans of these sizes (width, height, metres), seeds 10 + 5 * (index
+#: of the size) + k against plan k (k in CLEAN_SEEDS); the round rooms' map frame.
+OTHER_SIZES = ((30.0, 12.0), (18.0, 20.0), (36.0, 10.0), (20.0, 20.0), (32.0, 18.0))
+OTHER_SEED = 10
+ROOMS_FRAME = 7
+#: Screening of the synthetic other places: a pair is dropped when more than MAX_SHARED of
+#: either layout's wall points (centre lines, SHARED_STEP apart) lie within SHARED_M of the
+#: other layout's walls at the best pose of the global search.
+SHARED_M = 0.1
+MAX_SHARED = 0.3
+SHARED_STEP = 0.05
+#: Where ``python -m bench.validation --only corpus`` writes its records (to analyse them
+#: again with ``--records``).
+RECORDS = Path(tempfile.gettempdir()) / "pcmapq-corpus.jsonl"
 
 
 def bend_rate(displacement: float) -> float:
@@ -122,18 +152,59 @@ KINDS: dict[str, str] = {
     "bend": "far corner moved, m",
     "clutter": "boxes of 0.5 m",
     "broken half": "right half turned, degrees",
-    "drift": "drift (gain error), %",
-    "drift full log": "drift (gain error), %",
+    "drift": "gain error, %",
+    "drift full log": "gain error, %",
     "other carmen": "",
     "other halmstad": "",
     "other floor plans": "",
-    "other synthetic": "",
+    "other layout": "size of the map's layout",
+    "other rooms": "",
     "other degraded": "degradation",
 }
-#: Other places made of synthetic plans (plan i against plan j).
-SYNTHETIC_OTHER = ("other synthetic", "other degraded")
-#: The degradation ladders (a table each).
+#: Other places made of synthetic layouts (screened for shared walls, see :func:`screen`).
+SYNTHETIC_OTHER = ("other layout", "other rooms", "other degraded")
+#: The degradation ladders.
 LADDERS = ("noise", "missing walls", "bend", "clutter", "broken half", "drift")
+
+
+def round_rooms() -> np.ndarray:
+    """Three round rooms (radii 5, 4 and 3 m), nothing like a building plan: wall segments,
+    metres (``tests/test_confidence.py``'s round_rooms)."""
+    ring = np.linspace(0, 2 * np.pi, 60, endpoint=False)
+    rooms = []
+    for cx, cy, r in ((6, 6, 5), (16, 8, 4), (11, 15, 3)):
+        p = np.column_stack([cx + r * np.cos(ring), cy + r * np.sin(ring)])
+        rooms.append(np.hstack([p, np.roll(p, -1, axis=0)]))
+    return np.vstack(rooms)
+
+
+@dataclass(frozen=True)
+class Layout:
+    """A synthetic place: ``synth.building_plan(seed, width, height)``, or the round rooms."""
+
+    seed: int
+    width: float = WIDTH
+    height: float = HEIGHT
+    rooms: bool = False
+
+    @property
+    def name(self) -> str:
+        """'plan 3' (24 x 16 m), 'plan 12 30 x 12 m', or 'round rooms'."""
+        if self.rooms:
+            return "round rooms"
+        size = "" if (self.width, self.height) == (WIDTH, HEIGHT) else (
+            f" {self.width:g} x {self.height:g} m")
+        return f"plan {self.seed}{size}"
+
+    def segments(self) -> np.ndarray:
+        """Its walls (N, 4), metres, in its own frame."""
+        return round_rooms() if self.rooms else synth.building_plan(self.seed, self.width,
+                                                                    self.height)
+
+    def frame(self) -> Similarity2D:
+        """Its maps' known frame (see :func:`frame`)."""
+        return frame(ROOMS_FRAME if self.rooms else self.seed)
+
 
 @dataclass(frozen=True)
 class Pair:
@@ -143,7 +214,9 @@ class Pair:
     a scratch folder, the map (a path or a PointMap) and the truth's path, built on demand and
     deterministic; known: p_truth = known(p_map) where known (for a degraded map: the frame of
     the map before it was degraded); note: what else the level means (or how to say it, read
-    when the pair is measured)."""
+    when the pair is measured); displacement: how far the degradation moves the map's walls,
+    metres (or how to measure it); screen: the map's and the truth's layouts of a synthetic
+    other place, screened for shared walls before it is scored."""
 
     name: str
     kind: str
@@ -155,6 +228,8 @@ class Pair:
     settings: Settings = RIGID
     known: Similarity2D | None = None
     note: str | Callable[[], str] = ""
+    displacement: float | Callable[[], float] | None = None
+    screen: tuple[Layout, Layout] | None = None
 
 
 @dataclass
@@ -163,7 +238,10 @@ class Record:
     (fitness, truth recall, agreement, distinctiveness, confidence, a verdict where there is
     one), the coverage, the "consistency" block where there is one, the pose error against
     the known transform at the truth's centre (metres, degrees; None where unknown), seconds
-    to build the map and truth and to evaluate, and the error if the run failed."""
+    to build the map and truth (and screen them) and to evaluate, the error if the run failed,
+    what the level means, how far the degradation moves the walls (metres); for a screened
+    pair, its layouts' names, their best fitness and shared walls (:func:`screen`), and
+    whether it was dropped (then nothing was scored)."""
 
     name: str
     kind: str
@@ -179,6 +257,11 @@ class Record:
     seconds: float = 0.0
     error: str | None = None
     note: str = ""
+    displacement_m: float | None = None
+    layouts: list[str] | None = None
+    best_fitness: float | None = None
+    shared_walls: float | None = None
+    dropped: bool = False
 
     def summary(self) -> dict:
         """The figures a stored reference would keep."""
@@ -238,15 +321,20 @@ def cloud(segments: np.ndarray, name: str, noise: float = 0.0, seed: int = 0) ->
     return PointMap(Path(name), np.column_stack([xy, np.zeros(len(xy))]), False)
 
 
-def truth_plan(seed: int) -> Callable[[Path], Path]:
-    """Plan ``seed`` rendered in its own frame (the truth of every synthetic pair), written once
-    per scratch folder."""
+def truth_layout(layout: Layout) -> Callable[[Path], Path]:
+    """A layout rendered in its own frame (the truth of every synthetic pair), written once per
+    scratch folder."""
     def build(folder: Path) -> Path:
-        path = folder / f"truth-plan-{seed}.png"
+        path = folder / f"truth-{slug(layout.name)}.png"
         if not path.exists():
-            draw(synth.building_plan(seed), path)
+            draw(layout.segments(), path)
         return path
     return build
+
+
+def truth_plan(seed: int) -> Callable[[Path], Path]:
+    """Plan ``seed`` (24 x 16 m) rendered in its own frame."""
+    return truth_layout(Layout(seed))
 
 
 def broken(segments: np.ndarray, degrees: float) -> np.ndarray:
@@ -278,18 +366,37 @@ def degrade(kind: str, level: float, segments: np.ndarray, seed: int) -> tuple[n
     raise ValueError(f"unknown degradation {kind!r}")
 
 
-def synthetic_map(form: str, seed: int, kind: str | None = None, level: float = 0.0,
+def synthetic_map(form: str, seed: int | Layout, kind: str | None = None, level: float = 0.0,
                   name: str = "") -> Callable[[Path], Path | PointMap]:
-    """Plan ``seed`` (degraded by ``kind`` at ``level`` when given) in its map frame
-    :func:`frame`, as points or as an image."""
+    """Plan ``seed`` (or a layout; degraded by ``kind`` at ``level`` when given) in its map
+    frame :func:`frame`, as points or as an image."""
+    layout = seed if isinstance(seed, Layout) else Layout(seed)
+
     def build(folder: Path) -> Path | PointMap:
-        plan = synth.building_plan(seed)
-        segments, noise = (plan, 0.0) if kind is None else degrade(kind, level, plan, seed)
-        in_map = synth.transform_segments(segments, frame(seed).inverse())
+        plan = layout.segments()
+        segments, noise = (plan, 0.0) if kind is None else degrade(kind, level, plan,
+                                                                   layout.seed)
+        in_map = synth.transform_segments(segments, layout.frame().inverse())
         if form == "points":
-            return cloud(in_map, name, noise, seed)
-        return draw(in_map, folder / f"{slug(name)}.png", noise, seed)
+            return cloud(in_map, name, noise, layout.seed)
+        return draw(in_map, folder / f"{slug(name)}.png", noise, layout.seed)
     return build
+
+
+def moved(kind: str, level: float) -> float:
+    """How far degradation ``kind`` at ``level`` moves the walls of plan 0, metres: the wall
+    noise's sigma (each point's offset along each axis); the largest move of a wall point for
+    the bend and the broken half (the plan's far corner); 0 where walls are dropped or boxes
+    added."""
+    if kind == "noise":
+        return float(level)
+    if kind not in ("bend", "broken half"):
+        return 0.0
+    plan = synth.building_plan(0)
+    before = synth.densify(plan, 0.1).reshape(-1, 2)
+    after = (synth.bend(before, BENDS[float(level)]) if kind == "bend" else
+             broken(plan, float(level)).reshape(-1, 2))
+    return float(np.max(np.linalg.norm(after - before, axis=1)))
 
 
 def bend_note(displacement: float) -> str:
@@ -301,6 +408,51 @@ def bend_note(displacement: float) -> str:
     bottom = 2 * WIDTH * math.sin(math.radians(k * WIDTH) / 2)
     return (f"{k:.4f} deg/m: far corner moves {moved:.2f} m, far end of the bottom wall "
             f"{bottom:.2f} m")
+
+
+# ---- screening synthetic other places --------------------------------------------------------
+
+def wall_samples(segments: np.ndarray, step: float = SHARED_STEP) -> np.ndarray:
+    """Points along the walls' centre lines, ``step`` metres apart (N, 2)."""
+    fine = synth.densify(segments, step)
+    return np.vstack([fine[:, :2], fine[:, 2:]])
+
+
+def shared(a: np.ndarray, b: np.ndarray, within: float = SHARED_M) -> float:
+    """The larger of the share of points ``a`` (N, 2) within ``within`` metres of points ``b``
+    and of ``b`` within that of ``a``: how much of their walls two layouts share."""
+    ab = float(np.mean(cKDTree(b).query(a)[0] <= within))
+    ba = float(np.mean(cKDTree(a).query(b)[0] <= within))
+    return max(ab, ba)
+
+
+@dataclass(frozen=True)
+class Screened:
+    """Two layouts aligned at their best pose: that pose's fitness (the map's layout as
+    points against the truth's drawn), the walls they share there (:func:`shared`), seconds."""
+
+    fitness: float
+    shared: float
+    seconds: float
+
+    @property
+    def dropped(self) -> bool:
+        return self.shared > MAX_SHARED
+
+
+@lru_cache(maxsize=256)
+def screen(map_layout: Layout, truth_layout_: Layout, folder: Path) -> Screened:
+    """The map's layout, clean, as points in its map frame, aligned to the truth's layout drawn
+    (the global search of every corpus pair, :data:`RIGID`), and the walls the two share at the
+    pose found (once per layout pair and scratch folder)."""
+    start = time.perf_counter()
+    segments = synth.transform_segments(map_layout.segments(), map_layout.frame().inverse())
+    result = evaluate(cloud(segments, map_layout.name), truth_layout(truth_layout_)(folder),
+                      RIGID)
+    placed = result.transform.apply(wall_samples(segments))
+    return Screened(float(result.alignment.fitness),
+                    shared(placed, wall_samples(truth_layout_.segments())),
+                    time.perf_counter() - start)
 
 
 # ---- CARMEN ----------------------------------------------------------------------------------
@@ -333,14 +485,27 @@ def drift_truth(log: Path) -> Callable[[Path], Path]:
     return build
 
 
-def drift_note(log: Path, level: float) -> str:
-    """The drifted trajectory's largest position and heading errors (unaligned)."""
-    poses = _log(log)[0]
-    moved = drift.drifted(poses, level, DRIFT_SEED)
-    metres = float(np.max(np.linalg.norm(moved[:, :2] - poses[:, :2], axis=1)))
-    degrees = float(np.degrees(np.max(np.abs(drift.wrap(moved[:, 2] - poses[:, 2])))))
+def trajectory_error(poses: np.ndarray, level: float) -> tuple[float, float]:
+    """The drifted trajectory's largest position (m) and heading (degrees) errors, unaligned."""
+    shifted = drift.drifted(poses, level, DRIFT_SEED)
+    metres = float(np.max(np.linalg.norm(shifted[:, :2] - poses[:, :2], axis=1)))
+    degrees = float(np.degrees(np.max(np.abs(drift.wrap(shifted[:, 2] - poses[:, 2])))))
+    return metres, degrees
+
+
+def drift_note(log: Path, level: float, scans: int | None = DRIFT_SCANS) -> str:
+    """The drifted trajectory's largest position and heading errors (unaligned), over the
+    first ``scans`` scans (None: the whole log)."""
+    poses = _log(log)[0] if scans == DRIFT_SCANS else read_flaser(log)[0][:scans]
+    metres, degrees = trajectory_error(poses, level)
     return (f"{log.name.split('-corrected')[0]}: trajectory off by up to {metres:.1f} m and "
             f"{degrees:.1f} deg")
+
+
+def drift_offset(log: Path, level: float, scans: int | None = DRIFT_SCANS) -> float:
+    """The drifted trajectory's largest position error, metres."""
+    poses = _log(log)[0] if scans == DRIFT_SCANS else read_flaser(log)[0][:scans]
+    return trajectory_error(poses, level)[0]
 
 
 # ---- the corpus ------------------------------------------------------------------------------
@@ -370,22 +535,43 @@ def real_pairs(data: Path) -> Iterator[Pair]:
     """The pairs of :mod:`.same_place` (its table, not its Halmstad matrix): the sample with
     its known pose, the other same-place pairs as 'real' or 'drift full log', the rest as
     other places."""
-    drifts = {f"{log} drifted {100 * level:g} % vs corrected": level
+    drifts = {f"{log} drifted {100 * level:g} % vs corrected": (log, level)
               for log, level in same_place.DRIFTS}
     x, y, yaw = SAMPLE_POSE
     for p in same_place.pairs(data):
         if p.name == "sample scan vs its plan":
             kind, level, form = "sample", None, "points"
         elif p.name in drifts:
-            kind, level, form = "drift full log", 100 * drifts[p.name], "log"
+            kind, level, form = "drift full log", 100 * drifts[p.name][1], "log"
         elif p.same:
             kind, level, form = "real", None, "real"
         else:
             kind, level, form = _other_kind(p.name), None, "real"
         known = (Similarity2D(x, y, math.radians(yaw)) if kind == "sample" else
                  Similarity2D() if kind == "drift full log" else None)
+        note: str | Callable[[], str] = ""
+        displacement: Callable[[], float] | None = None
+        if kind == "drift full log":
+            log, rate = same_place.carmen(data, drifts[p.name][0]), drifts[p.name][1]
+            note = partial(drift_note, log, rate, None)
+            displacement = partial(drift_offset, log, rate, None)
         yield Pair(f"{kind}: {p.name}", kind, level, p.same, form, _source(p.map_source),
-                   _fixed(p.truth), p.settings, known)
+                   _fixed(p.truth), p.settings, known, note, displacement)
+
+
+def other_layouts() -> list[Layout]:
+    """The other layouts: per size of :data:`OTHER_SIZES`, one plan per seed of CLEAN_SEEDS
+    (layout k of a size is paired with plan k)."""
+    return [Layout(OTHER_SEED + 5 * z + k, w, h) for z, (w, h) in enumerate(OTHER_SIZES)
+            for k in range(len(CLEAN_SEEDS))]
+
+
+def degraded_truths(seed: int) -> list[Layout]:
+    """The two other layouts that plan ``seed``'s most degraded maps are set against: sizes
+    2 * seed and 2 * seed + 1 (modulo their count), each the one paired with plan ``seed``."""
+    n = len(CLEAN_SEEDS)
+    layouts = other_layouts()
+    return [layouts[n * (z % len(OTHER_SIZES)) + seed] for z in (2 * seed, 2 * seed + 1)]
 
 
 def synthetic_pairs() -> Iterator[Pair]:
@@ -405,21 +591,32 @@ def synthetic_pairs() -> Iterator[Pair]:
                     name = f"{kind} {form} {level:g}: plan {s}"
                     yield Pair(name, kind, level, True, form,
                                synthetic_map(form, s, kind, level, name), truth_plan(s),
-                               known=frame(s), note=note)
-    n = len(CLEAN_SEEDS)
+                               known=frame(s), note=note,
+                               displacement=lambda kind=kind, level=level: moved(kind, level))
     for form in ("points", "image"):
-        for i in CLEAN_SEEDS:
-            for j in ((i + 1) % n, (i + 2) % n):
-                name = f"other synthetic {form}: plan {i} vs plan {j}"
-                yield Pair(name, "other synthetic", None, False, form,
-                           synthetic_map(form, i, name=name), truth_plan(j))
+        for layout in other_layouts():
+            plan = Layout(CLEAN_SEEDS[(layout.seed - OTHER_SEED) % len(CLEAN_SEEDS)])
+            name = f"other layout {form}: {layout.name} vs {plan.name}"
+            yield Pair(name, "other layout", f"{layout.width:g} x {layout.height:g} m", False,
+                       form, synthetic_map(form, layout, name=name), truth_layout(plan),
+                       screen=(layout, plan))
+    rooms = Layout(0, rooms=True)
+    for form in ("points", "image"):
+        for s in CLEAN_SEEDS:
+            plan = Layout(s)
+            name = f"other rooms {form}: round rooms vs {plan.name}"
+            yield Pair(name, "other rooms", None, False, form,
+                       synthetic_map(form, rooms, name=name), truth_layout(plan),
+                       screen=(rooms, plan))
     for kind, levels in ladders.items():
         for form in ("points", "image"):
-            for i in LADDER_SEEDS:
-                j = (i + 1) % len(LADDER_SEEDS)
-                name = f"other degraded {form}: plan {i} {kind} {levels[-1]:g} vs plan {j}"
-                yield Pair(name, "other degraded", f"{kind} {levels[-1]:g}", False, form,
-                           synthetic_map(form, i, kind, levels[-1], name), truth_plan(j))
+            for s in LADDER_SEEDS:
+                for other in degraded_truths(s):
+                    name = (f"other degraded {form}: plan {s} {kind} {levels[-1]:g} vs "
+                            f"{other.name}")
+                    yield Pair(name, "other degraded", f"{kind} {levels[-1]:g}", False, form,
+                               synthetic_map(form, s, kind, levels[-1], name),
+                               truth_layout(other), screen=(Layout(s), other))
 
 
 def drift_pairs(data: Path) -> Iterator[Pair]:
@@ -430,7 +627,8 @@ def drift_pairs(data: Path) -> Iterator[Pair]:
             name = f"drift {log} {100 * level:g} %"
             yield Pair(name, "drift", 100 * level, True, "log", drift_map(path, level, name),
                        drift_truth(path), known=Similarity2D(),
-                       note=lambda path=path, level=level: drift_note(path, level))
+                       note=lambda path=path, level=level: drift_note(path, level),
+                       displacement=lambda path=path, level=level: drift_offset(path, level))
 
 
 def pairs(data: Path = DATA) -> list[Pair]:
@@ -461,6 +659,16 @@ def measure(pair: Pair, folder: Path) -> Record:
     start = time.perf_counter()
     try:
         record.note = pair.note if isinstance(pair.note, str) else pair.note()
+        record.displacement_m = (pair.displacement() if callable(pair.displacement) else
+                                 pair.displacement)
+        if pair.screen is not None:
+            record.layouts = [layout.name for layout in pair.screen]
+            screened = screen(*pair.screen, folder)
+            record.best_fitness, record.shared_walls = screened.fitness, screened.shared
+            if screened.dropped:
+                record.dropped = True
+                record.build_seconds = time.perf_counter() - start
+                return record
         source, truth = pair.build_map(folder), pair.build_truth(folder)
         record.build_seconds = time.perf_counter() - start
         start = time.perf_counter()
@@ -523,8 +731,8 @@ def load(path: Path) -> list[Record]:
 
 def value(record: Record, name: str) -> float | None:
     """A numeric figure of a record by name: a key of its alignment block, one of its fields
-    (coverage, pose_error_m, ...), or a dotted path ('consistency.worst_m'). None when absent
-    or not a number (a failed run has none)."""
+    (coverage, pose_error_m, ...), or a dotted path ('consistency.largest_offset_m'). None when
+    absent or not a number (a failed run has none)."""
     if "." in name:
         head, *rest = name.split(".")
         got = getattr(record, head, None)
@@ -633,29 +841,101 @@ def pose_wrong(records: list[Record], metres: float = 1.0, degrees: float = 5.0)
             and (r.pose_error_m > metres or (r.yaw_error_deg or 0.0) > degrees)]
 
 
+def kept(records: list[Record]) -> list[Record]:
+    """The records scored: without the synthetic other places dropped by the screening."""
+    return [r for r in records if not r.dropped]
+
+
+def scored(record: Record) -> bool:
+    """Scored by the verdict: "same place" or "same place, inconsistent map" (a failed run or
+    a result without a verdict is not)."""
+    return record.alignment.get("verdict") in (SAME, INCONSISTENT)
+
+
+def agreeing(record: Record) -> str:
+    """'k of n parts agreeing', or '' when no part was placed (the confidence settled it)."""
+    parts = record.alignment.get("parts") or []
+    return f"{sum(bool(p.get('agrees')) for p in parts)} of {len(parts)} parts agreeing" if (
+        parts) else ""
+
+
+@dataclass(frozen=True)
+class Verdicts:
+    """The pairs of one kind and level: how many, the forms, how many the verdict scores and
+    how many of those as "same place, inconsistent map", how many the confidence alone
+    accepts, the median confidence, the median largest offset of the consistency map (over
+    the maps that have one) and the median displacement of the degradation (None when
+    absent)."""
+
+    kind: str
+    level: float | str | None
+    same: bool
+    pairs: int
+    forms: tuple[str, ...]
+    scored: int
+    inconsistent: int
+    accepted: int
+    confidence: float | None
+    offset: float | None
+    displacement: float | None
+
+    @property
+    def share(self) -> float:
+        return self.scored / self.pairs if self.pairs else 0.0
+
+
+def _median(values: Iterable[float | None]) -> float | None:
+    got = [v for v in values if v is not None]
+    return statistics.median(got) if got else None
+
+
+def _kind_key(kind: str) -> tuple[int, str]:
+    kinds = list(KINDS)
+    return (kinds.index(kind) if kind in kinds else len(kinds), kind)
+
+
+def verdict_groups(records: list[Record]) -> list[Verdicts]:
+    """Per kind and level (forms together; KINDS' order, then level): the verdicts."""
+    groups: dict[tuple, list[Record]] = {}
+    for r in records:
+        groups.setdefault((r.kind, r.level), []).append(r)
+    out = []
+    for (kind, level), group in sorted(groups.items(),
+                                       key=lambda kv: (_kind_key(kv[0][0]), _order(kv[0][1]))):
+        out.append(Verdicts(
+            kind, level, group[0].same, len(group),
+            tuple(dict.fromkeys(r.form for r in group)), sum(scored(r) for r in group),
+            sum(r.alignment.get("verdict") == INCONSISTENT for r in group),
+            sum(accepted(r, CURRENT) for r in group),
+            _median(value(r, "confidence") for r in group),
+            _median(value(r, "consistency.largest_offset_m") for r in group),
+            _median(r.displacement_m for r in group)))
+    return out
+
+
+def offsets(records: list[Record], kind: str) -> list[tuple[float | str | None, float | None]]:
+    """Per level of a ladder: the median largest offset of its maps' consistency maps, m."""
+    return [(g.level, g.offset) for g in verdict_groups(records) if g.kind == kind]
+
+
+def rising(values: list[float | None]) -> bool:
+    """Whether the values grow from each level to the next (none missing)."""
+    got = [v for v in values if v is not None]
+    return len(got) == len(values) and all(b > a for a, b in zip(got, got[1:], strict=False))
+
+
 # ---- markdown --------------------------------------------------------------------------------
 
 def _level(level: float | str | None) -> str:
     return "-" if level is None else f"{level:g}" if isinstance(level, int | float) else level
 
 
-def _range(group: Group) -> str:
-    if group.low is None or group.high is None:
+def _spread(values: list[float], digits: int = 2) -> str:
+    """'lo-hi' of some values ('-' when none)."""
+    if not values:
         return "-"
-    lo, hi = number(group.low, 2), number(group.high, 2)
+    lo, hi = number(min(values), digits), number(max(values), digits)
     return lo if lo == hi else f"{lo}-{hi}"
-
-
-def ladder_table(groups: list[Group], kind: str, name: str = "confidence") -> str:
-    """One ladder: per form and level, pairs, share accepted, median and range of the figure."""
-    lines = [header([KINDS[kind] or "level", "form", "pairs", f"accepted at {CURRENT}",
-                     f"median {name}", "range"])]
-    for g in sorted((g for g in groups if g.kind == kind),
-                    key=lambda g: (_order(g.level), g.form)):
-        lines.append(row([_level(g.level), g.form, str(g.pairs),
-                          f"{g.accepted} ({100 * g.share:.0f} %)", number(g.median, 2),
-                          _range(g)]))
-    return "\n".join(lines)
 
 
 def roc_table(records: list[Record], names: tuple[str, ...] = ("confidence",),
@@ -678,18 +958,58 @@ def roc_table(records: list[Record], names: tuple[str, ...] = ("confidence",),
     return "\n".join(lines)
 
 
-def verdict_table(records: list[Record]) -> str:
-    """How many pairs of each kind got each verdict (where the result has one)."""
-    names = list(dict.fromkeys(str(r.alignment.get("verdict")) for r in records))
-    counts: dict[tuple[str, bool], dict[str, int]] = {}
+def holdings_table(records: list[Record]) -> str:
+    """What the corpus holds: per kind and level, the pairs, their forms and how far the
+    degradation moves the walls."""
+    lines = [header(["kind", "place", "level", "pairs", "forms", "walls moved, m"])]
+    for g in verdict_groups(records):
+        unit = KINDS.get(g.kind, "")
+        lines.append(row([g.kind + (f" ({unit})" if unit else ""),
+                          "same" if g.same else "other", _level(g.level), str(g.pairs),
+                          ", ".join(g.forms), number(g.displacement, 2)]))
+    return "\n".join(lines)
+
+
+def verdicts_table(records: list[Record]) -> str:
+    """Per kind and level: pairs, scored by the verdict, of them "same place, inconsistent
+    map", accepted by the confidence alone, median confidence and median largest offset."""
+    lines = [header(["kind", "level", "place", "pairs", "scored (verdict)",
+                     "of them inconsistent", f"confidence >= {CURRENT}", "median confidence",
+                     "median largest offset, m"])]
+    for g in verdict_groups(records):
+        wrong = g.scored < g.pairs if g.same else g.scored > 0
+        cell = f"{g.scored} ({100 * g.share:.0f} %)"
+        lines.append(row([g.kind, _level(g.level), "same" if g.same else "other", str(g.pairs),
+                          f"**{cell}**" if wrong else cell, str(g.inconsistent),
+                          str(g.accepted), number(g.confidence, 2), number(g.offset, 2)]))
+    return "\n".join(lines)
+
+
+def _size(name: str) -> str:
+    """The group of an other layout by its name: its size ('30 x 12 m'), or 'round rooms'."""
+    found = re.search(r"\d+ x \d+ m", name)
+    return found.group(0) if found else name
+
+
+def screening_table(records: list[Record]) -> str:
+    """The screened synthetic other places per size of the other layout: layout pairs, best
+    fitness and shared walls (ranges), pairs dropped."""
+    groups: dict[str, list[Record]] = {}
     for r in records:
-        tally = counts.setdefault((r.kind, r.same), dict.fromkeys(names, 0))
-        tally[str(r.alignment.get("verdict"))] += 1
-    kinds = list(KINDS)
-    lines = [header(["kind", "place", *names])]
-    for (kind, same), tally in sorted(counts.items(), key=lambda kv: (
-            not kv[0][1], kinds.index(kv[0][0]) if kv[0][0] in kinds else len(kinds))):
-        lines.append(row([kind, "same" if same else "other", *(str(tally[n]) for n in names)]))
+        if r.layouts:
+            other = next((n for n in r.layouts if n == "round rooms" or " x " in n),
+                         r.layouts[0])
+            groups.setdefault(_size(other), []).append(r)
+    lines = [header(["other layout", "layout pairs", "best fitness", "shared walls",
+                     "pairs dropped"])]
+    for size, group in groups.items():
+        layouts = {tuple(r.layouts or ()): r for r in group}
+        lines.append(row([size, str(len(layouts)),
+                          _spread([r.best_fitness for r in layouts.values()
+                                   if r.best_fitness is not None]),
+                          _spread([r.shared_walls for r in layouts.values()
+                                   if r.shared_walls is not None]),
+                          f"{sum(r.dropped for r in group)} of {len(group)}"]))
     return "\n".join(lines)
 
 
@@ -701,63 +1021,174 @@ def describe(r: Record) -> str:
             f"{number(a.get('truth_recall'), 2)}, fitness {number(a.get('fitness'), 2)})")
 
 
-def markdown(records: list[Record], names: tuple[str, ...] = ("confidence",)) -> str:
-    """The corpus's section: what it holds, a table per ladder, the other places, the ROC, the
-    worst other-place pair, wrong poses and failures."""
+def largest_turn(r: Record) -> float | None:
+    """How far the region of the largest offset turns, degrees (None without one)."""
+    offset = value(r, "consistency.largest_offset_m")
+    turns = [g.get("turn_deg") for g in (r.consistency or {}).get("regions", [])
+             if offset is not None and g.get("held") and g.get("offset_m") == offset]
+    return abs(float(turns[0])) if turns and isinstance(turns[0], int | float) else None
+
+
+#: A largest offset whose region turns by more than this (degrees) fits walls elsewhere.
+ELSEWHERE_DEG = 45.0
+
+
+def wrong_line(r: Record) -> str:
+    """'- name: verdict, confidence c, k of n parts agreeing, largest offset m (the turn of its
+    region), shared walls'."""
+    a = r.alignment
+    cells = [f"\"{a.get('verdict', r.error or 'no verdict')}\"",
+             f"confidence {number(a.get('confidence'), 2)}"]
+    cells += [part] if (part := agreeing(r)) else []
+    offset = value(r, "consistency.largest_offset_m")
+    if offset is not None:
+        turn = largest_turn(r)
+        cells += [f"largest offset {number(offset, 2)} m" + (
+            "" if turn is None else f" (its region turned {turn:.0f} degrees)")]
+    cells += [] if r.shared_walls is None else [
+        f"its layouts share {100 * r.shared_walls:.0f} % of their walls at their best pose"]
+    return f"- {r.name}: " + ", ".join(cells)
+
+
+KIND_TEXT = {
+    "clean": "synthetic plans (`synth.building_plan` seeds 0-4, 24 x 16 m: outer walls, a "
+             "corridor 2.2 m wide with rooms of random widths on both sides, an L-shaped wall, "
+             "two pillars) in a map frame turned and shifted by a known transform, as a point "
+             f"cloud (both faces of {THICKNESS} m walls, points {SPACING} m apart) and as an "
+             f"image ({RESOLUTION} m per pixel), against the plan drawn as an image",
+    "sample": "the shipped sample (`data/sample/scan.ply` against `truth.png`)",
+    "real": "the real same-place maps of the section above (Intel and Freiburg 079 maps against "
+            "their plans, four Halmstad maps against their layouts, Gazebo)",
+    "noise": "plans 0-2 with every wall point moved by Gaussian noise of sigma (images: ragged "
+             "walls drawn from such points, and a share sigma / (1 m) / 10 of the free cells "
+             "marked occupied)",
+    "missing walls": "plans 0-2 with that share of the inner walls dropped",
+    "bend": "plans 0-2 bent about their lower-left corner (`synth.bend_segments`) so that the "
+            "far corner moves by the level",
+    "clutter": "plans 0-2 with that many boxes of 0.5 m added in the free space",
+    "broken half": "plans 0-2 with the walls right of x = 12 m turned by the level about the "
+                   "plan's middle (12, 8) m",
+    "drift": f"the first {DRIFT_SCANS} scans of the CARMEN logs "
+             f"{', '.join(DRIFT_LOGS)} placed along their poses re-integrated with a relative "
+             "gain error of the level on every rotation and translation increment (seed 0), "
+             "against the same scans at their corrected poses",
+    "drift full log": "whole CARMEN logs re-integrated the same way, against the corrected log",
+    "other carmen": "every CARMEN building's log against every other's",
+    "other halmstad": "the Halmstad maps against the three other buildings' layouts",
+    "other floor plans": "the Intel and Freiburg 079 maps against each other's plan",
+    "other layout": "`synth.building_plan(seed, width, height)` of another outline (so the "
+                    "corridor lies at another height) and another seed (so other rooms), as "
+                    "points and images, against plans 0-4",
+    "other rooms": "three round rooms (radii 5, 4 and 3 m) against plans 0-4",
+    "other degraded": "the strongest level of each degradation of plans 0-2 (the maps of the "
+                      "ladders) against two other layouts each",
+}
+
+
+def markdown(records: list[Record], names: tuple[str, ...] = ("confidence",),
+             seconds: float | None = None) -> str:
+    """The corpus's section: what it holds, the verdicts per kind and level, the real other
+    places, the largest offsets, the ROC, the screening, the pairs that go wrong, wrong poses
+    and failures. ``seconds``: the run's time (else the records' own)."""
+    dropped = [r for r in records if r.dropped]
+    screened = [r for r in records if r.layouts]
+    everything = records
+    records = kept(records)
     same = [r for r in records if r.same]
     other = [r for r in records if not r.same]
-    groups = acceptance(records)
-    kinds: dict[str, int] = {}
-    for r in records:
-        kinds[r.kind] = kinds.get(r.kind, 0) + 1
-    seconds = sum(r.seconds + r.build_seconds for r in records)
+    if seconds is None:
+        seconds = sum(r.seconds + r.build_seconds for r in everything)
+    parts = PIECES[0] * PIECES[1]
+    kinds = list(dict.fromkeys(r.kind for r in sorted(records, key=lambda r: _kind_key(r.kind))))
     lines = [
-        "## Same place or another place: a labelled corpus", "",
-        f"{len(records)} pairs ({len(same)} of the truth's place, {len(other)} of another), "
-        "scored with `force` and no detectors (`python -m bench.validation.corpus`; "
-        "`bench/validation/corpus.py` says how each is made): "
-        + ", ".join(f"{k} {n}" for k, n in kinds.items())
-        + f". Today a map is refused below confidence {CURRENT}. {seconds:.0f} s in all.", "",
-        "### Clean maps of the truth's place",
+        "## Same place, inconsistent map, or another place: a labelled corpus", "",
+        f"{len(records)} pairs of a map and a truth, each labelled with whether the map shows "
+        f"the truth's place ({len(same)} do, {len(other)} show another place), scored with "
+        "`force` and no detectors (`python -m bench.validation --only corpus`, or "
+        "`python -m bench.validation.corpus`, which also analyses saved records again; "
+        "`bench/validation/corpus.py` builds every pair, seeded). The verdict is the result's "
+        f"`alignment.verdict`: \"{SAME}\" at confidence {CURRENT} or more; below it "
+        f"\"{INCONSISTENT}\" when at least {MIN_AGREEING} of the map's {parts} parts, each "
+        "placed on its own by the global search, land near the map's pose; else "
+        f"\"{OTHER}\", refused unless forced. A pair is *scored* when its verdict is not "
+        f"\"{OTHER}\". The whole corpus ran in {seconds:.0f} s.", "",
+        "### What the corpus holds", "",
+        holdings_table(records), "",
+        "\"walls moved\" is how far the degradation moves the map's walls (median of the "
+        "level's pairs): the noise's sigma along each axis; the largest move of a wall point "
+        "for a bend or a broken half (the plan's far corner); 0 where walls are dropped or "
+        "boxes added; for drift, the largest position error of the drifted trajectory.", "",
+        *(f"- {kind}: {KIND_TEXT[kind]}." for kind in kinds if kind in KIND_TEXT),
     ]
-    for kind in ("clean", "sample", "real"):
-        if any(g.kind == kind for g in groups):
-            lines += ["", f"{kind}:", "", ladder_table(groups, kind)]
-    for kind in (*LADDERS, "drift full log"):
-        if any(g.kind == kind for g in groups):
-            notes = list(dict.fromkeys(f"{_level(r.level)} %: {r.note}" if "drift" in kind
-                                       else f"{_level(r.level)}: {r.note}" for r in records
-                                       if r.kind == kind and r.note))
-            lines += ["", f"### {kind}", "", ladder_table(groups, kind)]
-            lines += ["", "; ".join(notes) + "."] if notes else []
-    lines += ["", "### Another place", ""]
-    rows = [header(["kind", "form", "level", "pairs", f"accepted at {CURRENT}",
-                    "median confidence", "range"])]
-    for g in groups:
-        if not g.same:
-            rows.append(row([g.kind, g.form, _level(g.level), str(g.pairs),
-                             f"{g.accepted} ({100 * g.share:.0f} %)", number(g.median, 2),
-                             _range(g)]))
-    lines += ["\n".join(rows), "", "### ROC: share accepted at each threshold", "",
-              roc_table(records, names)]
-    real = [r for r in records if r.kind not in SYNTHETIC_OTHER]
-    if len(real) < len(records) and any(not r.same for r in real):
-        lines += ["", "The same without the synthetic other places (plan i against plan j: "
-                      "the plans share their outer walls, corridor, L-shaped wall and pillars, "
-                      "most of their walls):", "", roc_table(real, names)]
-    if any("verdict" in r.alignment for r in records):
-        lines += ["", "### Verdicts (`alignment.verdict`) by kind", "", verdict_table(records)]
-    if other:
-        top = max(other, key=lambda r: value(r, "confidence") or 0.0)
-        lines += ["", f"Worst other-place pair: {describe(top)}."]
+    if screened:
+        lines += [
+            "", f"Plans of one size share much of their walls, so a synthetic other place "
+            "is screened before it is scored: its two layouts, clean, are aligned by the same "
+            "global search (the map's layout as points) and the pair is dropped when, at that "
+            f"best pose, more than {100 * MAX_SHARED:.0f} % of either layout's wall points "
+            f"(centre lines, {SHARED_STEP} m apart) lie within {SHARED_M} m of the other's "
+            f"walls. {len(dropped)} of the {len(screened)} synthetic other-place pairs were "
+            f"dropped; {len(screened) - len(dropped)} remain:", "",
+            screening_table(everything)]
+    lines += ["", "### Verdicts per kind and level", "",
+              "Counts in bold are wrong: a same-place map refused, another place scored. "
+              "\"median largest offset\": `consistency.largest_offset_m`, the largest offset "
+              "that fits a held 4 m region of the map to the truth on its own, median over the "
+              "level's scored maps.", "", verdicts_table(records), ""]
+    real_other = [r for r in other if r.kind not in SYNTHETIC_OTHER]
+    real_scored = [r for r in real_other if scored(r)]
+    synth_other = [r for r in other if r.kind in SYNTHETIC_OTHER]
+    lines += [f"Real other places scored: {len(real_scored)} of {len(real_other)}"
+              + (":" if real_scored else "."), *(wrong_line(r) for r in real_scored)]
+    if synth_other:
+        lines += ["", f"Synthetic other places scored: "
+                      f"{sum(scored(r) for r in synth_other)} of {len(synth_other)}."]
+    growth = []
+    for kind, unit in (("bend", "m of the far corner"), ("broken half", "degrees"),
+                       ("drift", "% of drift")):
+        levels = offsets(records, kind)
+        if levels:
+            values = [v for _, v in levels]
+            growth.append(
+                f"{kind}: {', '.join(number(v, 2) for v in values)} m at "
+                f"{', '.join(_level(lv) for lv, _ in levels)} {unit} "
+                f"({'grows' if rising(values) else 'does not grow'} with the level)")
+    if growth:
+        lines += ["", "Median largest offset per level, " + "; ".join(growth) + "."]
+    elsewhere = [r for r in same if scored(r) and (largest_turn(r) or 0.0) > ELSEWHERE_DEG]
+    if elsewhere:
+        lines += ["", f"Same-place maps whose largest offset comes from a region turned by more "
+                      f"than {ELSEWHERE_DEG:.0f} degrees (a region that fits walls elsewhere, "
+                      "not one moved back into place): " + "; ".join(
+                          f"{r.name}, {number(value(r, 'consistency.largest_offset_m'), 2)} m "
+                          f"turned {largest_turn(r):.0f} degrees"
+                          + ("" if r.displacement_m is None else
+                             f" (walls moved up to {number(r.displacement_m, 2)} m)")
+                          for r in elsewhere) + "."]
+    lines += ["", "### ROC of the confidence: share accepted at each threshold", "",
+              roc_table(records, names), ""]
+    lines += [f"The verdict as the accept rule scores {100 * _share(same):.0f} % of the "
+              f"same-place pairs ({sum(scored(r) for r in same)} of {len(same)}, "
+              f"{sum(r.alignment.get('verdict') == INCONSISTENT for r in same)} of them as "
+              f"\"{INCONSISTENT}\") and {100 * _share(other):.0f} % of the other-place pairs "
+              f"({sum(scored(r) for r in other)} of {len(other)}); the confidence alone at "
+              f"{CURRENT} accepts {sum(accepted(r, CURRENT) for r in same)} and "
+              f"{sum(accepted(r, CURRENT) for r in other)}."]
     s = safe(records)
     if s is not None:
         lines += ["", f"The lowest confidence threshold that accepts no other-place pair, "
                       f"{s.threshold:.2f}, accepts {100 * s.same:.0f} % of the same-place pairs "
-                      f"({sum(accepted(r, s.threshold) for r in same)} of {len(same)}); "
-                      f"{CURRENT} accepts {sum(accepted(r, CURRENT) for r in same)} of them and "
-                      f"{sum(accepted(r, CURRENT) for r in other)} of the {len(other)} "
-                      "other-place pairs."]
+                      f"({sum(accepted(r, s.threshold) for r in same)} of {len(same)})."]
+    if other:
+        top = max(other, key=lambda r: value(r, "confidence") or 0.0)
+        lines += ["", f"Worst other-place pair: {describe(top)}."]
+    refused = [r for r in same if not scored(r)]
+    let_in = [r for r in other if scored(r)]
+    lines += ["", "### Pairs that go wrong", "",
+              f"Same place refused (\"{OTHER}\"): {len(refused)} of {len(same)}"
+              + (":" if refused else "."), *(wrong_line(r) for r in refused), "",
+              f"Another place scored: {len(let_in)} of {len(other)}"
+              + (":" if let_in else "."), *(wrong_line(r) for r in let_in)]
     wrong = pose_wrong(records)
     known = [r for r in same if r.pose_error_m is not None]
     lines += ["", f"Poses off by more than 1 m or 5 degrees at the truth's centre: {len(wrong)} "
@@ -766,18 +1197,29 @@ def markdown(records: list[Record], names: tuple[str, ...] = ("confidence",)) ->
                   + (":" if wrong else ".")]
     lines += [f"- {r.name}: {number(r.pose_error_m, 2)} m, {number(r.yaw_error_deg, 1)} deg, "
               f"confidence {number(value(r, 'confidence'), 2)}" for r in wrong]
-    failed = [r for r in records if r.error]
+    failed = [r for r in everything if r.error]
     if failed:
         lines += ["", "Failed runs:", *(f"- {r.name}: {r.error}" for r in failed)]
     return "\n".join(lines)
 
 
+def _share(records: list[Record]) -> float:
+    """The share of the records the verdict scores."""
+    return sum(scored(r) for r in records) / len(records) if records else 0.0
+
+
+def cases(data: Path) -> list[Case]:
+    """None: the corpus keeps no stored references (its records are in :data:`RECORDS`)."""
+    return []
+
+
 def section(data: Path, record: Figures) -> Section:
-    """The corpus measured and its section (for docs/validation.md, not wired in)."""
-    records = run(pairs(data))
-    for r in records:
-        record[f"corpus-{r.name}"] = r.summary()
-    return Section(markdown(records))
+    """The corpus measured (records written to :data:`RECORDS` as they come) and its section
+    of docs/validation.md."""
+    start = time.perf_counter()
+    records = run(pairs(data), RECORDS)
+    print(f"corpus: records in {RECORDS}", file=sys.stderr, flush=True)
+    return Section(markdown(records, seconds=time.perf_counter() - start))
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -807,9 +1249,11 @@ def main(argv: list[str] | None = None) -> int:
             print(f"{args.data}: absent: synthetic pairs only", file=sys.stderr)
 
         def say(r: Record) -> None:
-            print(f"{r.name}: confidence {number(value(r, 'confidence'), 2)}, "
-                  f"{r.build_seconds + r.seconds:.1f} s" + (f" ({r.error})" if r.error else ""),
-                  file=sys.stderr, flush=True)
+            what = (f"dropped (shares {number(r.shared_walls, 2)} of its walls)" if r.dropped
+                    else f"confidence {number(value(r, 'confidence'), 2)}, "
+                         f"{r.alignment.get('verdict')}")
+            print(f"{r.name}: {what}, {r.build_seconds + r.seconds:.1f} s"
+                  + (f" ({r.error})" if r.error else ""), file=sys.stderr, flush=True)
 
         start = time.perf_counter()
         records = run(chosen, args.out, say)

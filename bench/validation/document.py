@@ -12,6 +12,7 @@ from pcmapq.io.writers import write_atomic
 
 from . import (
     carmen,
+    corpus,
     drawings,
     floorplans,
     fr79,
@@ -31,7 +32,7 @@ COMMAND = "python -m bench.validation --write"
 SECTIONS: dict[str, ModuleType] = {
     "drawings": drawings, "fr79": fr79, "lidar": lidar, "kitti": kitti, "gazebo": gazebo,
     "halmstad": halmstad, "floorplans": floorplans, "carmen": carmen, "noref": noref,
-    "same_place": same_place, "track": track,
+    "same_place": same_place, "corpus": corpus, "track": track,
 }
 
 
