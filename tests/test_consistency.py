@@ -35,11 +35,11 @@ def _part(agrees: bool) -> Part:
 
 
 def test_verdict_of_known_confidence_and_parts():
-    """The confidence settles it when it reaches the minimum; below it, two agreeing parts
-    make a map of the truth's place that no pose fits whole, one does not."""
+    """The confidence settles it when it reaches the minimum; below it, three agreeing parts
+    make a map of the truth's place that no pose fits whole, two do not."""
     assert verdict(0.5, 0.5, ()) == SAME
-    assert verdict(0.49, 0.5, [_part(True), _part(True)] + [_part(False)] * 6) == INCONSISTENT
-    assert verdict(0.49, 0.5, [_part(True)] + [_part(False)] * 7) == OTHER
+    assert verdict(0.49, 0.5, [_part(True)] * 3 + [_part(False)] * 5) == INCONSISTENT
+    assert verdict(0.49, 0.5, [_part(True)] * 2 + [_part(False)] * 6) == OTHER
     assert verdict(0.0, 0.5, ()) == OTHER
 
 
@@ -82,7 +82,7 @@ def test_a_map_broken_in_two_is_scored_and_says_where(seed, tmp_path):
     result = evaluate(_cloud(_broken(plan, 20.0)), truth, FAST)
     cover = result.overlap
     assert cover.confidence < 0.5 and cover.verdict == INCONSISTENT
-    assert sum(p.agrees for p in cover.parts) >= 2
+    assert sum(p.agrees for p in cover.parts) >= 3
     agreeing = np.array([p.centre_m for p in cover.parts if p.agrees])
     assert (agreeing[:, 0] < 12).all()  # the parts that agree are western
     c = result.consistency
