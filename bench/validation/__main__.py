@@ -14,7 +14,7 @@ from pathlib import Path
 
 from . import reference
 from .common import DATA, Record
-from .document import DOC, SECTIONS, write
+from .document import DOC, SECTIONS, write, write_one
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -27,12 +27,11 @@ def main(argv: list[str] | None = None) -> int:
                         help="compare every case run with its stored reference; exit 1 if any "
                         "differs")
     parser.add_argument("--write", action="store_true",
-                        help=f"write {DOC.relative_to(DOC.parents[1])} whole (not with --only)")
+                        help=f"write {DOC.relative_to(DOC.parents[1])} whole; with --only, that "
+                        "section in place")
     parser.add_argument("--save-references", action="store_true",
                         help="store the figures of every case run as its reference")
     args = parser.parse_args(argv)
-    if args.write and args.only:
-        parser.error("--write writes the whole document: not with --only")
     if not args.data.is_dir():
         print(f"{args.data}: absent (real data lives in ../shared/data)", file=sys.stderr)
         return 2
@@ -44,7 +43,9 @@ def main(argv: list[str] | None = None) -> int:
         print(f"{name}: {time.perf_counter() - start:.0f} s", file=sys.stderr, flush=True)
         if not (args.write or args.check):  # each section as soon as it is measured
             print(("\n" if len(sections) > 1 else "") + sections[-1].text, flush=True)
-    if args.write:
+    if args.write and args.only:
+        write_one(args.only, sections[0])
+    elif args.write:
         write(sections)
     if args.save_references:
         reference.store(record)

@@ -12,6 +12,7 @@ from pcmapq.io.writers import write_atomic
 
 from . import (
     carmen,
+    consistency,
     corpus,
     drawings,
     floorplans,
@@ -32,7 +33,7 @@ COMMAND = "python -m bench.validation --write"
 SECTIONS: dict[str, ModuleType] = {
     "drawings": drawings, "fr79": fr79, "lidar": lidar, "kitti": kitti, "gazebo": gazebo,
     "halmstad": halmstad, "floorplans": floorplans, "carmen": carmen, "noref": noref,
-    "same_place": same_place, "corpus": corpus, "track": track,
+    "same_place": same_place, "corpus": corpus, "consistency": consistency, "track": track,
 }
 
 
@@ -77,3 +78,29 @@ def write(sections: list[Section], path: Path = DOC) -> None:
     for rel, data in (f for s in sections for f in s.files.items()):
         write_atomic(path.parent / rel, data)
     write_atomic(path, "\n\n".join([opening(), *(s.text for s in sections)]) + "\n")
+
+
+#: The line after the opening that names the sections measured again since the whole document.
+AGAIN = "Measured again since, each with the code of its commit: "
+
+
+def write_one(name: str, section: Section, path: Path = DOC) -> None:
+    """Put one section, measured alone, in place in the document (each section is one ``## ``
+    block, in the order of SECTIONS; a section new to it goes where that order puts it), with
+    the files it shows, and name it, the date and the commit in the line after the opening."""
+    for rel, data in section.files.items():
+        write_atomic(path.parent / rel, data)
+    head, *blocks = path.read_text().rstrip("\n").split("\n\n## ")
+    blocks = ["## " + b for b in blocks]
+    order = list(SECTIONS)
+    present = [n for n in order if n != name] if len(blocks) < len(order) else order
+    if len(present) != len(blocks):
+        raise ValueError(f"{path}: {len(blocks)} sections, expected {len(present)}")
+    placed = dict(zip(present, blocks, strict=True))
+    placed[name] = section.text
+    opening_text, _, again = head.partition("\n\n" + AGAIN)
+    notes = [n for n in again.rstrip(".").split("; ") if n and not n.startswith(f"`{name}` ")]
+    notes.append(f"`{name}` on {datetime.date.today().isoformat()} ({commit()})")
+    text = "\n\n".join([opening_text, AGAIN + "; ".join(notes) + ".",
+                         *(placed[n] for n in order if n in placed)])
+    write_atomic(path, text + "\n")
