@@ -33,16 +33,6 @@ def run(*args: str) -> subprocess.CompletedProcess:
                           text=True, timeout=600)
 
 
-def round_rooms() -> np.ndarray:
-    """Three round rooms, nothing like the synthetic building: wall segments, metres."""
-    ring = np.linspace(0, 2 * np.pi, 60, endpoint=False)
-    rooms = []
-    for cx, cy, r in ((6, 6, 5), (16, 8, 4), (11, 15, 3)):
-        p = np.column_stack([cx + r * np.cos(ring), cy + r * np.sin(ring)])
-        rooms.append(np.hstack([p, np.roll(p, -1, axis=0)]))
-    return np.vstack(rooms)
-
-
 # --- the rule ---------------------------------------------------------------------------------
 
 def test_confidence_is_the_smaller_term():
@@ -89,7 +79,7 @@ def test_building_against_itself_turned_is_confident(plan, truth_png, tmp_path, 
 def test_other_places_are_refused(truth_png, tmp_path, scale):
     """Round rooms and another seeded building (other room widths, other size) over the
     synthetic building: confidence below 0.5, rigid or with the scale free."""
-    for name, segments in (("rooms", round_rooms()),
+    for name, segments in (("rooms", synth.round_rooms()),
                            ("other", synth.building_plan(7, 18.0, 20.0))):
         path = write_image_map(segments, tmp_path / f"{name}.png")
         settings = Settings(matching=MatchingConfig(detectors=()),
@@ -111,7 +101,7 @@ def test_cli_exit_codes_and_refusal_messages(tmp_path):
     assert ok.returncode == 0, ok.stderr
     assert json.loads(ok.stdout)["alignment"]["confidence"] == 1.0
 
-    rooms = write_image_map(round_rooms(), tmp_path / "rooms.png")
+    rooms = write_image_map(synth.round_rooms(), tmp_path / "rooms.png")
     other = run("eval", str(rooms), truth)
     lines = other.stderr.strip().splitlines()
     assert other.returncode == 1 and len(lines) == 1 and "Traceback" not in other.stderr

@@ -11,8 +11,6 @@ from bench.validation import corpus
 from bench.validation.common import DATA
 from pcmapq import synth
 
-from .test_confidence import round_rooms
-
 
 def record(name: str, same: bool, confidence: float | None, kind: str = "k",
            level: float | None = 1.0, **alignment: float) -> corpus.Record:
@@ -124,10 +122,6 @@ def test_other_layouts_differ_from_the_plans() -> None:
         assert len(inner_a & inner_b) <= 2, p.name
 
 
-def test_round_rooms_are_those_of_the_confidence_tests() -> None:
-    np.testing.assert_array_equal(corpus.round_rooms(), round_rooms())
-
-
 def test_shared_walls() -> None:
     """A plan shares all its walls with itself; plans 0 and 1 (one size) share most of theirs
     where they lie (more than the screening allows); the round rooms little."""
@@ -135,7 +129,7 @@ def test_shared_walls() -> None:
     assert corpus.shared(plan0, plan0) == 1.0
     plan1 = corpus.wall_samples(synth.building_plan(1))
     assert corpus.shared(plan0, plan1) > 0.8 > corpus.MAX_SHARED
-    assert corpus.shared(corpus.wall_samples(round_rooms()), plan0) < corpus.MAX_SHARED
+    assert corpus.shared(corpus.wall_samples(synth.round_rooms()), plan0) < corpus.MAX_SHARED
     assert corpus.Screened(0.4, 0.31, 1.0).dropped and not corpus.Screened(0.4, 0.3, 1.0).dropped
 
 

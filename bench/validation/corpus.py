@@ -167,17 +167,6 @@ SYNTHETIC_OTHER = ("other layout", "other rooms", "other degraded")
 LADDERS = ("noise", "missing walls", "bend", "clutter", "broken half", "drift")
 
 
-def round_rooms() -> np.ndarray:
-    """Three round rooms (radii 5, 4 and 3 m), nothing like a building plan: wall segments,
-    metres (``tests/test_confidence.py``'s round_rooms)."""
-    ring = np.linspace(0, 2 * np.pi, 60, endpoint=False)
-    rooms = []
-    for cx, cy, r in ((6, 6, 5), (16, 8, 4), (11, 15, 3)):
-        p = np.column_stack([cx + r * np.cos(ring), cy + r * np.sin(ring)])
-        rooms.append(np.hstack([p, np.roll(p, -1, axis=0)]))
-    return np.vstack(rooms)
-
-
 @dataclass(frozen=True)
 class Layout:
     """A synthetic place: ``synth.building_plan(seed, width, height)``, or the round rooms."""
@@ -198,7 +187,7 @@ class Layout:
 
     def segments(self) -> np.ndarray:
         """Its walls (N, 4), metres, in its own frame."""
-        return round_rooms() if self.rooms else synth.building_plan(self.seed, self.width,
+        return synth.round_rooms() if self.rooms else synth.building_plan(self.seed, self.width,
                                                                     self.height)
 
     def frame(self) -> Similarity2D:

@@ -72,6 +72,17 @@ def campus(columns: int, rows: int, seed: int = 0, gap: float = 4.0) -> np.ndarr
     return (one[None, :, :] + np.tile(shifts, 2)[:, None, :]).reshape(-1, 4)
 
 
+def round_rooms() -> np.ndarray:
+    """Three round rooms (radii 5, 4 and 3 m), nothing like :func:`building_plan`: wall
+    segments (N, 4), metres, 60 to a room."""
+    ring = np.linspace(0, 2 * np.pi, 60, endpoint=False)
+    rooms = []
+    for cx, cy, r in ((6, 6, 5), (16, 8, 4), (11, 15, 3)):
+        p = np.column_stack([cx + r * np.cos(ring), cy + r * np.sin(ring)])
+        rooms.append(np.hstack([p, np.roll(p, -1, axis=0)]))
+    return np.vstack(rooms)
+
+
 def transform_segments(segments: np.ndarray, tf: Similarity2D) -> np.ndarray:
     """Apply a similarity to both endpoints of every segment."""
     return tf.apply(segments.reshape(-1, 2)).reshape(-1, 4)
