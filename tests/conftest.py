@@ -86,5 +86,7 @@ def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
             item.add_marker(pytest.mark.realdata)
         elif any(call in source for call in E2E_CALLS) or fixtures & E2E_FIXTURES:
             item.add_marker(pytest.mark.e2e)
+        elif item.get_closest_marker("e2e"):  # marked by hand: a whole search, seconds long
+            continue
         else:
             item.add_marker(pytest.mark.unit)

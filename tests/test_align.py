@@ -199,6 +199,7 @@ def campus():
     return t_true, map_xy, synth.wall_points(walls, 0.1)
 
 
+@pytest.mark.e2e
 def test_pyramid_finds_a_repeated_campus(campus):
     """Swept at 6 m cells, the building's rooms vanish and ICP from the sweep's poses settles
     a corridor off; the descent to 0.5 m finds the right copy and turn, and ICP lands within

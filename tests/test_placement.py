@@ -140,6 +140,7 @@ def test_the_search_scores_as_well_as_an_exhaustive_one(pair):
     assert found.fitness >= slow.fitness - 0.005, (found, slow)
 
 
+@pytest.mark.e2e
 def test_a_map_under_clutter_is_placed_right_way_round():
     """The plan's walls under 800 boxes of clutter: the right start's rough ICP stage, dragged
     by the clutter, ranked third (fitness 0.163) and the map was placed turned by 180 degrees
