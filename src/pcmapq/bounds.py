@@ -1,4 +1,5 @@
-"""Bounding boxes: of many points, column by column, and of the nonzero cells of an image.
+"""Bounding boxes: of many points, column by column, and of the nonzero cells of an image;
+the radius of points about their centroid.
 
 NumPy reduces an (N, d) array over axis 0 with a strided inner loop: for 158,000 points of
 three columns about 4 ms, against 0.16 ms for the columns one at a time. The box is the same.
@@ -28,3 +29,8 @@ def nonzero_window(image: np.ndarray, margin: int = 0) -> tuple[int, int, int, i
     cols = np.flatnonzero(image.any(axis=0))
     return (max(0, int(rows[0]) - margin), min(image.shape[0], int(rows[-1]) + 1 + margin),
             max(0, int(cols[0]) - margin), min(image.shape[1], int(cols[-1]) + 1 + margin))
+
+
+def radius(xy: np.ndarray) -> float:
+    """Largest distance of points (N, 2) from their centroid, in their unit."""
+    return float(np.sqrt(((xy - xy.mean(axis=0)) ** 2).sum(axis=1).max()))

@@ -19,6 +19,7 @@ from pcmapq.config import DETECTOR_NAMES, DistancesConfig, MatchingConfig, Setti
 from pcmapq.errors import InputError
 from pcmapq.io import Thresholds
 from pcmapq.io.occupancy import IMAGE_SUFFIXES, YAML_SUFFIXES, read_yaml
+from pcmapq.io.writers import same_file
 from pcmapq.raster.footprint import FOOTPRINT_RULES
 from pcmapq.transform import Similarity2D
 
@@ -224,15 +225,6 @@ def input_files(path: Path) -> list[Path]:
         except InputError:
             return [path]
     return [path]
-
-
-def same_file(a: Path, b: Path) -> bool:
-    """Whether two paths name one file: ``os.path.samefile`` when both exist (links and hard
-    links included), else the same resolved path."""
-    try:
-        return os.path.samefile(a, b)
-    except OSError:
-        return a.resolve() == b.resolve()
 
 
 def check_eval_options(*, scans: Path | None, max_scans: int | None, no_align: bool,

@@ -12,6 +12,7 @@ import numpy as np
 
 from pcmapq.align import Alignment
 from pcmapq.align.parts import Part
+from pcmapq.bounds import radius
 from pcmapq.config import Settings
 from pcmapq.io import OccupancyMap, PointMap
 from pcmapq.io.extent import far_points
@@ -28,8 +29,7 @@ AGREE_NONE, AGREE_FULL = 0.7, 0.9
 OVERSIZE = 1.5
 #: A map below the minimum confidence still shows the truth's place when at least this many of
 #: its eight parts, each placed on its own, agree with its pose (:mod:`pcmapq.align.parts`):
-#: with two, 4 of the 108 Halmstad maps against another building's layout were scored, with
-#: three 2 (docs/validation.md).
+#: two let more maps of other, same-looking office floors through (docs/validation.md).
 MIN_AGREEING = 3
 
 
@@ -74,11 +74,6 @@ def overlap(truth_occ: np.ndarray, to_map: np.ndarray, footprint: np.ndarray,
     agreement = alignment.fitness * recall
     return Overlap(footprint, coverage, recall, agreement,
                    confidence(alignment.distinctiveness, recall, agreement))
-
-
-def radius(xy: np.ndarray) -> float:
-    """Largest distance of points (N, 2) from their centroid, in their unit."""
-    return float(np.sqrt(((xy - xy.mean(axis=0)) ** 2).sum(axis=1).max()))
 
 
 def refusal(source: OccupancyMap | PointMap, truth_path: Path, alignment: Alignment,

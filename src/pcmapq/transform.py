@@ -62,3 +62,9 @@ class Similarity2D:
         """Yaw in degrees, wrapped to (-180, 180]."""
         deg = float(np.degrees(self.yaw))
         return 180.0 - (180.0 - deg) % 360.0
+
+
+def wrapped(angle: np.ndarray | float) -> np.ndarray | float:
+    """Angles (radians) wrapped to (-pi, pi]: the turn between two yaws is
+    ``wrapped(a - b)``."""
+    return np.angle(np.exp(1j * np.asarray(angle)))

@@ -25,7 +25,7 @@ from pcmapq.bounds import bounds
 from pcmapq.grid import MetricGrid
 from pcmapq.morphology import distance_to
 from pcmapq.raster.draw import hit_counts
-from pcmapq.transform import Similarity2D
+from pcmapq.transform import Similarity2D, wrapped
 from pcmapq.voxels import voxel_centroids
 
 
@@ -74,7 +74,7 @@ def distinctiveness(search: Search, tf: Similarity2D) -> float:
     if len(poses) == 0:
         return 0.0
     centre = tf.apply(search.centre.reshape(1, 2))[0]
-    dyaw = np.abs(np.angle(np.exp(1j * (poses[:, 1] - tf.yaw))))
+    dyaw = np.abs(wrapped(poses[:, 1] - tf.yaw))
     dxy = np.hypot(poses[:, 2] - centre[0], poses[:, 3] - centre[1])
     near = (dyaw < np.radians(NEAR_DEG)) & (dxy < NEAR_RADIUS * tf.scale * search.radius)
     if poses.shape[1] > 4:
@@ -124,7 +124,7 @@ def _suppress(poses: np.ndarray, top_k: int, min_angle: float, min_dist: float,
             break
         if kept:
             k = poses[kept]
-            dyaw = np.abs(np.angle(np.exp(1j * (k[:, 1] - poses[i, 1]))))
+            dyaw = np.abs(wrapped(k[:, 1] - poses[i, 1]))
             dxy = np.hypot(k[:, 2] - poses[i, 2], k[:, 3] - poses[i, 3])
             near = (dyaw < min_angle) & (dxy < min_dist)
             if poses.shape[1] > 4:

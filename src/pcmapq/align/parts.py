@@ -3,8 +3,8 @@ pose that fits it whole, so its global search stands out little; yet each of its
 on its own by the same global search and ICP, lands near where the map's pose puts it. A map
 of another place has parts that land anywhere: each fits some walls somewhere.
 
-The map is cut into four parts of equal point count, by the medians of its points along their
-principal axes (the halves of a long corridor map are its first and second half). Each part
+The map is cut into eight parts of equal point count: four along its points' first principal
+axis, each cut in two across (the quarters of a long corridor map are its stretches). Each part
 is aligned to the truth with no initial guess (:func:`pcmapq.align.align`); it agrees with the
 map's pose when its centroid lands within :data:`AGREE_M` (or :data:`AGREE_RADIUS` of the
 map's radius, the larger) of where the map's pose puts it, turned by at most
@@ -20,7 +20,8 @@ import numpy as np
 
 from pcmapq.align.params import AlignParams
 from pcmapq.align.planar import RigidTarget, align
-from pcmapq.transform import Similarity2D
+from pcmapq.bounds import radius
+from pcmapq.transform import Similarity2D, wrapped
 
 #: Agreement: a part's centroid within this many metres of where the map's pose puts it ...
 AGREE_M = 3.0
@@ -76,14 +77,14 @@ def pieces(xy: np.ndarray, along: int = 2, across: int = 2) -> np.ndarray:
 def place_parts(map_xy: np.ndarray, truth_xy: np.ndarray, pose: Similarity2D,
                 params: AlignParams = AlignParams(),
                 target: RigidTarget | None = None) -> list[Part]:
-    """The four parts of the map (N, 2, map frame) each aligned to the truth (M, 2, metres,
-    truth frame; ``target``: those points prepared for the rigid alignment) with no initial
-    guess, against the map's ``pose``."""
+    """The parts of the map (N, 2, map frame; :data:`PIECES`) each aligned to the truth (M, 2,
+    metres, truth frame; ``target``: those points prepared for the rigid alignment) with no
+    initial guess, against the map's ``pose``."""
     scaled = np.asarray(map_xy, dtype=np.float64).reshape(-1, 2) * pose.scale
     rigid = Similarity2D(pose.tx, pose.ty, pose.yaw)
     if target is None or not target.fits(params):
         target = RigidTarget(truth_xy, params)
-    reach = max(AGREE_M, AGREE_RADIUS * _radius(scaled))
+    reach = max(AGREE_M, AGREE_RADIUS * radius(scaled))
     labels = pieces(scaled, *PIECES)
     parts = []
     for k in range(PIECES[0] * PIECES[1]):
@@ -94,15 +95,11 @@ def place_parts(map_xy: np.ndarray, truth_xy: np.ndarray, pose: Similarity2D,
         centre = part.mean(axis=0, keepdims=True)
         placed = rigid.apply(centre)[0]
         offset = float(np.hypot(*(own.transform.apply(centre)[0] - placed)))
-        turn = abs(float(np.degrees(np.angle(np.exp(1j * (own.transform.yaw - rigid.yaw))))))
+        turn = abs(float(np.degrees(wrapped(own.transform.yaw - rigid.yaw))))
         parts.append(Part(len(part) / len(scaled), (float(placed[0]), float(placed[1])),
                           offset, turn, own.fitness, offset <= reach and turn <= AGREE_DEG,
                           replace(own.transform, scale=pose.scale)))
     return parts
-
-
-def _radius(xy: np.ndarray) -> float:
-    return float(np.sqrt(((xy - xy.mean(axis=0)) ** 2).sum(axis=1).max()))
 
 
 def broken_off(parts: list[Part] | tuple[Part, ...], map_xy: np.ndarray,
@@ -111,6 +108,6 @@ def broken_off(parts: list[Part] | tuple[Part, ...], map_xy: np.ndarray,
     puts it (truth frame, metres): parts that do not agree, moved by at most BROKEN_RADIUS of
     the map's radius (map_xy (N, 2) in map units, scaled by ``pose``) and turned by at most
     BROKEN_DEG."""
-    reach = BROKEN_RADIUS * pose.scale * _radius(np.asarray(map_xy, dtype=np.float64))
+    reach = BROKEN_RADIUS * pose.scale * radius(np.asarray(map_xy, dtype=np.float64))
     return tuple((p.pose, p.centre_m) for p in parts
                  if not p.agrees and p.offset_m <= reach and p.turn_deg <= BROKEN_DEG)

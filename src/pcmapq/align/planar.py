@@ -28,7 +28,7 @@ from pcmapq.align.point_to_line import LineTarget, refine_point_to_line
 from pcmapq.align.point_to_point import DEFAULT_SCHEDULE, IcpTarget, refine_point_to_point
 from pcmapq.align.pyramid import descend
 from pcmapq.align.similarity_icp import SimilarityTarget, refine_similarity, similarity_schedule
-from pcmapq.transform import Similarity2D
+from pcmapq.transform import Similarity2D, wrapped
 from pcmapq.voxels import evenly, voxel_centroids, voxel_count
 
 #: The truth keeps this many times the map's ``max_points``: a sparse target would put map points
@@ -43,9 +43,9 @@ ICP_POINTS = 5_000
 THINNED_TRUTH_VOXEL = 0.4
 
 #: A rough-stage result whose fitness is at least this share of the best one's goes through the
-#: fine stages too, beyond the ``finalists``: clutter drags the rough stage of the right start
-#: below a wrong one (a plan's map under 800 boxes: 0.163 after the rough stage, 0.202 after
-#: the fine ones, against 0.186 for the pose turned by 180 degrees).
+#: fine stages too, beyond the ``finalists``: clutter can drag the rough stage of the right
+#: start below a wrong pose's, which the fine stages then overtake
+#: (``tests/test_placement.py``, a plan under 800 boxes).
 CLOSE_FINALISTS = 0.9
 #: ... when it is another pose than every finalist's: farther than these, metres and degrees.
 SAME_POSE_M, SAME_POSE_DEG = 1.0, 5.0
@@ -266,7 +266,7 @@ def refine_best(starts: Sequence[Similarity2D], rough: Refine, fine: Refine,
 def _same_pose(a: Similarity2D, b: Similarity2D) -> bool:
     """Whether two poses are one for the choice of finalists: within SAME_POSE_M of
     translation and SAME_POSE_DEG of yaw."""
-    turn = abs(np.degrees(np.angle(np.exp(1j * (a.yaw - b.yaw)))))
+    turn = abs(np.degrees(wrapped(a.yaw - b.yaw)))
     return bool(np.hypot(a.tx - b.tx, a.ty - b.ty) < SAME_POSE_M and turn < SAME_POSE_DEG)
 
 

@@ -66,6 +66,13 @@ class Consistency:
     fit_after: np.ndarray
     held: np.ndarray
 
+    @classmethod
+    def empty(cls, tile_m: float, tolerance_m: float) -> Consistency:
+        """A consistency map with no region."""
+        none = np.zeros((0, 2))
+        return cls(tile_m, tolerance_m, none, none, np.zeros(0), np.zeros(0, int), np.zeros(0),
+                   np.zeros(0), np.zeros(0, bool))
+
     @property
     def offset_m(self) -> np.ndarray:
         """(K,) length of each region's offset, metres."""
@@ -139,10 +146,8 @@ def regions(map_xy: np.ndarray, transform: Similarity2D, target: LineTarget,
     of the region's points on truth walls: a part that broke off further than ICP reaches from
     the map's pose is fitted from its own."""
     placed = voxel_centroids(transform.apply(map_xy), VOXEL)
-    empty = np.zeros((0, 2))
     if len(placed) == 0 or len(target.points) < 3:
-        return Consistency(tile_m, tolerance, empty, empty, np.zeros(0), np.zeros(0, int),
-                           np.zeros(0), np.zeros(0), np.zeros(0, bool))
+        return Consistency.empty(tile_m, tolerance)
     span = float(np.ptp(placed, axis=0).max())
     tile = max(tile_m, span / MAX_TILES)
     keys = np.floor(placed / tile).astype(np.int64)
@@ -172,8 +177,7 @@ def regions(map_xy: np.ndarray, transform: Similarity2D, target: LineTarget,
         rows.append((*centre, *shift, np.degrees(local.yaw), len(own), before, after,
                      _held(local.apply(window), target, tolerance)))
     if not rows:
-        return Consistency(tile, tolerance, empty, empty, np.zeros(0), np.zeros(0, int),
-                           np.zeros(0), np.zeros(0), np.zeros(0, bool))
+        return Consistency.empty(tile, tolerance)
     # to the micrometre (and 1e-6 of a share or degree), as results are saved: the figures
     # made from them are then the same read back from JSON
     table = np.round(np.array(rows, dtype=np.float64), 6) + 0.0

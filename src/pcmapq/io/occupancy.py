@@ -27,7 +27,7 @@ from pcmapq.errors import InputError
 from pcmapq.grid import MetricGrid
 from pcmapq.io.image_header import check_image_size
 from pcmapq.io.stderr import stderr_captured, stderr_uncaptured
-from pcmapq.io.writers import one_line
+from pcmapq.io.writers import one_line, same_file
 
 IMAGE_SUFFIXES = (".png", ".pgm", ".jpg", ".jpeg", ".bmp")
 YAML_SUFFIXES = (".yaml", ".yml")
@@ -135,7 +135,7 @@ def _meta_beside(image: Path, resolution: float | None) -> MapMeta:
         _warn(f"{beside[0]}: ignored, not a map_server YAML ({_after_path(error)}); "
               f"{image.name} read with the resolution given, {resolution:g} m")
         return MapMeta(resolution=None)
-    if not _same_file(image, named):
+    if not same_file(image, named):
         used = "origin and thresholds" if resolution is not None else \
             "resolution, origin and thresholds"
         _warn(f"{beside[0]}: names image '{_as_written(named, beside[0])}', not {image.name}; "
@@ -149,17 +149,6 @@ def _warn(message: str) -> None:
     other thread captures stderr (the truth is read while the map is), which would swallow it."""
     with stderr_uncaptured():
         warnings.warn(message, stacklevel=3)
-
-
-def _same_file(a: Path, b: Path) -> bool:
-    """Whether two paths name one file: the same path once resolved, or (both existing) the
-    same file on disk (a hard link)."""
-    if a.resolve() == b.resolve():
-        return True
-    try:
-        return a.samefile(b)
-    except OSError:
-        return False
 
 
 def _as_written(named: Path, yaml_path: Path) -> Path:

@@ -158,3 +158,12 @@ def write_cloud(path: Path, points: np.ndarray, outputs: OutputSet | None = None
     finally:
         if not staged:
             tmp.unlink(missing_ok=True)
+
+
+def same_file(a: Path, b: Path) -> bool:
+    """Whether two paths name one file: ``os.path.samefile`` when both exist (links and hard
+    links included), else the same resolved path."""
+    try:
+        return os.path.samefile(a, b)
+    except OSError:
+        return a.resolve() == b.resolve()

@@ -62,9 +62,12 @@ def summary_row(name: str, result: dict) -> dict[str, object]:
             row[f"{det}_{score}"] = (_number(detectors[det], score, f"detectors.{det}")
                                      if det in detectors else None)
     row["coverage"] = _number(result, "coverage")
-    for key in ("fitness", "confidence", "verdict", "x_m", "y_m", "yaw_deg", "scale"):
-        # a result written before verdicts and regions has neither: left empty
-        row[key] = align.get(key) if key == "verdict" else _number(align, key, "alignment")
+    for key in ("fitness", "confidence"):
+        row[key] = _number(align, key, "alignment")
+    # a result written before verdicts and regions has neither: left empty
+    row["verdict"] = align.get("verdict")
+    for key in ("x_m", "y_m", "yaw_deg", "scale"):
+        row[key] = _number(align, key, "alignment")
     row["largest_offset_m"] = (result.get("consistency") or {}).get("largest_offset_m")
     for side in ("accuracy", "completeness"):
         stats = _get(dist, f"{side}_m")
