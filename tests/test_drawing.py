@@ -191,3 +191,25 @@ def test_a_filled_area_is_drawn_along_its_outline():
     thick[100:500, 290:290 + int(THICKEST / res)] = True  # a wall 1 m thick, 14.5 m to 15.5 m
     centres = grid.cell_centres(wall_image(thick, grid).image > 0.5)
     assert np.all(np.abs(centres[:, 0] - (14.5 + THICKEST / 2)) < 0.1)
+
+
+@pytest.mark.parametrize("seed", [0, 3])
+def test_a_plan_drawn_with_its_outside_solid_scores_like_one_drawn_with_walls(seed, tmp_path):
+    """The plan's outside drawn black to the image's border (as the IPA room-segmentation plans
+    draw it) is read as its face, a wall FACE_M thick: every detector finds what it finds on
+    the usual drawing, both ways, and nothing along the image's border."""
+    from pcmapq.io.occupancy import load_occupancy
+
+    plan = synth.building_plan(seed)
+    grid = synth.plan_grid(plan, 0.05, margin=3.0)
+    image = synth.render(plan, grid, 0.15)
+    usual = {n: detect(n, image == synth.OCCUPIED, grid) for n in NAMES}
+    solid = np.where(image == synth.UNKNOWN, synth.OCCUPIED, image).astype(np.uint8)
+    cv2.imwrite(str(tmp_path / "solid.png"), solid)
+    read = load_occupancy(tmp_path / "solid.png", 0.05)
+    occupied = read.state == 1
+    assert occupied.mean() < 0.2 and not occupied[:5].any() and not occupied[:, :5].any()
+    for name in NAMES:
+        other = detect(name, occupied, grid)  # the image read without its frame
+        for m in (match(name, usual[name], other), match(name, other, usual[name])):
+            assert m.quality >= 0.95 and m.precision >= 0.95, (name, m.quality, m.precision)

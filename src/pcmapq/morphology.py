@@ -31,12 +31,22 @@ def disc(radius: float) -> np.ndarray:
     return cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * r + 1, 2 * r + 1))
 
 
-def outline(mask: np.ndarray, width: float) -> np.ndarray:
+def outline(mask: np.ndarray, width: float, edge_is_outside: bool = True) -> np.ndarray:
     """The cells of ``mask`` (bool) within ``width`` cells of a cell outside it (a cell next to
     one outside is 1 cell from it): a filled block becomes its band of that width, a wall up to
-    twice as thick stays whole. Cells at the image's border count as next to the outside. One
-    byte a cell: the mask less its erosion by :func:`disc` of ``width``."""
+    twice as thick stays whole. Cells at the image's border count as next to the outside, or
+    (``edge_is_outside`` False) the image goes on beyond its border as it is there. One byte a
+    cell: the mask less its erosion by :func:`disc` of ``width``."""
     mask = np.asarray(mask, dtype=bool)
-    inner = cv2.erode(mask.view(np.uint8), disc(width), borderType=cv2.BORDER_CONSTANT,
-                      borderValue=0)
+    border = cv2.BORDER_CONSTANT if edge_is_outside else cv2.BORDER_REPLICATE
+    inner = cv2.erode(mask.view(np.uint8), disc(width), borderType=border, borderValue=0)
     return mask & (inner == 0)
+
+
+def reaching_border(mask: np.ndarray) -> np.ndarray:
+    """The cells of ``mask`` (bool) in 8-connected regions that reach the image's border: one
+    flood fill from a ring of true cells around the image. One byte a cell."""
+    ring = np.pad(np.asarray(mask, dtype=bool), 1, constant_values=True).astype(np.uint8)
+    cv2.floodFill(ring, None, (0, 0), 2, flags=8)
+    return ring[1:-1, 1:-1] == 2
+

@@ -4,7 +4,9 @@ A pixel's grey value ``v`` (colour: mean of the colour channels; 16-bit images s
 gives ``p = (255 - v) / 255`` (``v / 255`` when ``negate``); the cell is occupied if
 ``p > occupied_thresh``, free if ``p < free_thresh`` and unknown otherwise. A transparent pixel
 (alpha 0) is unknown. The grid's frame is the map_server one: ``origin`` is the pose of the
-image's lower-left corner (see :mod:`pcmapq.grid`).
+image's lower-left corner (see :mod:`pcmapq.grid`). One reading goes beyond map_server's: the
+outside of a building drawn solid, reaching the image's border, is read as its face
+(:func:`open_outside`), as a laser sees it.
 """
 
 from __future__ import annotations
@@ -28,10 +30,18 @@ from pcmapq.grid import MetricGrid
 from pcmapq.io.image_header import check_image_size
 from pcmapq.io.stderr import stderr_captured, stderr_uncaptured
 from pcmapq.io.writers import one_line, same_file
+from pcmapq.morphology import disc, outline, reaching_border
 
 IMAGE_SUFFIXES = (".png", ".pgm", ".jpg", ".jpeg", ".bmp")
 YAML_SUFFIXES = (".yaml", ".yml")
 MODES = ("trinary", "scale", "raw")
+#: The outside of a building drawn solid is read as a wall this thick along its face, metres
+#: (:func:`open_outside`): a plan's usual wall, whose centre line then lies where a plan drawn
+#: with walls would put it, about half this beyond the face a laser sees.
+FACE_M = 0.15
+#: Parts of such a region thinner than this, metres, are walls or furniture joined to it, and
+#: kept (the building's own thickest wall, :data:`pcmapq.features.walls.THICKEST`).
+OUTSIDE_M = 2.0
 _T = TypeVar("_T")
 #: A decimal number as text, exponent allowed: ``5e-2``, ``1.0e9``, ``-.5``. PyYAML (YAML 1.1)
 #: reads an exponent without a dot or a signed exponent as a string; map_server reads a number.
@@ -115,8 +125,32 @@ def load_occupancy(path: Path, resolution: float | None = None,
     if meta.resolution is None:
         raise InputError(f"{path}: no resolution: give --map-resolution/--truth-resolution "
                          "or a YAML beside it")
-    state = classify(levels, channels, scale, transparent, meta)
+    state = open_outside(classify(levels, channels, scale, transparent, meta), meta.resolution)
     return OccupancyMap(path, MetricGrid(meta.resolution, meta.origin, state.shape), state)
+
+
+def open_outside(state: np.ndarray, resolution: float) -> np.ndarray:
+    """``state`` (int8 cells) with the outside of a building drawn solid read as its face: in
+    occupied regions that reach the image's border, the cells of parts thicker than
+    OUTSIDE_M (an opening by a disc of half that) and deeper than FACE_M metres inside the
+    region are UNKNOWN. The image goes on beyond its border as it is there, so a wall drawn
+    along the border keeps every cell, and so do walls and furniture joined to the border (none
+    that thick) and a region with no face (an all-black image). The state itself when no
+    border cell is occupied."""
+    occupied = state == OCCUPIED
+    if not (occupied[0].any() or occupied[-1].any() or occupied[:, 0].any()
+            or occupied[:, -1].any()):
+        return state
+    outside = reaching_border(occupied).view(np.uint8)
+    thick = cv2.morphologyEx(outside, cv2.MORPH_OPEN, disc(0.5 * OUTSIDE_M / resolution),
+                             borderType=cv2.BORDER_REPLICATE)
+    face = outline(outside.view(bool), FACE_M / resolution, edge_is_outside=False)
+    if not face.any():
+        return state
+    deep = thick.view(bool) & ~face
+    if not deep.any():
+        return state
+    return np.where(deep, np.int8(UNKNOWN), state).astype(np.int8)
 
 
 def _meta_beside(image: Path, resolution: float | None) -> MapMeta:
