@@ -8,16 +8,16 @@ import numpy as np
 
 from pcmapq.track.timeline import Step
 
-#: A fall smaller than this is no drop (the band a good run's curves stay within); a value
-#: within NOISE of the peak is still level with it.
-MIN_DROP, NOISE = 0.05, 0.025
+#: A fall smaller than this is no drop (the band a good run's curves stay within): a value
+#: within it of the peak is still level with the peak.
+MIN_DROP = 0.05
 
 
 @dataclass(frozen=True)
 class Drop:
     """The worst lasting fall of a figure along the steps: it peaked at step ``peak``, started
-    to fall at step ``start`` (the step after the last one still within :data:`NOISE` of the
-    peak: where the map went wrong) and was lowest at step ``low``, ``size`` below the peak;
+    to fall at step ``start`` (the step after the last one still within :data:`MIN_DROP` of
+    the peak: where the map went wrong; a partial map's dip before it, made up later, is none) and was lowest at step ``low``, ``size`` below the peak;
     every later step stays at least ``lasting`` below the peak."""
 
     figure: str
@@ -46,7 +46,7 @@ def worst_drop(steps: list[Step], figure: str = "precision") -> Drop | None:
         return None
     peak = int(np.flatnonzero(values[:worst + 1] == peaks[worst])[-1])
     low = peak + int(np.argmin(values[peak:worst + 1]))
-    level = np.flatnonzero(values[peak:low + 1] >= peaks[worst] - NOISE)
+    level = np.flatnonzero(values[peak:low + 1] > peaks[worst] - MIN_DROP)
     start = peak + int(level[-1]) + 1
     return Drop(figure, scored[peak].step, scored[start].step, scored[low].step,
                 float(peaks[worst] - values[low]), lasting)
