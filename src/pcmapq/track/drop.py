@@ -17,8 +17,9 @@ MIN_DROP = 0.05
 class Drop:
     """The worst lasting fall of a figure along the steps: it peaked at step ``peak``, started
     to fall at step ``start`` (the step after the last one still within :data:`MIN_DROP` of
-    the peak: where the map went wrong; a partial map's dip before it, made up later, is none) and was lowest at step ``low``, ``size`` below the peak;
-    every later step stays at least ``lasting`` below the peak."""
+    the peak: where the map went wrong; a partial map's dip before it, made up later, is
+    none) and was lowest at step ``low``, ``size`` below the peak; every later step stays at
+    least ``lasting`` below the peak."""
 
     figure: str
     peak: int
