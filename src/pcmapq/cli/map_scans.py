@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import warnings
 from pathlib import Path
 from typing import Annotated
 
@@ -17,11 +16,8 @@ from pcmapq.mapping import (
     build_map_from_poses,
     build_map_kiss,
     describe_scans,
-    lidar_poses_from_camera,
-    moves_along_z,
     open_scans,
-    read_calib,
-    read_poses,
+    scanner_poses,
     scans_for_poses,
     write_kitti_poses,
     write_tum_poses,
@@ -71,14 +67,7 @@ def map_command(
                 points, trajectory = build_map_kiss(source, max_scans=max_scans, voxel=voxel,
                                                     progress=tick)
             else:
-                trajectory = read_poses(poses)
-                if calib is not None:
-                    trajectory = lidar_poses_from_camera(trajectory, read_calib(calib))
-                elif moves_along_z(trajectory):
-                    warnings.warn(f"{poses}: these poses move along their z axis, as a camera's "
-                                  "do (KITTI's are the left camera's); without --calib (KITTI's "
-                                  "Tr) the scans are placed as if they were the scanner's, and "
-                                  "the map smears", stacklevel=1)
+                trajectory = scanner_poses(poses, calib)
                 every = open_scans(source)
                 scans = scans_for_poses(every, len(trajectory), max_scans=max_scans,
                                         poses_path=poses)

@@ -37,6 +37,11 @@ def track_command(
     reference_poses: Annotated[Path | None, typer.Option(
         help="Reference poses, one per scan (KITTI or TUM file, or a CARMEN log's): adds the "
         "trajectory's APE and RPE at every step, as evo computes them.")] = None,
+    calib: Annotated[Path | None, typer.Option(
+        help="As map's: the scanner -> pose-frame transform T of the reference poses (12 or "
+        "16 numbers, or a KITTI calib.txt with Tr:; KITTI's poses are the left camera's): "
+        "they are moved into the scanner's frame, inv(T) P_k T, the frame of the run's "
+        "poses.")] = None,
     every: Annotated[int | None, typer.Option(
         help="Score the map every N scans (default 20).", min=1, show_default=False)] = None,
     every_m: Annotated[float | None, typer.Option(
@@ -83,6 +88,7 @@ def track_command(
 ) -> None:
     """Score a SLAM run's map as it grows, every N scans or D metres, against the truth:
     when did the map go wrong, and where was the robot then?"""
+    from pcmapq.io.carmen import is_carmen
     from pcmapq.report.timeline import drop_words
     from pcmapq.track import PoseOptions, step_ends, track_run, travelled, write_track
     from pcmapq.track.runs import open_run, reference_poses_of
@@ -101,11 +107,15 @@ def track_command(
             raise typer.BadParameter("give one of --every and --every-m", param_hint="--every")
         if out.exists() and not out.is_dir():
             raise InputError(f"{out}: --out: not a folder")
-        options.check_outputs({"--json": json_path}, None, inputs=paths)
+        options.check_outputs({"--json": json_path}, None,
+                              inputs=(*paths, poses, reference_poses, calib))
+        if calib is not None and (reference_poses is None or is_carmen(reference_poses)):
+            raise InputError(f"{calib}: --calib moves the poses of a --reference-poses KITTI "
+                             "or TUM file into the scanner's frame; none is given")
         with scan_bar(err, enabled=shown) as tick:
             run = open_run(run_path, poses, progress=tick)
         reference = (None if reference_poses is None
-                     else reference_poses_of(reference_poses, len(run)))
+                     else reference_poses_of(reference_poses, len(run), calib))
         ends = step_ends(len(run), (every or 20) if every_m is None else None, every_m,
                          travelled(run.poses))
         if step is not None and step >= len(ends):

@@ -19,6 +19,7 @@ from pcmapq.mapping.poses import (
     read_pose_matrix,
     read_poses,
     read_tum_poses,
+    scanner_poses,
     write_kitti_poses,
     write_tum_poses,
 )
@@ -47,6 +48,7 @@ __all__ = [
     "read_pose_matrix",
     "read_poses",
     "read_tum_poses",
+    "scanner_poses",
     "scans_for_poses",
     "voxel_centroids",
     "write_kitti_poses",

@@ -25,6 +25,7 @@ scans are in the LiDAR frame, linked by the calibration ``Tr`` (LiDAR -> camera,
 from __future__ import annotations
 
 import re
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -34,6 +35,7 @@ from pcmapq.errors import InputError
 from pcmapq.io.writers import OutputSet, one_line, write_atomic
 
 __all__ = [
+    "scanner_poses",
     "lidar_poses_from_camera",
     "moves_along_z",
     "read_calib",
@@ -187,6 +189,24 @@ def moves_along_z(poses: np.ndarray, min_travel: float = 0.5) -> bool:
     far = steps[int(np.argmax(np.linalg.norm(steps, axis=1)))]
     travel = float(np.linalg.norm(far))
     return travel > min_travel and abs(far[2]) > travel / np.sqrt(2.0)
+
+
+def scanner_poses(path: str | Path, calib: str | Path | None = None) -> np.ndarray:
+    """The scanner's poses (K, 4, 4) from a KITTI or TUM file: as written, or, with ``calib``
+    (a file :func:`read_calib` reads: T, the scanner -> pose-frame transform), moved into the
+    scanner's frame, ``inv(T) @ P_k @ T`` (:func:`lidar_poses_from_camera`). Without
+    ``calib``, poses that move along their z axis as a camera's do (:func:`moves_along_z`)
+    get one warning naming the file: taken as the scanner's, a map built on them smears and
+    pose errors are the camera's."""
+    poses = read_poses(path)
+    if calib is not None:
+        return lidar_poses_from_camera(poses, read_calib(calib))
+    if moves_along_z(poses):
+        warnings.warn(f"{path}: these poses move along their z axis, as a camera's do (KITTI's "
+                      "are the left camera's); without --calib (KITTI's Tr) they are taken as "
+                      "the scanner's: a map built on them smears and pose errors are the "
+                      "camera's", stacklevel=2)
+    return poses
 
 
 # ---------------------------------------------------------------------------------------------

@@ -30,7 +30,7 @@ from pcmapq.errors import InputError
 from pcmapq.features.walls import CLOSING
 from pcmapq.io import PointMap
 from pcmapq.io.carmen import DEFAULT_MAX_RANGE, LaserScans, endpoints, is_carmen, read_laser_scans
-from pcmapq.mapping import ScanSequence, VoxelMap, build_map_kiss, open_scans, read_poses
+from pcmapq.mapping import ScanSequence, VoxelMap, build_map_kiss, open_scans, scanner_poses
 from pcmapq.mapping.reference import scans_for_poses
 from pcmapq.raster.footprint import joined_readings, view_outlines
 from pcmapq.raster.seen import NO_VIEW, add_views
@@ -156,9 +156,10 @@ Run = LaserRun | ScanRun
 def open_run(source: Path, poses: Path | None = None, *,
              progress: Callable[[int, int], None] | None = None) -> Run:
     """The run at ``source`` (a CARMEN log, or scans) with the poses of ``poses`` (a KITTI or
-    TUM file, one pose per scan), else the log's own, else KISS-ICP's (``progress(done,
-    total)`` while it runs). InputError, one line, when the counts differ."""
-    estimate = None if poses is None else read_poses(poses)
+    TUM file, one pose per scan, the scanner's: a warning when they move as a camera's, see
+    :func:`~pcmapq.mapping.scanner_poses`), else the log's own, else KISS-ICP's
+    (``progress(done, total)`` while it runs). InputError, one line, when the counts differ."""
+    estimate = None if poses is None else scanner_poses(poses)
     if is_carmen(source):
         scans = read_laser_scans(source)
         if estimate is None:
@@ -176,10 +177,12 @@ def open_run(source: Path, poses: Path | None = None, *,
                    poses_source="KISS-ICP's poses" if poses is None else str(poses))
 
 
-def reference_poses_of(path: Path, count: int) -> np.ndarray:
-    """Reference poses (count, 4, 4) from a KITTI or TUM file, or a CARMEN log's FLASER poses;
-    InputError, one line, when there are not ``count`` of them (one per scan)."""
-    poses = planar_poses(read_laser_scans(path).poses) if is_carmen(path) else read_poses(path)
+def reference_poses_of(path: Path, count: int, calib: Path | None = None) -> np.ndarray:
+    """Reference poses (count, 4, 4) from a KITTI or TUM file (with ``calib``, moved into the
+    scanner's frame: see :func:`~pcmapq.mapping.scanner_poses`), or a CARMEN log's FLASER
+    poses; InputError, one line, when there are not ``count`` of them (one per scan)."""
+    poses = (planar_poses(read_laser_scans(path).poses) if is_carmen(path)
+             else scanner_poses(path, calib))
     if len(poses) != count:
         raise InputError(f"{path}: {len(poses)} reference poses for {count} scans (one per "
                          "scan)")
