@@ -3,6 +3,8 @@ known answers: maps made from a plan with a known transform, exported, read back
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import open3d as o3d
 import pytest
@@ -129,8 +131,10 @@ def test_after_a_3d_registration_the_chain_is_the_registration():
 
 def test_2d_cloud_exports(tmp_path):
     """A 2D cloud of the plan with one wall moved 0.3 m, in a map frame KNOWN away: the aligned
-    cloud lies on the plan, the 3x3 matrix is KNOWN and gives the aligned points, and each
-    point's distance is its distance to the nearest truth point (0.3 m on the moved wall)."""
+    cloud lies on the plan, the 3x3 matrix is KNOWN and gives the aligned points; the distance
+    cloud holds the cells the accuracy counts (within a cell of the aligned points), each with
+    its distance to the truth (0.3 m on the moved wall), and their statistics are the JSON's
+    accuracy."""
     truth = synth.wall_points(PLAN, spacing=0.05)
     moved = synth.move_wall(PLAN, 7, (0.3, 0.0))
     in_plan = synth.wall_points(moved, spacing=0.05)
@@ -139,7 +143,7 @@ def test_2d_cloud_exports(tmp_path):
     out = {name: tmp_path / name for name in ("a.ply", "T.txt", "d.ply")}
     proc = run("eval", str(tmp_path / "map.npy"), str(tmp_path / "truth.npy"),
                "--aligned", str(out["a.ply"]), "--transform", str(out["T.txt"]),
-               "--distances", str(out["d.ply"]))
+               "--distances", str(out["d.ply"]), "--json", str(tmp_path / "r.json"))
     assert proc.returncode == 0, proc.stderr
     assert all(f"wrote {p}" in proc.stderr for p in out.values())
     matrix = np.loadtxt(out["T.txt"])
@@ -153,9 +157,21 @@ def test_2d_cloud_exports(tmp_path):
     assert np.abs(aligned[:, :2] - in_plan).max() < 0.02
     back = read_cloud(out["d.ply"])
     xy, got = back["positions"][:, :2].astype(np.float64), back[DISTANCE_FIELD].ravel()
-    np.testing.assert_allclose(xy, aligned[:, :2])
-    np.testing.assert_allclose(got, cdist(xy, truth).min(axis=1), atol=1e-5)
-    assert 0.29 < got.max() < 0.32 and np.median(got) < 0.01
+    assert np.abs(back["positions"][:, 2]).max() == 0.0
+    assert cdist(xy, aligned[:, :2]).min(axis=1).max() < 0.05
+    np.testing.assert_allclose(got, cdist(xy, truth).min(axis=1), atol=0.05)
+    assert 0.27 < got.max() < 0.33 and np.median(got) < 0.03
+    assert_reproduces(got, json.loads((tmp_path / "r.json").read_text())["distances"])
+
+
+def assert_reproduces(distances: np.ndarray, block: dict) -> None:
+    """The statistics of a --distances file's distances are the JSON's accuracy, to 1e-6."""
+    from pcmapq.stats import Stats
+
+    want, got = block["accuracy_m"], Stats.of(distances).to_dict()
+    assert got["count"] == want["count"]
+    for key in ("mean", "median", "rmse", "std", "min", "max", "p95"):
+        assert abs(got[key] - want[key]) <= 1e-6, (key, got[key], want[key])
 
 
 def test_3d_cloud_exports(truth_png, tmp_path):
@@ -169,7 +185,7 @@ def test_3d_cloud_exports(truth_png, tmp_path):
     np.save(tmp_path / "map.npy", cloud @ pose[:3, :3].T + pose[:3, 3])
     a, t, d = tmp_path / "a.pcd", tmp_path / "T.txt", tmp_path / "d.ply"
     proc = run("eval", str(tmp_path / "map.npy"), str(truth_png), "--aligned", str(a),
-               "--transform", str(t), "--distances", str(d))
+               "--transform", str(t), "--distances", str(d), "--json", str(tmp_path / "r.json"))
     assert proc.returncode == 0, proc.stderr
     matrix = np.loadtxt(t)
     assert matrix.shape == (4, 4)
@@ -177,12 +193,36 @@ def test_3d_cloud_exports(truth_png, tmp_path):
     source = np.load(tmp_path / "map.npy")
     np.testing.assert_allclose(aligned, source @ matrix[:3, :3].T + matrix[:3, 3], atol=1e-4)
     np.testing.assert_allclose(aligned, cloud, atol=0.03)
-    # the distance cloud: the wall band's points (0.3 m to 2.0 m above the floor)
+    # the distance cloud: the plan cells of the wall band the accuracy counts, on the floor
     band = read_cloud(d)
-    heights = band["positions"][:, 2]
-    assert 0.29 < heights.min() and heights.max() < 2.01
-    assert len(heights) == np.count_nonzero((aligned[:, 2] >= 0.3) & (aligned[:, 2] <= 2.0))
+    assert np.abs(band["positions"][:, 2]).max() == 0.0
     assert np.percentile(band[DISTANCE_FIELD], 95) < 0.06
+    assert_reproduces(band[DISTANCE_FIELD].ravel(),
+                      json.loads((tmp_path / "r.json").read_text())["distances"])
+
+
+def test_3d_pair_distances_reproduce_the_3d_accuracy(tmp_path):
+    """Two 3D clouds of the plan, the map with one wall moved 0.3 m and turned and shifted: the
+    distance cloud holds the map's voxel centroids the 3D accuracy counts, and their statistics
+    are the JSON's ``distances_3d.accuracy_m``; the JSON says what each block is computed on."""
+    truth = synth.lidar_cloud(PLAN, spacing=0.1, noise=0.005, outliers=0)
+    cloud = synth.lidar_cloud(synth.move_wall(PLAN, 7, (0.3, 0.0)), spacing=0.1, noise=0.005,
+                              outliers=0)
+    pose = np.eye(4)
+    pose[:3, :3], pose[:3, 3] = rotation_about([0, 0, 1], 30.0), [2.0, -1.0, 0.0]
+    np.save(tmp_path / "truth.npy", truth)
+    np.save(tmp_path / "map.npy", cloud @ pose[:3, :3].T + pose[:3, 3])
+    d = tmp_path / "d.ply"
+    proc = run("eval", str(tmp_path / "map.npy"), str(tmp_path / "truth.npy"), "--distances",
+               str(d), "--json", str(tmp_path / "r.json"))
+    assert proc.returncode == 0, proc.stderr
+    doc = json.loads((tmp_path / "r.json").read_text())
+    back = read_cloud(d)[DISTANCE_FIELD].ravel()
+    assert_reproduces(back, doc["distances_3d"])
+    assert 0.25 < back.max() < 0.35
+    assert "3D" in doc["distances_3d"]["computed_on"]
+    assert "plan" in doc["distances"]["computed_on"]
+    assert "wall band" in doc["distances"]["computed_on"]
 
 
 def test_image_map_exports(truth_png, tmp_path):

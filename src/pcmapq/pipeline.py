@@ -165,6 +165,16 @@ class PreparedTruth:
     maps: int = 1
 
 
+def _band_words(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap,
+                settings: Settings) -> str:
+    """How a 3D cloud's cells were made, for the wall distances' basis; '' when neither input
+    is a 3D cloud."""
+    if not any(isinstance(s, PointMap) and s.is_3d for s in (source, truth)):
+        return ""
+    r = settings.raster
+    return f" (a 3D cloud: its wall band, {r.band_low:g} to {r.band_high:g} m above its floor)"
+
+
 @dataclass(frozen=True)
 class MapSide:
     """One map aligned and drawn on the truth's grid: ``source`` (in the truth frame after a
@@ -305,7 +315,8 @@ def assemble(loaded: OccupancyMap | PointMap, side: MapSide, prepared: PreparedT
                   truth_path=Path(truth.path), truth_kind=truth.kind, grid=grid,
                   alignment=alignment, overlap=side.cover,
                   distances=distances(prepared.occupied, side.occupied, footprint, grid,
-                                      settings.distances.taus, side.to_map, prepared.to_truth),
+                                      settings.distances.taus, side.to_map, prepared.to_truth,
+                                      _band_words(side.source, truth, settings)),
                   registration_3d=registration, distances_3d=cloud_distances,
                   threshold=threshold, full=full, detectors=detectors,
                   footprint_rule=rule, frames=frames, settings=settings.to_dict(),

@@ -294,13 +294,15 @@ def _consistency_of(doc: dict | None, tolerance: float) -> Consistency | None:
 
 
 def _distances_dict(d: Distances) -> dict:
-    return {"accuracy_m": d.accuracy.to_dict(), "completeness_m": d.completeness.to_dict(),
-            "chamfer_m": d.chamfer_m, "f_score": [asdict(f) for f in d.fscores]}
+    return {"computed_on": d.basis, "accuracy_m": d.accuracy.to_dict(),
+            "completeness_m": d.completeness.to_dict(), "chamfer_m": d.chamfer_m,
+            "f_score": [asdict(f) for f in d.fscores]}
 
 
 def _distances_of(doc: dict) -> Distances:
     return Distances(Stats.from_dict(doc["accuracy_m"]), Stats.from_dict(doc["completeness_m"]),
-                     doc["chamfer_m"], tuple(FScore(**f) for f in doc["f_score"]))
+                     doc["chamfer_m"], tuple(FScore(**f) for f in doc["f_score"]),
+                     doc.get("computed_on", ""))
 
 
 def _xy(rows: list[dict], key: str) -> np.ndarray:

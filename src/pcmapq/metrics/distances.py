@@ -30,10 +30,13 @@ class FScore:
 
 @dataclass(frozen=True)
 class Distances:
+    """Wall distances, metres; ``basis``: what they are computed on, in words."""
+
     accuracy: Stats      # map -> truth
     completeness: Stats  # truth (inside the footprint) -> map
     chamfer_m: float | None      # mean of the two means
     fscores: tuple[FScore, ...]
+    basis: str = ""
 
 
 def nearest_distance(target: np.ndarray, grid: MetricGrid) -> np.ndarray:
@@ -46,21 +49,38 @@ def nearest_distance(target: np.ndarray, grid: MetricGrid) -> np.ndarray:
 def distances(truth_occ: np.ndarray, map_occ: np.ndarray, footprint: np.ndarray,
               grid: MetricGrid, taus: tuple[float, ...] = DEFAULT_TAUS,
               to_map: np.ndarray | None = None,
-              to_truth: np.ndarray | None = None) -> Distances:
+              to_truth: np.ndarray | None = None, band: str = "") -> Distances:
     """Distance metrics between the occupied cells of the aligned map and of the truth.
 
     truth_occ, map_occ, footprint: (rows, cols) bool on ``grid``. Completeness and recall only
     count the truth cells inside ``footprint`` (the area the map observed). to_map, to_truth:
     the map's and the truth's :func:`nearest_distance` fields, when the caller has them.
+    band: how a 3D cloud's cells were made, for the basis (" (a 3D cloud: ...)").
     """
     to_map = nearest_distance(map_occ, grid) if to_map is None else to_map
     to_truth = nearest_distance(truth_occ, grid) if to_truth is None else to_truth
     acc = to_truth[map_occ]
     comp = to_map[truth_occ & footprint]
-    return _summary(acc, comp, taus)
+    return _summary(acc, comp, taus, cells_basis(grid.resolution, band))
 
 
-def _summary(acc: np.ndarray, comp: np.ndarray, taus: tuple[float, ...]) -> Distances:
+def cells_basis(resolution: float, band: str = "") -> str:
+    """What :func:`distances` computes on, in words."""
+    return (f"in the plan: every occupied cell of the map on the truth's {resolution:g} m grid"
+            f"{band} to the nearest truth cell (accuracy, precision); every truth cell inside "
+            "the footprint to the nearest map cell (completeness, recall)")
+
+
+def accuracy_2d(map_occ: np.ndarray, grid: MetricGrid,
+                to_truth: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The points and distances :func:`distances`' accuracy is computed on: the centres (N, 2)
+    of the map's occupied cells on ``grid`` and each one's distance to the truth (N,), metres
+    (``to_truth``: the truth's :func:`nearest_distance` field)."""
+    return grid.cell_centres(map_occ), to_truth[map_occ]
+
+
+def _summary(acc: np.ndarray, comp: np.ndarray, taus: tuple[float, ...],
+             basis: str) -> Distances:
     """Metrics from the map->truth (``acc``) and truth->map (``comp``) distances, metres."""
     a, c = Stats.of(acc), Stats.of(comp)
     chamfer = None if a.mean is None or c.mean is None else 0.5 * (a.mean + c.mean)
@@ -69,7 +89,7 @@ def _summary(acc: np.ndarray, comp: np.ndarray, taus: tuple[float, ...]) -> Dist
         p = float(np.mean(acc <= tau)) if len(acc) else 0.0
         r = float(np.mean(comp <= tau)) if len(comp) else 0.0
         scores.append(FScore(tau, p, r, 2 * p * r / (p + r) if p + r > 0 else 0.0))
-    return Distances(a, c, chamfer, tuple(scores))
+    return Distances(a, c, chamfer, tuple(scores), basis)
 
 
 def distances_3d(map_xyz: np.ndarray, truth_xyz: np.ndarray, voxel: float = 0.05,
@@ -81,14 +101,31 @@ def distances_3d(map_xyz: np.ndarray, truth_xyz: np.ndarray, voxel: float = 0.05
     The exact nearest neighbours come from Open3D's ``compute_point_cloud_distance`` (a KD-tree,
     every core), one call per direction: the distances SciPy's ``cKDTree`` gives, in about
     two thirds of its time (``bench/bench_clouds.py``)."""
-    import open3d as o3d
+    from pcmapq.voxels import voxel_centroids
 
+    basis = (f"in 3D: the map's and the truth's points voxel-downsampled to {voxel:g} m "
+             "(centroids), each to the nearest of the other's")
+    m, t = voxel_centroids(map_xyz, voxel), voxel_centroids(truth_xyz, voxel)
+    if len(m) == 0 or len(t) == 0:
+        return _summary(np.full(len(m), np.inf), np.full(len(t), np.inf), taus, basis)
+    acc, comp = _nearest_3d(m, t), _nearest_3d(t, m)
+    return _summary(acc, comp, taus, basis)
+
+
+def accuracy_3d(map_xyz: np.ndarray, truth_xyz: np.ndarray,
+                voxel: float) -> tuple[np.ndarray, np.ndarray]:
+    """The points and distances :func:`distances_3d`' accuracy is computed on: the map's voxel
+    centroids (N, 3) and each one's distance to the nearest truth voxel centroid (N,),
+    metres."""
     from pcmapq.voxels import voxel_centroids
 
     m, t = voxel_centroids(map_xyz, voxel), voxel_centroids(truth_xyz, voxel)
-    if len(m) == 0 or len(t) == 0:
-        return _summary(np.full(len(m), np.inf), np.full(len(t), np.inf), taus)
-    clouds = [o3d.geometry.PointCloud(o3d.utility.Vector3dVector(c)) for c in (m, t)]
-    acc = np.asarray(clouds[0].compute_point_cloud_distance(clouds[1]))
-    comp = np.asarray(clouds[1].compute_point_cloud_distance(clouds[0]))
-    return _summary(acc, comp, taus)
+    return m, (_nearest_3d(m, t) if len(t) else np.full(len(m), np.inf))
+
+
+def _nearest_3d(points: np.ndarray, other: np.ndarray) -> np.ndarray:
+    """Each point's (N, 3) distance to the nearest of ``other`` (M, 3), metres (Open3D)."""
+    import open3d as o3d
+
+    clouds = [o3d.geometry.PointCloud(o3d.utility.Vector3dVector(c)) for c in (points, other)]
+    return np.asarray(clouds[0].compute_point_cloud_distance(clouds[1]))

@@ -11,10 +11,11 @@ placed on the truth's floor and un-levelled when the truth is a 3D cloud; agains
 already stands in the truth cloud's frame and the planar step is the identity, so its plan is
 read with the truth's levelling and the chain is the registration itself.
 
-Distances: both sides 3D clouds, each map point's distance to the nearest truth point in 3D;
-otherwise, in the plane, from each map point of the plan (an image's occupied cells, a 2D
-cloud's points, a 3D cloud's wall band) to the nearest point of the truth's plan (its
-occupied cells, its points or its wall band).
+Distances: the points the JSON's accuracy is computed on, with their distances, so that the
+file's statistics are the JSON's: both sides 3D clouds, the map's voxel centroids and their
+distance to the nearest truth voxel centroid in 3D (``distances_3d.accuracy_m``); otherwise the
+map's occupied cells on the truth's grid and their distance in the plan to the nearest truth
+cell (``distances.accuracy_m``).
 """
 
 from __future__ import annotations
@@ -23,7 +24,6 @@ from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from pcmapq.cells import FREE, OCCUPIED
 from pcmapq.config import Settings
@@ -33,7 +33,8 @@ from pcmapq.io import OccupancyMap, PointMap
 from pcmapq.io.export import DISTANCE_FIELD, record_dtype, records, write_matrix, write_records
 from pcmapq.io.ply import CHUNK
 from pcmapq.io.writers import OutputSet, write_ros_map
-from pcmapq.plan import MAP_CROP, TRUTH_CROP, cropped, load_input, plan_points
+from pcmapq.metrics.distances import accuracy_2d, accuracy_3d, nearest_distance
+from pcmapq.plan import MAP_CROP, TRUTH_CROP, cropped, load_input
 from pcmapq.raster.draw import warp_state
 from pcmapq.result import Result
 from pcmapq.transform import Similarity2D
@@ -102,20 +103,6 @@ def plan_cloud(xy: np.ndarray) -> np.ndarray:
     return np.column_stack([xy, np.zeros(len(xy))])
 
 
-def band_chunks(points: np.ndarray, level: Levelling, low: float, high: float,
-                matrix: np.ndarray) -> list[np.ndarray]:
-    """The points of a 3D cloud (N, 3) between ``low`` and ``high`` metres above the floor
-    of its levelling (the wall band the run scored), moved by a 4x4 matrix; CHUNK rows read
-    at a time."""
-    out = []
-    for start in range(0, len(points), CHUNK):
-        part = np.asarray(points[start:start + CHUNK], dtype=np.float64)
-        height = part @ level.rotation[2] - level.floor_z_m
-        part = part[(height >= low) & (height <= high)]
-        out.append(part @ matrix[:3, :3].T + matrix[:3, 3])
-    return out
-
-
 def aligned_grid(source: MetricGrid, tf: Similarity2D, truth: MetricGrid) -> MetricGrid:
     """The grid an image map is drawn on in the truth's frame: the truth's cell size and cell
     lattice (yaw 0), just covering the moved image."""
@@ -152,35 +139,23 @@ def write_aligned(path: Path, result: Result, source: OccupancyMap | PointMap,
     return [path]
 
 
-def truth_plan(truth: OccupancyMap | PointMap, settings: Settings) -> np.ndarray:
-    """The truth's plan points (N, 2) metres: occupied cell centres, points or wall band."""
-    if isinstance(truth, OccupancyMap):
-        return truth.grid.cell_centres(truth.state == OCCUPIED)
-    return plan_points(truth, settings)[0]
-
-
-def distance_chunks(result: Result, source: OccupancyMap | PointMap,
-                    truth: OccupancyMap | PointMap, settings: Settings
-                    ) -> tuple[int, Iterator[tuple[np.ndarray, np.ndarray]]]:
-    """How many map points get a distance, and (points (n, 3) in the truth's frame,
-    distances (n,) metres) chunk by chunk (see the module docstring)."""
-    frames = result.frames
-    if isinstance(source, PointMap) and source.is_3d and isinstance(truth, PointMap) \
-            and truth.is_3d:
-        tree = cKDTree(np.asarray(truth.points, dtype=np.float64))
-        return len(source.points), ((xyz, tree.query(xyz, workers=-1)[0])
-                                    for xyz in moved(source.points, cloud_matrix(frames)))
-    tree = cKDTree(truth_plan(truth, settings))
-    if isinstance(source, PointMap) and source.is_3d:
-        parts = band_chunks(source.points, frames.map_levelling, settings.raster.band_low,
-                            settings.raster.band_high, cloud_matrix(frames))
-    elif isinstance(source, PointMap):
-        parts = [plan_cloud(frames.planar.apply(source.points[:, :2]))]
-    else:
-        parts = [plan_cloud(frames.planar.apply(
-            source.grid.cell_centres(source.state == OCCUPIED)))]
-    return sum(map(len, parts)), ((xyz, tree.query(xyz[:, :2], workers=-1)[0])
-                                  for xyz in parts)
+def accuracy_points(result: Result, source: OccupancyMap | PointMap,
+                    settings: Settings) -> tuple[str, np.ndarray, np.ndarray]:
+    """The points (n, 3, truth frame) and distances (n,) metres the JSON's accuracy is computed
+    on, and that figure's JSON path: both inputs 3D clouds, the map's voxel centroids and
+    their 3D distances (``distances_3d.accuracy_m``); otherwise the map's occupied cells on the
+    truth's grid, z = 0, and their distances in the plan (``distances.accuracy_m``)."""
+    if result.distances_3d is not None:
+        truth = load_input(result.truth_path, settings.truth, TRUTH_CROP)
+        xyz = np.vstack(list(moved(source.points, cloud_matrix(result.frames))))
+        points, d = accuracy_3d(xyz, np.asarray(truth.points, dtype=np.float64),
+                                settings.raster.cloud_resolution)
+        return "distances_3d.accuracy_m", points, d
+    if result.map_occupied is None or result.truth_occupied is None:
+        raise ValueError("--distances needs the rasters of a run, not of a JSON read back")
+    xy, d = accuracy_2d(result.map_occupied, result.grid,
+                        nearest_distance(result.truth_occupied, result.grid))
+    return "distances.accuracy_m", plan_cloud(xy), d
 
 
 def colours(distance: np.ndarray, clip: float) -> np.ndarray:
@@ -193,16 +168,17 @@ def colours(distance: np.ndarray, clip: float) -> np.ndarray:
 
 def write_distances(path: Path, result: Result, source: OccupancyMap | PointMap,
                     settings: Settings, outputs: OutputSet | None = None) -> list[Path]:
-    """The map's points in the truth's frame with their distance to the truth (float
-    ``scalar_distance_m``) and a colour (0 m to the largest ``--tau``), as a binary PLY (with
-    ``outputs``: staged there, written when it is committed)."""
-    truth = load_input(result.truth_path, settings.truth, TRUTH_CROP)
-    count, chunks = distance_chunks(result, source, truth, settings)
+    """The points the JSON's accuracy is computed on, in the truth's frame, each with its
+    distance to the truth (float ``scalar_distance_m``, :func:`accuracy_points`: their
+    statistics are the JSON's) and a colour (0 m to the largest ``--tau``), as a binary PLY
+    (with ``outputs``: staged there, written when it is committed)."""
+    figure, xyz, d = accuracy_points(result, source, settings)
     dtype = record_dtype(DISTANCE_FIELD, colour=True)
     clip = max(settings.distances.taus)
-    write_records(path, count, (records(xyz, dtype, d, colours(d, clip)) for xyz, d in chunks),
-                  dtype, f"pcmapq: {source.path} against {result.truth_path}: {DISTANCE_FIELD}"
-                  f" in metres, colour {COLOURS} from 0 to {clip:g} m", outputs)
+    write_records(path, len(xyz), iter([records(xyz, dtype, d, colours(d, clip))]), dtype,
+                  f"pcmapq: {source.path} against {result.truth_path}: {DISTANCE_FIELD} in "
+                  f"metres, the distances of the JSON's {figure}; colour {COLOURS} from 0 to "
+                  f"{clip:g} m", outputs)
     return [path]
 
 

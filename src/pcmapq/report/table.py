@@ -95,13 +95,16 @@ def _summary(result: Result) -> list[tuple[str, list[str]]]:
 def _distances(result: Result) -> list[tuple[str, list[str]]]:
     """The wall distances (and the 3D ones when both inputs are 3D clouds) as lines."""
     d = result.distances
-    lines = [("accuracy", _stats_parts(d.accuracy, "map -> truth")),
+    cells = f"{result.grid.resolution:g} m plan cells"
+    lines = [("accuracy", _stats_parts(d.accuracy, f"map -> truth on {cells}")),
              ("completeness", _stats_parts(d.completeness, "truth -> map")),
              ("F-score", [f"F@{s.tau_m:g} m {s.f:.3f}" for s in d.fscores]
               + [f"Chamfer {metres(d.chamfer_m)}"])]
     if result.distances_3d is not None:
         d3 = result.distances_3d
-        lines += [("3D accuracy", _stats_parts(d3.accuracy, "map -> truth, 3D")),
+        voxel = (result.settings or {}).get("raster", {}).get("cloud_resolution")
+        voxels = "3D" if voxel is None else f"{voxel:g} m voxels, 3D"
+        lines += [("3D accuracy", _stats_parts(d3.accuracy, f"map -> truth on {voxels}")),
                   ("3D complete", _stats_parts(d3.completeness, "truth -> map, 3D")),
                   ("3D", [f"Chamfer {metres(d3.chamfer_m)}"])]
     return lines
@@ -135,7 +138,7 @@ def _g(value: float | None) -> str:
 
 def _stats_parts(stats: Stats, direction: str) -> list[str]:
     """A distance's statistics as 'mean 0.127 m' pieces, with its direction."""
-    return [f"{direction}: mean {metres(stats.mean)}",
+    return [direction, f"mean {metres(stats.mean)}",
             *(f"{k} {metres(getattr(stats, k))}" for k in ("median", "rmse", "std", "p95",
                                                            "max"))]
 

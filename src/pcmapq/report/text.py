@@ -14,7 +14,8 @@ LEGEND = ("quality: share of the truth's features the map has (the paper's q = m
           "truth); precision: share of the map's features that are in the truth (matched map / "
           "map); f1: their harmonic mean; n/a: nothing to count; pair: a matched truth feature "
           "and map feature; displacement: the length from a pair's truth feature to its map "
-          "feature; accuracy: distance from the map's walls to the truth's; completeness: from "
+          "feature; accuracy: distance from the map's walls to the truth's (their cells on the "
+          "truth's grid, in the plan; 3D: between voxel centroids); completeness: from "
           "the truth's walls to the map's; F@tau: F-score of the walls within tau; noref: the "
           "input's own figures without a ground truth, as 'pcmapq inspect' gives them (lower "
           "is better, between maps of one place only); definitions in docs/metrics.md")
