@@ -175,6 +175,35 @@ def test_a_map_in_millimetres_with_scale_auto_says_so(tmp_path, scan_points):
     assert "millimetres" in stderr and len(stderr.strip().splitlines()) == 1
 
 
+@pytest.mark.parametrize("mistake", ["millimetres", "cells of 50 m"])
+def test_a_unit_mistake_on_the_map_side_is_refused_before_the_search(mistake, tmp_path,
+                                                                      scan_points, monkeypatch):
+    """The truth's mistakes, made on the map's side (a cloud in millimetres, a YAML whose
+    resolution is 50): exit 1 with the same reason the truth's side gives, before the global
+    search, which took 30-40 s and 8 GB on them."""
+    if mistake == "millimetres":
+        path = tmp_path / "mm.npy"
+        np.save(path, scan_points * 1000.0)
+        why = "millimetres"
+    else:
+        (tmp_path / "t.png").write_bytes((SAMPLE / "truth.png").read_bytes())
+        text = (SAMPLE / "truth.yaml").read_text()
+        path = tmp_path / "t.yaml"
+        path.write_text("\n".join("resolution: 50" if line.startswith("resolution") else
+                                  "image: t.png" if line.startswith("image") else line
+                                  for line in text.splitlines()))
+        why = "its cells are 50 m wide"
+    called = []
+    import pcmapq.align.planar as planar
+
+    original = planar.coarse_search
+    monkeypatch.setattr(planar, "coarse_search",
+                        lambda *a, **k: called.append(1) or original(*a, **k))
+    code, _, stderr = _eval(str(path), str(SAMPLE / "truth.yaml"))
+    assert code == 1 and why in stderr and str(path) in stderr, stderr
+    assert len(stderr.strip().splitlines()) == 1 and not called
+
+
 def test_a_map_of_one_straight_wall_is_refused_with_exit_1(tmp_path):
     path = tmp_path / "line.npy"
     np.save(path, np.column_stack([np.linspace(0, 10, 2000), np.zeros(2000)]))

@@ -51,6 +51,25 @@ def check_scale_range(source: OccupancyMap | PointMap, map_xy: np.ndarray,
                               f"the truth; {why}")
 
 
+def check_size(source: OccupancyMap | PointMap, map_xy: np.ndarray, truth_xy: np.ndarray,
+               settings: Settings) -> None:
+    """EvaluationError (one line), before the global search, for a map :data:`OVERSIZE` times
+    larger than the truth that also looks wrong in itself (:func:`~pcmapq.io.extent.hint`: cells
+    not metres wide, points far from the rest, a span of another unit): the mistakes the
+    truth's side is refused for, caught before the search across the map's size costs minutes
+    and gigabytes. Not with ``--scale auto`` (it estimates the unit), a guess or no search."""
+    option = settings.alignment
+    if option.scale or option.init is not None or not option.enabled:
+        return
+    size = radius(map_xy) / max(radius(truth_xy), 1e-12)
+    if size <= OVERSIZE:
+        return
+    why = hint(source, MAP_CROP)
+    if why:
+        raise EvaluationError(f"{source.path}: {size:.0f} times the size of the truth, too "
+                              f"large to be a map of its place: {why}")
+
+
 def align_plan(source: OccupancyMap | PointMap, map_xy: np.ndarray, truth_xy: np.ndarray,
                registration: Registration3D | None, settings: Settings,
                target: RigidTarget | None = None) -> Alignment:
@@ -60,6 +79,7 @@ def align_plan(source: OccupancyMap | PointMap, map_xy: np.ndarray, truth_xy: np
     option = settings.alignment
     if registration is None:
         check_scale_range(source, map_xy, truth_xy, settings)
+        check_size(source, map_xy, truth_xy, settings)
         return align(map_xy, truth_xy, option.params, init=option.init, refine=option.enabled,
                      scale=option.scale, target=target)
     return replace(align(map_xy, truth_xy, option.params, init=Similarity2D(), refine=False),
