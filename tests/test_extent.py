@@ -238,3 +238,17 @@ def test_every_cloud_loader_checks_the_points_declared_against_the_limit(tmp_pat
     with pytest.raises(InputError, match=f"{name}.*needs about"):
         load_map(path, memory_limit=need - 50 * n)
     assert len(load_map(path, memory_limit=need).points) == n
+
+
+def test_inspect_refuses_a_yaml_of_50_m_cells_in_one_line(tmp_path):
+    """`pcmapq inspect` goes through eval's input checks: the sample's YAML with resolution 50
+    (a 26 km image whose walls' image would take terabytes) is refused from its size, with
+    the reason, in one line; it ended in an OpenCV traceback."""
+    (tmp_path / "t.png").write_bytes((SAMPLE / "truth.png").read_bytes())
+    path = tmp_path / "t.yaml"
+    path.write_text("\n".join("resolution: 50" if line.startswith("resolution") else
+                              "image: t.png" if line.startswith("image") else line
+                              for line in (SAMPLE / "truth.yaml").read_text().splitlines()))
+    got = CliRunner().invoke(app, ["inspect", str(path)])
+    assert got.exit_code == 2 and "its cells are 50 m wide" in got.stderr, got.stderr
+    assert len(got.stderr.strip().splitlines()) == 1 and str(path) in got.stderr

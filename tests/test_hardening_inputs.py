@@ -131,3 +131,53 @@ def test_degenerate_map_is_refused_with_exit_1(tmp_path: Path, name: str) -> Non
     assert code == 1, stderr
     assert len(stderr.strip().splitlines()) == 1 and str(path) in stderr, stderr
     assert "degenerate map" in stderr and "fewer than 10" in stderr, stderr
+
+
+def _tiny_log(path: Path) -> Path:
+    """A CARMEN log of three scans in the sample's hall: a run for `pcmapq track`."""
+    from .test_track import flaser_log
+
+    poses = np.array([[6.0, 8.0, 0.0], [6.5, 8.0, 0.0], [7.0, 8.0, 0.0]])
+    return flaser_log(path, np.full((3, 181), 3.0), poses)
+
+
+#: Every command that reads a map or a truth, as (name, arguments for the broken file).
+COMMANDS: dict[str, Callable[[Path, Path], list[str]]] = {
+    "eval truth": lambda bad, tmp: ["eval", str(SAMPLE / "truth.png"), str(bad),
+                                    "--truth-resolution", "0.05"],
+    "inspect": lambda bad, tmp: ["inspect", str(bad), "--map-resolution", "0.05"],
+    "track truth": lambda bad, tmp: ["track", str(_tiny_log(tmp / "run.log")), str(bad),
+                                     "--truth-resolution", "0.05", "--out", str(tmp / "t")],
+}
+
+
+@pytest.mark.e2e
+@pytest.mark.parametrize("command", sorted(COMMANDS))
+@pytest.mark.parametrize("name", ["cut_binary.ply", "rows_1e12.npy", "pixels_1e12.png",
+                                  "beams_1e8.log"])
+def test_every_command_refuses_a_broken_file_in_one_line(tmp_path: Path, name: str,
+                                                         command: str) -> None:
+    """The broken files of eval's map side, given to eval as the truth, to inspect and to
+    track as the truth: exit 2, one line naming the file and the problem, no traceback."""
+    make, expected = BROKEN[name]
+    path = make(tmp_path / name)
+    got = CliRunner().invoke(app, COMMANDS[command](path, tmp_path))
+    assert got.exit_code == 2, got.stderr
+    assert len(got.stderr.strip().splitlines()) == 1, got.stderr
+    assert str(path) in got.stderr and expected in got.stderr, got.stderr
+    assert "Traceback" not in got.stderr
+
+
+@pytest.mark.e2e
+def test_a_broken_map_fails_its_batch_row_with_the_same_line(tmp_path: Path) -> None:
+    """`pcmapq batch`: a truncated PLY among the maps fails its row (exit 1) with the line eval
+    gives; the other row is scored."""
+    make, expected = BROKEN["cut_binary.ply"]
+    path = make(tmp_path / "cut_binary.ply")
+    got = CliRunner().invoke(app, ["batch", str(path), str(SAMPLE / "scan.ply"), "--truth",
+                                   str(SAMPLE / "truth.png"), "--out", str(tmp_path / "b"),
+                                   "--workers", "1", "--quiet"])
+    assert got.exit_code == 1, got.stderr
+    table = (tmp_path / "b" / "table.csv").read_text()
+    assert expected in table and expected in got.stderr, (table, got.stderr)
+    assert "Traceback" not in table + got.stderr and (tmp_path / "b" / "scan.json").is_file()

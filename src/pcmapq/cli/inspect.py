@@ -10,13 +10,13 @@ import numpy as np
 import typer
 from rich.console import Console
 
-from pcmapq import options, terminal
-from pcmapq.cli.app import app
-from pcmapq.config import (
-    NoRefConfig,
-)
+from pcmapq import memory, options, terminal
+from pcmapq.cli.app import MaxMemory, app, memory_limit
+from pcmapq.config import NoRefConfig
 from pcmapq.inspect_map import inspect_map, summary_lines, to_json
-from pcmapq.io import PointMap, load_map
+from pcmapq.io import OccupancyMap, PointMap, load_map
+from pcmapq.io.extent import Box, check_span, hint
+from pcmapq.io.extent import crop as crop_input
 from pcmapq.io.writers import OutputSet, write_atomic
 from pcmapq.mapping import (
     posed_map,
@@ -25,9 +25,26 @@ from pcmapq.mapping import (
 )
 from pcmapq.metrics.noref import DEPTH_RADIUS, LIDAR_RADIUS, MAX_NN, MIN_KNN
 from pcmapq.metrics.posed import place_subset, read_orthogonal_subset
+from pcmapq.pipeline import needed_memory
 from pcmapq.terminal import (
     report_errors,
 )
+
+#: The crop option of inspect, named in messages.
+CROP = "--crop"
+
+
+def checked(source: OccupancyMap | PointMap, box: Box | None,
+            limit: int | None) -> OccupancyMap | PointMap:
+    """The map cut to ``box``, after the checks eval makes on its inputs: no wider than it
+    can score (:func:`~pcmapq.io.extent.check_span`) and, for an image, within the memory
+    limit its walls' image takes, each refused in one line that says what looks wrong."""
+    source = source if box is None else crop_input(source, box, CROP)
+    check_span(source, CROP)
+    if isinstance(source, OccupancyMap):
+        memory.guard(needed_memory((source,), source.grid), limit, str(source.path),
+                     lambda: hint(source, CROP))
+    return source
 
 
 @app.command("inspect")
@@ -65,6 +82,10 @@ def inspect_command(
     map_resolution: Annotated[float | None, typer.Option(
         help="Metres per pixel of an image without YAML.", min=1e-6, callback=options.finite)
     ] = None,
+    crop: Annotated[str | None, typer.Option(
+        metavar="<x0,y0,x1,y1>", help="Keep only the part of the map inside this box, metres, "
+        "in its own frame (as eval's --map-crop).")] = None,
+    max_memory: MaxMemory = None,
     json_path: Annotated[str | None, typer.Option(
         "--json", help="Write the figures as JSON to this path ('-' for stdout only).")] = None,
     quiet: Annotated[bool, typer.Option(
@@ -88,7 +109,8 @@ def inspect_command(
             first = trajectory[0]
             source = PointMap(scans, posed_map(scans, trajectory), True, kind="scans")
         else:
-            source = load_map(map_path, map_resolution)
+            source = load_map(map_path, map_resolution, memory_limit=memory_limit(max_memory))
+        source = checked(source, options.parse_box(crop, CROP), memory_limit(max_memory))
         planes = None if orth_subset is None else read_orthogonal_subset(orth_subset)
         if planes is not None and orth_pose is not None:
             planes = place_subset(planes, read_pose_matrix(orth_pose), first)
