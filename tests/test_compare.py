@@ -79,7 +79,7 @@ def test_results_of_different_truths_are_refused_unless_allowed(saved, tmp_path)
     proc = run("compare", str(saved["a"]), str(saved["other"]), "--out", str(out))
     assert proc.returncode == 2
     assert proc.stderr.count("\n") == 1 and "Traceback" not in proc.stderr
-    assert str(saved["other"]) in proc.stderr and "path" in proc.stderr
+    assert str(saved["other"]) in proc.stderr and "sha256" in proc.stderr
     assert "--allow-different-truths" in proc.stderr
     assert not out.exists()  # refused before anything is written
     proc = run("compare", str(saved["a"]), str(saved["other"]), "--out", str(out),
@@ -87,6 +87,28 @@ def test_results_of_different_truths_are_refused_unless_allowed(saved, tmp_path)
     assert proc.returncode == 0, proc.stderr
     assert proc.stderr.startswith("pcmapq: warning: 1 of 2 results have another truth")
     assert [r["name"] for r in table(out)] == ["a", "other"]
+
+
+def test_one_truth_written_two_ways_is_one_truth(saved, tmp_path, monkeypatch):
+    """The sample's truth given to eval as typed from its folder ('truth.yaml') and as an
+    absolute path (as batch stores it): compare takes them as one truth, by their SHA-256;
+    without it (an older result), by the path resolved from the folder compare runs in."""
+    monkeypatch.chdir(SAMPLE)
+    relative = tmp_path / "relative.json"
+    proc = run("eval", "scan.ply", "truth.yaml", "--json", str(relative), "--quiet")
+    assert proc.returncode == 0, proc.stderr
+    doc = json.loads(relative.read_text())
+    assert doc["truth"]["path"] == "truth.yaml"
+    assert doc["truth"]["sha256"] == json.loads(saved["a"].read_text())["truth"]["sha256"]
+    proc = run("compare", str(saved["a"]), str(relative), "--out", str(tmp_path / "cmp"))
+    assert proc.returncode == 0 and "another truth" not in proc.stderr, proc.stderr
+    for key in ("a", "relative"):
+        older = json.loads((saved["a"] if key == "a" else relative).read_text())
+        del older["truth"]["sha256"]
+        (tmp_path / f"{key}_old.json").write_text(json.dumps(older))
+    proc = run("compare", str(tmp_path / "a_old.json"), str(tmp_path / "relative_old.json"),
+               "--out", str(tmp_path / "cmp_old"))
+    assert proc.returncode == 0 and "another truth" not in proc.stderr, proc.stderr
 
 
 @pytest.mark.parametrize("content, says", [

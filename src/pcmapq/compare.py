@@ -1,6 +1,8 @@
 """``pcmapq compare``: saved results (``eval --json``, or a batch's per-map JSONs) side by side,
-like evo_res. They must share a truth (same path, grid shape, resolution and origin) unless
-told otherwise; each becomes one row of the comparison table and figure (report/summary.py)."""
+like evo_res. They must share a truth (the same file: the same SHA-256 when both results
+record it, else the same path, resolved from here; and the same grid shape, resolution and
+origin) unless told otherwise; each becomes one row of the comparison table and figure
+(report/summary.py)."""
 
 from __future__ import annotations
 
@@ -42,13 +44,17 @@ def read_results(paths: Sequence[Path], names: Sequence[str] | None = None) -> l
 
 
 def truth_differences(results: Sequence[Saved]) -> list[str]:
-    """The results whose truth differs from the first's, each as 'file (what differs)'."""
+    """The results whose truth differs from the first's, each as 'file (what differs)': the
+    file (its SHA-256 when both record one, else its resolved path) or the grid."""
     first = _truth_key(results[0].doc)
     out = []
     for saved in results[1:]:
         key = _truth_key(saved.doc)
-        what = [field for field, a, b in zip(("path", *TRUTH_GRID), first, key, strict=True)
-                if a != b]
+        (path_a, digest_a, *grid_a), (path_b, digest_b, *grid_b) = first, key
+        what = (["sha256"] if digest_a and digest_b and digest_a != digest_b else
+                ["path"] if not (digest_a and digest_b) and path_a != path_b else [])
+        what += [field for field, a, b in zip(TRUTH_GRID, grid_a, grid_b, strict=True)
+                 if a != b]
         if what:
             out.append(f"{saved.path} ({', '.join(what)})")
     return out
@@ -87,7 +93,9 @@ def _read(path: Path, name: str) -> Saved:
 
 
 def _truth_key(doc: dict) -> tuple:
-    """The truth's path (normalised) and grid (None for what the JSON lacks)."""
+    """The truth's path (resolved from the current folder, as the user typed it to eval or
+    batch wrote it), its SHA-256 (None when not recorded) and grid (None for what the JSON
+    lacks)."""
     truth = doc["truth"]
     grid = tuple(json.dumps(truth.get(k), sort_keys=True) for k in TRUTH_GRID)
-    return (os.path.normpath(str(truth["path"])), *grid)
+    return (os.path.realpath(str(truth["path"])), truth.get("sha256"), *grid)

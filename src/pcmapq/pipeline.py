@@ -22,6 +22,7 @@ from pcmapq.features import Features, SideBySide, default_params
 from pcmapq.frames import Frames, Levelling
 from pcmapq.grid import MetricGrid
 from pcmapq.io import OccupancyMap, PointMap
+from pcmapq.io.digest import sha256_file
 from pcmapq.io.extent import check_span, hint
 from pcmapq.match import match
 from pcmapq.metrics.distances import distances, distances_3d, nearest_distance
@@ -117,7 +118,8 @@ def evaluate(map_path: str | Path | PointMap, truth_path: str | Path,
         guess = truth.grid.resolution if isinstance(truth, OccupancyMap) else (
             settings.truth.resolution or settings.raster.cloud_resolution)
         source = load_input(map_path, settings.map, MAP_CROP, guess, memory_limit)
-    return score(source, truth, settings, progress, memory_limit)
+    result = score(source, truth, settings, progress, memory_limit)
+    return replace(result, truth_sha256=sha256_file(truth_path))
 
 
 def needed_memory(inputs: Sequence[OccupancyMap | PointMap], grid: MetricGrid,

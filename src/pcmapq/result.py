@@ -96,7 +96,9 @@ class Result:
     metres and degrees); command: the command line that made it (``pcmapq eval ...``, defaults
     left out), None from the library. noref: each input's no-reference figures,
     ``{"map": ..., "truth": ...}`` (:func:`pcmapq.noref_figures.input_figures`), None when not
-    asked for. truth_occupied, map_occupied (and the overlap's
+    asked for. truth_sha256: the truth file's SHA-256 (hex; None from the library's
+    :func:`~pcmapq.pipeline.score`), so that results of one truth are known as such however
+    its path was written. truth_occupied, map_occupied (and the overlap's
     footprint): the rasters on ``grid``; None in a result read back by :meth:`from_json`, which
     holds everything the JSON holds and no more.
     """
@@ -122,6 +124,7 @@ class Result:
     command: str | None = None
     noref: dict | None = None
     consistency: Consistency | None = None
+    truth_sha256: str | None = None
 
     @property
     def transform(self) -> Similarity2D:
@@ -153,7 +156,8 @@ class Result:
             "truth": {"path": str(self.truth_path), "kind": self.truth_kind,
                       "resolution_m": self.grid.resolution,
                       "origin": {"x_m": x0, "y_m": y0, "yaw_deg": float(np.degrees(yaw0))},
-                      "shape": list(self.grid.shape)},
+                      "shape": list(self.grid.shape),
+                      **({} if self.truth_sha256 is None else {"sha256": self.truth_sha256})},
             "alignment": {**tf.to_dict(), "matrix": tf.matrix.tolist(),
                           "fitness": self.alignment.fitness,
                           "rmse_m": self.alignment.rmse_m,
@@ -367,7 +371,7 @@ def _from_dict(doc: dict) -> Result:
         full=doc["scored_against"] == "whole truth", detectors=detectors,
         truth_occupied=None, map_occupied=None, frames=frames,
         footprint_rule=doc["footprint"], settings=doc["settings"],
-        command=doc["pcmapq"]["command"], noref=doc.get("noref"),
+        command=doc["pcmapq"]["command"], noref=doc.get("noref"), truth_sha256=t.get("sha256"),
         consistency=_consistency_of(doc.get("consistency"), a["tolerance_m"]))
 
 

@@ -23,6 +23,7 @@ from pcmapq import __version__, gates
 from pcmapq.batch.manifest import Row
 from pcmapq.errors import EvaluationError, InputError
 from pcmapq.gates import Gate
+from pcmapq.io.digest import sha256_file
 from pcmapq.io.writers import OutputSet, one_line, write_atomic
 from pcmapq.options import input_files
 from pcmapq.pipeline import evaluate
@@ -37,8 +38,6 @@ RECORDS = ".pcmapq-batch"
 DASK_RETRIES = 2
 #: Local pools started in turn when a worker process dies (the unfinished rows go again).
 LOCAL_ROUNDS = 2
-#: Bytes read at a time when hashing an input.
-CHUNK = 1 << 20
 #: One row at a time in a process: a Dask worker with several threads runs its rows in turn
 #: (warnings are caught per process, and matplotlib's pyplot is not thread-safe).
 ONE_AT_A_TIME = threading.Lock()
@@ -117,14 +116,6 @@ def row_key(task: Task) -> dict:
 def checksums(path: Path) -> dict[str, str]:
     """SHA-256 (hex) of each existing file an input reads, by file name."""
     return {f.name: sha256_file(f) for f in input_files(path) if f.is_file()}
-
-
-def sha256_file(path: Path) -> str:
-    digest = hashlib.sha256()
-    with open(path, "rb") as f:
-        while block := f.read(CHUNK):
-            digest.update(block)
-    return digest.hexdigest()
 
 
 def saved_result(task: Task, key: dict) -> dict | None:
