@@ -1,3 +1,3 @@
-from pcmapq.cli import app
+from pcmapq.cli import main
 
-app()
+main()

@@ -11,7 +11,7 @@ import typer
 from rich.console import Console
 
 from pcmapq import gates, options, terminal
-from pcmapq.cli.app import FailOver, FailUnder, app
+from pcmapq.cli.commands import HELP, FailOver, FailUnder, app
 from pcmapq.errors import InputError
 from pcmapq.io.writers import OutputSet, write_atomic
 from pcmapq.terminal import (
@@ -19,7 +19,7 @@ from pcmapq.terminal import (
 )
 
 
-@app.command("batch")
+@app.command("batch", help=HELP["batch"])
 def batch_command(
     sources: Annotated[list[str], typer.Argument(
         metavar="MANIFEST | MAP...", help="A manifest (.csv, .yaml or .yml: one row per "
@@ -55,9 +55,6 @@ def batch_command(
     quiet: Annotated[bool, typer.Option(
         "--quiet", "-q", help="Print nothing but warnings and errors.")] = False,
 ) -> None:
-    """Evaluate many maps, on local processes or a Dask cluster: a result per row, a table
-    and a figure of them all; a rerun skips the rows already done. Exit 1 if any row failed,
-    else 3 if a row failed a gate."""
     from pcmapq.batch import glob_rows, parse_assignments, read_rows, run_batch
     from pcmapq.batch.progress import row_bar
 

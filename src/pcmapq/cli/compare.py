@@ -10,13 +10,13 @@ import typer
 from rich.console import Console
 
 from pcmapq import terminal
-from pcmapq.cli.app import app
+from pcmapq.cli.commands import HELP, app
 from pcmapq.terminal import (
     report_errors,
 )
 
 
-@app.command("compare")
+@app.command("compare", help=HELP["compare"])
 def compare_command(
     results: Annotated[list[Path], typer.Argument(
         metavar="RESULTS...", help="Saved results: JSON files of 'pcmapq eval --json' (or of "
@@ -32,8 +32,6 @@ def compare_command(
     quiet: Annotated[bool, typer.Option(
         "--quiet", "-q", help="Print nothing but warnings and errors.")] = False,
 ) -> None:
-    """Compare saved results side by side (like evo_res): a table and a figure of the
-    qualities, precisions, f1, coverage, alignment and wall distances (metres, degrees)."""
     from pcmapq.compare import check_same_truth, read_results
     from pcmapq.report.summary import print_summary, write_summary
 

@@ -11,7 +11,7 @@ import typer
 from rich.console import Console
 
 from pcmapq import gates, options, terminal
-from pcmapq.cli.app import DEFAULTS, FailOver, FailUnder, MaxMemory, app, memory_limit
+from pcmapq.cli.commands import DEFAULTS, HELP, FailOver, FailUnder, MaxMemory, app, memory_limit
 from pcmapq.config import (
     DETECTOR_NAMES,
     Settings,
@@ -33,7 +33,7 @@ from pcmapq.terminal import (
 )
 
 
-@app.command("eval")
+@app.command("eval", help=HELP["eval"])
 def eval_command(
     ctx: typer.Context,
     paths: Annotated[list[Path], typer.Argument(
@@ -168,7 +168,6 @@ def eval_command(
         "--quiet", "-q", help="Print nothing but warnings and errors (and the JSON of "
         "--json -).")] = False,
 ) -> None:
-    """Align MAP to TRUTH, then score it with Harris, Hough and SIFT features."""
     if len(paths) != (1 if scans else 2):
         raise typer.BadParameter("give MAP and TRUTH, or --scans DIR and TRUTH",
                                  param_hint="MAP TRUTH")

@@ -11,7 +11,7 @@ import typer
 from rich.console import Console
 
 from pcmapq import memory, options, terminal
-from pcmapq.cli.app import MaxMemory, app, memory_limit
+from pcmapq.cli.commands import HELP, MaxMemory, app, memory_limit
 from pcmapq.config import NoRefConfig
 from pcmapq.inspect_map import inspect_map, summary_lines, to_json
 from pcmapq.io import OccupancyMap, PointMap, load_map
@@ -47,7 +47,7 @@ def checked(source: OccupancyMap | PointMap, box: Box | None,
     return source
 
 
-@app.command("inspect")
+@app.command("inspect", help=HELP["inspect"])
 def inspect_command(
     ctx: typer.Context,
     map_path: Annotated[Path | None, typer.Argument(
@@ -91,8 +91,6 @@ def inspect_command(
     quiet: Annotated[bool, typer.Option(
         "--quiet", "-q", help="Print nothing but warnings and errors.")] = False,
 ) -> None:
-    """How good is a map without a ground truth: MME, MPV and MOM of a 3D cloud, occupancy
-    figures of a 2D map (docs/metrics.md)."""
     err = Console(stderr=True)
     with report_errors(err), terminal.show_warnings(err):
         if (map_path is None) == (scans is None) or (scans is None) != (poses is None):

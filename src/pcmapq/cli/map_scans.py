@@ -9,7 +9,7 @@ import typer
 from rich.console import Console
 
 from pcmapq import options, terminal
-from pcmapq.cli.app import app
+from pcmapq.cli.commands import HELP, app
 from pcmapq.errors import InputError
 from pcmapq.io.writers import OutputSet, write_cloud
 from pcmapq.mapping import (
@@ -28,7 +28,7 @@ from pcmapq.terminal import (
 )
 
 
-@app.command("map")
+@app.command("map", help=HELP["map"])
 def map_command(
     source: Annotated[Path, typer.Argument(
         help="Scan sequence: a folder of KITTI .bin / .ply / .pcd / .npy scans, a ROS bag or "
@@ -54,7 +54,6 @@ def map_command(
     quiet: Annotated[bool, typer.Option(
         "--quiet", "-q", help="Print nothing but warnings and errors.")] = False,
 ) -> None:
-    """Build a map from LiDAR scans with KISS-ICP (or with given poses) and save it."""
     err = Console(stderr=True)
     with report_errors(err), terminal.show_warnings(err):
         if calib is not None and poses is None:

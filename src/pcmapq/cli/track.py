@@ -11,7 +11,7 @@ import typer
 from rich.console import Console
 
 from pcmapq import options, terminal
-from pcmapq.cli.app import DEFAULTS, MaxMemory, app, memory_limit
+from pcmapq.cli.commands import DEFAULTS, HELP, MaxMemory, app, memory_limit
 from pcmapq.errors import InputError
 from pcmapq.io.writers import OutputSet, write_atomic
 from pcmapq.raster.footprint import FOOTPRINT_RULES
@@ -22,7 +22,7 @@ from pcmapq.terminal import (
 )
 
 
-@app.command("track")
+@app.command("track", help=HELP["track"])
 def track_command(
     ctx: typer.Context,
     paths: Annotated[list[Path], typer.Argument(
@@ -86,8 +86,6 @@ def track_command(
     quiet: Annotated[bool, typer.Option(
         "--quiet", "-q", help="Print nothing but warnings and errors.")] = False,
 ) -> None:
-    """Score a SLAM run's map as it grows, every N scans or D metres, against the truth:
-    when did the map go wrong, and where was the robot then?"""
     from pcmapq.io.carmen import is_carmen
     from pcmapq.report.timeline import drop_words
     from pcmapq.track import PoseOptions, step_ends, track_run, travelled, write_track

@@ -1,4 +1,5 @@
-"""The ``pcmapq`` Typer application, its global options and what every command shares."""
+"""The ``pcmapq`` Typer application (:mod:`pcmapq.cli.base`) that the commands register on, and
+what they share: the documented defaults, the CI gates, the memory limit."""
 
 from __future__ import annotations
 
@@ -6,38 +7,15 @@ from typing import Annotated
 
 import typer
 
-from pcmapq import __version__, options
+from pcmapq import options
+from pcmapq.cli.base import HELP, new_app
 from pcmapq.config import Settings
-from pcmapq.terminal import HELP_WIDTH, OneLineUsageErrors
 
 #: The documented defaults, read from the one place that defines them.
 DEFAULTS = Settings()
 
-#: Help at the terminal's width (click caps it at 80 columns unless told otherwise), as plain
-#: text: rich's markup would eat "[default: ...]" and squeeze the help into a narrow column.
-app = typer.Typer(cls=OneLineUsageErrors, add_completion=False, no_args_is_help=True,
-                  pretty_exceptions_enable=False, rich_markup_mode=None,
-                  context_settings={"max_content_width": HELP_WIDTH},
-                  help="Map quality against a ground-truth map, in metres.")
-
-
-def _print_version(value: bool) -> None:
-    """--version: print pcmapq's version and stop."""
-    if value:
-        print(f"pcmapq {__version__}")
-        raise typer.Exit()
-
-
-@app.callback()
-def main(
-    version: Annotated[bool, typer.Option(
-        "--version", help="Print pcmapq's version and exit.", callback=_print_version,
-        is_eager=True)] = False,
-) -> None:
-    """pcmapq: score a robot-made map against a ground-truth map (frame convention:
-    p_truth = s * R(yaw) * p_map + t; metres and degrees). The scores are defined in
-    docs/metrics.md."""
-
+app = new_app()
+__all__ = ["DEFAULTS", "HELP", "app"]
 
 
 #: The CI gates of eval and batch (a batch judges every row; docs/ci.md).
