@@ -181,3 +181,31 @@ def test_a_broken_map_fails_its_batch_row_with_the_same_line(tmp_path: Path) -> 
     table = (tmp_path / "b" / "table.csv").read_text()
     assert expected in table and expected in got.stderr, (table, got.stderr)
     assert "Traceback" not in table + got.stderr and (tmp_path / "b" / "scan.json").is_file()
+
+
+@pytest.mark.e2e
+def test_grey_walls_get_the_threshold_that_would_read_them(tmp_path: Path) -> None:
+    """The sample's plan with its walls drawn grey (128, p = 0.50, as a CARMEN map draws them):
+    the line says how dark its darkest pixels read and which option marks them; with it, the
+    evaluation runs."""
+    image = cv2.imread(str(SAMPLE / "truth.png"), cv2.IMREAD_GRAYSCALE)
+    image[image == 0] = 128
+    cv2.imwrite(str(tmp_path / "grey.png"), image)
+    got = CliRunner().invoke(app, ["eval", str(SAMPLE / "scan.ply"), str(tmp_path / "grey.png"),
+                                   "--truth-resolution", "0.05"])
+    assert got.exit_code == 2 and len(got.stderr.strip().splitlines()) == 1, got.stderr
+    assert "p = 0.50" in got.stderr and "--truth-occupied-thresh" in got.stderr, got.stderr
+    got = CliRunner().invoke(app, ["eval", str(SAMPLE / "scan.ply"), str(tmp_path / "grey.png"),
+                                   "--truth-resolution", "0.05", "--truth-occupied-thresh",
+                                   "0.4", "--force", "--quiet"])
+    assert got.exit_code == 0, got.stderr
+
+
+@pytest.mark.unit
+def test_two_images_without_resolution_are_both_named(tmp_path: Path) -> None:
+    for name in ("a.png", "b.png"):
+        (tmp_path / name).write_bytes((SAMPLE / "truth.png").read_bytes())
+    got = CliRunner().invoke(app, ["eval", str(tmp_path / "a.png"), str(tmp_path / "b.png")])
+    assert got.exit_code == 2 and len(got.stderr.strip().splitlines()) == 1, got.stderr
+    assert all(str(tmp_path / n) in got.stderr for n in ("a.png", "b.png")), got.stderr
+    assert "--map-resolution and --truth-resolution" in got.stderr

@@ -43,3 +43,17 @@ def test_a_command_still_gets_the_whole_application():
     got = subprocess.run([sys.executable, "-m", "pcmapq", "eval", "--help"], capture_output=True,
                          text=True, timeout=120)
     assert got.returncode == 0 and "--map-crop" in got.stdout, got.stderr
+
+
+@pytest.mark.unit
+def test_help_offers_what_each_command_does():
+    """eval's --footprint does not offer 'seen' (only track has the scans it needs), --plot
+    names the formats its extension picks, and eval's gates speak of one result, batch's of
+    rows."""
+    text = CliRunner().invoke(app, ["eval", "--help"], terminal_width=200).output
+    footprint = next(line for line in text.splitlines() if "--footprint" in line)
+    assert "seen" not in footprint and "walls" in footprint
+    assert "SVG" in text and "PDF" in text
+    assert "row" not in text.split("--fail-under")[1].split("--fail-over")[0]
+    rows = CliRunner().invoke(app, ["batch", "--help"], terminal_width=200).output
+    assert "any row" in rows.split("--fail-under")[1]

@@ -82,7 +82,9 @@ def plan_points(source: OccupancyMap | PointMap,
     else:
         xy = source.points[:, :2]
     if len(xy) == 0:
-        raise InputError(f"{source.path}: no occupied cells or wall points")
+        why = source.empty if isinstance(source, OccupancyMap) else ""
+        raise InputError(f"{source.path}: no occupied cells: {why}" if why else
+                         f"{source.path}: no occupied cells or wall points")
     check_structure(source.path, xy)
     if isinstance(source, OccupancyMap):
         check_occupied_share(source, int(np.count_nonzero(occupied)))

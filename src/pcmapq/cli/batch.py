@@ -11,7 +11,7 @@ import typer
 from rich.console import Console
 
 from pcmapq import gates, options, terminal
-from pcmapq.cli.commands import HELP, FailOver, FailUnder, app
+from pcmapq.cli.commands import HELP, RowsFailOver, RowsFailUnder, app
 from pcmapq.errors import InputError
 from pcmapq.io.writers import OutputSet, write_atomic
 from pcmapq.terminal import (
@@ -50,8 +50,8 @@ def batch_command(
     json_path: Annotated[str | None, typer.Option(
         "--json", help="Write how each row ended as JSON to this path ('-' for stdout only)."
     )] = None,
-    fail_under: FailUnder = None,
-    fail_over: FailOver = None,
+    fail_under: RowsFailUnder = None,
+    fail_over: RowsFailOver = None,
     quiet: Annotated[bool, typer.Option(
         "--quiet", "-q", help="Print nothing but warnings and errors.")] = False,
 ) -> None:

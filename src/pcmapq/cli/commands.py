@@ -18,15 +18,24 @@ app = new_app()
 __all__ = ["DEFAULTS", "HELP", "app"]
 
 
-#: The CI gates of eval and batch (a batch judges every row; docs/ci.md).
+#: The CI gates of eval (one result) and batch (every row; docs/ci.md).
 FailUnder = Annotated[str | None, typer.Option(
     metavar="<KEY=VALUE,...>",
-    help="CI gate: exit 3 when a figure (of any row, in a batch) is below its bound, e.g. "
+    help="CI gate: exit 3 when a figure is below its bound, e.g. "
     "harris.quality=0.8,coverage=0.9 (keys: docs/ci.md; a figure that is n/a fails). The "
     "outputs are written all the same.")]
 FailOver = Annotated[str | None, typer.Option(
     metavar="<KEY=VALUE,...>",
     help="CI gate for distances: exit 3 when a figure is above its bound, e.g. "
+    "accuracy.mean=0.05 (metres).")]
+RowsFailUnder = Annotated[str | None, typer.Option(
+    "--fail-under", metavar="<KEY=VALUE,...>",
+    help="CI gate: exit 3 when a figure of any row is below its bound, e.g. "
+    "harris.quality=0.8,coverage=0.9 (keys: docs/ci.md; a figure that is n/a fails). The "
+    "outputs are written all the same.")]
+RowsFailOver = Annotated[str | None, typer.Option(
+    "--fail-over", metavar="<KEY=VALUE,...>",
+    help="CI gate for distances: exit 3 when a figure of any row is above its bound, e.g. "
     "accuracy.mean=0.05 (metres).")]
 #: The memory limit of eval and track, in GB (:func:`memory_limit` in bytes).
 MaxMemory = Annotated[float | None, typer.Option(

@@ -118,7 +118,8 @@ def eval_command(
         "metres), the offset and turn (degrees) that fit it to the truth on its own, its "
         "points, its fitness before and after, and whether its walls hold it (held).")] = None,
     plot: Annotated[Path | None, typer.Option(
-        help="Draw the vectorial map, one panel per detector, as PNG.")] = None,
+        help="Draw the vectorial map, one panel per detector: PNG, SVG or PDF by the file's "
+        "extension.")] = None,
     report: Annotated[Path | None, typer.Option(
         help="Write a self-contained HTML report (figures embedded).")] = None,
     arrow_scale: Annotated[float, typer.Option(
@@ -132,7 +133,7 @@ def eval_command(
         help="Distance thresholds of the F-score, metres, comma-separated.")
     ] = ",".join(f"{t:g}" for t in DEFAULTS.distances.taus),
     footprint: Annotated[str, typer.Option(
-        metavar="<" + "|".join(FOOTPRINT_RULES) + ">",
+        metavar="<" + "|".join(r for r in FOOTPRINT_RULES if r != "seen") + ">",
         help="The area the map observed: 'known' cells of an image, the area its 'walls' "
         "enclose, 'all' of its rectangle; 'auto': known cells for an image with unknown "
         "regions, walls for a binary image or a cloud.")] = DEFAULTS.footprint.rule,

@@ -35,6 +35,8 @@ from pcmapq.morphology import disc, outline, reaching_border
 IMAGE_SUFFIXES = (".png", ".pgm", ".jpg", ".jpeg", ".bmp")
 YAML_SUFFIXES = (".yaml", ".yml")
 MODES = ("trinary", "scale", "raw")
+#: The problem of an image read without a resolution.
+NO_RESOLUTION = "no resolution"
 #: The outside of a building drawn solid is read as a wall this thick along its face, metres
 #: (:func:`open_outside`): a plan's usual wall, whose centre line then lies where a plan drawn
 #: with walls would put it, about half this beyond the face a laser sees.
@@ -55,12 +57,14 @@ class OccupancyMap:
     path: the file given (image or YAML).
     grid: cell size and pose of the image in the map's metric frame.
     state: (rows, cols) int8, OCCUPIED (1), FREE (0) or UNKNOWN (-1); row 0 is the image's top.
+    empty: why no cell is occupied, and what would read its walls (empty when some are).
     """
 
     path: Path
     grid: MetricGrid
     state: np.ndarray
     kind: str = "image"
+    empty: str = ""
 
 
 @dataclass(frozen=True)
@@ -123,10 +127,32 @@ def load_occupancy(path: Path, resolution: float | None = None,
     if meta.resolution is None and fallback is not None:
         meta = replace(meta, resolution=_resolution(path, fallback))
     if meta.resolution is None:
-        raise InputError(f"{path}: no resolution: give --map-resolution/--truth-resolution "
+        raise InputError(f"{path}: {NO_RESOLUTION}: give --map-resolution/--truth-resolution "
                          "or a YAML beside it")
-    state = open_outside(classify(levels, channels, scale, transparent, meta), meta.resolution)
-    return OccupancyMap(path, MetricGrid(meta.resolution, meta.origin, state.shape), state)
+    state = classify(levels, channels, scale, transparent, meta)
+    empty = "" if (state == OCCUPIED).any() else _darkest(levels, channels, scale, transparent,
+                                                          meta)
+    state = open_outside(state, meta.resolution)
+    return OccupancyMap(path, MetricGrid(meta.resolution, meta.origin, state.shape), state,
+                        empty=empty)
+
+
+def _darkest(levels: np.ndarray, channels: int, scale: float, transparent: np.ndarray,
+             meta: MapMeta) -> str:
+    """Why an image has no occupied cell and what to change, one clause: its most occupied
+    pixel's p against ``occupied_thresh`` (walls drawn grey, as a CARMEN map's are)."""
+    shown = levels[~transparent]
+    if shown.size == 0:
+        return "every pixel is transparent"
+    value = np.unique(shown) / channels * scale
+    p = (value / 100.0 if meta.mode == "raw" else
+         value / 255.0 if meta.negate else (255.0 - value) / 255.0)
+    if meta.mode == "raw":
+        p = p[value <= 100.0]
+    top = float(p.max(initial=0.0))
+    return (f"its darkest pixels read p = {top:.2f}, not above occupied_thresh "
+            f"{meta.occupied_thresh:g}; walls drawn grey need a lower --map-occupied-thresh "
+            "or --truth-occupied-thresh (occupied_thresh in its YAML)")
 
 
 def open_outside(state: np.ndarray, resolution: float) -> np.ndarray:
