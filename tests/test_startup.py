@@ -29,9 +29,9 @@ def test_the_listing_says_what_the_whole_application_says(args):
 @pytest.mark.e2e
 @pytest.mark.parametrize("flag", ["--help", "--version"])
 def test_help_and_version_import_no_heavy_library(flag):
-    code = ("import sys; from pcmapq.cli import main; sys.argv = ['pcmapq', %r]\n"
+    code = (f"import sys; from pcmapq.cli import main; sys.argv = ['pcmapq', {flag!r}]\n"
             "try:\n    main()\nexcept SystemExit:\n    pass\n"
-            "print(sorted({m.split('.')[0] for m in sys.modules} & set(%r)))") % (flag, HEAVY)
+            f"print(sorted({{m.split('.')[0] for m in sys.modules}} & set({HEAVY!r})))")
     got = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          timeout=120)
     assert got.returncode == 0, got.stderr
