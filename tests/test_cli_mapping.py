@@ -21,6 +21,7 @@ def test_map_with_kiss_and_with_reference_poses(tmp_path):
     proc = run("map", str(scans), "--out", str(tmp_path / "kiss.ply"), "--max-scans", "5",
                "--poses-out", str(tmp_path / "kiss.txt"), "--tum-out", str(tmp_path / "kiss.tum"))
     assert proc.returncode == 0, proc.stderr
+    assert "mapping scans 000000.bin to 000004.bin (the first 5 of 20)" in proc.stderr
     kitti = read_kitti_poses(tmp_path / "kiss.txt")
     _, tum = read_tum_poses(tmp_path / "kiss.tum")
     assert kitti.shape == (5, 4, 4)

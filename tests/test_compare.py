@@ -61,6 +61,17 @@ def test_compare_writes_one_row_per_result(saved, tmp_path):
                               for k in ("harris", "hough", "sift")]
     assert shown["b"][1] == "n/a" and shown["b"][-1] == "ok"
     assert proc.stderr.count("wrote ") == 3
+    assert f"wrote {tmp_path / 'cmp' / 'table.csv'}\n" in proc.stderr  # as --out was given
+
+
+def test_wrote_lines_give_the_paths_as_typed(saved, tmp_path, monkeypatch):
+    """eval and compare both name what they wrote as the user typed it (compare gave the
+    resolved absolute path)."""
+    monkeypatch.chdir(tmp_path)
+    proc = run("compare", str(saved["a"]), str(saved["b"]), "--out", "cmp")
+    assert proc.returncode == 0, proc.stderr
+    assert [line for line in proc.stderr.splitlines() if line.startswith("wrote ")] == \
+        ["wrote cmp/table.csv", "wrote cmp/table.md", "wrote cmp/figure.png"]
 
 
 def test_names_replace_the_file_stems(saved, tmp_path):

@@ -43,7 +43,8 @@ def compare_command(
         rows = [s.row for s in saved]
         wrote = write_summary(rows, out)
     if not quiet:
-        for path in wrote:
-            err.print(f"wrote {path}", markup=False, highlight=False, soft_wrap=True)
+        for path in wrote:  # as the user wrote --out, as eval's and batch's
+            err.print(f"wrote {out / path.name}", markup=False, highlight=False,
+                      soft_wrap=True)
         print_summary(rows, Console())
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 from typing import Annotated
 
@@ -63,6 +64,12 @@ def map_command(
                               None, inputs=(source, poses, calib))
         with scan_bar(err, enabled=not quiet) as tick:
             if poses is None:
+                if max_scans is not None and not quiet:
+                    every = open_scans(source)
+                    first = replace(every, count=min(max_scans, len(every)),
+                                    files=every.files[:max_scans])
+                    err.print(f"mapping {describe_scans(first, len(every))}", markup=False,
+                              highlight=False, soft_wrap=True)
                 points, trajectory = build_map_kiss(source, max_scans=max_scans, voxel=voxel,
                                                     progress=tick)
             else:
