@@ -147,11 +147,12 @@ def test_2d_cloud_exports(tmp_path):
     assert proc.returncode == 0, proc.stderr
     assert all(f"wrote {p}" in proc.stderr for p in out.values())
     matrix = np.loadtxt(out["T.txt"])
-    assert matrix.shape == (3, 3)
-    np.testing.assert_allclose(matrix, KNOWN.matrix, atol=0.01)
+    assert matrix.shape == (4, 4)  # as CloudCompare applies it
+    np.testing.assert_allclose(matrix[[0, 1, 3]][:, [0, 1, 3]], KNOWN.matrix, atol=0.01)
+    np.testing.assert_allclose(matrix[2], [0.0, 0.0, 1.0, 0.0], atol=1e-12)
     aligned = read_cloud(out["a.ply"])["positions"]
     map_xy = np.load(tmp_path / "map.npy")
-    np.testing.assert_allclose(aligned[:, :2], map_xy @ matrix[:2, :2].T + matrix[:2, 2],
+    np.testing.assert_allclose(aligned[:, :2], map_xy @ matrix[:2, :2].T + matrix[:2, 3],
                                atol=1e-5)
     assert np.abs(aligned[:, 2]).max() == 0.0
     assert np.abs(aligned[:, :2] - in_plan).max() < 0.02
@@ -234,7 +235,8 @@ def test_image_map_exports(truth_png, tmp_path):
                "--transform", str(t))
     assert proc.returncode == 0, proc.stderr
     assert f"wrote {aligned.with_suffix('.yaml')}" in proc.stderr
-    np.testing.assert_allclose(np.loadtxt(t), KNOWN.matrix, atol=0.025)  # half a cell
+    matrix = np.loadtxt(t)
+    np.testing.assert_allclose(matrix[[0, 1, 3]][:, [0, 1, 3]], KNOWN.matrix, atol=0.025)
     doc = yaml.safe_load(aligned.with_suffix(".yaml").read_text())
     assert doc["image"] == "aligned.png" and doc["origin"][2] == 0.0
     back, truth = load_map(aligned.with_suffix(".yaml")), load_map(truth_png)

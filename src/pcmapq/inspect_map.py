@@ -17,6 +17,7 @@ from pcmapq import __version__
 from pcmapq.config import NoRefConfig
 from pcmapq.io import OccupancyMap, PointMap
 from pcmapq.noref_figures import input_figures
+from pcmapq.stats import significant
 
 
 def inspect_map(source: OccupancyMap | PointMap, config: NoRefConfig = NoRefConfig(),
@@ -32,8 +33,9 @@ def inspect_map(source: OccupancyMap | PointMap, config: NoRefConfig = NoRefConf
 
 
 def to_json(record: dict[str, Any]) -> str:
-    """The record as strict JSON (no NaN or infinity), as ``eval --json`` writes."""
-    return json.dumps(record, indent=2, allow_nan=False) + "\n"
+    """The record as strict JSON (no NaN or infinity; figures to six significant digits), as
+    ``eval --json`` writes its ``noref`` block."""
+    return json.dumps(significant(record), indent=2, allow_nan=False) + "\n"
 
 
 def summary_lines(record: dict[str, Any]) -> list[str]:

@@ -16,7 +16,7 @@ from pcmapq.frames import Frames
 from pcmapq.grid import MetricGrid
 from pcmapq.match import Matching
 from pcmapq.metrics.distances import Distances, FScore
-from pcmapq.stats import Stats
+from pcmapq.stats import Stats, significant
 from pcmapq.transform import Similarity2D
 
 if TYPE_CHECKING:  # the alignment modules load Open3D; a Result only holds their outputs
@@ -209,7 +209,7 @@ class Result:
             doc["extra"] += [{"detector": name, "map_xy_m": p}
                              for p in det.map.xy[m.extra].tolist()]
         doc = _rounded(doc)
-        doc["noref"] = self.noref  # unrounded: MPV and MOM are small areas (1e-3 m^2 and less)
+        doc["noref"] = significant(self.noref)  # MPV, MOM: areas of 1e-3 m^2 and less
         return doc
 
     def to_json(self) -> str:

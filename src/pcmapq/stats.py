@@ -4,6 +4,7 @@ displacements, map-to-truth and truth-to-map distances, in 2D and 3D), metres.""
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass
+from typing import Any
 
 import numpy as np
 
@@ -45,3 +46,16 @@ class Stats:
     def from_dict(cls, doc: dict) -> Stats:
         """The inverse of :meth:`to_dict`."""
         return cls(**{k: doc[k] for k in FIELDS})
+
+
+def significant(value: Any, digits: int = 6) -> Any:
+    """Every float of a nested structure (dicts, lists) to ``digits`` significant digits: the
+    JSON form of figures whose scale varies (MPV and MOM are areas of 1e-3 m^2 and less, where
+    a fixed number of decimals would keep one digit)."""
+    if isinstance(value, float):
+        return float(f"{value:.{digits}g}") + 0.0
+    if isinstance(value, dict):
+        return {k: significant(v, digits) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [significant(v, digits) for v in value]
+    return value

@@ -146,8 +146,9 @@ def eval_command(
         "cloud keeps its heights), .png/.pgm with its map_server YAML for an image map.")
     ] = None,
     transform: Annotated[Path | None, typer.Option(
-        help="Write the map -> truth matrix as plain text (.txt): 4x4 for a 3D cloud map, 3x3 "
-        "for a 2D map (np.loadtxt, CloudCompare).")] = None,
+        help="Write the map -> truth matrix as plain text (.txt), 4x4 as CloudCompare and "
+        "np.loadtxt read it: a 2D map's plan similarity with z scaled alike (the JSON's "
+        "alignment.matrix is its 3x3).")] = None,
     distances: Annotated[Path | None, typer.Option(
         help="Write the map's points in the truth's frame with their distance to the truth "
         "(.ply: scalar field scalar_distance_m, metres, and a colour).")] = None,

@@ -74,10 +74,12 @@ def cloud_matrix(frames: Frames) -> np.ndarray:
 
 
 def map_matrix(result: Result, source: OccupancyMap | PointMap) -> np.ndarray:
-    """The matrix ``--transform`` writes: 4x4 for a 3D cloud map, else the plan's 3x3."""
+    """The 4x4 matrix ``--transform`` writes, as CloudCompare and Open3D apply it: a 3D cloud
+    map's whole chain; for a 2D map the plan's similarity lifted (:func:`lift`: z scaled by
+    its scale, so a 2D map's z = 0 stays 0), the JSON's 3x3 ``alignment.matrix`` in 3D."""
     if isinstance(source, PointMap) and source.is_3d:
         return cloud_matrix(result.frames)
-    return result.frames.planar.matrix
+    return lift(result.frames.planar)
 
 
 def load_source(result: Result, given: Path | PointMap, settings: Settings
