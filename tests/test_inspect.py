@@ -27,7 +27,7 @@ def _inspect(*args: str) -> tuple[int, str, str]:
 
 def test_a_3d_cloud_gets_the_library_figures_and_the_same_json_twice(tmp_path):
     """A noisy floor and two walls (1 cm noise): the JSON holds noref.scores' MME and MPV of
-    the same points and is byte-identical across runs; the floor alone has an MPV of the
+    the same points (rounded: see pcmapq.stats.significant) and is byte-identical across runs; the floor alone has an MPV of the
     noise's variance."""
     rng = np.random.default_rng(5)
     floor = np.column_stack([rng.uniform(0, 4, (3000, 2)), rng.normal(0, 0.01, 3000)])
@@ -47,7 +47,8 @@ def test_a_3d_cloud_gets_the_library_figures_and_the_same_json_twice(tmp_path):
     assert texts[0] == texts[1]
     got = json.loads(texts[0])["cloud"]
     want = noref.scores(points, 0.3, noref.MIN_KNN)
-    assert got["mme"] == want.mme and got["mpv"] == want.mpv
+    # the JSON's figures: 6 decimals, or 6 significant digits where that keeps more
+    assert got["mme"] == round(want.mme, 6) and got["mpv"] == float(f"{want.mpv:.6g}")
     assert got["points"] == len(points) and got["radius_m"] == 0.3
     np.save(path, floor)  # one plane alone: MPV is the noise's variance, 1e-4 m^2
     code, stdout, stderr = _inspect(str(path), "--radius", "0.3", "--json", "-")

@@ -3,6 +3,7 @@ displacements, map-to-truth and truth-to-map distances, in 2D and 3D), metres.""
 
 from __future__ import annotations
 
+import math
 from dataclasses import asdict, dataclass
 from typing import Any
 
@@ -49,11 +50,14 @@ class Stats:
 
 
 def significant(value: Any, digits: int = 6) -> Any:
-    """Every float of a nested structure (dicts, lists) to ``digits`` significant digits: the
-    JSON form of figures whose scale varies (MPV and MOM are areas of 1e-3 m^2 and less, where
-    a fixed number of decimals would keep one digit)."""
+    """Every float of a nested structure (dicts, lists) rounded to ``digits`` decimals, or to
+    ``digits`` significant digits where that keeps more: the JSON form of figures whose scale
+    varies (MME in nats near -3.6 keeps 6 decimals; MPV and MOM, areas of 1e-3 m^2 and less,
+    keep 6 significant digits where 6 decimals would keep one)."""
     if isinstance(value, float):
-        return float(f"{value:.{digits}g}") + 0.0
+        if value == 0.0 or not math.isfinite(value):
+            return value + 0.0
+        return round(value, max(digits, digits - 1 - math.floor(math.log10(abs(value))))) + 0.0
     if isinstance(value, dict):
         return {k: significant(v, digits) for k, v in value.items()}
     if isinstance(value, list | tuple):
