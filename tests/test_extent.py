@@ -132,6 +132,7 @@ def _crop_option(stderr: str, option: str) -> str:
     return stderr.split(f"{option} ")[-1].split(" keeps")[0]
 
 
+@pytest.mark.e2e  # whole evaluations
 def test_a_truth_with_a_copy_far_away_is_refused_then_cropped_to_the_clean_result(
         tmp_path, scan_points):
     """The sample's scan as truth, plus its copy 20 km away: refused (exit 2) with the box of the
@@ -156,6 +157,7 @@ def test_a_truth_with_a_copy_far_away_is_refused_then_cropped_to_the_clean_resul
     assert cropped_run["settings"]["truth"]["crop"] == [float(v) for v in box.split(",")]
 
 
+@pytest.mark.e2e  # whole evaluations
 def test_a_map_with_a_point_at_1e300_is_refused_then_cropped(tmp_path, scan_points):
     path = tmp_path / "outlier.npy"
     np.save(path, np.vstack([scan_points, [[1e300, 0.0, 1.0]]]))

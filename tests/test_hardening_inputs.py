@@ -98,7 +98,7 @@ def test_broken_file_is_one_line_exit_2_quickly(tmp_path: Path, name: str) -> No
     assert time.perf_counter() - start < 10.0
 
 
-@pytest.mark.unit
+@pytest.mark.e2e  # writes a 30000 x 30000 PNG
 def test_an_image_too_large_for_the_memory_guard_is_refused_before_decoding(
         tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     """30000 x 30000 pixels (a real, 1 MB PNG) under a 1 GB limit: refused from its header."""

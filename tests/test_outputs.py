@@ -128,6 +128,7 @@ def test_special_files_are_refused(tmp_path: Path):
     assert (tmp_path / "fifo.json").is_fifo() and (tmp_path / "stdout.csv").is_symlink()
 
 
+@pytest.mark.e2e  # whole evaluations
 def test_an_output_failing_after_the_work_leaves_none(tmp_path: Path, monkeypatch):
     """The report fails after the JSON, CSV, plot and aligned map are produced: none of them
     appears, no temporary file stays, nothing goes to stdout for ``--json -``."""

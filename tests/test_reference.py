@@ -7,6 +7,8 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import pytest
+
 from bench.validation.reference import differences
 from pcmapq.pipeline import evaluate
 
@@ -29,6 +31,7 @@ def write_reference() -> None:
     REFERENCE.write_text(json.dumps(sample_document(), indent=1) + "\n")
 
 
+@pytest.mark.e2e  # whole evaluations
 def test_sample_result_equals_the_reference():
     found = differences(sample_document(), json.loads(REFERENCE.read_text()))
     assert not found, "\n".join(found[:20])
