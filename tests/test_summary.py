@@ -130,19 +130,24 @@ def test_markdown_table_shows_nulls_and_failures(summary_rows):
                               "nor an image (second line) |")
 
 
-def test_figure_draws_a_bar_per_defined_quality_and_marks_the_gaps(summary_rows):
+@pytest.mark.parametrize("panel, score", enumerate(("quality", "precision", "f1")))
+def test_figure_draws_a_bar_per_defined_score_and_marks_the_gaps(summary_rows, panel, score):
+    """A panel per score (quality, precision, f1: a map with precision 0.82 shows it)."""
     fig = summary_figure(summary_rows)
-    ax = fig.axes[0]
+    assert len(fig.axes) == 3
+    ax = fig.axes[panel]
+    assert ax.get_ylabel().startswith(score)
     bars = {c.get_label(): c for c in ax.containers}
     assert list(bars) == list(DETECTOR_NAMES)
     for det, container in bars.items():
-        expected = [r[f"{det}_quality"] for r in summary_rows
-                    if r[f"{det}_quality"] is not None and not r["exit_code"]]
+        expected = [r[f"{det}_{score}"] for r in summary_rows
+                    if r[f"{det}_{score}"] is not None and not r["exit_code"]]
         assert [p.get_height() for p in container.patches] == pytest.approx(expected)
     assert len(bars["hough"].patches) == 1  # the degraded map's and the failed one's: gaps
     texts = [t.get_text() for t in ax.texts]
     assert texts.count("n/a") == 1 and texts.count("failed (exit 2)") == 1
-    assert [t.get_text() for t in ax.get_xticklabels()] == ["sample", "degraded", "broken"]
+    labels = [t.get_text() for t in fig.axes[-1].get_xticklabels()]
+    assert labels == ["sample", "degraded", "broken"]
 
 
 def test_outputs_are_the_same_bytes_every_time(summary_rows, tmp_path):

@@ -170,19 +170,39 @@ def print_summary(rows: Sequence[dict[str, object]], console) -> None:
                           soft_wrap=True)
 
 
+#: The panels of the summary figure: a detector's score and its axis label.
+PANELS = (("quality", "quality\n(matched truth / truth)"),
+          ("precision", "precision\n(matched map / map)"),
+          ("f1", "f1"))
+
+
 def summary_figure(rows: Sequence[dict[str, object]]):
-    """The qualities grouped per map (the paper's Figure 7): one bar per detector, a gap
-    marked 'n/a' where a quality is undefined, 'failed (exit N)' over a failed map's group.
-    A matplotlib Figure (Agg)."""
+    """Each detector's quality, precision and f1 grouped per map, a panel each (quality is the
+    paper's Figure 7): one bar per detector, a gap marked 'n/a' where a score is undefined,
+    'failed (exit N)' over a failed map's group. A matplotlib Figure (Agg)."""
     from pcmapq.report.plot import plt  # matplotlib on the Agg backend
 
     n, k = len(rows), len(DETECTOR_NAMES)
     width = 0.8 / k
-    fig, ax = plt.subplots(figsize=(min(max(4.0, 1.2 + 0.9 * n), 20.0), 4.0),
-                           layout="constrained")
+    fig, axes = plt.subplots(len(PANELS), 1, sharex=True, layout="constrained",
+                             figsize=(min(max(4.0, 1.2 + 0.9 * n), 20.0), 2.6 * len(PANELS)))
+    for ax, (score, label) in zip(axes, PANELS, strict=True):
+        _score_panel(ax, rows, score, width)
+        ax.set_ylabel(label)
+    axes[0].set_title("feature quality, precision and f1 per map")
+    axes[0].legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), frameon=False)
+    axes[-1].set_xticks(range(n), [str(row.get("name")) for row in rows],
+                        rotation=30 if n > 6 else 0, ha="right" if n > 6 else "center")
+    axes[-1].set_xlim(-0.6, n - 0.4)
+    return fig
+
+
+def _score_panel(ax, rows: Sequence[dict[str, object]], score: str, width: float) -> None:
+    """One panel of :func:`summary_figure`: ``score`` of every detector, per map."""
+    k = len(DETECTOR_NAMES)
     for j, det in enumerate(DETECTOR_NAMES):
-        xs = [i + (j - (k - 1) / 2) * width for i in range(n)]
-        values = [row.get(f"{det}_quality") for row in rows]
+        xs = [i + (j - (k - 1) / 2) * width for i in range(len(rows))]
+        values = [row.get(f"{det}_{score}") for row in rows]
         shown = [(x, v) for x, v, row in zip(xs, values, rows, strict=True)
                  if v is not None and not row.get("exit_code")]
         ax.bar([x for x, _ in shown], [v for _, v in shown], width, color=COLOURS.get(det),
@@ -195,14 +215,7 @@ def summary_figure(rows: Sequence[dict[str, object]]):
         if row.get("exit_code"):
             ax.text(i, 0.5, f"failed (exit {row['exit_code']})", rotation=90, ha="center",
                     va="center", fontsize=8, color="#aa3377")
-    ax.set_xticks(range(n), [str(row.get("name")) for row in rows],
-                  rotation=30 if n > 6 else 0, ha="right" if n > 6 else "center")
-    ax.set_xlim(-0.6, n - 0.4)
     ax.set_ylim(0.0, 1.05)
-    ax.set_ylabel("quality (matched truth / truth features)")
-    ax.set_title("feature quality per map")
-    ax.legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), frameon=False)
-    return fig
 
 
 def write_summary(rows: Sequence[dict[str, object]], out_dir: Path) -> list[Path]:
