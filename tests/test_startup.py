@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 from typer.testing import CliRunner
@@ -57,3 +58,20 @@ def test_help_offers_what_each_command_does():
     assert "row" not in text.split("--fail-under")[1].split("--fail-over")[0]
     rows = CliRunner().invoke(app, ["batch", "--help"], terminal_width=200).output
     assert "any row" in rows.split("--fail-under")[1]
+
+
+@pytest.mark.e2e
+def test_dev_null_discards_an_output(tmp_path):
+    """`--json /dev/null` (and any output option) discards, as Unix tools do: exit 0, no
+    "wrote" line, and /dev/null is still the device."""
+    import os
+    import stat
+
+    sample = Path(__file__).resolve().parents[1] / "data" / "sample"
+    got = CliRunner().invoke(app, ["eval", str(sample / "scan.ply"), str(sample / "truth.png"),
+                                   "--json", os.devnull, "--plot", os.devnull, "--quiet"])
+    assert got.exit_code == 0, got.stderr
+    assert "wrote" not in got.stderr
+    assert stat.S_ISCHR(os.stat(os.devnull).st_mode)
+    got = CliRunner().invoke(app, ["inspect", str(sample / "truth.yaml"), "--json", os.devnull])
+    assert got.exit_code == 0 and "wrote" not in got.stderr, got.stderr

@@ -155,6 +155,12 @@ def output_suffixes(option: str, map_path: Path | None) -> tuple[str, ...]:
 SPECIAL_FOLDERS, ORDINARY_FOLDER = (Path("/dev"), Path("/proc")), Path("/dev/shm")
 
 
+def kept(path: str | Path | None) -> str | Path | None:
+    """An output option's path, or None (nothing written) for ``/dev/null`` (``os.devnull``),
+    as Unix tools read it: never written through (an atomic write would replace the device)."""
+    return None if path is not None and str(path) == os.devnull else path
+
+
 def check_outputs(outputs: dict[str, str | Path | None], map_path: Path | None,
                   inputs: Iterable[Path | None] = ()) -> None:
     """Refuse, before any work, an output that could not be written: ``outputs`` maps each

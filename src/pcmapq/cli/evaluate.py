@@ -184,6 +184,9 @@ def eval_command(
         voxel_3d=voxel_3d, tau=tau, footprint=footprint, full=full, noref=noref,
         noref_radius=noref_radius, noref_voxel=noref_voxel))
     auto = settings.alignment.scale
+    json_path, vectors, regions, plot, report, aligned, transform, distances = (
+        options.kept(p) for p in (json_path, vectors, regions, plot, report, aligned, transform,
+                                  distances))
     exports = {"--aligned": aligned, "--transform": transform, "--distances": distances}
     err = Console(stderr=True)
     out = Console(quiet=quiet or json_path == "-")  # not a terminal: COLUMNS or 80 wide

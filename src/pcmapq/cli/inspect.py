@@ -92,6 +92,7 @@ def inspect_command(
         "--quiet", "-q", help="Print nothing but warnings and errors.")] = False,
 ) -> None:
     err = Console(stderr=True)
+    json_path = options.kept(json_path)
     with report_errors(err), terminal.show_warnings(err):
         if (map_path is None) == (scans is None) or (scans is None) != (poses is None):
             raise typer.BadParameter("give MAP, or --scans DIR with --poses FILE",

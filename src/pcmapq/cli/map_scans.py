@@ -56,6 +56,7 @@ def map_command(
         "--quiet", "-q", help="Print nothing but warnings and errors.")] = False,
 ) -> None:
     err = Console(stderr=True)
+    poses_out, tum_out = options.kept(poses_out), options.kept(tum_out)
     with report_errors(err), terminal.show_warnings(err):
         if calib is not None and poses is None:
             raise InputError(f"{calib}: --calib places scans with --poses only (KISS-ICP's "

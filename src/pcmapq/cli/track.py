@@ -98,6 +98,7 @@ def track_command(
         truth_resolution=truth_resolution, init=init, no_align=no_align, force=force,
         threshold=threshold, detectors=detectors, footprint=footprint, tau=tau))
     err = Console(stderr=True)
+    json_path = options.kept(json_path)
     shown = not quiet and json_path != "-"
     with report_errors(err), terminal.show_warnings(err), \
             step_progress(err, enabled=shown) as progress:
