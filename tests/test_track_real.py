@@ -1,6 +1,7 @@
-"""`pcmapq track` reads KITTI's reference poses, which are the left camera's, through
-``--calib`` as `pcmapq map` does: its pose errors are those of the LiDAR frame its run is in,
-checked against figures computed here from the poses alone."""
+"""`pcmapq track` on real runs. KITTI's reference poses, which are the left camera's, are read
+through ``--calib`` as `pcmapq map` does: the pose errors are those of the LiDAR frame the run
+is in, checked against figures computed here from the poses alone. A CARMEN log scored against
+itself ends at 1."""
 
 from __future__ import annotations
 
@@ -117,3 +118,21 @@ def test_calib_without_reference_poses_is_refused(tmp_path) -> None:
                                    "--out", str(tmp_path / "o"), "--calib", str(calib)])
     assert got.exit_code == 2, got.stderr
     assert got.stderr.count("\n") == 1 and str(calib) in got.stderr, got.stderr
+
+
+@pytest.mark.e2e
+def test_a_log_scored_against_itself_ends_at_one(tmp_path) -> None:
+    """The README's FHW run against itself (docs/metrics.md, 'A run scored against itself'):
+    at the last step the map is the truth, every quality and precision 1; its coverage under
+    the 'seen' footprint stays below 1 by the far walls drawn as dots (0.953), and is 1 with
+    --footprint all."""
+    log = shared("carmen", "fhw-corrected.log.gz")
+    for footprint, coverage in (("auto", (0.9, 0.99)), ("all", (1.0, 1.0))):
+        out = tmp_path / footprint
+        got = CliRunner().invoke(app, ["track", str(log), str(log), "--every", "1000",
+                                       "--footprint", footprint, "--out", str(out), "--quiet"])
+        assert got.exit_code == 0, got.stderr
+        last = json.loads((out / "track.json").read_text())["steps"][-1]
+        for name in ("harris", "hough", "sift"):
+            assert last[f"{name}_quality"] == last[f"{name}_precision"] == 1.0, (name, last)
+        assert coverage[0] <= last["coverage"] <= coverage[1], last["coverage"]
