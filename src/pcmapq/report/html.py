@@ -73,8 +73,16 @@ def _lists(name: str, det: DetectorResult) -> str:
         det.map.xy[m.extra], det.truth.xy, "truth") + "</div>"
 
 
-def _table(header: list[str], rows: list[list[str]]) -> str:
-    head = "".join(f"<th>{html.escape(h)}</th>" for h in header)
+def _table(header: list[str], rows: list[list[str]], breaks: str = "") -> str:
+    """A table: ``header`` above ``rows`` (text, escaped); a header may break after any of the
+    characters ``breaks`` (long column names such as ``wall_precision@0.1m``)."""
+    def name(h: str) -> str:
+        text = html.escape(h)
+        for c in breaks:
+            text = text.replace(c, c + "<wbr>")
+        return text
+
+    head = "".join(f"<th>{name(h)}</th>" for h in header)
     body = "".join("<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in row) + "</tr>"
                    for row in rows)
     return f"<table><tr>{head}</tr>{body}</table>"

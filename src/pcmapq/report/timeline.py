@@ -37,8 +37,15 @@ OTHER = ("#222222", "#aa3377", "#66ccee", "#ccbb44", "#bbbbbb")
 MIN_METRES, MIN_DEGREES = 0.1, 0.5
 #: The path over the vectorial map, drawn over a white edge above every marker.
 PATH_COLOUR, PATH_Z = "#08306b", 10
-#: The inputs' table reads left to right.
-FACTS_STYLE = ".facts td { text-align: left; }\n"
+#: The inputs' table reads left to right, a long path or command breaks anywhere rather than
+#: widen the page, and the table of steps scrolls inside its own box when wider than the page.
+FACTS_STYLE = """.facts td { text-align: left; }
+.sub, .facts td, code { overflow-wrap: anywhere; }
+.steps { max-width: 100%; overflow-x: auto; } .steps table { margin: 0; }
+.steps th { vertical-align: bottom; } .steps td { white-space: nowrap; }
+"""
+#: Column names in the table of steps break after these characters, so it fits a 1400 px window.
+BREAKS = "_@"
 #: The columns of the report's table of steps, those the rows have, and their decimals.
 TABLE = {"step": 0, "scans": 0, "distance_m": 1, "harris_quality": 3, "hough_quality": 3,
          "sift_quality": 3, "precision": 3, "wall_precision@0.1m": 3, "coverage": 3,
@@ -158,9 +165,9 @@ def timeline_html(rows: list[dict], drop: dict | None, shown: int, result: Resul
     marks = {shown: " (shown)"} | ({} if drop is None else
                                    {drop["peak"]: " (peak)", drop["start"]: " (fall starts)",
                                     drop["low"]: " (lowest)"})
-    parts.append("<h2>Steps</h2>" + _table(columns, [
+    parts.append("<h2>Steps</h2><div class='steps'>" + _table(columns, [
         [_cell(r[c], TABLE[c]) + (marks.get(r["step"], "") if c == "step" else "")
-         for c in columns] for r in rows]))
+         for c in columns] for r in rows], BREAKS) + "</div>")
     return ("<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'><meta "
             "name='viewport' content='width=device-width, initial-scale=1'><title>pcmapq "
             f"track</title><style>{STYLE}{FACTS_STYLE}</style></head><body>{''.join(parts)}"

@@ -10,7 +10,10 @@ truth dark over the aligned map light, as in the figures), pooled to at most
 :data:`VIEWER_PX` pixels across and down (:mod:`pcmapq.raster.pool`), so a map of any size
 costs pictures of bounded size; every feature is kept, none thinned. One ``<g>`` per detector
 and status holds its circles (Hough: its segments too; matched: the displacement arrows), and a
-checkbox shows or hides it. No network: the script is inline and plain JavaScript.
+checkbox shows or hides it. Markers keep their size on screen while the walls scale with the
+zoom, so where the markers crowd over thin walls (a street map seen whole) the walls are drawn
+over them and the features as rings (:data:`CROWDED_PX`, :data:`SMALL_CELL_PX`); zoomed in,
+the features are drawn over the walls. No network: the script is inline and plain JavaScript.
 """
 
 from __future__ import annotations
@@ -32,6 +35,14 @@ from pcmapq.result import DetectorResult, Result
 VIEWER_PX = 2048
 #: Opacity of the truth's walls over the map's (plot.TRUTH_ALPHA).
 TRUTH_OPACITY = 0.9
+#: Radius of a feature's circle, screen pixels, at every zoom.
+R_PX = 4
+#: The features crowd while the median distance from one to its nearest other is under this
+#: many screen pixels (two radii: their circles overlap) ...
+CROWDED_PX = 2 * R_PX
+#: ... over thin walls: a cell under this many screen pixels (a wall a few cells thick is then
+#: narrower than a circle, which shows around it). Both hold: walls over features, as rings.
+SMALL_CELL_PX = R_PX / 2
 #: What each status means, in the tooltip and beside its checkbox.
 STATUSES = {"matched": "matched", "missing": "missing (truth, no map partner)",
             "extra": "extra (map, no truth partner)"}
@@ -44,10 +55,9 @@ STYLE = """
 .viewer svg.dragging { cursor: grabbing; }
 .viewer circle { r: var(--r, 3px); vector-effect: non-scaling-stroke; pointer-events: all;
                  stroke-width: 2; }
-.viewer circle:hover, .viewer circle.pinned { stroke: #000; stroke-width: 3; }
 .viewer line { vector-effect: non-scaling-stroke; pointer-events: none; }
 .viewer .arrow { stroke: #000; stroke-width: 1.5; }
-.viewer image { image-rendering: pixelated; }
+.viewer image { image-rendering: pixelated; pointer-events: none; }
 #viewer-tip { position: absolute; pointer-events: none; background: rgba(255,255,255,0.95);
               border: 1px solid #888; padding: 0.3em 0.5em; font-size: 0.85em;
               white-space: pre; display: none; }
@@ -56,20 +66,37 @@ STYLE = """
 """ + "".join(
     f'.viewer g[id$="-{status}"] circle {{ fill: {colour}; stroke: {colour}; }}\n'
     f'.viewer g[id$="-{status}"] .segment {{ stroke: {colour}; stroke-width: 2; }}\n'
-    for status, colour in COLOURS.items()) + \
-    '.viewer g[id$="-missing"] circle, .viewer g[id$="-extra"] circle { fill-opacity: 0.25; }\n'
+    for status, colour in COLOURS.items()) + """\
+.viewer g[id$="-missing"] circle, .viewer g[id$="-extra"] circle { fill-opacity: 0.25; }
+.viewer svg.crowded g circle { fill-opacity: 0.15; stroke-width: 1.5; }
+.viewer svg.crowded g .segment { stroke-width: 1; stroke-opacity: 0.6; }
+.viewer svg.crowded g .arrow { stroke-width: 1; stroke-opacity: 0.6; }
+.viewer svg g circle:hover, .viewer svg g circle.pinned { stroke: #000; stroke-width: 3; }
+"""
+
+#: The script's own copies of the sizes above.
+SIZES = (f"const R_PX = {R_PX:g}, CROWDED_PX = {CROWDED_PX:g}, "
+         f"SMALL_CELL_PX = {SMALL_CELL_PX:g};")
 
 SCRIPT = """
 (function () {
+  """ + SIZES + """
   const svg = document.getElementById('viewer-svg');
   const tip = document.getElementById('viewer-tip');
   const home = svg.getAttribute('viewBox');
   let box = home.split(' ').map(Number);
-  const R_PX = 4;
+  const walls = [document.getElementById('walls-map'), document.getElementById('walls-truth')];
+  const spacing = Number(svg.dataset.spacing);
   function show() {
     svg.setAttribute('viewBox', box.join(' '));
     const ctm = svg.getScreenCTM();
-    if (ctm && ctm.a > 0) svg.style.setProperty('--r', (R_PX / ctm.a) + 'px');
+    if (!ctm || !(ctm.a > 0)) return;
+    svg.style.setProperty('--r', (R_PX / ctm.a) + 'px');
+    const crowded = spacing * ctm.a < CROWDED_PX && ctm.a < SMALL_CELL_PX;
+    if (crowded !== svg.classList.contains('crowded')) {
+      svg.classList.toggle('crowded', crowded);
+      if (crowded) svg.append(...walls); else svg.prepend(...walls);
+    }
   }
   function toUser(x, y) {
     const p = new DOMPoint(x, y).matrixTransform(svg.getScreenCTM().inverse());
@@ -239,6 +266,17 @@ def _groups(result: Result, name: str, det: DetectorResult, gain: float) -> dict
     }
 
 
+def spacing(result: Result) -> float:
+    """Median distance, grid cells, from each feature the viewer draws (every detector and
+    status) to its nearest other one; infinite when there are fewer than two."""
+    xy = [np.vstack([d.truth_xy, d.truth.xy[d.matching.missing], d.map.xy[d.matching.extra]])
+          for d in result.detectors.values()]
+    uv = _uv(result, np.vstack(xy)) if xy else np.zeros((0, 2))
+    if len(uv) < 2:
+        return float("inf")
+    return float(np.median(cKDTree(uv).query(uv, k=2)[0][:, 1]))
+
+
 def _controls(result: Result) -> str:
     """Checkboxes: the two wall layers, and each detector's matched, missing, extra groups
     (with their counts)."""
@@ -273,17 +311,21 @@ def viewer_html(result: Result, arrow_scale: float) -> str:
         f'preserveAspectRatio="none" href="{_png(alpha, rgb, opacity)}"/></g>'
         for layer, alpha, rgb, opacity in (("walls-map", walls, MAP_LIGHT, 1.0),
                                            ("walls-truth", truth, TRUTH_DARK, TRUTH_OPACITY)))
+    gap = min(spacing(result), 1e9)
     groups = "".join(f'<g id="f-{name}-{status}">{svg}</g>'
                      for name, det in result.detectors.items()
                      for status, svg in _groups(result, name, det, arrow_scale).items())
     return f"""{_controls(result)}
 <div class="viewer"><svg id="viewer-svg" viewBox="-0.5 -0.5 {cols} {rows}"
- style="aspect-ratio: {cols} / {rows}" data-labels="{html.escape(json.dumps(STATUSES))}">
+ style="aspect-ratio: {cols} / {rows}" data-spacing="{gap:.3f}"
+ data-labels="{html.escape(json.dumps(STATUSES))}">
 {images}{groups}</svg>
 <div id="viewer-tip"></div></div>
 <p class="note">Wheel: zoom; drag: pan; hover or click a feature: its detector, match, position
 and displacement (truth frame, metres). Arrows: {arrow_scale:g} times the displacement, from
 the truth feature towards the map feature; rings: missing truth features (red) and extra map
 features (orange). Walls shown at up to {VIEWER_PX} pixels across (here {factor} x {factor}
-cells a pixel); every feature is shown.</p>
+cells a pixel); every feature is shown. Where the features crowd over thin walls (zoomed out),
+the walls are drawn over them and every feature as a ring; zoom in to draw them over the
+walls.</p>
 <script>{SCRIPT}</script>"""
