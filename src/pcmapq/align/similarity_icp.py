@@ -46,15 +46,9 @@ class SimilarityTarget:
 
 
 # Hand-written, not Open3D's TransformationEstimationPointToPoint(with_scaling=True): the same
-# Umeyama fit (5 iterations a stage gave the same floor-plan poses to 4 digits), but its rule
-# (fitness and RMSE changing by under 1e-6, absolute, in truth units) leaves slow scale drifts
-# unconverged. Measured 2026-11-23: with 30 iterations a stage the Intel floor plan's scale came
-# out 1.184 instead of 1.164 (survey 1.168) and it was refused (confidence 0.34 < 0.5); with 100
-# it matched this one, 20 % faster in this stage (13.2-13.9 s against 16.4-19.2 s of CPU over
-# the 35 Halmstad maps and 5 synthetic cases, about 6 % of their alignment), with Halmstad
-# keypoint residuals of 8.17 / 18.74 px (median / worst) against 8.15 / 18.65. This rule, a move
-# under 1e-4 of the stage's distance, is free of the unit; with it 30 iterations put the Intel
-# scale within 0.04 % of where 100 do.
+# Umeyama fit, but Open3D's rule (fitness and RMSE changing by under 1e-6 in truth units) leaves
+# slow scale drifts unconverged (the Intel floor plan's scale 1.184, survey 1.168: refused),
+# where this one, a move under 1e-4 of the stage's distance, is free of the unit.
 def refine_similarity(map_xy: np.ndarray, target: SimilarityTarget, init: Similarity2D,
                       max_iterations: int = 30) -> Similarity2D:
     """Point-to-point ICP with scale of the map (N, 2, map units) onto the truth from ``init``.
