@@ -35,6 +35,6 @@ def main() -> None:
     if sys.argv[1:] in LISTING:
         from pcmapq.cli.base import listing_app
 
-        listing_app()(prog_name="pcmapq")
+        listing_app()()
     else:
-        __getattr__("app")(prog_name="pcmapq")
+        __getattr__("app")()
