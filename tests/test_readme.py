@@ -98,3 +98,20 @@ def test_python_example_runs_as_written(body, repo, capsys):
     quality, accuracy = capsys.readouterr().out.split()
     assert 0.5 < float(quality) <= 1.0 and float(accuracy) > 0
     assert (repo / "result.json").stat().st_size > 0
+
+
+API = (ROOT / "docs" / "api.md").read_text()
+
+
+def test_the_api_page_runs_as_written(repo, capsys):
+    """docs/api.md's example: evaluate, inspect and track through `import pcmapq`, printing
+    what the commands print."""
+    body, = (b for lang, b in re.findall(r"^```(\w*)\n(.*?)^```", API, flags=re.S | re.M)
+             if lang == "python")
+    if not (SHARED_DATA / "carmen" / "fhw-corrected.log.gz").exists():
+        pytest.skip("../shared/data/carmen is absent (real data lives in ../shared/data)")
+    exec(compile(body, "docs/api.md", "exec"), {})
+    out = capsys.readouterr().out.splitlines()
+    assert out[0].startswith("harris: quality ") and "occupied cells" in out[4]
+    scans = [int(line.split()[0]) for line in out[5:]]
+    assert scans[-1] == 488 and scans == sorted(scans)

@@ -75,3 +75,18 @@ def test_dev_null_discards_an_output(tmp_path):
     assert stat.S_ISCHR(os.stat(os.devnull).st_mode)
     got = CliRunner().invoke(app, ["inspect", str(sample / "truth.yaml"), "--json", os.devnull])
     assert got.exit_code == 0 and "wrote" not in got.stderr, got.stderr
+
+
+@pytest.mark.e2e
+def test_the_library_names_load_on_first_use():
+    """`import pcmapq` imports no heavy library; each name of pcmapq.__all__ then resolves to
+    the library's object (pcmapq.evaluate is the pipeline's evaluate)."""
+    code = ("import sys, pcmapq\n"
+            f"print(sorted({{m.split('.')[0] for m in sys.modules}} & set({HEAVY!r})))\n"
+            "from pcmapq.pipeline import evaluate\n"
+            "print(pcmapq.evaluate is evaluate, all(getattr(pcmapq, n) is not None "
+            "for n in pcmapq.__all__))")
+    got = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         timeout=120)
+    assert got.returncode == 0, got.stderr
+    assert got.stdout.split("\n")[:2] == ["[]", "True True"], got.stdout
