@@ -15,7 +15,7 @@ import numpy as np
 
 from pcmapq import synth
 from pcmapq.align import align
-from pcmapq.transform import Similarity2D
+from pcmapq.core.transform import Similarity2D
 
 W, H = 24.0, 16.0
 

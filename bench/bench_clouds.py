@@ -43,8 +43,8 @@ from pathlib import Path
 import numpy as np
 
 from pcmapq import synth
+from pcmapq.core.transform import Similarity2D
 from pcmapq.io.writers import write_ros_map
-from pcmapq.transform import Similarity2D
 
 #: Point spacing of the generated buildings, metres (about 3.4 M points per building).
 SPACING = 0.018
@@ -75,7 +75,7 @@ import numpy as np
 import open3d as o3d
 from scipy.spatial import cKDTree
 from pcmapq.metrics.distances import distances_3d
-from pcmapq.voxels import voxel_centroids
+from pcmapq.core.voxels import voxel_centroids
 sys.path.insert(0, sys.argv[1])
 from bench.bench_clouds import campus_cloud
 

@@ -1,7 +1,7 @@
 """Time and memory of the distance transform (metres to the nearest wall cell) on a large grid:
 pcmapq's ``nearest_distance`` (OpenCV's exact transform in float32, then metres in float64)
 against SciPy's ``distance_transform_edt`` (what it used before), and the float32 transform
-alone (:func:`pcmapq.morphology.distance_to`).
+alone (:func:`pcmapq.core.morphology.distance_to`).
 
     python bench/bench_distance.py [--size 8000] [--repeat 3]   prints a markdown table
 
@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from pcmapq import synth
-from pcmapq.grid import MetricGrid
+from pcmapq.core.grid import MetricGrid
 
 RESOLUTION = 0.05
 
@@ -31,9 +31,9 @@ CHILD = r"""
 import json, resource, sys, time
 import numpy as np
 from scipy import ndimage
-from pcmapq.grid import MetricGrid
+from pcmapq.core.grid import MetricGrid
 from pcmapq.metrics.distances import nearest_distance
-from pcmapq.morphology import distance_to
+from pcmapq.core.morphology import distance_to
 
 case, path, repeat, res = sys.argv[1], sys.argv[2], int(sys.argv[3]), float(sys.argv[4])
 walls = np.load(path)

@@ -24,7 +24,7 @@ from pathlib import Path
 
 from bench import large_grid
 from bench.bench_clouds import measured
-from pcmapq.transform import Similarity2D
+from pcmapq.core.transform import Similarity2D
 
 FLOOR_CHILD = r"""
 import json, sys, time

@@ -22,7 +22,7 @@ import json, resource, sys, time
 from pathlib import Path
 import numpy as np
 from pcmapq import synth
-from pcmapq.transform import Similarity2D
+from pcmapq.core.transform import Similarity2D
 from pcmapq.pipeline import evaluate
 sys.path.insert(0, sys.argv[1])
 from tests.conftest import in_map_frame, write_cloud_map, write_image_map

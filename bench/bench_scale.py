@@ -19,7 +19,7 @@ import numpy as np
 
 from pcmapq.align import AlignParams, align
 from pcmapq.align.similarity_icp import fit_similarity
-from pcmapq.transform import Similarity2D
+from pcmapq.core.transform import Similarity2D
 
 DATA = Path(__file__).resolve().parents[2] / "shared" / "data" / "halmstad"
 SKIP = {"E5_08"}

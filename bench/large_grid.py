@@ -15,10 +15,10 @@ from pathlib import Path
 import numpy as np
 
 from pcmapq import synth
-from pcmapq.grid import MetricGrid
+from pcmapq.core.grid import MetricGrid
+from pcmapq.core.transform import Similarity2D
 from pcmapq.io.writers import write_ros_map
 from pcmapq.raster.draw import points_to_grid, polygon_cells
-from pcmapq.transform import Similarity2D
 
 RESOLUTION = 0.05
 #: The map's pose in the truth frame (p_truth = R(yaw) p_map + t), as the issue tried it.

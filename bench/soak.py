@@ -31,11 +31,11 @@ import numpy as np
 
 from pcmapq import synth
 from pcmapq.config import AlignmentConfig, Settings, SourceConfig
-from pcmapq.errors import EvaluationError, InputError
+from pcmapq.core.errors import EvaluationError, InputError
+from pcmapq.core.transform import Similarity2D
 from pcmapq.io.carmen import DEFAULT_MAX_RANGE, endpoints, read_flaser
 from pcmapq.io.writers import write_ros_map
 from pcmapq.pipeline import evaluate
-from pcmapq.transform import Similarity2D
 
 from .validation.drift import drifted, save_cloud
 

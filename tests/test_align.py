@@ -9,8 +9,8 @@ from pcmapq import synth
 from pcmapq.align import Alignment, AlignParams, align, score
 from pcmapq.align.coarse import coarse_search
 from pcmapq.align.planar import refine_best
-from pcmapq.transform import Similarity2D
-from pcmapq.voxels import voxel_centroids
+from pcmapq.core.transform import Similarity2D
+from pcmapq.core.voxels import voxel_centroids
 
 from .conftest import HEIGHT, PLAN, WIDTH
 

@@ -23,8 +23,8 @@ from pcmapq.batch.manifest import glob_rows, parse_assignments
 from pcmapq.batch.run import run_local as pool_run
 from pcmapq.cli import app
 from pcmapq.config import MatchingConfig, Settings
-from pcmapq.errors import InputError
-from pcmapq.transform import Similarity2D
+from pcmapq.core.errors import InputError
+from pcmapq.core.transform import Similarity2D
 from tests.conftest import in_map_frame, write_image_map
 
 #: name, map pose in the truth frame (x m, y m, yaw deg), manifest cells of the row's options.

@@ -11,7 +11,7 @@ import pytest
 
 from bench.validation import drift
 from pcmapq.config import AlignmentConfig, Settings
-from pcmapq.errors import InputError
+from pcmapq.core.errors import InputError
 from pcmapq.io import PointMap, load_map
 from pcmapq.io.carmen import beam_angles, endpoints, load_carmen, read_flaser
 from pcmapq.pipeline import evaluate

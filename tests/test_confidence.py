@@ -15,12 +15,12 @@ import pytest
 from pcmapq import synth
 from pcmapq.align.coarse import Search, distinctiveness
 from pcmapq.config import AlignmentConfig, MatchingConfig, Settings, SourceConfig
-from pcmapq.errors import EvaluationError
+from pcmapq.core.errors import EvaluationError
+from pcmapq.core.transform import Similarity2D
 from pcmapq.io import Thresholds, load_map
 from pcmapq.pipeline import evaluate
 from pcmapq.raster.draw import FREE, OCCUPIED, UNKNOWN
 from pcmapq.same_place import confidence
-from pcmapq.transform import Similarity2D
 
 from .conftest import in_map_frame, shared, write_image_map
 

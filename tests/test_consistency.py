@@ -16,13 +16,13 @@ from pcmapq.align.parts import Part, pieces
 from pcmapq.align.point_to_line import LineTarget
 from pcmapq.align.regions import regions
 from pcmapq.config import MatchingConfig, Settings
-from pcmapq.errors import EvaluationError
+from pcmapq.core.errors import EvaluationError
+from pcmapq.core.transform import Similarity2D
+from pcmapq.core.voxels import voxel_centroids
 from pcmapq.io import PointMap
 from pcmapq.pipeline import evaluate
 from pcmapq.result import INCONSISTENT, OTHER, SAME, Result
 from pcmapq.same_place import verdict
-from pcmapq.transform import Similarity2D
-from pcmapq.voxels import voxel_centroids
 
 from .conftest import write_image_map
 

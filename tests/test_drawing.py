@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 
 from pcmapq import synth
+from pcmapq.core.grid import MetricGrid
 from pcmapq.features import detect
 from pcmapq.features.walls import prune, wall_image
-from pcmapq.grid import MetricGrid
 from pcmapq.match import match
 
 NAMES = ("harris", "hough", "sift")
@@ -154,8 +154,8 @@ def test_strips_computed_only_near_walls_equal_the_whole():
 def test_cores_on_the_rows_and_columns_of_objects_equal_the_whole_image():
     """cores() drops the rows and columns without objects: every object's depth and core are
     those of the whole image (objects at the border, next to each other, far apart)."""
+    from pcmapq.core.morphology import distance_to
     from pcmapq.features.walls import cores, fill_holes
-    from pcmapq.morphology import distance_to
 
     rng = np.random.default_rng(5)
     image = np.zeros((150, 150), np.uint8)

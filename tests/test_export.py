@@ -12,12 +12,12 @@ import yaml
 from scipy.spatial.distance import cdist
 
 from pcmapq import synth
-from pcmapq.frames import Frames, Levelling
+from pcmapq.core.frames import Frames, Levelling
+from pcmapq.core.transform import Similarity2D
 from pcmapq.io import load_map
 from pcmapq.io.export import DISTANCE_FIELD, record_dtype, records, write_matrix, write_records
 from pcmapq.report.export import cloud_matrix, colours
 from pcmapq.report.plot import figure_bytes
-from pcmapq.transform import Similarity2D
 
 from .conftest import PLAN, in_map_frame, write_image_map
 from .test_cli import run
@@ -66,7 +66,7 @@ def test_distance_cloud_has_a_scalar_field_and_colours(tmp_path):
 
 
 def test_a_cloud_with_a_scalar_field_is_not_written_as_pcd(tmp_path):
-    from pcmapq.errors import InputError
+    from pcmapq.core.errors import InputError
 
     dtype = record_dtype(DISTANCE_FIELD)
     with pytest.raises(InputError, match="d.pcd: a cloud with a scalar field"):
@@ -167,7 +167,7 @@ def test_2d_cloud_exports(tmp_path):
 
 def assert_reproduces(distances: np.ndarray, block: dict) -> None:
     """The statistics of a --distances file's distances are the JSON's accuracy, to 1e-6."""
-    from pcmapq.stats import Stats
+    from pcmapq.core.stats import Stats
 
     want, got = block["accuracy_m"], Stats.of(distances).to_dict()
     assert got["count"] == want["count"]

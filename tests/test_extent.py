@@ -14,8 +14,8 @@ import typer
 from typer.testing import CliRunner
 
 from pcmapq.cli import app
-from pcmapq.errors import EvaluationError, InputError
-from pcmapq.grid import MetricGrid
+from pcmapq.core.errors import EvaluationError, InputError
+from pcmapq.core.grid import MetricGrid
 from pcmapq.io import OccupancyMap, PointMap, load_map
 from pcmapq.io.extent import MAX_SPAN, check_span, crop, hint, main_group
 from pcmapq.options import parse_box
@@ -224,7 +224,7 @@ def test_max_memory_reaches_the_loaders(tmp_path):
 def test_every_cloud_loader_checks_the_points_declared_against_the_limit(tmp_path, name):
     """A limit that holds half of what the declared points need refuses the file before it is
     read; one that holds them all loads it."""
-    from pcmapq import memory
+    from pcmapq.core import memory
 
     n = 20_000
     points = np.random.default_rng(3).uniform(0, 5, (n, 3))

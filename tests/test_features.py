@@ -7,11 +7,11 @@ import numpy as np
 import pytest
 
 from pcmapq import synth
+from pcmapq.core.grid import MetricGrid
+from pcmapq.core.transform import Similarity2D
 from pcmapq.features import DETECTORS, Features, detect
-from pcmapq.grid import MetricGrid
 from pcmapq.match import match
 from pcmapq.raster import draw
-from pcmapq.transform import Similarity2D
 
 NAMES = ("harris", "hough", "sift")
 

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 
-from pcmapq.errors import InputError
+from pcmapq.core.errors import InputError
 from pcmapq.io import PointMap, load_map
 from tools.fuzz_loaders import MUTATIONS, Op, make_seeds, run_example
 

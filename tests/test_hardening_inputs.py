@@ -102,7 +102,7 @@ def test_broken_file_is_one_line_exit_2_quickly(tmp_path: Path, name: str) -> No
 def test_an_image_too_large_for_the_memory_guard_is_refused_before_decoding(
         tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     """30000 x 30000 pixels (a real, 1 MB PNG) under a 1 GB limit: refused from its header."""
-    from pcmapq import memory
+    from pcmapq.core import memory
     path = tmp_path / "big.png"
     image = np.full((30000, 30000), 254, dtype=np.uint8)
     cv2.imwrite(str(path), image)

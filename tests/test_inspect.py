@@ -27,7 +27,7 @@ def _inspect(*args: str) -> tuple[int, str, str]:
 
 def test_a_3d_cloud_gets_the_library_figures_and_the_same_json_twice(tmp_path):
     """A noisy floor and two walls (1 cm noise): the JSON holds noref.scores' MME and MPV of
-    the same points (rounded: see pcmapq.stats.significant) and is byte-identical across
+    the same points (rounded: see pcmapq.core.stats.significant) and is byte-identical across
     runs; the floor alone has an MPV of the noise's variance."""
     rng = np.random.default_rng(5)
     floor = np.column_stack([rng.uniform(0, 4, (3000, 2)), rng.normal(0, 0.01, 3000)])

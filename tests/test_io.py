@@ -12,8 +12,8 @@ import numpy as np
 import open3d as o3d
 import pytest
 
-from pcmapq.errors import InputError
-from pcmapq.grid import MetricGrid
+from pcmapq.core.errors import InputError
+from pcmapq.core.grid import MetricGrid
 from pcmapq.io import OccupancyMap, PointMap, load_map, writers
 from pcmapq.io.writers import write_atomic
 from pcmapq.raster.draw import FREE, OCCUPIED, UNKNOWN

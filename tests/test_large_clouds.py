@@ -10,10 +10,10 @@ import numpy as np
 import pytest
 
 from pcmapq import synth
+from pcmapq.core.transform import Similarity2D
 from pcmapq.io import clouds, load_map
 from pcmapq.pipeline import evaluate
 from pcmapq.raster import slice as slice_module
-from pcmapq.transform import Similarity2D
 
 from .conftest import in_map_frame, write_image_map
 

@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 from pcmapq.align.rigid3d import align_3d
-from pcmapq.errors import InputError
+from pcmapq.core.errors import InputError
+from pcmapq.core.voxels import voxel_keys
 from pcmapq.mapping import (
     VoxelMap,
     build_map_from_poses,
@@ -22,7 +23,6 @@ from pcmapq.mapping import (
     write_kitti_poses,
     write_tum_poses,
 )
-from pcmapq.voxels import voxel_keys
 
 from .conftest import shared
 

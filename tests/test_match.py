@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from pcmapq.errors import InputError
+from pcmapq.core.errors import InputError
 from pcmapq.features.base import Features
 from pcmapq.match import assign, match
 

@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import pytest
 
-from pcmapq import memory
-from pcmapq.errors import InputError
+from pcmapq.core import memory
+from pcmapq.core.errors import InputError
 
 
 def test_estimate_grows_with_each_size():

@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from pcmapq.core.grid import MetricGrid
 from pcmapq.features.merging import merge
 from pcmapq.features.segments import wall_test
-from pcmapq.grid import MetricGrid
 
 #: The Hough detector's defaults: 15 degrees, 0.15 m across, 0.2 m along, bridges of 1.5 m.
 ANGLE, OFFSET, GAP, BRIDGE = 15.0, 0.15, 0.2, 1.5

@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 from scipy import ndimage
 
-from pcmapq.grid import MetricGrid
+from pcmapq.core.grid import MetricGrid
+from pcmapq.core.morphology import distance_to
 from pcmapq.metrics.distances import distances, nearest_distance
-from pcmapq.morphology import distance_to
 
 GRID = MetricGrid(0.05, (0.0, 0.0, 0.0), (200, 200))
 
@@ -72,8 +72,8 @@ def test_distances_3d_are_the_kd_tree_distances_and_a_known_offset():
     """Two walls 0.2 m apart: every distance is 0.2 m; on random clouds, exactly SciPy's."""
     from scipy.spatial import cKDTree
 
+    from pcmapq.core.voxels import voxel_centroids
     from pcmapq.metrics.distances import distances_3d
-    from pcmapq.voxels import voxel_centroids
 
     y, z = np.meshgrid(np.arange(0.025, 4, 0.05), np.arange(0.025, 2, 0.05))
     wall_a = np.column_stack([np.full(y.size, 1.025), y.ravel(), z.ravel()])

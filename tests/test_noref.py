@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from numpy.lib import format as npy
 
-from pcmapq.errors import EvaluationError, InputError
+from pcmapq.core.errors import EvaluationError, InputError
 from pcmapq.mapping.poses import read_pose_matrix, read_poses
 from pcmapq.mapping.reference import posed_map
 from pcmapq.metrics import noref, orthogonal, posed

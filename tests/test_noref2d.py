@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from pcmapq.cells import FREE, OCCUPIED, UNKNOWN
-from pcmapq.grid import MetricGrid
+from pcmapq.core.cells import FREE, OCCUPIED, UNKNOWN
+from pcmapq.core.grid import MetricGrid
 from pcmapq.metrics import noref2d
 
 RES = 0.05

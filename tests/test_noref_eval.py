@@ -20,12 +20,12 @@ from pcmapq.config import (
     Settings,
     SourceConfig,
 )
+from pcmapq.core.stats import significant
 from pcmapq.io import load_map
 from pcmapq.metrics import orthogonal
 from pcmapq.noref_figures import input_figures
 from pcmapq.pipeline import evaluate
 from pcmapq.result import Result
-from pcmapq.stats import significant
 
 from .conftest import write_image_map
 from .test_noref import room_corner

@@ -13,7 +13,7 @@ import pytest
 from typer.testing import CliRunner
 
 from pcmapq.cli import app
-from pcmapq.errors import InputError
+from pcmapq.core.errors import InputError
 from pcmapq.io.writers import OutputSet, atomic_file, write_atomic
 
 SAMPLE = Path(__file__).resolve().parents[1] / "data" / "sample"

@@ -11,11 +11,11 @@ import pytest
 
 from pcmapq import synth
 from pcmapq.config import AlignmentConfig, MatchingConfig, Settings
+from pcmapq.core.morphology import outline
+from pcmapq.core.transform import Similarity2D
 from pcmapq.io import PointMap
-from pcmapq.morphology import outline
 from pcmapq.pipeline import evaluate
 from pcmapq.raster.draw import OCCUPIED, polygon_cells
-from pcmapq.transform import Similarity2D
 
 from .conftest import write_ros_map
 
@@ -82,7 +82,7 @@ def exhaustive_pose(map_xy: np.ndarray, truth_xy: np.ndarray, resolution: float)
     from scipy.signal import fftconvolve
 
     from pcmapq.align.coarse import likelihood_field
-    from pcmapq.grid import MetricGrid
+    from pcmapq.core.grid import MetricGrid
     from pcmapq.raster.draw import hit_counts
 
     centre = map_xy.mean(axis=0)
@@ -107,8 +107,8 @@ def exhaustive_pose(map_xy: np.ndarray, truth_xy: np.ndarray, resolution: float)
 
 def _plan_xy(path: Path) -> np.ndarray:
     from pcmapq.config import Settings, SourceConfig
+    from pcmapq.core.voxels import voxel_centroids
     from pcmapq.plan import TRUTH_CROP, load_input, plan_points
-    from pcmapq.voxels import voxel_centroids
 
     # The room-segmentation benchmark's images have no YAML: 0.05 m a pixel (its README).
     config = SourceConfig(resolution=0.05) if path.suffix == ".png" else Settings().truth
@@ -156,7 +156,7 @@ def test_a_map_under_clutter_is_placed_right_way_round():
     (0.186); every start within 0.9 of the best rough fitness now goes through the fine
     stages, and the right pose wins (0.202)."""
     from pcmapq.align import align
-    from pcmapq.voxels import voxel_centroids
+    from pcmapq.core.voxels import voxel_centroids
 
     plan = synth.building_plan(0)
     truth = voxel_centroids(synth.wall_points(plan), 0.05)

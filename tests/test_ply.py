@@ -9,7 +9,7 @@ import numpy as np
 import open3d as o3d
 import pytest
 
-from pcmapq.errors import InputError
+from pcmapq.core.errors import InputError
 from pcmapq.io import clouds, load_map
 from pcmapq.io.ply import vertex_block
 

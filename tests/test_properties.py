@@ -26,10 +26,10 @@ from typer.testing import CliRunner
 
 from pcmapq import synth
 from pcmapq.cli import app
+from pcmapq.core.transform import Similarity2D
 from pcmapq.io.writers import write_ros_map
 from pcmapq.pipeline import evaluate
 from pcmapq.result import Result
-from pcmapq.transform import Similarity2D
 
 ROOT = Path(__file__).resolve().parents[1]
 SAMPLE = ROOT / "data" / "sample"

@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 
 from pcmapq import synth
-from pcmapq.grid import MetricGrid
+from pcmapq.core.grid import MetricGrid
+from pcmapq.core.transform import Similarity2D
 from pcmapq.raster.draw import FREE, OCCUPIED, UNKNOWN, hit_counts, points_to_grid, warp_state
 from pcmapq.raster.footprint import footprint_rule
-from pcmapq.transform import Similarity2D
 
 
 def state_of(img: np.ndarray) -> np.ndarray:

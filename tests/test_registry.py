@@ -12,8 +12,8 @@ import pcmapq.features as features
 from pcmapq import synth
 from pcmapq.cli import app
 from pcmapq.config import DETECTOR_NAMES, Settings
-from pcmapq.errors import InputError
-from pcmapq.grid import MetricGrid
+from pcmapq.core.errors import InputError
+from pcmapq.core.grid import MetricGrid
 from pcmapq.match import match
 
 

@@ -11,9 +11,9 @@ import pytest
 
 from bench.validation.reference import differences
 from pcmapq.config import Settings
+from pcmapq.core.stats import FIELDS, Stats
 from pcmapq.pipeline import evaluate
 from pcmapq.result import Result
-from pcmapq.stats import FIELDS, Stats
 
 ROOT = Path(__file__).resolve().parents[1]
 SAMPLE = ROOT / "data" / "sample"
@@ -149,9 +149,9 @@ def test_settings_read_back_from_their_dict():
     from dataclasses import replace
 
     from pcmapq.config import AlignmentConfig, SourceConfig
+    from pcmapq.core.transform import Similarity2D
     from pcmapq.features import harris
     from pcmapq.io import Thresholds
-    from pcmapq.transform import Similarity2D
 
     s = Settings(map=SourceConfig(0.1, Thresholds(0.4, 0.05, None)),
                  alignment=AlignmentConfig(init=Similarity2D(1.0, 2.0, 0.5), scale=True))

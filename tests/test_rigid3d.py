@@ -9,7 +9,7 @@ from scipy.spatial.transform import Rotation
 
 from pcmapq.align.features3d import feature_matches, keypoints
 from pcmapq.align.rigid3d import align_3d
-from pcmapq.errors import EvaluationError, InputError
+from pcmapq.core.errors import EvaluationError, InputError
 
 from .conftest import shared
 

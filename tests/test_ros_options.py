@@ -11,7 +11,7 @@ import cv2
 import numpy as np
 import pytest
 
-from pcmapq.errors import InputError
+from pcmapq.core.errors import InputError
 from pcmapq.io import load_map
 
 from .test_cli import SAMPLE, run

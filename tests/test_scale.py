@@ -10,8 +10,8 @@ from pcmapq import synth
 from pcmapq.align import AlignParams, align
 from pcmapq.align.point_to_line import LineTarget, refine_point_to_line
 from pcmapq.align.similarity_icp import fit_similarity
-from pcmapq.transform import Similarity2D
-from pcmapq.voxels import voxel_centroids
+from pcmapq.core.transform import Similarity2D
+from pcmapq.core.voxels import voxel_centroids
 
 from .conftest import HEIGHT, PLAN, WIDTH, shared
 

@@ -7,12 +7,12 @@ import numpy as np
 import pytest
 
 from pcmapq import synth
+from pcmapq.core.grid import MetricGrid
+from pcmapq.core.transform import Similarity2D
 from pcmapq.features import Features, detect
 from pcmapq.features.sift import DESCRIPTOR_NORM, Params
-from pcmapq.grid import MetricGrid
 from pcmapq.match import match
 from pcmapq.raster import draw
-from pcmapq.transform import Similarity2D
 
 
 def unit(*weights: float) -> np.ndarray:

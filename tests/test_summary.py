@@ -13,7 +13,7 @@ import pytest
 
 from pcmapq import synth
 from pcmapq.config import DETECTOR_NAMES, MatchingConfig, Settings
-from pcmapq.errors import InputError
+from pcmapq.core.errors import InputError
 from pcmapq.pipeline import evaluate
 from pcmapq.report import summary
 from pcmapq.report.summary import (

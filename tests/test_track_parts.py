@@ -8,8 +8,9 @@ from dataclasses import asdict
 import numpy as np
 import pytest
 
-from pcmapq import memory
-from pcmapq.grid import MetricGrid
+from pcmapq.core import memory
+from pcmapq.core.grid import MetricGrid
+from pcmapq.core.transform import Similarity2D
 from pcmapq.io.carmen import beam_angles
 from pcmapq.plan import distinct_cells
 from pcmapq.raster.footprint import (
@@ -24,7 +25,6 @@ from pcmapq.track.drop import MIN_DROP, worst_drop
 from pcmapq.track.outputs import step_rows
 from pcmapq.track.steps import step_ends, travelled
 from pcmapq.track.timeline import Step
-from pcmapq.transform import Similarity2D
 
 pytestmark = pytest.mark.unit
 

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from pcmapq.errors import EvaluationError
+from pcmapq.core.errors import EvaluationError
 from pcmapq.trajectory import (
     align_umeyama,
     ape,

@@ -16,8 +16,8 @@ import pytest
 
 from pcmapq import synth
 from pcmapq.config import MatchingConfig, Settings
+from pcmapq.core.grid import MetricGrid
 from pcmapq.features import Features
-from pcmapq.grid import MetricGrid
 from pcmapq.match import Matching
 from pcmapq.pipeline import evaluate
 from pcmapq.report.html import report_html

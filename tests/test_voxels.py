@@ -8,9 +8,16 @@ from hypothesis import given
 from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
 
-from pcmapq import voxels
-from pcmapq.bounds import bounds, nonzero_window
-from pcmapq.voxels import VoxelMap, evenly, voxel_centroids, voxel_count, voxel_index, voxel_keys
+from pcmapq.core import voxels
+from pcmapq.core.bounds import bounds, nonzero_window
+from pcmapq.core.voxels import (
+    VoxelMap,
+    evenly,
+    voxel_centroids,
+    voxel_count,
+    voxel_index,
+    voxel_keys,
+)
 
 
 def by_sorting(points: np.ndarray, voxel: float) -> np.ndarray:

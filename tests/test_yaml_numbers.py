@@ -9,7 +9,7 @@ import pytest
 from typer.testing import CliRunner
 
 from pcmapq.cli import app
-from pcmapq.errors import InputError
+from pcmapq.core.errors import InputError
 from pcmapq.io.occupancy import load_occupancy, read_yaml
 
 SAMPLE = Path(__file__).resolve().parents[1] / "data" / "sample"

@@ -34,8 +34,8 @@ from pathlib import Path
 import numpy as np
 from hypothesis import strategies as st
 
-from pcmapq.cells import FREE, OCCUPIED, UNKNOWN
-from pcmapq.errors import InputError
+from pcmapq.core.cells import FREE, OCCUPIED, UNKNOWN
+from pcmapq.core.errors import InputError
 from pcmapq.io import OccupancyMap, PointMap, load_map
 from pcmapq.mapping.poses import read_calib, read_poses
 

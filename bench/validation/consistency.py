@@ -26,11 +26,11 @@ import numpy as np
 
 from pcmapq import synth
 from pcmapq.config import AlignmentConfig, MatchingConfig, Settings
+from pcmapq.core.transform import Similarity2D
 from pcmapq.io import PointMap
 from pcmapq.io.carmen import endpoints, read_flaser
 from pcmapq.pipeline import evaluate
 from pcmapq.report.plot import figure_bytes, vectorial_figure
-from pcmapq.transform import Similarity2D
 
 from .common import Case, Record, Section
 from .drift import increments, integrate

@@ -20,8 +20,8 @@ from skimage.morphology import skeletonize
 
 from pcmapq import synth
 from pcmapq.config import Settings
+from pcmapq.core.grid import MetricGrid
 from pcmapq.features import Features, detect
-from pcmapq.grid import MetricGrid
 from pcmapq.io import OccupancyMap, load_map
 from pcmapq.match import match
 from pcmapq.plan import plan_points, truth_raster

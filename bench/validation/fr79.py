@@ -13,10 +13,10 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from pcmapq.grid import MetricGrid
+from pcmapq.core.grid import MetricGrid
+from pcmapq.core.transform import Similarity2D
 from pcmapq.io.writers import write_ros_map
 from pcmapq.report.text import score
-from pcmapq.transform import Similarity2D
 
 from .common import Case, Record, Run, Section, header, row, span, timed_evaluate
 

@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 
 from pcmapq.config import Settings
-from pcmapq.transform import Similarity2D
+from pcmapq.core.transform import Similarity2D
 
 from .common import Case, Record, Run, Section, f_at, header, q_p, row, timed_evaluate
 

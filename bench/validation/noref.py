@@ -26,9 +26,10 @@ import cv2
 import numpy as np
 from scipy.stats import spearmanr
 
-from pcmapq.cells import FREE, OCCUPIED, UNKNOWN
 from pcmapq.config import AlignmentConfig, MatchingConfig, Settings
-from pcmapq.grid import MetricGrid
+from pcmapq.core.cells import FREE, OCCUPIED, UNKNOWN
+from pcmapq.core.grid import MetricGrid
+from pcmapq.core.voxels import voxel_centroids
 from pcmapq.io.carmen import DEFAULT_MAX_RANGE, endpoints
 from pcmapq.io.writers import write_cloud
 from pcmapq.mapping import build_map_from_poses, lidar_poses_from_camera, read_kitti_poses
@@ -38,7 +39,6 @@ from pcmapq.metrics.inspection import noref_figures
 from pcmapq.metrics.noref2d import grid_scores
 from pcmapq.metrics.orthogonal import extract_orthogonal_subset
 from pcmapq.raster.draw import hit_counts
-from pcmapq.voxels import voxel_centroids
 
 from . import carmen, drift, noref_grids
 from .common import Case, Record, Run, Section, f_at, header, row, timed_evaluate

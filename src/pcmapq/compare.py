@@ -12,7 +12,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-from pcmapq.errors import InputError
+from pcmapq.core.errors import InputError
 from pcmapq.io.writers import one_line
 from pcmapq.report.summary import summary_row
 

@@ -7,13 +7,13 @@ from dataclasses import dataclass, field, fields, is_dataclass
 from typing import Any
 
 from pcmapq.align.params import AlignParams
+from pcmapq.core.transform import Similarity2D
 from pcmapq.features import DETECTORS, default_params
 from pcmapq.io.extent import Box
 from pcmapq.io.occupancy import Thresholds
 from pcmapq.metrics.distances import DEFAULT_TAUS
 from pcmapq.metrics.noref import LIDAR_RADIUS, MAX_NN, MIN_KNN
 from pcmapq.metrics.orthogonal import MAX_WARD_POINTS
-from pcmapq.transform import Similarity2D
 
 #: Every registered detector (a module of :mod:`pcmapq.features` that defines ``DETECTOR``).
 DETECTOR_NAMES = tuple(DETECTORS)

@@ -18,8 +18,8 @@ from dataclasses import dataclass
 from typing import Any
 
 from pcmapq.config import DETECTOR_NAMES
-from pcmapq.errors import InputError
-from pcmapq.stats import FIELDS as STAT_FIELDS
+from pcmapq.core.errors import InputError
+from pcmapq.core.stats import FIELDS as STAT_FIELDS
 
 #: The exit code of a run whose figures fail a gate (0 scored, 1 evaluation failed, 2 usage).
 EXIT_CODE = 3

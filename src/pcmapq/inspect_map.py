@@ -15,9 +15,9 @@ import numpy as np
 
 from pcmapq import __version__
 from pcmapq.config import NoRefConfig
+from pcmapq.core.stats import significant
 from pcmapq.io import OccupancyMap, PointMap
 from pcmapq.noref_figures import input_figures
-from pcmapq.stats import significant
 
 
 def inspect_map(source: OccupancyMap | PointMap, config: NoRefConfig = NoRefConfig(),

@@ -9,18 +9,19 @@ from pathlib import Path
 
 import numpy as np
 
-from pcmapq import memory
 from pcmapq.align import Alignment
 from pcmapq.align.parts import broken_off, place_parts
 from pcmapq.align.planar import RigidTarget
 from pcmapq.align.regions import regions
 from pcmapq.align.rigid3d import Registration3D
-from pcmapq.bounds import bounds
 from pcmapq.config import Settings
-from pcmapq.errors import EvaluationError, InputError
+from pcmapq.core import memory
+from pcmapq.core.bounds import bounds
+from pcmapq.core.errors import EvaluationError, InputError
+from pcmapq.core.frames import Frames, Levelling
+from pcmapq.core.grid import MetricGrid
+from pcmapq.core.transform import Similarity2D
 from pcmapq.features import Features, SideBySide, default_params
-from pcmapq.frames import Frames, Levelling
-from pcmapq.grid import MetricGrid
 from pcmapq.io import OccupancyMap, PointMap
 from pcmapq.io.digest import sha256_file
 from pcmapq.io.extent import check_span, hint
@@ -44,7 +45,6 @@ from pcmapq.raster.footprint import footprint_rule, map_footprint
 from pcmapq.raster.seen import seen_on
 from pcmapq.result import OTHER, DetectorResult, Overlap, Result
 from pcmapq.same_place import overlap, refusal, verdict
-from pcmapq.transform import Similarity2D
 
 Progress = Callable[[str], None]
 
@@ -101,7 +101,7 @@ def evaluate(map_path: str | Path | PointMap, truth_path: str | Path,
              memory_limit: int | None = None) -> Result:
     """Score the map at ``map_path`` (or a map already built, e.g. from scans) against the
     truth at ``truth_path``; stop (InputError) when the run would need more than
-    ``memory_limit`` bytes (None: :func:`pcmapq.memory.default_limit`)."""
+    ``memory_limit`` bytes (None: :func:`pcmapq.core.memory.default_limit`)."""
     settings = Settings() if settings is None else settings
     progress("loading")
     scaled = settings.alignment.scale
@@ -143,7 +143,7 @@ def needed_memory(inputs: Sequence[OccupancyMap | PointMap], grid: MetricGrid,
                   more_maps: int = 0) -> int:
     """Estimated peak memory, bytes, of scoring a map against a truth (``inputs``: both, or
     the truth alone for what it needs whatever the map) on the truth's ``grid``, with
-    ``more_maps`` maps more scored on it at once: see :mod:`pcmapq.memory`."""
+    ``more_maps`` maps more scored on it at once: see :mod:`pcmapq.core.memory`."""
     images = sum(int(np.prod(s.grid.shape)) for s in inputs if isinstance(s, OccupancyMap))
     points = sum(len(s.points) for s in inputs if isinstance(s, PointMap))
     cells = int(np.prod(grid.shape))

@@ -12,14 +12,14 @@ import numpy as np
 from pcmapq.align import Alignment, align
 from pcmapq.align.planar import RigidTarget
 from pcmapq.align.rigid3d import Registration3D, align_3d, apply
-from pcmapq.bounds import radius
 from pcmapq.config import Settings
-from pcmapq.errors import EvaluationError
+from pcmapq.core.bounds import radius
+from pcmapq.core.errors import EvaluationError
+from pcmapq.core.transform import Similarity2D
 from pcmapq.io import OccupancyMap, PointMap
 from pcmapq.io.extent import hint
 from pcmapq.plan import MAP_CROP
 from pcmapq.same_place import OVERSIZE
-from pcmapq.transform import Similarity2D
 
 
 def align_clouds_3d(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap,

@@ -14,15 +14,15 @@ from pathlib import Path
 
 import numpy as np
 
-from pcmapq import memory
-from pcmapq.bounds import bounds
 from pcmapq.config import Settings, SourceConfig
-from pcmapq.errors import EvaluationError, InputError
-from pcmapq.frames import Levelling
-from pcmapq.grid import MetricGrid
+from pcmapq.core import memory
+from pcmapq.core.bounds import bounds
+from pcmapq.core.errors import EvaluationError, InputError
+from pcmapq.core.frames import Levelling
+from pcmapq.core.grid import MetricGrid
+from pcmapq.core.morphology import outline
 from pcmapq.io import OccupancyMap, PointMap, load_map
 from pcmapq.io.extent import crop
-from pcmapq.morphology import outline
 from pcmapq.raster.draw import OCCUPIED, points_to_grid
 from pcmapq.raster.slice import wall_band
 

@@ -3,9 +3,9 @@ results of :func:`pcmapq.pipeline.score` without the truth's work for each map."
 
 from __future__ import annotations
 
-from pcmapq import memory
 from pcmapq.align.planar import RigidTarget
 from pcmapq.config import Settings
+from pcmapq.core import memory
 from pcmapq.features import SideBySide
 from pcmapq.io import OccupancyMap, PointMap
 from pcmapq.io.extent import check_span, hint

@@ -11,13 +11,13 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from pcmapq import __version__
+from pcmapq.core.frames import Frames
+from pcmapq.core.grid import MetricGrid
+from pcmapq.core.stats import Stats, significant
+from pcmapq.core.transform import Similarity2D
 from pcmapq.features import Features
-from pcmapq.frames import Frames
-from pcmapq.grid import MetricGrid
 from pcmapq.match import Matching
 from pcmapq.metrics.distances import Distances, FScore
-from pcmapq.stats import Stats, significant
-from pcmapq.transform import Similarity2D
 
 if TYPE_CHECKING:  # the alignment modules load Open3D; a Result only holds their outputs
     from pcmapq.align import Alignment
@@ -92,15 +92,16 @@ class Result:
     """A finished evaluation; all coordinates in the truth frame, metres.
 
     frames: the chain from each input to the truth's plan (levelling, 3D registration, the 2D
-    alignment; :mod:`pcmapq.frames`). settings: the options it ran with (``Settings.to_dict()``,
-    metres and degrees); command: the command line that made it (``pcmapq eval ...``, defaults
-    left out), None from the library. noref: each input's no-reference figures,
-    ``{"map": ..., "truth": ...}`` (:func:`pcmapq.noref_figures.input_figures`), None when not
-    asked for. truth_sha256: the truth file's SHA-256 (hex; None from the library's
-    :func:`~pcmapq.pipeline.score`), so that results of one truth are known as such however
-    its path was written. truth_occupied, map_occupied (and the overlap's
-    footprint): the rasters on ``grid``; None in a result read back by :meth:`from_json`, which
-    holds everything the JSON holds and no more.
+    alignment; :mod:`pcmapq.core.frames`). settings: the options it ran with
+    (``Settings.to_dict()``, metres and degrees); command: the command line that made it
+    (``pcmapq eval ...``, defaults left out), None from the library. noref: each input's
+    no-reference figures, ``{"map": ..., "truth": ...}``
+    (:func:`pcmapq.noref_figures.input_figures`), None when not asked for. truth_sha256: the
+    truth file's SHA-256 (hex; None from the library's :func:`~pcmapq.pipeline.score`), so
+    that results of one truth are known as such however its path was written.
+    truth_occupied, map_occupied (and the overlap's footprint): the rasters on ``grid``; None
+    in a result read back by :meth:`from_json`, which holds everything the JSON holds and no
+    more.
     """
 
     map_path: Path

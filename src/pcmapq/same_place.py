@@ -12,11 +12,11 @@ import numpy as np
 
 from pcmapq.align import Alignment
 from pcmapq.align.parts import Part
-from pcmapq.bounds import radius
 from pcmapq.config import Settings
+from pcmapq.core.bounds import radius
+from pcmapq.core.morphology import outline
 from pcmapq.io import OccupancyMap, PointMap
 from pcmapq.io.extent import far_points
-from pcmapq.morphology import outline
 from pcmapq.plan import MAP_CROP, OUTLINE_M
 from pcmapq.result import INCONSISTENT, OTHER, SAME, Overlap
 

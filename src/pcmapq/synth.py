@@ -9,8 +9,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from pcmapq.grid import MetricGrid
-from pcmapq.transform import Similarity2D
+from pcmapq.core.grid import MetricGrid
+from pcmapq.core.transform import Similarity2D
 
 #: ROS map_server pixel values (negate = 0): occupied, free, unknown.
 OCCUPIED, FREE, UNKNOWN = 0, 254, 205

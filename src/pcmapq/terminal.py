@@ -20,7 +20,7 @@ try:  # recent typer carries its own copy of click
 except ImportError:  # older typer runs on click itself
     from click.exceptions import NoSuchOption, UsageError
 
-from pcmapq.errors import EvaluationError, InputError
+from pcmapq.core.errors import EvaluationError, InputError
 
 HELP_WIDTH = 200
 

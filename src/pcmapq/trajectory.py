@@ -14,8 +14,8 @@ from typing import Literal
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from pcmapq.errors import EvaluationError
-from pcmapq.stats import Stats
+from pcmapq.core.errors import EvaluationError
+from pcmapq.core.stats import Stats
 
 Relation = Literal["translation_part", "rotation_angle_deg", "full"]
 DeltaUnit = Literal["frames", "metres"]

@@ -17,6 +17,6 @@ from __future__ import annotations
 
 from pcmapq.align.params import AlignParams
 from pcmapq.align.planar import Alignment, align, align_similarity, score
-from pcmapq.transform import Similarity2D
+from pcmapq.core.transform import Similarity2D
 
 __all__ = ["AlignParams", "Alignment", "Similarity2D", "align", "align_similarity", "score"]

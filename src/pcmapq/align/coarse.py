@@ -21,12 +21,12 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from pcmapq.bounds import bounds
-from pcmapq.grid import MetricGrid
-from pcmapq.morphology import distance_to
+from pcmapq.core.bounds import bounds
+from pcmapq.core.grid import MetricGrid
+from pcmapq.core.morphology import distance_to
+from pcmapq.core.transform import Similarity2D, wrapped
+from pcmapq.core.voxels import voxel_centroids
 from pcmapq.raster.draw import hit_counts
-from pcmapq.transform import Similarity2D, wrapped
-from pcmapq.voxels import voxel_centroids
 
 
 @dataclass(frozen=True)

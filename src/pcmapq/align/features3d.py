@@ -19,8 +19,8 @@ from contextlib import contextmanager
 import numpy as np
 import open3d as o3d
 
-from pcmapq.errors import EvaluationError
-from pcmapq.voxels import voxel_keys
+from pcmapq.core.errors import EvaluationError
+from pcmapq.core.voxels import voxel_keys
 
 __all__ = ["feature_matches", "global_registration", "keypoints"]
 

@@ -20,8 +20,8 @@ import numpy as np
 
 from pcmapq.align.params import AlignParams
 from pcmapq.align.planar import RigidTarget, align
-from pcmapq.bounds import radius
-from pcmapq.transform import Similarity2D, wrapped
+from pcmapq.core.bounds import radius
+from pcmapq.core.transform import Similarity2D, wrapped
 
 #: Agreement: a part's centroid within this many metres of where the map's pose puts it ...
 AGREE_M = 3.0

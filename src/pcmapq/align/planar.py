@@ -28,8 +28,8 @@ from pcmapq.align.point_to_line import LineTarget, refine_point_to_line
 from pcmapq.align.point_to_point import DEFAULT_SCHEDULE, IcpTarget, refine_point_to_point
 from pcmapq.align.pyramid import descend
 from pcmapq.align.similarity_icp import SimilarityTarget, refine_similarity, similarity_schedule
-from pcmapq.transform import Similarity2D, wrapped
-from pcmapq.voxels import evenly, voxel_centroids, voxel_count
+from pcmapq.core.transform import Similarity2D, wrapped
+from pcmapq.core.voxels import evenly, voxel_centroids, voxel_count
 
 #: The truth keeps this many times the map's ``max_points``: a sparse target would put map points
 #: on its walls farther than the tolerance from its nearest point.

@@ -8,7 +8,7 @@ from threading import Lock
 import numpy as np
 from scipy.spatial import cKDTree
 
-from pcmapq.transform import Similarity2D
+from pcmapq.core.transform import Similarity2D
 
 
 def line_normals(tree: cKDTree, index: np.ndarray, neighbours: int = 8) -> np.ndarray:

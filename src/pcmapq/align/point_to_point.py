@@ -11,8 +11,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from pcmapq.transform import Similarity2D
-from pcmapq.voxels import voxel_centroids
+from pcmapq.core.transform import Similarity2D
+from pcmapq.core.voxels import voxel_centroids
 
 if TYPE_CHECKING:
     import open3d as o3d

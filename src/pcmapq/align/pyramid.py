@@ -30,8 +30,8 @@ import cv2
 import numpy as np
 
 from pcmapq.align.coarse import Candidate, Search, _pose, _suppress, likelihood_field
-from pcmapq.grid import MetricGrid
-from pcmapq.voxels import evenly, voxel_centroids
+from pcmapq.core.grid import MetricGrid
+from pcmapq.core.voxels import evenly, voxel_centroids
 
 #: Distinct poses searched per level, in beams: the bound prunes all but a few of them.
 PARENTS = 4

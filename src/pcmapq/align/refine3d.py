@@ -20,7 +20,7 @@ from __future__ import annotations
 import numpy as np
 import small_gicp
 
-from pcmapq.voxels import voxel_centroids
+from pcmapq.core.voxels import voxel_centroids
 
 __all__ = ["refine"]
 

@@ -17,8 +17,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from pcmapq.align.point_to_line import LineTarget, refine_point_to_line
-from pcmapq.transform import Similarity2D
-from pcmapq.voxels import voxel_centroids
+from pcmapq.core.transform import Similarity2D
+from pcmapq.core.voxels import voxel_centroids
 
 #: Map points are taken at this voxel, metres, before they are cut into regions.
 VOXEL = 0.15

@@ -31,8 +31,8 @@ from scipy.spatial import cKDTree
 
 from pcmapq.align.features3d import global_registration
 from pcmapq.align.refine3d import refine
-from pcmapq.errors import EvaluationError, InputError
-from pcmapq.voxels import voxel_centroids
+from pcmapq.core.errors import EvaluationError, InputError
+from pcmapq.core.voxels import voxel_centroids
 
 __all__ = ["Registration3D", "align_3d"]
 

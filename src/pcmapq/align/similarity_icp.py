@@ -6,8 +6,8 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial import cKDTree
 
-from pcmapq.transform import Similarity2D
-from pcmapq.voxels import voxel_centroids
+from pcmapq.core.transform import Similarity2D
+from pcmapq.core.voxels import voxel_centroids
 
 
 def fit_similarity(src: np.ndarray, dst: np.ndarray) -> Similarity2D:

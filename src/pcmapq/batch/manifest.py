@@ -19,7 +19,7 @@ import yaml
 
 from pcmapq import options
 from pcmapq.config import Settings
-from pcmapq.errors import InputError
+from pcmapq.core.errors import InputError
 
 #: Names a row cannot take: the batch's own table and figure are written beside the rows.
 RESERVED = ("table", "figure")

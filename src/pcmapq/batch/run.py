@@ -21,7 +21,7 @@ from pathlib import Path
 
 from pcmapq import __version__, gates
 from pcmapq.batch.manifest import Row
-from pcmapq.errors import EvaluationError, InputError
+from pcmapq.core.errors import EvaluationError, InputError
 from pcmapq.gates import Gate
 from pcmapq.io.digest import sha256_file
 from pcmapq.io.writers import OutputSet, one_line, write_atomic

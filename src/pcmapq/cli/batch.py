@@ -12,7 +12,7 @@ from rich.console import Console
 
 from pcmapq import gates, options, terminal
 from pcmapq.cli.commands import HELP, RowsFailOver, RowsFailUnder, app
-from pcmapq.errors import InputError
+from pcmapq.core.errors import InputError
 from pcmapq.io.writers import OutputSet, write_atomic
 from pcmapq.terminal import (
     report_errors,

@@ -10,9 +10,10 @@ import numpy as np
 import typer
 from rich.console import Console
 
-from pcmapq import memory, options, terminal
+from pcmapq import options, terminal
 from pcmapq.cli.commands import HELP, MaxMemory, app, memory_limit
 from pcmapq.config import NoRefConfig
+from pcmapq.core import memory
 from pcmapq.inspect_map import inspect_map, summary_lines, to_json
 from pcmapq.io import OccupancyMap, PointMap, load_map
 from pcmapq.io.extent import Box, check_span, hint

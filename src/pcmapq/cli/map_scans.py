@@ -11,7 +11,7 @@ from rich.console import Console
 
 from pcmapq import options, terminal
 from pcmapq.cli.commands import HELP, app
-from pcmapq.errors import InputError
+from pcmapq.core.errors import InputError
 from pcmapq.io.writers import OutputSet, write_cloud
 from pcmapq.mapping import (
     build_map_from_poses,

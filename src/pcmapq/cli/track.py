@@ -12,7 +12,7 @@ from rich.console import Console
 
 from pcmapq import options, terminal
 from pcmapq.cli.commands import DEFAULTS, HELP, MaxMemory, app, memory_limit
-from pcmapq.errors import InputError
+from pcmapq.core.errors import InputError
 from pcmapq.io.writers import OutputSet, write_atomic
 from pcmapq.raster.footprint import FOOTPRINT_RULES
 from pcmapq.terminal import (

@@ -16,10 +16,10 @@ from typing import Any
 
 import numpy as np
 
-from pcmapq.errors import InputError
+from pcmapq.core.errors import InputError
+from pcmapq.core.grid import MetricGrid
 from pcmapq.features.base import Candidates, Detector, Features
 from pcmapq.features.walls import WallImage, wall_image
-from pcmapq.grid import MetricGrid
 
 __all__ = ["DETECTORS", "Candidates", "Detector", "Features", "SideBySide", "WallImage",
            "default_params", "detect", "detect_in", "detector", "walls_of"]

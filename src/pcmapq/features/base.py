@@ -17,8 +17,8 @@ import cv2
 import numpy as np
 from scipy.spatial import cKDTree
 
-from pcmapq.bounds import nonzero_window
-from pcmapq.errors import InputError
+from pcmapq.core.bounds import nonzero_window
+from pcmapq.core.errors import InputError
 from pcmapq.features.walls import WallImage
 
 #: Candidate pairs: truth indices, map indices, costs, displacements (M, 2) in metres.

@@ -13,7 +13,7 @@ import math
 import numba
 import numpy as np
 
-from pcmapq.bounds import bounds
+from pcmapq.core.bounds import bounds
 from pcmapq.features.segments import WallTest, directions
 
 #: Regroup-and-refit rounds of one merged segment.

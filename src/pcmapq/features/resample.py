@@ -7,7 +7,7 @@ import cv2
 import numpy as np
 from scipy import sparse
 
-from pcmapq.grid import MetricGrid
+from pcmapq.core.grid import MetricGrid
 
 
 def _overlap_matrix(n_out: int, out_size: float, n_in: int, in_size: float) -> sparse.csr_array:

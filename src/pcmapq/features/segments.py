@@ -10,7 +10,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
-from pcmapq.grid import MetricGrid
+from pcmapq.core.grid import MetricGrid
 
 
 def directions(seg: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -46,12 +46,12 @@ import cv2
 import numpy as np
 from skimage.morphology import skeletonize
 
-from pcmapq.bounds import nonzero_window
+from pcmapq.core.bounds import nonzero_window
+from pcmapq.core.grid import MetricGrid
+from pcmapq.core.morphology import disc, distance_to
 from pcmapq.features.pixels import flat_index, neighbour_pairs
 from pcmapq.features.pixels import pieces as connected
 from pcmapq.features.resample import resample
-from pcmapq.grid import MetricGrid
-from pcmapq.morphology import disc, distance_to
 
 #: Working cells a side of a tile of a large raster, and the halo drawn around each, metres:
 #: more than any step looks (a small object's 1 m, a spur's 0.25 m, the closing's 0.1 m).

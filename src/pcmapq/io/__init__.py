@@ -1,14 +1,14 @@
 """Loading maps: occupancy images (with their ROS map_server YAML) and point clouds.
 
 ``load_map`` picks the loader from the file extension. Every problem with an input raises
-:class:`pcmapq.errors.InputError` with one line naming the file; inputs are never modified.
+:class:`pcmapq.core.errors.InputError` with one line naming the file; inputs are never modified.
 """
 
 from __future__ import annotations
 
 from pathlib import Path
 
-from pcmapq.errors import InputError
+from pcmapq.core.errors import InputError
 from pcmapq.io.carmen import is_carmen, load_carmen
 from pcmapq.io.clouds import CLOUD_SUFFIXES, PointMap, load_cloud
 from pcmapq.io.occupancy import (
@@ -38,7 +38,7 @@ def load_map(path: str | Path, resolution: float | None = None,
     endpoints at the logged poses) give a :class:`PointMap`; ``resolution`` is ignored for them.
     ``thresholds`` (map_server's occupied_thresh, free_thresh, negate) override an image's YAML;
     clouds ignore them. Sizes declared in headers (an image's pixels, a .npy's rows) are checked
-    against ``memory_limit`` bytes (None: :func:`pcmapq.memory.default_limit`) before anything
+    against ``memory_limit`` bytes (None: :func:`pcmapq.core.memory.default_limit`) before anything
     is allocated.
     """
     path = Path(path)

@@ -30,7 +30,7 @@ from typing import NoReturn
 
 import numpy as np
 
-from pcmapq.errors import InputError
+from pcmapq.core.errors import InputError
 from pcmapq.io.clouds import PointMap
 from pcmapq.io.writers import one_line
 

@@ -22,8 +22,8 @@ from tokenize import TokenError
 import numpy as np
 from numpy.lib import format as npy
 
-from pcmapq import memory
-from pcmapq.errors import InputError
+from pcmapq.core import memory
+from pcmapq.core.errors import InputError
 from pcmapq.io import pcd, ply
 from pcmapq.io.ply import CHUNK, VertexBlock, vertex_block
 from pcmapq.io.stderr import stderr_captured
@@ -75,7 +75,7 @@ class PointMap:
 def load_cloud(path: Path, memory_limit: int | None = None) -> PointMap:
     """Load a point cloud, choosing the reader by extension; a PLY, PCD, .npy or KITTI .bin whose
     header (or size) declares more points than ``memory_limit`` bytes hold (None: the default
-    limit, see :mod:`pcmapq.memory`) is refused unread."""
+    limit, see :mod:`pcmapq.core.memory`) is refused unread."""
     readers: dict[str, Callable[[Path], np.ndarray]] = {
         ".ply": lambda p: read_open3d(p, memory_limit),
         ".pcd": lambda p: read_open3d(p, memory_limit), ".xyz": read_text, ".txt": read_text,
@@ -190,7 +190,7 @@ def read_npy(path: Path, memory_limit: int | None = None) -> np.ndarray:
 def check_npy(path: Path, memory_limit: int | None = None) -> None:
     """InputError, before anything is allocated, when the header of the .npy ``path`` declares
     more bytes than the file holds (truncated, or an absurd shape) or an array the memory guard
-    (:mod:`pcmapq.memory`; ``memory_limit`` bytes, None: the default) refuses as a cloud."""
+    (:mod:`pcmapq.core.memory`; ``memory_limit`` bytes, None: the default) refuses as a cloud."""
     with path.open("rb") as f:
         try:
             version = npy.read_magic(f)

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from pcmapq.errors import InputError
+from pcmapq.core.errors import InputError
 from pcmapq.io.writers import OutputSet, atomic_file
 
 #: The scalar field of a distance cloud: metres. CloudCompare reads a PLY property named

@@ -12,10 +12,10 @@ from dataclasses import replace
 
 import numpy as np
 
-from pcmapq.bounds import bounds
-from pcmapq.cells import OCCUPIED, UNKNOWN
-from pcmapq.errors import InputError
-from pcmapq.grid import MetricGrid
+from pcmapq.core.bounds import bounds
+from pcmapq.core.cells import OCCUPIED, UNKNOWN
+from pcmapq.core.errors import InputError
+from pcmapq.core.grid import MetricGrid
 from pcmapq.io.clouds import PointMap
 from pcmapq.io.occupancy import OccupancyMap
 

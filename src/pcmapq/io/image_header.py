@@ -12,8 +12,8 @@ import struct
 import zlib
 from pathlib import Path
 
-from pcmapq import memory
-from pcmapq.errors import InputError
+from pcmapq.core import memory
+from pcmapq.core.errors import InputError
 
 __all__ = ["check_image_size", "check_png_chunks", "declared_size"]
 
@@ -38,7 +38,7 @@ def declared_size(path: Path) -> tuple[int, int, int] | None:
 
 def check_image_size(path: Path, memory_limit: int | None = None) -> None:
     """InputError (one line) when the image's declared pixels would need more memory to read
-    and classify than the memory guard allows (:mod:`pcmapq.memory`; ``memory_limit`` bytes,
+    and classify than the memory guard allows (:mod:`pcmapq.core.memory`; ``memory_limit`` bytes,
     None: the default limit)."""
     size = declared_size(path)
     if size is None:

@@ -4,7 +4,7 @@ A pixel's grey value ``v`` (colour: mean of the colour channels; 16-bit images s
 gives ``p = (255 - v) / 255`` (``v / 255`` when ``negate``); the cell is occupied if
 ``p > occupied_thresh``, free if ``p < free_thresh`` and unknown otherwise. A transparent pixel
 (alpha 0) is unknown. The grid's frame is the map_server one: ``origin`` is the pose of the
-image's lower-left corner (see :mod:`pcmapq.grid`). One reading goes beyond map_server's: the
+image's lower-left corner (see :mod:`pcmapq.core.grid`). One reading goes beyond map_server's: the
 outside of a building drawn solid, reaching the image's border, is read as its face
 (:func:`open_outside`), as a laser sees it.
 """
@@ -24,13 +24,13 @@ import cv2
 import numpy as np
 import yaml
 
-from pcmapq.cells import FREE, OCCUPIED, UNKNOWN
-from pcmapq.errors import InputError
-from pcmapq.grid import MetricGrid
+from pcmapq.core.cells import FREE, OCCUPIED, UNKNOWN
+from pcmapq.core.errors import InputError
+from pcmapq.core.grid import MetricGrid
+from pcmapq.core.morphology import disc, outline, reaching_border
 from pcmapq.io.image_header import check_image_size
 from pcmapq.io.stderr import stderr_captured, stderr_uncaptured
 from pcmapq.io.writers import one_line, same_file
-from pcmapq.morphology import disc, outline, reaching_border
 
 IMAGE_SUFFIXES = (".png", ".pgm", ".jpg", ".jpeg", ".bmp")
 YAML_SUFFIXES = (".yaml", ".yml")

@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from pcmapq.errors import InputError
+from pcmapq.core.errors import InputError
 
 __all__ = ["VertexBlock", "check_size", "count_lines", "vertex_block"]
 

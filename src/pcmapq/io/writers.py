@@ -12,7 +12,7 @@ from typing import BinaryIO
 import cv2
 import numpy as np
 
-from pcmapq.errors import InputError
+from pcmapq.core.errors import InputError
 
 
 class OutputSet:

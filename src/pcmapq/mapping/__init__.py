@@ -10,6 +10,7 @@ Frames: ``p_world = pose_k @ calib @ p_sensor``; every length in metres.
 
 from __future__ import annotations
 
+from pcmapq.core.voxels import VoxelMap, voxel_centroids
 from pcmapq.mapping.kiss import build_map_kiss, kiss_config
 from pcmapq.mapping.poses import (
     lidar_poses_from_camera,
@@ -30,7 +31,6 @@ from pcmapq.mapping.reference import (
     scans_for_poses,
 )
 from pcmapq.mapping.scans import ScanSequence, open_scans
-from pcmapq.voxels import VoxelMap, voxel_centroids
 
 __all__ = [
     "ScanSequence",

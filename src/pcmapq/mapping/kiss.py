@@ -3,7 +3,7 @@
 KISS-ICP keeps only a local map around the sensor. Each scan goes through
 ``KissICP.register_frame``, which returns the scan deskewed (motion compensated, range cropped)
 in the sensor frame; it is placed in the world with the pose KISS-ICP estimated for it and
-accumulated into a :class:`~pcmapq.voxels.VoxelMap`.
+accumulated into a :class:`~pcmapq.core.voxels.VoxelMap`.
 
 Frames: the world frame is the sensor frame of the first scan (its pose is the identity);
 ``p_world = poses[k] @ p_sensor_k``; metres.
@@ -18,9 +18,9 @@ import numpy as np
 from kiss_icp.config import KISSConfig
 from kiss_icp.kiss_icp import KissICP
 
-from pcmapq.errors import InputError
+from pcmapq.core.errors import InputError
+from pcmapq.core.voxels import VoxelMap
 from pcmapq.mapping.scans import open_scans
-from pcmapq.voxels import VoxelMap
 
 __all__ = ["build_map_kiss", "kiss_config"]
 

@@ -31,7 +31,7 @@ from pathlib import Path
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from pcmapq.errors import InputError
+from pcmapq.core.errors import InputError
 from pcmapq.io.writers import OutputSet, one_line, write_atomic
 
 __all__ = [

@@ -17,10 +17,10 @@ from pathlib import Path
 
 import numpy as np
 
-from pcmapq.errors import InputError
+from pcmapq.core.errors import InputError
+from pcmapq.core.voxels import VoxelMap
 from pcmapq.mapping.scans import ScanSequence, open_scans
 from pcmapq.metrics.posed import place
-from pcmapq.voxels import VoxelMap
 
 __all__ = ["build_map_from_poses", "describe_scans", "scans_for_poses"]
 

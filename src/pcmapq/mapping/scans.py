@@ -28,7 +28,7 @@ from typing import Any
 import numpy as np
 import open3d as o3d
 
-from pcmapq.errors import InputError
+from pcmapq.core.errors import InputError
 from pcmapq.io.clouds import read_kitti_bin, read_npy, with_z
 from pcmapq.io.writers import one_line
 

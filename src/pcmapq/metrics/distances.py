@@ -1,6 +1,6 @@
 """Cloud-to-cloud style distance metrics on the truth's grid: accuracy, completeness, Chamfer
 distance and precision / recall / F-score at distance thresholds (definitions in
-docs/metrics.md). Exact Euclidean distance transforms (:func:`pcmapq.morphology.distance_to`);
+docs/metrics.md). Exact Euclidean distance transforms (:func:`pcmapq.core.morphology.distance_to`);
 metres."""
 
 from __future__ import annotations
@@ -9,9 +9,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pcmapq.grid import MetricGrid
-from pcmapq.morphology import distance_to
-from pcmapq.stats import Stats
+from pcmapq.core.grid import MetricGrid
+from pcmapq.core.morphology import distance_to
+from pcmapq.core.stats import Stats
 
 #: Default distance thresholds of the F-score, metres.
 DEFAULT_TAUS = (0.05, 0.1, 0.2, 0.5)
@@ -101,7 +101,7 @@ def distances_3d(map_xyz: np.ndarray, truth_xyz: np.ndarray, voxel: float = 0.05
     The exact nearest neighbours come from Open3D's ``compute_point_cloud_distance`` (a KD-tree,
     every core), one call per direction: the distances SciPy's ``cKDTree`` gives, in about
     two thirds of its time (``bench/bench_clouds.py``)."""
-    from pcmapq.voxels import voxel_centroids
+    from pcmapq.core.voxels import voxel_centroids
 
     basis = (f"in 3D: the map's and the truth's points voxel-downsampled to {voxel:g} m "
              "(centroids), each to the nearest of the other's")
@@ -117,7 +117,7 @@ def accuracy_3d(map_xyz: np.ndarray, truth_xyz: np.ndarray,
     """The points and distances :func:`distances_3d`' accuracy is computed on: the map's voxel
     centroids (N, 3) and each one's distance to the nearest truth voxel centroid (N,),
     metres."""
-    from pcmapq.voxels import voxel_centroids
+    from pcmapq.core.voxels import voxel_centroids
 
     m, t = voxel_centroids(map_xyz, voxel), voxel_centroids(truth_xyz, voxel)
     return m, (_nearest_3d(m, t) if len(t) else np.full(len(m), np.inf))

@@ -9,7 +9,7 @@ from typing import Any
 
 import numpy as np
 
-from pcmapq.errors import EvaluationError
+from pcmapq.core.errors import EvaluationError
 from pcmapq.metrics.noref import LIDAR_RADIUS, MAX_NN, MIN_KNN, mom, scores
 from pcmapq.metrics.orthogonal import MAX_WARD_POINTS, extract_orthogonal_subset
 

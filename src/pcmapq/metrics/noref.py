@@ -24,7 +24,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.spatial import cKDTree
 
-from pcmapq.bounds import bounds
+from pcmapq.core.bounds import bounds
 from pcmapq.metrics.ballsums import CHUNK_POINTS, ball_sums, moments
 
 #: map-metrics' presets (metres, neighbour counts): ``LidarConfig`` and ``DepthConfig``.

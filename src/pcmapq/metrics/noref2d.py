@@ -13,10 +13,10 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from pcmapq.cells import FREE, OCCUPIED, UNKNOWN
+from pcmapq.core.cells import FREE, OCCUPIED, UNKNOWN
+from pcmapq.core.grid import MetricGrid
 from pcmapq.features import detect
 from pcmapq.features.harris import Params as HarrisParams
-from pcmapq.grid import MetricGrid
 
 #: Enclosed free regions smaller than this are gaps inside a thick wall, not areas, m^2.
 MIN_ENCLOSED_AREA = 0.05

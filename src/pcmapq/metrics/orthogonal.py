@@ -21,7 +21,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.cluster.hierarchy import fcluster, ward
 
-from pcmapq.errors import EvaluationError
+from pcmapq.core.errors import EvaluationError
 from pcmapq.metrics.noref import MAX_NN, flat, neighbourhood_sums
 
 #: map-metrics' constants: Ward cut distance, near-orthogonality |cos|, smallest cluster.

@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 from numpy.lib import format as npy
 
-from pcmapq.errors import InputError
+from pcmapq.core.errors import InputError
 
 
 def place(clouds: Sequence[np.ndarray], poses: Sequence[np.ndarray]) -> np.ndarray:

@@ -8,11 +8,11 @@ from typing import TYPE_CHECKING
 import cv2
 import numpy as np
 
-from pcmapq.cells import FREE, OCCUPIED, UNKNOWN
-from pcmapq.grid import MetricGrid
+from pcmapq.core.cells import FREE, OCCUPIED, UNKNOWN
+from pcmapq.core.grid import MetricGrid
 
 if TYPE_CHECKING:
-    from pcmapq.transform import Similarity2D
+    from pcmapq.core.transform import Similarity2D
 
 
 

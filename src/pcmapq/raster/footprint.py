@@ -31,8 +31,8 @@ import cv2
 import numpy as np
 from scipy import ndimage
 
-from pcmapq.grid import MetricGrid
-from pcmapq.morphology import disc, distance_to
+from pcmapq.core.grid import MetricGrid
+from pcmapq.core.morphology import disc, distance_to
 from pcmapq.raster.draw import polygon_cells
 
 #: The footprint rules, ``auto`` first (the default).

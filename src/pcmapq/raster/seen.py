@@ -13,10 +13,10 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
-from pcmapq.bounds import bounds
-from pcmapq.grid import MetricGrid
+from pcmapq.core.bounds import bounds
+from pcmapq.core.grid import MetricGrid
+from pcmapq.core.transform import Similarity2D
 from pcmapq.io.clouds import SEEN_CELL, SeenCells
-from pcmapq.transform import Similarity2D
 
 #: Fractional bits of the vertices given to OpenCV's polygon filling.
 SHIFT = 8

@@ -11,7 +11,7 @@ from collections.abc import Iterator
 import numpy as np
 import open3d as o3d
 
-from pcmapq.frames import Levelling
+from pcmapq.core.frames import Levelling
 
 #: Height histogram bin for finding the floor, metres.
 FLOOR_BIN = 0.05
@@ -39,7 +39,7 @@ def wall_band(points: np.ndarray, low: float = 0.3,
     is first levelled with :func:`level_rotation` (a rotation about the horizontal axis only, so
     x, y and yaw are kept as far as the tilt allows), then the floor is found as
     :func:`floor_height` finds it. Returns (M, 2) float64 x, y in metres of the levelled cloud
-    and the :class:`~pcmapq.frames.Levelling` that made it. Raises ValueError if there are no
+    and the :class:`~pcmapq.core.frames.Levelling` that made it. Raises ValueError if there are no
     points or the band is empty.
 
     Up to CHUNK points this is computed in one go. A larger cloud is read CHUNK rows at a time

@@ -2,7 +2,7 @@
 that moves it (``--transform``) and the map's points with their distance to the truth
 (``--distances``). Metres.
 
-Frames (:mod:`pcmapq.frames`). A 2D map (an image, a 2D cloud) is moved by the planar
+Frames (:mod:`pcmapq.core.frames`). A 2D map (an image, a 2D cloud) is moved by the planar
 alignment into the truth's plan, ``p_truth = s * R(yaw) * p_map + t``: the 3x3 matrix of the
 JSON's ``alignment``. A 3D cloud keeps its three dimensions and is moved by the whole chain,
 one 4x4 matrix: levelled (heights above its floor), moved in the plan (z scaled by s), then
@@ -25,10 +25,11 @@ from pathlib import Path
 
 import numpy as np
 
-from pcmapq.cells import FREE, OCCUPIED
 from pcmapq.config import Settings
-from pcmapq.frames import Frames, Levelling
-from pcmapq.grid import MetricGrid
+from pcmapq.core.cells import FREE, OCCUPIED
+from pcmapq.core.frames import Frames, Levelling
+from pcmapq.core.grid import MetricGrid
+from pcmapq.core.transform import Similarity2D
 from pcmapq.io import OccupancyMap, PointMap
 from pcmapq.io.export import DISTANCE_FIELD, record_dtype, records, write_matrix, write_records
 from pcmapq.io.ply import CHUNK
@@ -37,7 +38,6 @@ from pcmapq.metrics.distances import accuracy_2d, accuracy_3d, nearest_distance
 from pcmapq.plan import MAP_CROP, TRUTH_CROP, cropped, load_input
 from pcmapq.raster.draw import warp_state
 from pcmapq.result import Result
-from pcmapq.transform import Similarity2D
 
 #: map_server grey values of an occupied, a free and an unknown cell (negate 0).
 ROS_OCCUPIED, ROS_FREE, ROS_UNKNOWN = 0, 254, 205

@@ -12,7 +12,7 @@ from matplotlib.cm import ScalarMappable
 from matplotlib.colors import Normalize
 from matplotlib.figure import Figure
 
-from pcmapq.morphology import distance_to
+from pcmapq.core.morphology import distance_to
 from pcmapq.raster.pool import max_pool, min_pool
 from pcmapq.report.plot import WIDTH_IN, extent, frame, plt, pooling  # Agg backend
 from pcmapq.report.style import TEXT_PT, TITLE_PT

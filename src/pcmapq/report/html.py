@@ -10,6 +10,7 @@ import json
 import numpy as np
 
 from pcmapq import __version__
+from pcmapq.core.stats import Stats
 from pcmapq.report.heatmap import distance_heatmap
 from pcmapq.report.plot import png_bytes, vectorial_figure
 from pcmapq.report.style import ARROW_SCALE, FIGURE_WIDTH_PX
@@ -17,7 +18,6 @@ from pcmapq.report.text import number, score
 from pcmapq.report.viewer import STYLE as VIEWER_STYLE
 from pcmapq.report.viewer import nearest_distances, viewer_html
 from pcmapq.result import DetectorResult, Result
-from pcmapq.stats import Stats
 
 STYLE = """
 body { font-family: -apple-system, 'Segoe UI', Helvetica, Arial, sans-serif; margin: 2em auto;

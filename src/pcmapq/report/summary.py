@@ -10,7 +10,7 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from pcmapq.config import DETECTOR_NAMES
-from pcmapq.errors import InputError
+from pcmapq.core.errors import InputError
 from pcmapq.io.writers import OutputSet, one_line, write_atomic
 from pcmapq.result import DECIMALS
 

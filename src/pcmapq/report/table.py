@@ -9,9 +9,9 @@ from rich import box
 from rich.console import Console
 from rich.table import Table
 
+from pcmapq.core.stats import FIELDS, Stats
 from pcmapq.report.text import LEGEND, metres, number, score, verdict, words, wrap
 from pcmapq.result import DetectorResult, Result
-from pcmapq.stats import FIELDS, Stats
 
 #: Width of the labels of the key-value lines, characters.
 LABEL = 12

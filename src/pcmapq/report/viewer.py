@@ -3,7 +3,7 @@
 whether it is matched, missing or extra, where it stands and its displacement, metres.
 
 The SVG's user unit is one cell of the truth grid (cell centres at integers, as
-:meth:`~pcmapq.grid.MetricGrid.xy_to_pixels` gives them), so the walls, drawn in the grid's own
+:meth:`~pcmapq.core.grid.MetricGrid.xy_to_pixels` gives them), so the walls, drawn in the grid's own
 rows and columns, and the features, placed from their metric (truth frame) coordinates, stand
 where the grid puts them for any grid origin and yaw. The walls are two embedded PNGs (the
 truth dark over the aligned map light, as in the figures), pooled to at most

@@ -79,7 +79,7 @@ def track_run(run: Run, truth_path: Path, settings: Settings, ends: np.ndarray, 
     no-reference figures are left out: they do not change with the map's pose); ``reference``:
     reference poses (K, 4, 4) from ``reference_path``; ``show``: the step the report shows
     (default: where the worst drop starts, else the last). As many steps are scored at once
-    as fit in ``memory_limit`` bytes (None: :func:`pcmapq.memory.default_limit`), at most
+    as fit in ``memory_limit`` bytes (None: :func:`pcmapq.core.memory.default_limit`), at most
     three; InputError (one line) when not even one does. The results kept for the report
     (at most :data:`~pcmapq.track.timeline.KEEP_BYTES`) are not counted."""
     settings = replace(settings, noref=replace(settings.noref, enabled=False))

@@ -26,7 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
-from pcmapq.errors import InputError
+from pcmapq.core.errors import InputError
 from pcmapq.features.walls import CLOSING
 from pcmapq.io import PointMap
 from pcmapq.io.carmen import DEFAULT_MAX_RANGE, LaserScans, endpoints, is_carmen, read_laser_scans

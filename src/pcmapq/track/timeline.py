@@ -26,8 +26,10 @@ import numpy as np
 
 from pcmapq.align import align
 from pcmapq.config import Settings
-from pcmapq.errors import EvaluationError, InputError
-from pcmapq.frames import Frames
+from pcmapq.core.errors import EvaluationError, InputError
+from pcmapq.core.frames import Frames
+from pcmapq.core.transform import Similarity2D
+from pcmapq.core.voxels import evenly, voxel_centroids
 from pcmapq.pipeline import MapSide, PreparedTruth
 from pcmapq.prepared import finish_prepared, place_prepared, score_prepared
 from pcmapq.report.summary import summary_row
@@ -35,8 +37,6 @@ from pcmapq.result import Result
 from pcmapq.track.runs import Run
 from pcmapq.track.steps import travelled
 from pcmapq.trajectory import ape, rpe
-from pcmapq.transform import Similarity2D
-from pcmapq.voxels import evenly, voxel_centroids
 
 #: The summary columns a step does not repeat (they name the inputs or a batch's outcome).
 NOT_PER_STEP = ("name", "map", "truth", "gates", "exit_code", "error")

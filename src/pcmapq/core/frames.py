@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pcmapq.transform import Similarity2D
+from pcmapq.core.transform import Similarity2D
 
 #: The documented convention, stored beside the transforms in the JSON.
 CONVENTION = "p_truth = s * R(yaw) * p_map + t"

@@ -13,7 +13,7 @@ from __future__ import annotations
 import os
 from collections.abc import Callable
 
-from pcmapq.errors import InputError
+from pcmapq.core.errors import InputError
 
 #: Resident memory of the imported libraries, bytes.
 BASE = 450e6

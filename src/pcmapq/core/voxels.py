@@ -18,8 +18,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from pcmapq.bounds import bounds
-from pcmapq.errors import InputError
+from pcmapq.core.bounds import bounds
+from pcmapq.core.errors import InputError
 
 __all__ = ["VoxelMap", "evenly", "voxel_centroids", "voxel_count"]
 

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pcmapq.bounds import bounds
+from pcmapq.core.bounds import bounds
 
 
 @dataclass(frozen=True)
