@@ -160,3 +160,16 @@ def test_settings_read_back_from_their_dict():
     assert back.to_dict() == s.to_dict()
     assert back.alignment.init.yaw == pytest.approx(0.5)
     assert back.matching.params["harris"] == harris.Params(sigma=0.2)
+
+
+@pytest.mark.e2e
+def test_a_result_without_detectors_keeps_its_threshold_when_read_back():
+    """The matching threshold of a result whose detectors were all left out comes back from
+    its settings (it fell back to 0.5: the settings' threshold was looked for at the top)."""
+    from pcmapq.config import MatchingConfig
+
+    sample = Path(__file__).resolve().parents[1] / "data" / "sample"
+    result = evaluate(sample / "scan.ply", sample / "truth.png",
+                      Settings(matching=MatchingConfig(detectors=(), threshold=0.3)))
+    assert result.detectors == {}
+    assert Result.from_json(result.to_json()).threshold == 0.3

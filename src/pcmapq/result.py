@@ -368,7 +368,7 @@ def _from_dict(doc: dict) -> Result:
             np.asarray(reg["matrix"], dtype=np.float64), reg["fitness"], reg["rmse_m"]),
         distances_3d=_distances_of(doc["distances_3d"]) if "distances_3d" in doc else None,
         threshold=next((d["threshold_m"] for d in doc["detectors"].values()),
-                       (doc["settings"] or {}).get("threshold", 0.5)),
+                       ((doc["settings"] or {}).get("matching") or {}).get("threshold", 0.5)),
         full=doc["scored_against"] == "whole truth", detectors=detectors,
         truth_occupied=None, map_occupied=None, frames=frames,
         footprint_rule=doc["footprint"], settings=doc["settings"],
