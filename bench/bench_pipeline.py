@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 from pcmapq import synth
 from pcmapq.core.transform import Similarity2D
-from pcmapq.pipeline import evaluate
+from pcmapq.evaluation.pipeline import evaluate
 sys.path.insert(0, sys.argv[1])
 from tests.conftest import in_map_frame, write_cloud_map, write_image_map
 

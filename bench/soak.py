@@ -1,8 +1,9 @@
 """Soak test (issue 12): many evaluations of varied inputs in one process through the Python
-API (``pcmapq.pipeline.evaluate``), cycled round-robin. Checks that every run's outcome equals
-the first run of its input (the JSON the CLI writes, byte for byte; for an input that fails by
-design, the same exception type and message), that the resident memory after the last round is
-within 10 % of that after the first, and that threads and open file descriptors do not grow.
+API (``pcmapq.evaluation.pipeline.evaluate``), cycled round-robin. Checks that every run's
+outcome equals the first run of its input (the JSON the CLI writes, byte for byte; for an
+input that fails by design, the same exception type and message), that the resident memory
+after the last round is within 10 % of that after the first, and that threads and open file
+descriptors do not grow.
 
     python -m bench.soak [--runs 200] [--json out.json] [--data DIR]
 
@@ -33,9 +34,9 @@ from pcmapq import synth
 from pcmapq.config import AlignmentConfig, Settings, SourceConfig
 from pcmapq.core.errors import EvaluationError, InputError
 from pcmapq.core.transform import Similarity2D
+from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.io.carmen import DEFAULT_MAX_RANGE, endpoints, read_flaser
 from pcmapq.io.writers import write_ros_map
-from pcmapq.pipeline import evaluate
 
 from .validation.drift import drifted, save_cloud
 

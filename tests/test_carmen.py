@@ -12,9 +12,9 @@ import pytest
 from bench.validation import drift
 from pcmapq.config import AlignmentConfig, Settings
 from pcmapq.core.errors import InputError
+from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.io import PointMap, load_map
 from pcmapq.io.carmen import beam_angles, endpoints, load_carmen, read_flaser
-from pcmapq.pipeline import evaluate
 
 from .conftest import shared
 

@@ -17,10 +17,10 @@ from pcmapq.align.coarse import Search, distinctiveness
 from pcmapq.config import AlignmentConfig, MatchingConfig, Settings, SourceConfig
 from pcmapq.core.errors import EvaluationError
 from pcmapq.core.transform import Similarity2D
+from pcmapq.evaluation.pipeline import evaluate
+from pcmapq.evaluation.same_place import confidence
 from pcmapq.io import Thresholds, load_map
-from pcmapq.pipeline import evaluate
 from pcmapq.raster.draw import FREE, OCCUPIED, UNKNOWN
-from pcmapq.same_place import confidence
 
 from .conftest import in_map_frame, shared, write_image_map
 

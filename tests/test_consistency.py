@@ -19,10 +19,10 @@ from pcmapq.config import MatchingConfig, Settings
 from pcmapq.core.errors import EvaluationError
 from pcmapq.core.transform import Similarity2D
 from pcmapq.core.voxels import voxel_centroids
+from pcmapq.evaluation.pipeline import evaluate
+from pcmapq.evaluation.same_place import verdict
 from pcmapq.io import PointMap
-from pcmapq.pipeline import evaluate
 from pcmapq.result import INCONSISTENT, OTHER, SAME, Result
-from pcmapq.same_place import verdict
 
 from .conftest import write_image_map
 

@@ -16,10 +16,10 @@ from typer.testing import CliRunner
 from pcmapq.cli import app
 from pcmapq.core.errors import EvaluationError, InputError
 from pcmapq.core.grid import MetricGrid
+from pcmapq.evaluation.inputs import check_structure
 from pcmapq.io import OccupancyMap, PointMap, load_map
 from pcmapq.io.extent import MAX_SPAN, check_span, crop, hint, main_group
 from pcmapq.options import parse_box
-from pcmapq.plan import check_structure
 from pcmapq.raster.draw import FREE, OCCUPIED, UNKNOWN
 
 SAMPLE = Path(__file__).resolve().parents[1] / "data" / "sample"

@@ -11,8 +11,8 @@ import pytest
 
 from pcmapq import synth
 from pcmapq.core.transform import Similarity2D
+from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.io import clouds, load_map
-from pcmapq.pipeline import evaluate
 from pcmapq.raster import slice as slice_module
 
 from .conftest import in_map_frame, write_image_map

@@ -17,7 +17,7 @@ from typer.testing import CliRunner
 
 import pcmapq
 from pcmapq import cli, terminal
-from pcmapq.plan import MAX_OCCUPIED_SHARE
+from pcmapq.evaluation.inputs import MAX_OCCUPIED_SHARE
 
 from .conftest import shared
 

@@ -21,10 +21,10 @@ from pcmapq.config import (
     SourceConfig,
 )
 from pcmapq.core.stats import significant
+from pcmapq.evaluation.noref_figures import input_figures
+from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.io import load_map
 from pcmapq.metrics import orthogonal
-from pcmapq.noref_figures import input_figures
-from pcmapq.pipeline import evaluate
 from pcmapq.result import Result
 
 from .conftest import write_image_map

@@ -8,7 +8,7 @@ import pytest
 from pcmapq import synth
 from pcmapq.config import AlignmentConfig, MatchingConfig, Settings
 from pcmapq.core.transform import Similarity2D
-from pcmapq.pipeline import evaluate
+from pcmapq.evaluation.pipeline import evaluate
 
 from .conftest import in_map_frame, write_cloud_map, write_image_map
 

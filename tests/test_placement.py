@@ -13,8 +13,8 @@ from pcmapq import synth
 from pcmapq.config import AlignmentConfig, MatchingConfig, Settings
 from pcmapq.core.morphology import outline
 from pcmapq.core.transform import Similarity2D
+from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.io import PointMap
-from pcmapq.pipeline import evaluate
 from pcmapq.raster.draw import OCCUPIED, polygon_cells
 
 from .conftest import write_ros_map
@@ -108,7 +108,7 @@ def exhaustive_pose(map_xy: np.ndarray, truth_xy: np.ndarray, resolution: float)
 def _plan_xy(path: Path) -> np.ndarray:
     from pcmapq.config import Settings, SourceConfig
     from pcmapq.core.voxels import voxel_centroids
-    from pcmapq.plan import TRUTH_CROP, load_input, plan_points
+    from pcmapq.evaluation.inputs import TRUTH_CROP, load_input, plan_points
 
     # The room-segmentation benchmark's images have no YAML: 0.05 m a pixel (its README).
     config = SourceConfig(resolution=0.05) if path.suffix == ".png" else Settings().truth

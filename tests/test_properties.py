@@ -27,8 +27,8 @@ from typer.testing import CliRunner
 from pcmapq import synth
 from pcmapq.cli import app
 from pcmapq.core.transform import Similarity2D
+from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.io.writers import write_ros_map
-from pcmapq.pipeline import evaluate
 from pcmapq.result import Result
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -12,11 +12,11 @@ from skimage.morphology import skeletonize
 from pcmapq.config import AlignmentConfig, Settings
 from pcmapq.core.grid import MetricGrid
 from pcmapq.core.transform import Similarity2D
+from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.features import DETECTORS, detect
 from pcmapq.io import load_map
 from pcmapq.io.writers import write_ros_map
 from pcmapq.match import match
-from pcmapq.pipeline import evaluate
 from pcmapq.raster.draw import OCCUPIED
 from pcmapq.report.html import report_html
 

@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 from bench.validation.reference import differences
-from pcmapq.pipeline import evaluate
+from pcmapq.evaluation.pipeline import evaluate
 
 ROOT = Path(__file__).resolve().parents[1]
 REFERENCE = ROOT / "tests" / "reference" / "sample.json"

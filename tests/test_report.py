@@ -15,7 +15,7 @@ import pytest
 from pcmapq import synth
 from pcmapq.config import MatchingConfig, Settings
 from pcmapq.core.grid import MetricGrid
-from pcmapq.pipeline import evaluate
+from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.report.heatmap import distance_heatmap, wall_distances
 from pcmapq.report.html import report_html
 from pcmapq.report.plot import (

@@ -12,7 +12,7 @@ import pytest
 from bench.validation.reference import differences
 from pcmapq.config import Settings
 from pcmapq.core.stats import FIELDS, Stats
-from pcmapq.pipeline import evaluate
+from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.result import Result
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -16,7 +16,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 SINGLE_RUN = """
 import sys
-from pcmapq.pipeline import evaluate
+from pcmapq.evaluation.pipeline import evaluate
 sys.stdout.write(evaluate(sys.argv[1], sys.argv[2]).to_json())
 """
 

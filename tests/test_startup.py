@@ -83,7 +83,7 @@ def test_the_library_names_load_on_first_use():
     the library's object (pcmapq.evaluate is the pipeline's evaluate)."""
     code = ("import sys, pcmapq\n"
             f"print(sorted({{m.split('.')[0] for m in sys.modules}} & set({HEAVY!r})))\n"
-            "from pcmapq.pipeline import evaluate\n"
+            "from pcmapq.evaluation.pipeline import evaluate\n"
             "print(pcmapq.evaluate is evaluate, all(getattr(pcmapq, n) is not None "
             "for n in pcmapq.__all__))")
     got = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,

@@ -14,7 +14,7 @@ import pytest
 from pcmapq import synth
 from pcmapq.config import DETECTOR_NAMES, MatchingConfig, Settings
 from pcmapq.core.errors import InputError
-from pcmapq.pipeline import evaluate
+from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.report import summary
 from pcmapq.report.summary import (
     HEAD,

@@ -31,10 +31,10 @@ from typer.testing import CliRunner
 from pcmapq import synth
 from pcmapq.cli import app
 from pcmapq.config import Settings
+from pcmapq.evaluation.inputs import TRUTH_CROP, load_input
+from pcmapq.evaluation.pipeline import score
 from pcmapq.io.carmen import beam_angles, read_laser_scans
 from pcmapq.io.writers import write_ros_map
-from pcmapq.pipeline import score
-from pcmapq.plan import TRUTH_CROP, load_input
 from pcmapq.track import Tracked, open_run, step_ends, track_run, travelled
 from pcmapq.track.drop import MIN_DROP
 from pcmapq.track.outputs import HEAD
@@ -434,8 +434,8 @@ def test_every_m_steps_at_the_first_scan_reaching_each_multiple(runs: Runs) -> N
 def test_a_step_equals_a_from_scratch_evaluation(runs: Runs, which: str, tmp_path) -> None:
     """A step of the drifted run (the first, found by the global search; the first holding a
     drifted scan; the last) is the result of scoring the map of its first scans, read from
-    their own log, with :func:`pcmapq.pipeline.score` (the truth not prepared) and ICP from
-    the step's start: the same figures, to 1e-9."""
+    their own log, with :func:`pcmapq.evaluation.pipeline.score` (the truth not prepared) and
+    ICP from the step's start: the same figures, to 1e-9."""
     tracked = runs.track_run("drifted")
     step = tracked.steps[{"first": 0, "drifted": runs.k_step(), "last": -1}[which]]
     assert step.scored and (step.start is None) == (which == "first")

@@ -11,8 +11,8 @@ import pytest
 from pcmapq.core import memory
 from pcmapq.core.grid import MetricGrid
 from pcmapq.core.transform import Similarity2D
+from pcmapq.evaluation.inputs import distinct_cells
 from pcmapq.io.carmen import beam_angles
-from pcmapq.plan import distinct_cells
 from pcmapq.raster.footprint import (
     footprint_rule,
     joined_readings,

@@ -12,7 +12,7 @@ from typer.testing import CliRunner
 
 from pcmapq.cli import app
 from pcmapq.config import AlignmentConfig, FootprintConfig, MatchingConfig, Settings
-from pcmapq.pipeline import evaluate
+from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.report.html import report_html
 from pcmapq.report.plot import vectorial_figure
 from pcmapq.report.table import print_table

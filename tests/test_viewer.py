@@ -17,9 +17,9 @@ import pytest
 from pcmapq import synth
 from pcmapq.config import MatchingConfig, Settings
 from pcmapq.core.grid import MetricGrid
+from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.features import Features
 from pcmapq.match import Matching
-from pcmapq.pipeline import evaluate
 from pcmapq.report.html import report_html
 from pcmapq.report.viewer import STYLE, VIEWER_PX, viewer_html
 from pcmapq.result import DetectorResult, Result

@@ -17,8 +17,8 @@ import numpy as np
 from pcmapq import synth
 from pcmapq.config import AlignmentConfig, FootprintConfig, Settings
 from pcmapq.core.transform import Similarity2D
+from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.io.writers import write_ros_map
-from pcmapq.pipeline import evaluate
 from pcmapq.report.text import score
 
 #: Parts of the 24 m x 16 m plan (x0, y0, x1, y1, metres), 25-60 % of its walls; no cut runs

@@ -15,9 +15,9 @@ from typing import Generic, Protocol, TypeVar
 import numpy as np
 
 from pcmapq.config import Settings
+from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.io import PointMap
 from pcmapq.io.occupancy import MapMeta, read_levels
-from pcmapq.pipeline import evaluate
 from pcmapq.report.text import score
 from pcmapq.result import Result
 

@@ -27,9 +27,9 @@ import numpy as np
 from pcmapq import synth
 from pcmapq.config import AlignmentConfig, MatchingConfig, Settings
 from pcmapq.core.transform import Similarity2D
+from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.io import PointMap
 from pcmapq.io.carmen import endpoints, read_flaser
-from pcmapq.pipeline import evaluate
 from pcmapq.report.plot import figure_bytes, vectorial_figure
 
 from .common import Case, Record, Section

@@ -74,14 +74,14 @@ from pcmapq import synth
 from pcmapq.align.parts import PIECES
 from pcmapq.config import Settings
 from pcmapq.core.transform import Similarity2D
+from pcmapq.evaluation.pipeline import evaluate
+from pcmapq.evaluation.same_place import MIN_AGREEING
 from pcmapq.io import PointMap
 from pcmapq.io.carmen import DEFAULT_MAX_RANGE, endpoints, read_flaser
 from pcmapq.io.writers import write_ros_map
-from pcmapq.pipeline import evaluate
 from pcmapq.raster.draw import points_to_grid, polygon_cells
 from pcmapq.report.text import number
 from pcmapq.result import INCONSISTENT, OTHER, SAME
-from pcmapq.same_place import MIN_AGREEING
 
 from . import drift, same_place
 from .common import DATA, ROOT, Case, Section, header, row

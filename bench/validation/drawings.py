@@ -21,10 +21,10 @@ from skimage.morphology import skeletonize
 from pcmapq import synth
 from pcmapq.config import Settings
 from pcmapq.core.grid import MetricGrid
+from pcmapq.evaluation.inputs import plan_points, truth_raster
 from pcmapq.features import Features, detect
 from pcmapq.io import OccupancyMap, load_map
 from pcmapq.match import match
-from pcmapq.plan import plan_points, truth_raster
 from pcmapq.raster.draw import OCCUPIED
 
 from .common import Case, Record, Section, header, row

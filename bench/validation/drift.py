@@ -7,7 +7,7 @@ integrated again from the first pose with multiplicative gain errors: at drift l
 rotation and translation increments of step k are multiplied by ``1 + e * (1 + z_k)``
 (z ~ N(0, 1), seeded, independent for rotation and translation): a systematic gain error e
 plus a per-step random one of standard deviation e. Each map is written as a .npy point cloud
-and scored with ``pcmapq.pipeline.evaluate(map, reference)``
+and scored with ``pcmapq.evaluation.pipeline.evaluate(map, reference)``
 (``Settings(alignment=AlignmentConfig(force=True))``).
 
     python -m bench.validation.drift LOG [LOG ...] [--levels 0,0.0005,...] [--seed 0]

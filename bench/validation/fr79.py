@@ -2,7 +2,7 @@
 known answers on a real map's texture.
 
 The map (0.05 m per pixel assumed) is turned about its origin with nearest-neighbour sampling,
-shifted, and aligned back by ``pcmapq.pipeline.evaluate``.
+shifted, and aligned back by ``pcmapq.evaluation.pipeline.evaluate``.
 """
 
 from __future__ import annotations

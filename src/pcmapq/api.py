@@ -16,9 +16,9 @@ from pathlib import Path
 from typing import Any
 
 from pcmapq.config import NoRefConfig, Settings
-from pcmapq.inspect_map import inspect_map
+from pcmapq.evaluation.inspect_map import inspect_map
+from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.io import OccupancyMap, PointMap, load_map
-from pcmapq.pipeline import evaluate
 from pcmapq.result import Result
 from pcmapq.track import Tracked, open_run, step_ends, track_run, travelled
 from pcmapq.track.runs import reference_poses_of

@@ -64,7 +64,7 @@ class AlignmentConfig:
     voxel_3d: working voxel of the 3D registration when both sides are 3D clouds, metres
         (0.3 indoors; 0.5-1 for outdoor maps).
     min_confidence: the map is taken to show another place when its ``confidence`` (see
-        :func:`pcmapq.same_place.confidence`) is below this.
+        :func:`pcmapq.evaluation.same_place.confidence`) is below this.
     force: evaluate even when the confidence is below ``min_confidence``.
     params: the 2D alignment's tunables (:class:`~pcmapq.align.AlignParams`: the inlier
         tolerance, voxel, global search cell, candidates, finalists, scale range).
@@ -121,7 +121,7 @@ class DistancesConfig:
 
 @dataclass(frozen=True)
 class NoRefConfig:
-    """The no-reference figures of each input (:mod:`pcmapq.noref_figures`, ``pcmapq
+    """The no-reference figures of each input (:mod:`pcmapq.evaluation.noref_figures`, ``pcmapq
     inspect``).
 
     enabled: ``eval`` reports them for the map and the truth (``--no-noref``: not).

@@ -27,9 +27,9 @@ if TYPE_CHECKING:  # the alignment modules load Open3D; a Result only holds thei
 
 #: Decimals kept in saved numbers: micrometres, so reruns give byte-identical files.
 DECIMALS = 6
-#: The verdicts on whether a map shows the truth's place (see :mod:`pcmapq.same_place`): one
-#: pose fits it; it is of the truth's place but no single pose fits it whole (scored); it
-#: shows another place (refused unless ``--force``).
+#: The verdicts on whether a map shows the truth's place (see
+#: :mod:`pcmapq.evaluation.same_place`): one pose fits it; it is of the truth's place but no
+#: single pose fits it whole (scored); it shows another place (refused unless ``--force``).
 SAME, INCONSISTENT, OTHER = "same place", "same place, inconsistent map", "another place"
 
 
@@ -96,9 +96,10 @@ class Result:
     (``Settings.to_dict()``, metres and degrees); command: the command line that made it
     (``pcmapq eval ...``, defaults left out), None from the library. noref: each input's
     no-reference figures, ``{"map": ..., "truth": ...}``
-    (:func:`pcmapq.noref_figures.input_figures`), None when not asked for. truth_sha256: the
-    truth file's SHA-256 (hex; None from the library's :func:`~pcmapq.pipeline.score`), so
-    that results of one truth are known as such however its path was written.
+    (:func:`pcmapq.evaluation.noref_figures.input_figures`), None when not asked for.
+    truth_sha256: the truth file's SHA-256 (hex; None from the library's
+    :func:`~pcmapq.evaluation.pipeline.score`), so that results of one truth are known as such
+    however its path was written.
     truth_occupied, map_occupied (and the overlap's footprint): the rasters on ``grid``; None
     in a result read back by :meth:`from_json`, which holds everything the JSON holds and no
     more.

@@ -22,11 +22,11 @@ from pathlib import Path
 from pcmapq import __version__, gates
 from pcmapq.batch.manifest import Row
 from pcmapq.core.errors import EvaluationError, InputError
+from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.gates import Gate
 from pcmapq.io.digest import sha256_file
 from pcmapq.io.writers import OutputSet, one_line, write_atomic
 from pcmapq.options import input_files
-from pcmapq.pipeline import evaluate
 from pcmapq.report.style import ARROW_SCALE
 from pcmapq.report.summary import failed_row, summary_row, write_summary
 

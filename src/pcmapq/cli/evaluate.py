@@ -16,12 +16,12 @@ from pcmapq.config import (
     DETECTOR_NAMES,
     Settings,
 )
+from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.io import PointMap
 from pcmapq.io.writers import OutputSet, write_atomic
 from pcmapq.mapping import (
     build_map_kiss,
 )
-from pcmapq.pipeline import evaluate
 from pcmapq.raster.footprint import FOOTPRINT_RULES
 from pcmapq.report import export
 from pcmapq.report.style import ARROW_SCALE

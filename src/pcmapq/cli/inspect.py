@@ -14,7 +14,8 @@ from pcmapq import options, terminal
 from pcmapq.cli.commands import HELP, MaxMemory, app, memory_limit
 from pcmapq.config import NoRefConfig
 from pcmapq.core import memory
-from pcmapq.inspect_map import inspect_map, summary_lines, to_json
+from pcmapq.evaluation.inspect_map import inspect_map, summary_lines, to_json
+from pcmapq.evaluation.pipeline import needed_memory
 from pcmapq.io import OccupancyMap, PointMap, load_map
 from pcmapq.io.extent import Box, check_span, hint
 from pcmapq.io.extent import crop as crop_input
@@ -26,7 +27,6 @@ from pcmapq.mapping import (
 )
 from pcmapq.metrics.noref import DEPTH_RADIUS, LIDAR_RADIUS, MAX_NN, MIN_KNN
 from pcmapq.metrics.posed import place_subset, read_orthogonal_subset
-from pcmapq.pipeline import needed_memory
 from pcmapq.terminal import (
     report_errors,
 )

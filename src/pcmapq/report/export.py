@@ -30,12 +30,12 @@ from pcmapq.core.cells import FREE, OCCUPIED
 from pcmapq.core.frames import Frames, Levelling
 from pcmapq.core.grid import MetricGrid
 from pcmapq.core.transform import Similarity2D
+from pcmapq.evaluation.inputs import MAP_CROP, TRUTH_CROP, cropped, load_input
 from pcmapq.io import OccupancyMap, PointMap
 from pcmapq.io.export import DISTANCE_FIELD, record_dtype, records, write_matrix, write_records
 from pcmapq.io.ply import CHUNK
 from pcmapq.io.writers import OutputSet, write_ros_map
 from pcmapq.metrics.distances import accuracy_2d, accuracy_3d, nearest_distance
-from pcmapq.plan import MAP_CROP, TRUTH_CROP, cropped, load_input
 from pcmapq.raster.draw import warp_state
 from pcmapq.result import Result
 

@@ -30,8 +30,8 @@ from pcmapq.core.errors import EvaluationError, InputError
 from pcmapq.core.frames import Frames
 from pcmapq.core.transform import Similarity2D
 from pcmapq.core.voxels import evenly, voxel_centroids
-from pcmapq.pipeline import MapSide, PreparedTruth
-from pcmapq.prepared import finish_prepared, place_prepared, score_prepared
+from pcmapq.evaluation.pipeline import MapSide, PreparedTruth
+from pcmapq.evaluation.prepared import finish_prepared, place_prepared, score_prepared
 from pcmapq.report.summary import summary_row
 from pcmapq.result import Result
 from pcmapq.track.runs import Run
@@ -127,7 +127,7 @@ def figures_of(result: Result) -> dict[str, float | None]:
 
 def place_step(source, prepared: PreparedTruth, settings: Settings,
                start: Similarity2D | None) -> tuple[MapSide, Similarity2D | None]:
-    """Align and draw one step's map (:func:`~pcmapq.prepared.place_prepared`), ICP from
+    """Align and draw one step's map (:func:`~pcmapq.evaluation.prepared.place_prepared`), ICP from
     ``start`` (None: the global search); a start whose pose is refused is followed by a global
     search. The placed map and the start it used."""
     option = settings.alignment

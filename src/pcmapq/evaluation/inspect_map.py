@@ -16,8 +16,8 @@ import numpy as np
 from pcmapq import __version__
 from pcmapq.config import NoRefConfig
 from pcmapq.core.stats import significant
+from pcmapq.evaluation.noref_figures import input_figures
 from pcmapq.io import OccupancyMap, PointMap
-from pcmapq.noref_figures import input_figures
 
 
 def inspect_map(source: OccupancyMap | PointMap, config: NoRefConfig = NoRefConfig(),
@@ -25,8 +25,8 @@ def inspect_map(source: OccupancyMap | PointMap, config: NoRefConfig = NoRefConf
                 command: str = "") -> dict[str, Any]:
     """The no-reference figures of one map as a JSON-ready record: ``cloud`` (3D clouds: MME
     nats, MPV and MOM m^2) or ``grid`` (images and 2D clouds), the other None
-    (:func:`pcmapq.noref_figures.input_figures`). ``orth_subset``: MOM's planes in the map's
-    frame (None: extracted from the map)."""
+    (:func:`pcmapq.evaluation.noref_figures.input_figures`). ``orth_subset``: MOM's planes in
+    the map's frame (None: extracted from the map)."""
     return {"pcmapq": {"version": __version__, "command": command},
             "map": {"path": str(source.path), "kind": source.kind},
             **input_figures(source, config, None if orth_subset is None else list(orth_subset))}

@@ -21,16 +21,7 @@ from pcmapq.core.errors import EvaluationError, InputError
 from pcmapq.core.frames import Frames, Levelling
 from pcmapq.core.grid import MetricGrid
 from pcmapq.core.transform import Similarity2D
-from pcmapq.features import Features, SideBySide, default_params
-from pcmapq.io import OccupancyMap, PointMap
-from pcmapq.io.digest import sha256_file
-from pcmapq.io.extent import check_span, hint
-from pcmapq.io.occupancy import NO_RESOLUTION
-from pcmapq.match import match
-from pcmapq.metrics.distances import distances, distances_3d, nearest_distance
-from pcmapq.noref_figures import input_figures
-from pcmapq.placing import align_clouds_3d, align_plan
-from pcmapq.plan import (
+from pcmapq.evaluation.inputs import (
     MAP_CROP,
     TRUTH_CROP,
     cropped,
@@ -40,11 +31,20 @@ from pcmapq.plan import (
     truth_cells,
     truth_grid,
 )
+from pcmapq.evaluation.noref_figures import input_figures
+from pcmapq.evaluation.placing import align_clouds_3d, align_plan
+from pcmapq.evaluation.same_place import overlap, refusal, verdict
+from pcmapq.features import Features, SideBySide, default_params
+from pcmapq.io import OccupancyMap, PointMap
+from pcmapq.io.digest import sha256_file
+from pcmapq.io.extent import check_span, hint
+from pcmapq.io.occupancy import NO_RESOLUTION
+from pcmapq.match import match
+from pcmapq.metrics.distances import distances, distances_3d, nearest_distance
 from pcmapq.raster.draw import OCCUPIED, UNKNOWN, points_to_grid, warp_state
 from pcmapq.raster.footprint import footprint_rule, map_footprint
 from pcmapq.raster.seen import seen_on
 from pcmapq.result import OTHER, DetectorResult, Overlap, Result
-from pcmapq.same_place import overlap, refusal, verdict
 
 Progress = Callable[[str], None]
 
@@ -171,7 +171,7 @@ class PreparedTruth:
     cell's distance to the nearest truth wall, metres; ``aligner``: its points prepared for
     the rigid alignment (:class:`~pcmapq.align.planar.RigidTarget`); ``maps``: how many maps
     may be scored on its grid at once in the memory allowed. Made once by
-    :func:`pcmapq.prepared.prepare_truth` for many maps (``pcmapq track``'s steps)."""
+    :func:`pcmapq.evaluation.prepared.prepare_truth` for many maps (``pcmapq track``'s steps)."""
 
     source: OccupancyMap | PointMap
     xy: np.ndarray

@@ -16,10 +16,10 @@ from pcmapq.config import Settings
 from pcmapq.core.bounds import radius
 from pcmapq.core.errors import EvaluationError
 from pcmapq.core.transform import Similarity2D
+from pcmapq.evaluation.inputs import MAP_CROP
+from pcmapq.evaluation.same_place import OVERSIZE
 from pcmapq.io import OccupancyMap, PointMap
 from pcmapq.io.extent import hint
-from pcmapq.plan import MAP_CROP
-from pcmapq.same_place import OVERSIZE
 
 
 def align_clouds_3d(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap,

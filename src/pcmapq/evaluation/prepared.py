@@ -1,16 +1,13 @@
 """A truth prepared once, and many maps scored against it (``pcmapq track``'s steps): the
-results of :func:`pcmapq.pipeline.score` without the truth's work for each map."""
+results of :func:`pcmapq.evaluation.pipeline.score` without the truth's work for each map."""
 
 from __future__ import annotations
 
 from pcmapq.align.planar import RigidTarget
 from pcmapq.config import Settings
 from pcmapq.core import memory
-from pcmapq.features import SideBySide
-from pcmapq.io import OccupancyMap, PointMap
-from pcmapq.io.extent import check_span, hint
-from pcmapq.metrics.distances import nearest_distance
-from pcmapq.pipeline import (
+from pcmapq.evaluation.inputs import MAP_CROP, TRUTH_CROP, plan_points, truth_cells, truth_grid
+from pcmapq.evaluation.pipeline import (
     MapSide,
     PreparedTruth,
     Progress,
@@ -20,7 +17,10 @@ from pcmapq.pipeline import (
     place_map,
     with_features,
 )
-from pcmapq.plan import MAP_CROP, TRUTH_CROP, plan_points, truth_cells, truth_grid
+from pcmapq.features import SideBySide
+from pcmapq.io import OccupancyMap, PointMap
+from pcmapq.io.extent import check_span, hint
+from pcmapq.metrics.distances import nearest_distance
 from pcmapq.result import Result
 
 
@@ -28,7 +28,7 @@ def prepare_truth(truth: OccupancyMap | PointMap, settings: Settings,
                   memory_limit: int | None = None,
                   maps: tuple[int, ...] = (1,)) -> PreparedTruth:
     """Everything of the truth that does not depend on the map: plan points, raster, features
-    (on two threads) and distance field; see :class:`~pcmapq.pipeline.PreparedTruth`.
+    (on two threads) and distance field; see :class:`~pcmapq.evaluation.pipeline.PreparedTruth`.
 
     maps: how many maps the caller would score on its grid at once, most wanted first; the
     first whose estimated memory fits in ``memory_limit`` bytes (None: the default) is kept as
@@ -56,8 +56,9 @@ def prepare_truth(truth: OccupancyMap | PointMap, settings: Settings,
 
 def score_prepared(source: OccupancyMap | PointMap, prepared: PreparedTruth,
                    settings: Settings, progress: Progress = lambda step: None) -> Result:
-    """:func:`~pcmapq.pipeline.score` against a truth prepared once (:func:`prepare_truth`)
-    with the same ``settings``: the same result, without the truth's work."""
+    """:func:`~pcmapq.evaluation.pipeline.score` against a truth prepared once
+    (:func:`prepare_truth`) with the same ``settings``: the same result, without the truth's
+    work."""
     return finish_prepared(source, place_prepared(source, prepared, settings, progress),
                            prepared, settings, progress)
 
@@ -65,7 +66,7 @@ def score_prepared(source: OccupancyMap | PointMap, prepared: PreparedTruth,
 def place_prepared(source: OccupancyMap | PointMap, prepared: PreparedTruth,
                    settings: Settings, progress: Progress = lambda step: None) -> MapSide:
     """The first half of :func:`score_prepared`: ``source`` aligned, drawn and checked
-    (:func:`~pcmapq.pipeline.place_map`), without features."""
+    (:func:`~pcmapq.evaluation.pipeline.place_map`), without features."""
     check_span(source, MAP_CROP)
     return place_map(source, prepared.source, prepared.xy, prepared.grid, prepared.occupied,
                      settings, map_footprint_rule(source, settings), progress,

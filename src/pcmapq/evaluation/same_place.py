@@ -15,9 +15,9 @@ from pcmapq.align.parts import Part
 from pcmapq.config import Settings
 from pcmapq.core.bounds import radius
 from pcmapq.core.morphology import outline
+from pcmapq.evaluation.inputs import MAP_CROP, OUTLINE_M
 from pcmapq.io import OccupancyMap, PointMap
 from pcmapq.io.extent import far_points
-from pcmapq.plan import MAP_CROP, OUTLINE_M
 from pcmapq.result import INCONSISTENT, OTHER, SAME, Overlap
 
 #: Confidence terms (see :func:`confidence`): the distinctiveness worth full confidence, the
@@ -64,8 +64,8 @@ def overlap(truth_occ: np.ndarray, to_map: np.ndarray, footprint: np.ndarray,
     """How much of the truth the map covers, how well the two agree there, and the confidence
     that they show one place; ``to_map`` is each cell's distance to the nearest map wall,
     metres, on a grid of ``resolution`` metres. The recall counts the truth's walls by their
-    outline (:data:`~pcmapq.plan.OUTLINE_M`): a map sees a filled block's faces, not its
-    inside."""
+    outline (:data:`~pcmapq.evaluation.inputs.OUTLINE_M`): a map sees a filled block's faces,
+    not its inside."""
     seen = truth_occ & footprint
     coverage = float(seen.sum() / truth_occ.sum()) if truth_occ.any() else 0.0
     tolerance = alignment.tolerance_m

@@ -13,10 +13,10 @@ import numpy as np
 
 from pcmapq.config import NoRefConfig, Settings
 from pcmapq.core.voxels import voxel_centroids
+from pcmapq.evaluation.inputs import truth_raster
 from pcmapq.io import OccupancyMap, PointMap
 from pcmapq.metrics.inspection import noref_figures
 from pcmapq.metrics.noref2d import grid_scores
-from pcmapq.plan import truth_raster
 from pcmapq.raster.draw import OCCUPIED, UNKNOWN
 
 
@@ -42,7 +42,7 @@ def input_figures(source: OccupancyMap | PointMap, config: NoRefConfig = NoRefCo
 def occupancy_figures(source: OccupancyMap | PointMap, scale: float = 1.0,
                       corners: int | None = None) -> dict[str, Any]:
     """The 2D figures of an image, or of a 2D cloud drawn as ``eval`` draws a cloud truth
-    (:func:`pcmapq.plan.truth_raster`, default settings; a cloud has no free cells: its
+    (:func:`pcmapq.evaluation.inputs.truth_raster`, default settings; a cloud has no free cells: its
     occupied/free ratio and enclosed areas are None). Cells ``scale`` times their size."""
     if isinstance(source, OccupancyMap):
         state, grid = source.state, source.grid
