@@ -13,9 +13,9 @@ import time
 
 import numpy as np
 
-from pcmapq import synth
 from pcmapq.align import align
 from pcmapq.core.transform import Similarity2D
+from pcmapq.testing import synth
 
 W, H = 24.0, 16.0
 

@@ -20,10 +20,10 @@ from pathlib import Path
 
 import numpy as np
 
-from pcmapq import synth
 from pcmapq.batch import read_rows, run_batch
 from pcmapq.core.transform import Similarity2D
 from pcmapq.io.writers import write_ros_map
+from pcmapq.testing import synth
 
 #: Dask's worker environment (``distributed.nanny.pre-spawn-environ``) unset, as the README
 #: advises: its MALLOC_TRIM_THRESHOLD_ and one-thread BLAS/OpenMP slow pcmapq down.

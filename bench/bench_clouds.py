@@ -42,9 +42,9 @@ from pathlib import Path
 
 import numpy as np
 
-from pcmapq import synth
 from pcmapq.core.transform import Similarity2D
 from pcmapq.io.writers import write_ros_map
+from pcmapq.testing import synth
 
 #: Point spacing of the generated buildings, metres (about 3.4 M points per building).
 SPACING = 0.018

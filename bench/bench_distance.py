@@ -22,8 +22,8 @@ from pathlib import Path
 
 import numpy as np
 
-from pcmapq import synth
 from pcmapq.core.grid import MetricGrid
+from pcmapq.testing import synth
 
 RESOLUTION = 0.05
 

@@ -21,7 +21,7 @@ CHILD = r"""
 import json, resource, sys, time
 from pathlib import Path
 import numpy as np
-from pcmapq import synth
+from pcmapq.testing import synth
 from pcmapq.core.transform import Similarity2D
 from pcmapq.evaluation.pipeline import evaluate
 sys.path.insert(0, sys.argv[1])

@@ -14,11 +14,11 @@ from pathlib import Path
 
 import numpy as np
 
-from pcmapq import synth
 from pcmapq.core.grid import MetricGrid
 from pcmapq.core.transform import Similarity2D
 from pcmapq.io.writers import write_ros_map
 from pcmapq.raster.draw import points_to_grid, polygon_cells
+from pcmapq.testing import synth
 
 RESOLUTION = 0.05
 #: The map's pose in the truth frame (p_truth = R(yaw) p_map + t), as the issue tried it.

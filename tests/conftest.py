@@ -7,9 +7,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pcmapq import synth
 from pcmapq.core.transform import Similarity2D
 from pcmapq.io.writers import write_ros_map
+from pcmapq.testing import synth
 
 SHARED_DATA = Path(__file__).resolve().parents[2] / "shared" / "data"
 

@@ -5,12 +5,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from pcmapq import synth
 from pcmapq.align import Alignment, AlignParams, align, score
 from pcmapq.align.coarse import coarse_search
 from pcmapq.align.planar import refine_best
 from pcmapq.core.transform import Similarity2D
 from pcmapq.core.voxels import voxel_centroids
+from pcmapq.testing import synth
 
 from .conftest import HEIGHT, PLAN, WIDTH
 

@@ -16,7 +16,6 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
-from pcmapq import synth
 from pcmapq.batch import Task, read_rows, run_row
 from pcmapq.batch import run_batch as batch_run
 from pcmapq.batch.manifest import glob_rows, parse_assignments
@@ -25,6 +24,7 @@ from pcmapq.cli import app
 from pcmapq.config import MatchingConfig, Settings
 from pcmapq.core.errors import InputError
 from pcmapq.core.transform import Similarity2D
+from pcmapq.testing import synth
 from tests.conftest import in_map_frame, write_image_map
 
 #: name, map pose in the truth frame (x m, y m, yaw deg), manifest cells of the row's options.

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 
-from pcmapq import synth
+from pcmapq.testing import synth
 
 from .conftest import write_image_map
 from .test_cli import run

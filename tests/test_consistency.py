@@ -10,7 +10,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pcmapq import synth
 from pcmapq.align import align
 from pcmapq.align.parts import Part, pieces
 from pcmapq.align.point_to_line import LineTarget
@@ -23,6 +22,7 @@ from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.evaluation.same_place import verdict
 from pcmapq.io import PointMap
 from pcmapq.result import INCONSISTENT, OTHER, SAME, Result
+from pcmapq.testing import synth
 
 from .conftest import write_image_map
 

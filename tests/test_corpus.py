@@ -9,7 +9,7 @@ import pytest
 
 from bench.validation import corpus
 from bench.validation.common import DATA
-from pcmapq import synth
+from pcmapq.testing import synth
 
 
 def record(name: str, same: bool, confidence: float | None, kind: str = "k",

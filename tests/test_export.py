@@ -11,13 +11,13 @@ import pytest
 import yaml
 from scipy.spatial.distance import cdist
 
-from pcmapq import synth
 from pcmapq.core.frames import Frames, Levelling
 from pcmapq.core.transform import Similarity2D
 from pcmapq.io import load_map
 from pcmapq.io.export import DISTANCE_FIELD, record_dtype, records, write_matrix, write_records
 from pcmapq.report.export import cloud_matrix, colours
 from pcmapq.report.plot import figure_bytes
+from pcmapq.testing import synth
 
 from .conftest import PLAN, in_map_frame, write_image_map
 from .test_cli import run

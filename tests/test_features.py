@@ -6,12 +6,12 @@ import cv2
 import numpy as np
 import pytest
 
-from pcmapq import synth
 from pcmapq.core.grid import MetricGrid
 from pcmapq.core.transform import Similarity2D
 from pcmapq.features import DETECTORS, Features, detect
 from pcmapq.match import match
 from pcmapq.raster import draw
+from pcmapq.testing import synth
 
 NAMES = ("harris", "hough", "sift")
 

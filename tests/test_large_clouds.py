@@ -9,11 +9,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pcmapq import synth
 from pcmapq.core.transform import Similarity2D
 from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.io import clouds, load_map
 from pcmapq.raster import slice as slice_module
+from pcmapq.testing import synth
 
 from .conftest import in_map_frame, write_image_map
 

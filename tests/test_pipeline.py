@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from pcmapq import synth
 from pcmapq.config import AlignmentConfig, MatchingConfig, Settings
 from pcmapq.core.transform import Similarity2D
 from pcmapq.evaluation.pipeline import evaluate
+from pcmapq.testing import synth
 
 from .conftest import in_map_frame, write_cloud_map, write_image_map
 

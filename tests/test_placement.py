@@ -9,13 +9,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pcmapq import synth
 from pcmapq.config import AlignmentConfig, MatchingConfig, Settings
 from pcmapq.core.morphology import outline
 from pcmapq.core.transform import Similarity2D
 from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.io import PointMap
 from pcmapq.raster.draw import OCCUPIED, polygon_cells
+from pcmapq.testing import synth
 
 from .conftest import write_ros_map
 

@@ -5,11 +5,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from pcmapq import synth
 from pcmapq.core.grid import MetricGrid
 from pcmapq.core.transform import Similarity2D
 from pcmapq.raster.draw import FREE, OCCUPIED, UNKNOWN, hit_counts, points_to_grid, warp_state
 from pcmapq.raster.footprint import footprint_rule
+from pcmapq.testing import synth
 
 
 def state_of(img: np.ndarray) -> np.ndarray:

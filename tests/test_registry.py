@@ -9,12 +9,12 @@ import pytest
 import typer
 
 import pcmapq.features as features
-from pcmapq import synth
 from pcmapq.cli import app
 from pcmapq.config import DETECTOR_NAMES, Settings
 from pcmapq.core.errors import InputError
 from pcmapq.core.grid import MetricGrid
 from pcmapq.match import match
+from pcmapq.testing import synth
 
 
 def test_cli_defaults_are_the_settings_defaults():

@@ -123,8 +123,8 @@ def test_a_3d_registration_in_the_chain_and_back(tmp_path: Path):
     """Both sides 3D clouds, the map turned 30 degrees and moved (3, -2) m: the reported
     map -> truth transform is that pose, and the 3D registration and both levellings survive
     the round trip."""
-    from pcmapq import synth
     from pcmapq.io.writers import write_cloud
+    from pcmapq.testing import synth
 
     cloud = synth.lidar_cloud(synth.building_plan(0))
     yaw, t = np.radians(30.0), np.array([3.0, -2.0, 0.0])

@@ -6,12 +6,12 @@ import cv2
 import numpy as np
 import pytest
 
-from pcmapq import synth
 from pcmapq.align import AlignParams, align
 from pcmapq.align.point_to_line import LineTarget, refine_point_to_line
 from pcmapq.align.similarity_icp import fit_similarity
 from pcmapq.core.transform import Similarity2D
 from pcmapq.core.voxels import voxel_centroids
+from pcmapq.testing import synth
 
 from .conftest import HEIGHT, PLAN, WIDTH, shared
 

@@ -6,13 +6,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from pcmapq import synth
 from pcmapq.core.grid import MetricGrid
 from pcmapq.core.transform import Similarity2D
 from pcmapq.features import Features, detect
 from pcmapq.features.sift import DESCRIPTOR_NORM, Params
 from pcmapq.match import match
 from pcmapq.raster import draw
+from pcmapq.testing import synth
 
 
 def unit(*weights: float) -> np.ndarray:

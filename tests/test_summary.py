@@ -11,7 +11,6 @@ from pathlib import Path
 
 import pytest
 
-from pcmapq import synth
 from pcmapq.config import DETECTOR_NAMES, MatchingConfig, Settings
 from pcmapq.core.errors import InputError
 from pcmapq.evaluation.pipeline import evaluate
@@ -25,6 +24,7 @@ from pcmapq.report.summary import (
     table_md,
     write_summary,
 )
+from pcmapq.testing import synth
 
 from .conftest import write_image_map
 

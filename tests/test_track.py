@@ -1,6 +1,6 @@
 """``pcmapq track`` end to end, on a CARMEN log generated here with a known answer.
 
-A robot drives along the corridor of :func:`pcmapq.synth.building_plan` (east, 14 m), turns
+A robot drives along the corridor of :func:`pcmapq.testing.synth.building_plan` (east, 14 m), turns
 left by 90 degrees into the hall at its end and drives north; at each of its 111 poses a
 180-beam FLASER scan is ray-cast exactly against the plan's walls. The corrected log holds
 those poses; the drifted log holds the same ranges at poses integrated again with a gain error
@@ -28,13 +28,13 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
-from pcmapq import synth
 from pcmapq.cli import app
 from pcmapq.config import Settings
 from pcmapq.evaluation.inputs import TRUTH_CROP, load_input
 from pcmapq.evaluation.pipeline import score
 from pcmapq.io.carmen import beam_angles, read_laser_scans
 from pcmapq.io.writers import write_ros_map
+from pcmapq.testing import synth
 from pcmapq.track import Tracked, open_run, step_ends, track_run, travelled
 from pcmapq.track.drop import MIN_DROP
 from pcmapq.track.outputs import HEAD

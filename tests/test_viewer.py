@@ -14,7 +14,6 @@ import cv2
 import numpy as np
 import pytest
 
-from pcmapq import synth
 from pcmapq.config import MatchingConfig, Settings
 from pcmapq.core.grid import MetricGrid
 from pcmapq.evaluation.pipeline import evaluate
@@ -23,6 +22,7 @@ from pcmapq.match import Matching
 from pcmapq.report.html import report_html
 from pcmapq.report.viewer import STYLE, VIEWER_PX, viewer_html
 from pcmapq.result import DetectorResult, Result
+from pcmapq.testing import synth
 
 from .conftest import write_image_map
 

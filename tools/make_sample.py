@@ -17,8 +17,8 @@ import cv2
 import numpy as np
 import open3d as o3d
 
-from pcmapq import synth
 from pcmapq.core.transform import Similarity2D
+from pcmapq.testing import synth
 
 #: The scan frame's pose in the truth frame: x, y metres, yaw degrees.
 SCAN_POSE = (6.0, 8.0, 37.0)

@@ -1,9 +1,9 @@
 """Where a map breaks: does the consistency map (each region of the map aligned on its own,
 :mod:`pcmapq.align.regions`) report the displacement a known distortion put there?
 
-- Plans bent like odometry drift (:func:`pcmapq.synth.bend`) and plans whose eastern half was
-  turned about the plan's middle: the displacement that undoes the distortion is known at every
-  map point, so each region's expected offset is the mean of its points'.
+- Plans bent like odometry drift (:func:`pcmapq.testing.synth.bend`) and plans whose eastern
+  half was turned about the plan's middle: the displacement that undoes the distortion is known
+  at every map point, so each region's expected offset is the mean of its points'.
 - CARMEN logs whose poses drift from a known scan k on (every increment after it scaled by
   1 + level, :func:`bench.validation.track.drifted_poses`), against the map of their corrected
   poses: each drifted endpoint's corrected position is the same beam at the corrected pose.
@@ -24,13 +24,13 @@ from pathlib import Path
 
 import numpy as np
 
-from pcmapq import synth
 from pcmapq.config import AlignmentConfig, MatchingConfig, Settings
 from pcmapq.core.transform import Similarity2D
 from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.io import PointMap
 from pcmapq.io.carmen import endpoints, read_flaser
 from pcmapq.report.plot import figure_bytes, vectorial_figure
+from pcmapq.testing import synth
 
 from .common import Case, Record, Section
 from .drift import increments, integrate

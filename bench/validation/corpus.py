@@ -70,7 +70,6 @@ import cv2
 import numpy as np
 from scipy.spatial import cKDTree
 
-from pcmapq import synth
 from pcmapq.align.parts import PIECES
 from pcmapq.config import Settings
 from pcmapq.core.transform import Similarity2D
@@ -82,6 +81,7 @@ from pcmapq.io.writers import write_ros_map
 from pcmapq.raster.draw import points_to_grid, polygon_cells
 from pcmapq.report.text import number
 from pcmapq.result import INCONSISTENT, OTHER, SAME
+from pcmapq.testing import synth
 
 from . import drift, same_place
 from .common import DATA, ROOT, Case, Section, header, row
