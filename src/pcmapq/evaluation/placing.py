@@ -1,7 +1,7 @@
 """The map put into the truth's frame before it is drawn: two 3D clouds registered in 3D,
 then the 2D alignment of the plans (the global search and ICP of :func:`pcmapq.align.align`),
-or the plan scored as it is after a 3D registration; and the check that ``--scale auto`` can
-reach the truth's size at all."""
+or the plan scored as it is after a 3D registration; and the check, before the search, that
+the map's size can be the truth's at all."""
 
 from __future__ import annotations
 
@@ -34,37 +34,27 @@ def align_clouds_3d(source: OccupancyMap | PointMap, truth: OccupancyMap | Point
     return replace(source, points=apply(reg.transform, source.points)), reg
 
 
-def check_scale_range(source: OccupancyMap | PointMap, map_xy: np.ndarray,
-                      truth_xy: np.ndarray, settings: Settings) -> None:
-    """EvaluationError (one line) when ``--scale auto`` searches for a map's scale that even its
-    lowest scale leaves :data:`OVERSIZE` times larger than the truth: another unit, or a much
-    larger place."""
-    option = settings.alignment
-    if not option.scale or option.init is not None or not option.enabled:
-        return
-    lowest = option.params.scale_range[0]
-    size = lowest * radius(map_xy) / max(radius(truth_xy), 1e-12)
-    if size > OVERSIZE:
-        why = hint(source, MAP_CROP) or "a map of a larger place, or in another unit"
-        raise EvaluationError(f"{source.path}: at the lowest scale --scale auto tries "
-                              f"({lowest:g}), the map is still {size:.0f} times the size of "
-                              f"the truth; {why}")
-
-
 def check_size(source: OccupancyMap | PointMap, map_xy: np.ndarray, truth_xy: np.ndarray,
                settings: Settings) -> None:
     """EvaluationError (one line), before the global search, for a map :data:`OVERSIZE` times
-    larger than the truth that also looks wrong in itself (:func:`~pcmapq.io.extent.hint`: cells
-    not metres wide, points far from the rest, a span of another unit): the mistakes the
-    truth's side is refused for, caught before the search across the map's size costs minutes
-    and gigabytes. Not with ``--scale auto`` (it estimates the unit), a guess or no search."""
+    larger than the truth: with ``--scale auto``, even at the lowest scale it tries (another
+    unit, or a much larger place); with the scale fixed, when the map also looks wrong in
+    itself (:func:`~pcmapq.io.extent.hint`: cells not metres wide, points far from the rest, a
+    span of another unit), the mistakes the truth's side is refused for, caught before the
+    search across the map's size costs minutes and gigabytes. Not with a guess or no search."""
     option = settings.alignment
-    if option.scale or option.init is not None or not option.enabled:
+    if option.init is not None or not option.enabled:
         return
-    size = radius(map_xy) / max(radius(truth_xy), 1e-12)
+    lowest = option.params.scale_range[0] if option.scale else 1.0
+    size = lowest * radius(map_xy) / max(radius(truth_xy), 1e-12)
     if size <= OVERSIZE:
         return
     why = hint(source, MAP_CROP)
+    if option.scale:
+        raise EvaluationError(f"{source.path}: at the lowest scale --scale auto tries "
+                              f"({lowest:g}), the map is still {size:.0f} times the size of "
+                              "the truth; "
+                              f"{why or 'a map of a larger place, or in another unit'}")
     if why:
         raise EvaluationError(f"{source.path}: {size:.0f} times the size of the truth, too "
                               f"large to be a map of its place: {why}")
@@ -78,7 +68,6 @@ def align_plan(source: OccupancyMap | PointMap, map_xy: np.ndarray, truth_xy: np
     points prepared for it), or, after a 3D registration, the plan scored as it is."""
     option = settings.alignment
     if registration is None:
-        check_scale_range(source, map_xy, truth_xy, settings)
         check_size(source, map_xy, truth_xy, settings)
         return align(map_xy, truth_xy, option.params, init=option.init, refine=option.enabled,
                      scale=option.scale, target=target)
