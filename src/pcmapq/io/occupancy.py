@@ -145,8 +145,7 @@ def _darkest(levels: np.ndarray, channels: int, scale: float, transparent: np.nd
     if shown.size == 0:
         return "every pixel is transparent"
     value = np.unique(shown) / channels * scale
-    p = (value / 100.0 if meta.mode == "raw" else
-         value / 255.0 if meta.negate else (255.0 - value) / 255.0)
+    p = occupancy_of(value, meta)
     if meta.mode == "raw":
         p = p[value <= 100.0]
     top = float(p.max(initial=0.0))
@@ -304,6 +303,14 @@ def _opencv_quiet() -> Iterator[None]:
         cv2.utils.logging.setLogLevel(level)
 
 
+def occupancy_of(value: np.ndarray, meta: MapMeta) -> np.ndarray:
+    """map_server's occupancy probability p of grey values (0..255): ``(255 - v) / 255``,
+    ``v / 255`` when ``negate``; in ``raw`` mode the value itself in percent."""
+    if meta.mode == "raw":
+        return value / 100.0
+    return value / 255.0 if meta.negate else (255.0 - value) / 255.0
+
+
 def classify(levels: np.ndarray, channels: int, scale: float, transparent: np.ndarray,
              meta: MapMeta) -> np.ndarray:
     """Cell states (int8 OCCUPIED/FREE/UNKNOWN) of :func:`read_levels`' pixels by map_server's
@@ -311,10 +318,7 @@ def classify(levels: np.ndarray, channels: int, scale: float, transparent: np.nd
     value itself as occupancy in percent (above 100: unknown) and ignores ``negate``. The rule
     is applied once per possible level, and the pixels look their state up."""
     value = np.arange(int(levels.max(initial=0)) + 1) / channels * scale
-    if meta.mode == "raw":
-        p = value / 100.0
-    else:
-        p = value / 255.0 if meta.negate else (255.0 - value) / 255.0
+    p = occupancy_of(value, meta)
     state = np.full(value.shape, UNKNOWN, dtype=np.int8)
     state[p < meta.free_thresh] = FREE
     state[p > meta.occupied_thresh] = OCCUPIED
