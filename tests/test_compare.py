@@ -171,3 +171,16 @@ def test_alike_file_stems_are_named_by_their_paths(saved, tmp_path):
     assert proc.returncode == 0, proc.stderr
     assert [r["name"] for r in table(tmp_path / "cmp")] == \
         [str(saved["a"].with_suffix("")), str(copy.with_suffix(""))]
+
+
+def test_a_batch_result_and_an_eval_result_share_their_truth(saved, tmp_path):
+    """batch stores the truth's path absolute and takes its SHA-256 from the row's key; eval's
+    result of the same truth is one truth with it."""
+    proc = run("batch", str(SAMPLE / "scan.ply"), "--truth", str(SAMPLE / "truth.yaml"),
+               "--out", str(tmp_path / "b"), "--quiet")
+    assert proc.returncode == 0, proc.stderr
+    batch_doc = json.loads((tmp_path / "b" / "scan.json").read_text())
+    assert batch_doc["truth"]["sha256"] == json.loads(saved["a"].read_text())["truth"]["sha256"]
+    proc = run("compare", str(saved["a"]), str(tmp_path / "b" / "scan.json"), "--out",
+               str(tmp_path / "cmp"))
+    assert proc.returncode == 0 and "another truth" not in proc.stderr, proc.stderr

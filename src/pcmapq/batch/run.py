@@ -143,7 +143,8 @@ def _compute(task: Task, key: dict) -> Outcome:
     row, outputs = task.row, task.outputs()
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        result = replace(evaluate(row.map, row.truth, row.settings),
+        result = replace(evaluate(row.map, row.truth, row.settings,
+                                  truth_sha256=key["truth"].get(Path(row.truth).name)),
                          command=row.command(outputs))
         text = result.to_json()
         files = {outputs["--json"]: text.encode("utf-8")}

@@ -98,10 +98,12 @@ def inside(features: Features, area: np.ndarray, grid: MetricGrid) -> np.ndarray
 
 def evaluate(map_path: str | Path | PointMap, truth_path: str | Path,
              settings: Settings | None = None, progress: Progress = lambda step: None,
-             memory_limit: int | None = None) -> Result:
+             memory_limit: int | None = None, truth_sha256: str | None = None) -> Result:
     """Score the map at ``map_path`` (or a map already built, e.g. from scans) against the
     truth at ``truth_path``; stop (InputError) when the run would need more than
-    ``memory_limit`` bytes (None: :func:`pcmapq.core.memory.default_limit`)."""
+    ``memory_limit`` bytes (None: :func:`pcmapq.core.memory.default_limit`).
+    ``truth_sha256``: the truth file's SHA-256 when the caller has it (a batch row's key),
+    else read here."""
     settings = Settings() if settings is None else settings
     progress("loading")
     scaled = settings.alignment.scale
@@ -122,7 +124,7 @@ def evaluate(map_path: str | Path | PointMap, truth_path: str | Path,
             settings.truth.resolution or settings.raster.cloud_resolution)
         source = load_input(map_path, settings.map, MAP_CROP, guess, memory_limit)
     result = score(source, truth, settings, progress, memory_limit)
-    return replace(result, truth_sha256=sha256_file(truth_path))
+    return replace(result, truth_sha256=truth_sha256 or sha256_file(truth_path))
 
 
 def _both(truth_job: Future, map_error: InputError, map_path: object,
