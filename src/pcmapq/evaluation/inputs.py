@@ -10,6 +10,7 @@ occupied (not walls: a picture read inverted).
 
 from __future__ import annotations
 
+from concurrent.futures import Future, ThreadPoolExecutor
 from pathlib import Path
 
 import numpy as np
@@ -23,6 +24,7 @@ from pcmapq.core.grid import MetricGrid
 from pcmapq.core.morphology import outline
 from pcmapq.io import OccupancyMap, PointMap, load_map
 from pcmapq.io.extent import crop
+from pcmapq.io.occupancy import NO_RESOLUTION
 from pcmapq.raster.draw import OCCUPIED, points_to_grid
 from pcmapq.raster.slice import wall_band
 
@@ -55,6 +57,46 @@ def load_input(path: str | Path, config: SourceConfig, option: str,
     an image that has none) and cut to its crop box; see :func:`pcmapq.io.load_map`."""
     return cropped(load_map(path, config.resolution, fallback, config.thresholds, memory_limit),
                    config, option)
+
+
+def load_pair(map_path: str | Path | PointMap, truth_path: str | Path, settings: Settings,
+              memory_limit: int | None = None) -> tuple[OccupancyMap | PointMap,
+                                                         OccupancyMap | PointMap]:
+    """The map (or a map already built, cropped as the settings say) and the truth, read at
+    once on two threads; the truth's error first, as when read one after the other, or one
+    line for both when neither image has a resolution. A map of unknown unit (scale free) is
+    read after the truth, from the truth's resolution."""
+    scaled = settings.alignment.scale
+    with ThreadPoolExecutor(1) as background:
+        truth_job = background.submit(load_input, truth_path, settings.truth, TRUTH_CROP,
+                                      memory_limit=memory_limit)
+        try:
+            source = (cropped(map_path, settings.map, MAP_CROP)
+                      if isinstance(map_path, PointMap) else None if scaled else
+                      load_input(map_path, settings.map, MAP_CROP, memory_limit=memory_limit))
+        except InputError as map_error:
+            _both(truth_job, map_error, map_path, truth_path)
+            raise
+        truth = truth_job.result()
+    if source is None:
+        guess = truth.grid.resolution if isinstance(truth, OccupancyMap) else (
+            settings.truth.resolution or settings.raster.cloud_resolution)
+        source = load_input(map_path, settings.map, MAP_CROP, guess, memory_limit)
+    return source, truth
+
+
+def _both(truth_job: Future, map_error: InputError, map_path: object,
+          truth_path: object) -> None:
+    """When the map failed to load: the truth's error first (InputError), as one after the
+    other, or one line for both when neither image has a resolution."""
+    try:
+        truth_job.result()
+    except InputError as truth_error:
+        if all(NO_RESOLUTION in str(e) for e in (map_error, truth_error)):
+            raise InputError(f"{map_path} and {truth_path}: {NO_RESOLUTION} for either: give "
+                             "--map-resolution and --truth-resolution, or a YAML beside "
+                             "each") from None
+        raise
 
 
 def cropped(source: OccupancyMap | PointMap, config: SourceConfig,

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from concurrent.futures import Future, ThreadPoolExecutor
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -24,8 +24,7 @@ from pcmapq.core.transform import Similarity2D
 from pcmapq.evaluation.inputs import (
     MAP_CROP,
     TRUTH_CROP,
-    cropped,
-    load_input,
+    load_pair,
     min_hits,
     plan_points,
     truth_cells,
@@ -38,7 +37,6 @@ from pcmapq.features import Features, SideBySide, default_params
 from pcmapq.io import OccupancyMap, PointMap
 from pcmapq.io.digest import sha256_file
 from pcmapq.io.extent import check_span, hint
-from pcmapq.io.occupancy import NO_RESOLUTION
 from pcmapq.match import match
 from pcmapq.metrics.distances import distances, distances_3d, nearest_distance
 from pcmapq.raster.draw import OCCUPIED, UNKNOWN, points_to_grid, warp_state
@@ -106,39 +104,9 @@ def evaluate(map_path: str | Path | PointMap, truth_path: str | Path,
     else read here."""
     settings = Settings() if settings is None else settings
     progress("loading")
-    scaled = settings.alignment.scale
-    with ThreadPoolExecutor(1) as background:  # the two files at once
-        truth_job = background.submit(load_input, truth_path, settings.truth, TRUTH_CROP,
-                                      memory_limit=memory_limit)
-        try:
-            source = (cropped(map_path, settings.map, MAP_CROP)
-                      if isinstance(map_path, PointMap) else None if scaled else
-                      load_input(map_path, settings.map, MAP_CROP, memory_limit=memory_limit))
-        except InputError as map_error:
-            _both(truth_job, map_error, map_path, truth_path)
-            raise
-        truth = truth_job.result()  # the truth's error first, as one after the other
-    if scaled and not isinstance(map_path, PointMap):
-        # a map of unknown unit starts from the truth's resolution
-        guess = truth.grid.resolution if isinstance(truth, OccupancyMap) else (
-            settings.truth.resolution or settings.raster.cloud_resolution)
-        source = load_input(map_path, settings.map, MAP_CROP, guess, memory_limit)
+    source, truth = load_pair(map_path, truth_path, settings, memory_limit)
     result = score(source, truth, settings, progress, memory_limit)
     return replace(result, truth_sha256=truth_sha256 or sha256_file(truth_path))
-
-
-def _both(truth_job: Future, map_error: InputError, map_path: object,
-          truth_path: object) -> None:
-    """When the map failed to load: the truth's error first (InputError), as one after the
-    other, or one line for both when neither image has a resolution."""
-    try:
-        truth_job.result()
-    except InputError as truth_error:
-        if all(NO_RESOLUTION in str(e) for e in (map_error, truth_error)):
-            raise InputError(f"{map_path} and {truth_path}: {NO_RESOLUTION} for either: give "
-                             "--map-resolution and --truth-resolution, or a YAML beside "
-                             "each") from None
-        raise
 
 
 def needed_memory(inputs: Sequence[OccupancyMap | PointMap], grid: MetricGrid,
