@@ -35,7 +35,6 @@ from pcmapq.core.errors import InputError
 from pcmapq.io.writers import OutputSet, one_line, write_atomic
 
 __all__ = [
-    "scanner_poses",
     "lidar_poses_from_camera",
     "moves_along_z",
     "read_calib",
@@ -43,6 +42,7 @@ __all__ = [
     "read_pose_matrix",
     "read_poses",
     "read_tum_poses",
+    "scanner_poses",
     "write_kitti_poses",
     "write_tum_poses",
 ]
