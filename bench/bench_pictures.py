@@ -28,7 +28,7 @@ RESOLUTION = 1.0 / 529.0
 
 CHILD = r"""
 import json, resource, sys, time
-from pcmapq.config import AlignmentConfig, Settings, SourceConfig
+from pcmapq.settings import AlignmentConfig, Settings, SourceConfig
 from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.report.html import report_html
 from pcmapq.report.plot import png_bytes, vectorial_figure

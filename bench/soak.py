@@ -30,12 +30,12 @@ from pathlib import Path
 
 import numpy as np
 
-from pcmapq.config import AlignmentConfig, Settings, SourceConfig
 from pcmapq.core.errors import EvaluationError, InputError
 from pcmapq.core.transform import Similarity2D
 from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.io.carmen import DEFAULT_MAX_RANGE, endpoints, read_flaser
 from pcmapq.io.writers import write_ros_map
+from pcmapq.settings import AlignmentConfig, Settings, SourceConfig
 from pcmapq.testing import synth
 
 from .validation.drift import drifted, save_cloud

@@ -21,9 +21,9 @@ from pcmapq.batch import run_batch as batch_run
 from pcmapq.batch.manifest import glob_rows, parse_assignments
 from pcmapq.batch.run import run_local as pool_run
 from pcmapq.cli import app
-from pcmapq.config import MatchingConfig, Settings
 from pcmapq.core.errors import InputError
 from pcmapq.core.transform import Similarity2D
+from pcmapq.settings import MatchingConfig, Settings
 from pcmapq.testing import synth
 from tests.conftest import in_map_frame, write_image_map
 

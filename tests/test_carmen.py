@@ -10,11 +10,11 @@ import numpy as np
 import pytest
 
 from bench.validation import drift
-from pcmapq.config import AlignmentConfig, Settings
 from pcmapq.core.errors import InputError
 from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.io import PointMap, load_map
 from pcmapq.io.carmen import beam_angles, endpoints, load_carmen, read_flaser
+from pcmapq.settings import AlignmentConfig, Settings
 
 from .conftest import shared
 

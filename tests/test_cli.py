@@ -16,7 +16,7 @@ from typer.testing import CliRunner
 
 import pcmapq
 from pcmapq.cli import app
-from pcmapq.config import Settings
+from pcmapq.settings import Settings
 
 ROOT = Path(__file__).resolve().parents[1]
 SAMPLE = ROOT / "data" / "sample"

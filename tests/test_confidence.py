@@ -13,13 +13,13 @@ import numpy as np
 import pytest
 
 from pcmapq.align.coarse import Search, distinctiveness
-from pcmapq.config import AlignmentConfig, MatchingConfig, Settings, SourceConfig
 from pcmapq.core.errors import EvaluationError
 from pcmapq.core.transform import Similarity2D
 from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.evaluation.same_place import confidence
 from pcmapq.io import Thresholds, load_map
 from pcmapq.raster.draw import FREE, OCCUPIED, UNKNOWN
+from pcmapq.settings import AlignmentConfig, MatchingConfig, Settings, SourceConfig
 from pcmapq.testing import synth
 
 from .conftest import in_map_frame, shared, write_image_map

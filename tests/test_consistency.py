@@ -14,14 +14,14 @@ from pcmapq.align import align
 from pcmapq.align.parts import Part, pieces
 from pcmapq.align.point_to_line import LineTarget
 from pcmapq.align.regions import regions
-from pcmapq.config import MatchingConfig, Settings
 from pcmapq.core.errors import EvaluationError
 from pcmapq.core.transform import Similarity2D
 from pcmapq.core.voxels import voxel_centroids
 from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.evaluation.same_place import verdict
 from pcmapq.io import PointMap
-from pcmapq.result import INCONSISTENT, OTHER, SAME, Result
+from pcmapq.results.result import INCONSISTENT, OTHER, SAME, Result
+from pcmapq.settings import MatchingConfig, Settings
 from pcmapq.testing import synth
 
 from .conftest import write_image_map

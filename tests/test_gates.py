@@ -9,9 +9,18 @@ from pathlib import Path
 import pytest
 from typer.testing import CliRunner
 
-from pcmapq import gates
 from pcmapq.cli import app
-from pcmapq.gates import OVER, UNDER, Gate, GateError, check, failures, json_path, parse_gates
+from pcmapq.results import gates
+from pcmapq.results.gates import (
+    OVER,
+    UNDER,
+    Gate,
+    GateError,
+    check,
+    failures,
+    json_path,
+    parse_gates,
+)
 
 SAMPLE = Path(__file__).resolve().parents[1] / "data" / "sample"
 MAP, TRUTH = str(SAMPLE / "scan.ply"), str(SAMPLE / "truth.yaml")

@@ -9,7 +9,7 @@ import sys
 import pytest
 
 HEAVY = ("open3d", "kiss_icp", "matplotlib")
-CORE = ("pcmapq.config", "pcmapq.match", "pcmapq.metrics.distances", "pcmapq.result",
+CORE = ("pcmapq.settings", "pcmapq.match", "pcmapq.metrics.distances", "pcmapq.results.result",
         "pcmapq.features", "pcmapq.io", "pcmapq.align", "pcmapq.align.params")
 
 

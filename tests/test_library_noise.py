@@ -16,7 +16,8 @@ import pytest
 from typer.testing import CliRunner
 
 import pcmapq
-from pcmapq import cli, terminal
+from pcmapq import cli
+from pcmapq.cli import terminal
 from pcmapq.evaluation.inputs import MAX_OCCUPIED_SHARE
 
 from .conftest import shared

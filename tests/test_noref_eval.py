@@ -13,19 +13,19 @@ import pytest
 from typer.testing import CliRunner
 
 from pcmapq.cli import app
-from pcmapq.config import (
+from pcmapq.core.stats import significant
+from pcmapq.evaluation.noref_figures import input_figures
+from pcmapq.evaluation.pipeline import evaluate
+from pcmapq.io import load_map
+from pcmapq.metrics import orthogonal
+from pcmapq.results.result import Result
+from pcmapq.settings import (
     AlignmentConfig,
     MatchingConfig,
     NoRefConfig,
     Settings,
     SourceConfig,
 )
-from pcmapq.core.stats import significant
-from pcmapq.evaluation.noref_figures import input_figures
-from pcmapq.evaluation.pipeline import evaluate
-from pcmapq.io import load_map
-from pcmapq.metrics import orthogonal
-from pcmapq.result import Result
 
 from .conftest import write_image_map
 from .test_noref import room_corner

@@ -9,13 +9,13 @@ import cv2
 import numpy as np
 import pytest
 
-from pcmapq.config import AlignmentConfig, FootprintConfig, MatchingConfig, Settings
 from pcmapq.core.errors import InputError
 from pcmapq.core.transform import Similarity2D
 from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.io import PointMap
 from pcmapq.io.writers import write_ros_map
 from pcmapq.raster.seen import NO_VIEW, add_views
+from pcmapq.settings import AlignmentConfig, FootprintConfig, MatchingConfig, Settings
 from pcmapq.testing import synth
 
 from .conftest import in_map_frame, write_cloud_map, write_image_map

@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from pcmapq.config import AlignmentConfig, MatchingConfig, Settings
 from pcmapq.core.transform import Similarity2D
 from pcmapq.evaluation.pipeline import evaluate
+from pcmapq.settings import AlignmentConfig, MatchingConfig, Settings
 from pcmapq.testing import synth
 
 from .conftest import in_map_frame, write_cloud_map, write_image_map

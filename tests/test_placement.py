@@ -9,12 +9,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pcmapq.config import AlignmentConfig, MatchingConfig, Settings
 from pcmapq.core.morphology import outline
 from pcmapq.core.transform import Similarity2D
 from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.io import PointMap
 from pcmapq.raster.draw import OCCUPIED, polygon_cells
+from pcmapq.settings import AlignmentConfig, MatchingConfig, Settings
 from pcmapq.testing import synth
 
 from .conftest import write_ros_map
@@ -106,9 +106,9 @@ def exhaustive_pose(map_xy: np.ndarray, truth_xy: np.ndarray, resolution: float)
 
 
 def _plan_xy(path: Path) -> np.ndarray:
-    from pcmapq.config import Settings, SourceConfig
     from pcmapq.core.voxels import voxel_centroids
     from pcmapq.evaluation.inputs import TRUTH_CROP, load_input, plan_points
+    from pcmapq.settings import Settings, SourceConfig
 
     # The room-segmentation benchmark's images have no YAML: 0.05 m a pixel (its README).
     config = SourceConfig(resolution=0.05) if path.suffix == ".png" else Settings().truth

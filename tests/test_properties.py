@@ -28,7 +28,7 @@ from pcmapq.cli import app
 from pcmapq.core.transform import Similarity2D
 from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.io.writers import write_ros_map
-from pcmapq.result import Result
+from pcmapq.results.result import Result
 from pcmapq.testing import synth
 
 ROOT = Path(__file__).resolve().parents[1]

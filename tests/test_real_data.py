@@ -9,7 +9,6 @@ import numpy as np
 import pytest
 from skimage.morphology import skeletonize
 
-from pcmapq.config import AlignmentConfig, Settings
 from pcmapq.core.grid import MetricGrid
 from pcmapq.core.transform import Similarity2D
 from pcmapq.evaluation.pipeline import evaluate
@@ -19,6 +18,7 @@ from pcmapq.io.writers import write_ros_map
 from pcmapq.match import match
 from pcmapq.raster.draw import OCCUPIED
 from pcmapq.report.html import report_html
+from pcmapq.settings import AlignmentConfig, Settings
 
 from .conftest import shared
 

@@ -10,10 +10,10 @@ import typer
 
 import pcmapq.features as features
 from pcmapq.cli import app
-from pcmapq.config import DETECTOR_NAMES, Settings
 from pcmapq.core.errors import InputError
 from pcmapq.core.grid import MetricGrid
 from pcmapq.match import match
+from pcmapq.settings import DETECTOR_NAMES, Settings
 from pcmapq.testing import synth
 
 

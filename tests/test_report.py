@@ -12,7 +12,6 @@ import matplotlib
 import numpy as np
 import pytest
 
-from pcmapq.config import MatchingConfig, Settings
 from pcmapq.core.grid import MetricGrid
 from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.report.heatmap import distance_heatmap, wall_distances
@@ -27,6 +26,7 @@ from pcmapq.report.plot import (
 )
 from pcmapq.report.style import ARROW_SCALE, DPI, FIGURE_WIDTH_PX, MAP_LIGHT
 from pcmapq.report.text import number
+from pcmapq.settings import MatchingConfig, Settings
 from pcmapq.testing import synth
 
 from .conftest import write_image_map

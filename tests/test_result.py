@@ -10,10 +10,10 @@ import numpy as np
 import pytest
 
 from bench.validation.reference import differences
-from pcmapq.config import Settings
 from pcmapq.core.stats import FIELDS, Stats
 from pcmapq.evaluation.pipeline import evaluate
-from pcmapq.result import Result
+from pcmapq.results.result import Result
+from pcmapq.settings import Settings
 
 ROOT = Path(__file__).resolve().parents[1]
 SAMPLE = ROOT / "data" / "sample"
@@ -148,10 +148,10 @@ def test_a_3d_registration_in_the_chain_and_back(tmp_path: Path):
 def test_settings_read_back_from_their_dict():
     from dataclasses import replace
 
-    from pcmapq.config import AlignmentConfig, SourceConfig
     from pcmapq.core.transform import Similarity2D
     from pcmapq.features import harris
     from pcmapq.io import Thresholds
+    from pcmapq.settings import AlignmentConfig, SourceConfig
 
     s = Settings(map=SourceConfig(0.1, Thresholds(0.4, 0.05, None)),
                  alignment=AlignmentConfig(init=Similarity2D(1.0, 2.0, 0.5), scale=True))
@@ -166,7 +166,7 @@ def test_settings_read_back_from_their_dict():
 def test_a_result_without_detectors_keeps_its_threshold_when_read_back():
     """The matching threshold of a result whose detectors were all left out comes back from
     its settings (it fell back to 0.5: the settings' threshold was looked for at the top)."""
-    from pcmapq.config import MatchingConfig
+    from pcmapq.settings import MatchingConfig
 
     sample = Path(__file__).resolve().parents[1] / "data" / "sample"
     result = evaluate(sample / "scan.ply", sample / "truth.png",

@@ -22,7 +22,7 @@ import pcmapq
 from pcmapq.cli import app
 from pcmapq.report.table import DISPLACEMENT_COLUMNS, print_table
 from pcmapq.report.text import verdict, words, wrap
-from pcmapq.result import Result
+from pcmapq.results.result import Result
 
 ROOT = Path(__file__).resolve().parents[1]
 SAMPLE = ROOT / "data" / "sample"

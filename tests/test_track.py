@@ -29,11 +29,11 @@ import pytest
 from typer.testing import CliRunner
 
 from pcmapq.cli import app
-from pcmapq.config import Settings
 from pcmapq.evaluation.inputs import TRUTH_CROP, load_input
 from pcmapq.evaluation.pipeline import score
 from pcmapq.io.carmen import beam_angles, read_laser_scans
 from pcmapq.io.writers import write_ros_map
+from pcmapq.settings import Settings
 from pcmapq.testing import synth
 from pcmapq.track import Tracked, open_run, step_ends, track_run, travelled
 from pcmapq.track.drop import MIN_DROP

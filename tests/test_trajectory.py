@@ -1,4 +1,5 @@
-"""Trajectory errors (pcmapq.trajectory): APE and RPE with evo's definitions, known answers."""
+"""Trajectory errors (pcmapq.metrics.trajectory): APE and RPE as evo defines them, known
+answers."""
 
 from __future__ import annotations
 
@@ -7,7 +8,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from pcmapq.core.errors import EvaluationError
-from pcmapq.trajectory import (
+from pcmapq.metrics.trajectory import (
     align_umeyama,
     ape,
     pairs_by_frames,

@@ -11,11 +11,11 @@ from rich.console import Console
 from typer.testing import CliRunner
 
 from pcmapq.cli import app
-from pcmapq.config import AlignmentConfig, FootprintConfig, MatchingConfig, Settings
 from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.report.html import report_html
 from pcmapq.report.plot import vectorial_figure
 from pcmapq.report.table import print_table
+from pcmapq.settings import AlignmentConfig, FootprintConfig, MatchingConfig, Settings
 
 from .conftest import write_image_map
 

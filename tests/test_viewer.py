@@ -14,14 +14,14 @@ import cv2
 import numpy as np
 import pytest
 
-from pcmapq.config import MatchingConfig, Settings
 from pcmapq.core.grid import MetricGrid
 from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.features import Features
 from pcmapq.match import Matching
 from pcmapq.report.html import report_html
 from pcmapq.report.viewer import STYLE, VIEWER_PX, viewer_html
-from pcmapq.result import DetectorResult, Result
+from pcmapq.results.result import DetectorResult, Result
+from pcmapq.settings import MatchingConfig, Settings
 from pcmapq.testing import synth
 
 from .conftest import write_image_map

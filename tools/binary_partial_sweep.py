@@ -14,11 +14,11 @@ from pathlib import Path
 
 import numpy as np
 
-from pcmapq.config import AlignmentConfig, FootprintConfig, Settings
 from pcmapq.core.transform import Similarity2D
 from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.io.writers import write_ros_map
 from pcmapq.report.text import score
+from pcmapq.settings import AlignmentConfig, FootprintConfig, Settings
 from pcmapq.testing import synth
 
 #: Parts of the 24 m x 16 m plan (x0, y0, x1, y1, metres), 25-60 % of its walls; no cut runs

@@ -5,8 +5,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from pcmapq.config import Settings
 from pcmapq.io.carmen import DEFAULT_MAX_RANGE
+from pcmapq.settings import Settings
 
 from . import drift
 from .common import Case, Record, Section, span

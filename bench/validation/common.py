@@ -14,12 +14,12 @@ from typing import Generic, Protocol, TypeVar
 
 import numpy as np
 
-from pcmapq.config import Settings
 from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.io import PointMap
 from pcmapq.io.occupancy import MapMeta, read_levels
 from pcmapq.report.text import score
-from pcmapq.result import Result
+from pcmapq.results.result import Result
+from pcmapq.settings import Settings
 
 from .reference import summary
 

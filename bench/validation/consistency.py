@@ -24,12 +24,12 @@ from pathlib import Path
 
 import numpy as np
 
-from pcmapq.config import AlignmentConfig, MatchingConfig, Settings
 from pcmapq.core.transform import Similarity2D
 from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.io import PointMap
 from pcmapq.io.carmen import endpoints, read_flaser
 from pcmapq.report.plot import figure_bytes, vectorial_figure
+from pcmapq.settings import AlignmentConfig, MatchingConfig, Settings
 from pcmapq.testing import synth
 
 from .common import Case, Record, Section

@@ -71,7 +71,6 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from pcmapq.align.parts import PIECES
-from pcmapq.config import Settings
 from pcmapq.core.transform import Similarity2D
 from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.evaluation.same_place import MIN_AGREEING
@@ -80,7 +79,8 @@ from pcmapq.io.carmen import DEFAULT_MAX_RANGE, endpoints, read_flaser
 from pcmapq.io.writers import write_ros_map
 from pcmapq.raster.draw import points_to_grid, polygon_cells
 from pcmapq.report.text import number
-from pcmapq.result import INCONSISTENT, OTHER, SAME
+from pcmapq.results.result import INCONSISTENT, OTHER, SAME
+from pcmapq.settings import Settings
 from pcmapq.testing import synth
 
 from . import drift, same_place

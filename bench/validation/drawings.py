@@ -18,13 +18,13 @@ import cv2
 import numpy as np
 from skimage.morphology import skeletonize
 
-from pcmapq.config import Settings
 from pcmapq.core.grid import MetricGrid
 from pcmapq.evaluation.inputs import plan_points, truth_raster
 from pcmapq.features import Features, detect
 from pcmapq.io import OccupancyMap, load_map
 from pcmapq.match import match
 from pcmapq.raster.draw import OCCUPIED
+from pcmapq.settings import Settings
 from pcmapq.testing import synth
 
 from .common import Case, Record, Section, header, row

@@ -28,9 +28,9 @@ from pathlib import Path
 
 import numpy as np
 
-from pcmapq.config import AlignmentConfig, Settings
 from pcmapq.io.carmen import DEFAULT_MAX_RANGE, endpoints, read_flaser
 from pcmapq.report.text import number, score
+from pcmapq.settings import AlignmentConfig, Settings
 
 from .common import f_at, timed_evaluate
 

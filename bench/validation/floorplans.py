@@ -6,10 +6,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-from pcmapq.config import AlignmentConfig, Settings, SourceConfig
 from pcmapq.io import Thresholds
 from pcmapq.report.text import number
-from pcmapq.result import Result
+from pcmapq.results.result import Result
+from pcmapq.settings import AlignmentConfig, Settings, SourceConfig
 
 from .common import (
     ROS,

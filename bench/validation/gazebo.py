@@ -8,7 +8,7 @@ from pathlib import Path
 
 import cv2
 
-from pcmapq.config import AlignmentConfig, Settings, SourceConfig
+from pcmapq.settings import AlignmentConfig, Settings, SourceConfig
 
 from .common import Case, Record, Run, Section, cm, qualities, timed_evaluate
 

@@ -11,13 +11,13 @@ from pathlib import Path
 import numpy as np
 
 from bench import bench_scale
-from pcmapq.config import AlignmentConfig, Settings, SourceConfig
 from pcmapq.core.transform import Similarity2D
 from pcmapq.io import OccupancyMap, load_map
 from pcmapq.io.occupancy import classify, read_levels
 from pcmapq.raster.draw import OCCUPIED
 from pcmapq.report.text import number
-from pcmapq.result import Result
+from pcmapq.results.result import Result
+from pcmapq.settings import AlignmentConfig, Settings, SourceConfig
 
 from .common import (
     ROS,

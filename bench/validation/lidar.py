@@ -6,8 +6,8 @@ from pathlib import Path
 
 import numpy as np
 
-from pcmapq.config import Settings
 from pcmapq.core.transform import Similarity2D
+from pcmapq.settings import Settings
 
 from .common import Case, Record, Run, Section, f_at, header, q_p, row, timed_evaluate
 

@@ -26,7 +26,6 @@ import cv2
 import numpy as np
 from scipy.stats import spearmanr
 
-from pcmapq.config import AlignmentConfig, MatchingConfig, Settings
 from pcmapq.core.cells import FREE, OCCUPIED, UNKNOWN
 from pcmapq.core.grid import MetricGrid
 from pcmapq.core.voxels import voxel_centroids
@@ -39,6 +38,7 @@ from pcmapq.metrics.inspection import noref_figures
 from pcmapq.metrics.noref2d import grid_scores
 from pcmapq.metrics.orthogonal import extract_orthogonal_subset
 from pcmapq.raster.draw import hit_counts
+from pcmapq.settings import AlignmentConfig, MatchingConfig, Settings
 
 from . import carmen, drift, noref_grids
 from .common import Case, Record, Run, Section, f_at, header, row, timed_evaluate

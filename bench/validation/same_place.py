@@ -23,13 +23,13 @@ from pathlib import Path
 import numpy as np
 
 from pcmapq.align.parts import PIECES
-from pcmapq.config import AlignmentConfig, MatchingConfig, Settings, SourceConfig
 from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.evaluation.same_place import MIN_AGREEING
 from pcmapq.io import PointMap
 from pcmapq.io.carmen import DEFAULT_MAX_RANGE, endpoints, read_flaser
 from pcmapq.report.text import number
-from pcmapq.result import INCONSISTENT, OTHER, SAME
+from pcmapq.results.result import INCONSISTENT, OTHER, SAME
+from pcmapq.settings import AlignmentConfig, MatchingConfig, Settings, SourceConfig
 
 from . import drift, gazebo, halmstad
 from .common import ROOT, Case, Record, Section, header, row

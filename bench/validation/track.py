@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from pcmapq.config import Settings
+from pcmapq.settings import Settings
 from pcmapq.track import open_run, planar_of, planar_poses, step_ends, track_run, travelled
 from pcmapq.track.drop import Drop
 from pcmapq.track.timeline import Step

@@ -15,13 +15,13 @@ from pathlib import Path
 import numpy as np
 import typer
 
-from pcmapq.config import DETECTOR_NAMES, DistancesConfig, MatchingConfig, Settings, SourceConfig
 from pcmapq.core.errors import InputError
 from pcmapq.core.transform import Similarity2D
 from pcmapq.io import Thresholds
 from pcmapq.io.occupancy import IMAGE_SUFFIXES, YAML_SUFFIXES, read_yaml
 from pcmapq.io.writers import same_file
 from pcmapq.raster.footprint import FOOTPRINT_RULES
+from pcmapq.settings import DETECTOR_NAMES, DistancesConfig, MatchingConfig, Settings, SourceConfig
 
 
 def command_line(ctx: typer.Context) -> str:

@@ -1,6 +1,6 @@
 """A batch's rows: read from a CSV or YAML manifest, or one per map of a glob. Each row's
 options are ``pcmapq eval``'s, by name (``threshold``, ``map_resolution`` ...), turned into
-:class:`~pcmapq.config.Settings` by the same parsers as eval's, and into the ``pcmapq eval``
+:class:`~pcmapq.settings.Settings` by the same parsers as eval's, and into the ``pcmapq eval``
 command line that makes the same result. A bad manifest is one InputError (exit 2) naming
 the file, the row and the problem."""
 
@@ -18,8 +18,8 @@ import typer
 import yaml
 
 from pcmapq import options
-from pcmapq.config import Settings
 from pcmapq.core.errors import InputError
+from pcmapq.settings import Settings
 
 #: Names a row cannot take: the batch's own table and figure are written beside the rows.
 RESERVED = ("table", "figure")

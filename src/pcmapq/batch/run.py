@@ -19,16 +19,18 @@ from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-from pcmapq import __version__, gates
+from pcmapq import __version__
 from pcmapq.batch.manifest import Row
 from pcmapq.core.errors import EvaluationError, InputError
 from pcmapq.evaluation.pipeline import evaluate
-from pcmapq.gates import Gate
 from pcmapq.io.digest import sha256_file
 from pcmapq.io.writers import OutputSet, one_line, write_atomic
 from pcmapq.options import input_files
 from pcmapq.report.style import ARROW_SCALE
-from pcmapq.report.summary import failed_row, summary_row, write_summary
+from pcmapq.report.summary import write_summary
+from pcmapq.results import gates
+from pcmapq.results.figures import failed_row, table_row
+from pcmapq.results.gates import Gate
 
 #: The folder of DIR where each row's record (its inputs' checksums, settings, outputs) is
 #: kept; hidden, so ``DIR/*.json`` holds the results only.
@@ -70,7 +72,7 @@ class Task:
 class Outcome:
     """How a row ended: status 'computed', 'skipped' (a valid saved result) or 'failed';
     exit_code 0 or the error's (2 bad input, 1 evaluation failed or any other error); its
-    table row (:func:`~pcmapq.report.summary.summary_row` or ``failed_row``); pcmapq's
+    table row (:func:`~pcmapq.results.figures.table_row` or ``failed_row``); pcmapq's
     warnings while it ran."""
 
     name: str
@@ -98,7 +100,7 @@ def _run(task: Task) -> Outcome:
     """:func:`run_row` without its safety net."""
     row, key = task.row, row_key(task)
     if not task.force and (doc := saved_result(task, key)) is not None:
-        return Outcome(row.name, "skipped", 0, "", summary_row(row.name, doc))
+        return Outcome(row.name, "skipped", 0, "", table_row(row.name, doc))
     return _compute(task, key)
 
 
@@ -131,7 +133,7 @@ def saved_result(task: Task, key: dict) -> dict | None:
         if any(sha256_file(task.out_dir / name) != digest for name, digest in files.items()):
             return None
         doc = json.loads((task.outputs()["--json"]).read_text(encoding="utf-8"))
-        summary_row(task.row.name, doc)
+        table_row(task.row.name, doc)
     except (OSError, ValueError, KeyError, TypeError):
         return None
     return doc
@@ -162,7 +164,7 @@ def _compute(task: Task, key: dict) -> Outcome:
                   "outputs": {p.name: hashlib.sha256(d).hexdigest() for p, d in files.items()}}
         _write_record(task, record, staged)
         staged.commit()
-    return Outcome(row.name, "computed", 0, "", summary_row(row.name, json.loads(text)),
+    return Outcome(row.name, "computed", 0, "", table_row(row.name, json.loads(text)),
                    _pcmapq_warnings(caught))
 
 
@@ -292,13 +294,13 @@ def run_batch(rows: list[Row], out_dir: Path, *, plot: bool = False, report: boo
 
 def judged(outcome: Outcome, rules: list[Gate], out_dir: Path) -> Outcome:
     """A finished row judged by the gates on its saved JSON: its table row gains their verdict;
-    a failing row's exit code becomes :data:`pcmapq.gates.EXIT_CODE` (3) and its error the
+    a failing row's exit code becomes :data:`pcmapq.results.gates.EXIT_CODE` (3) and its error the
     failing figures. The JSON itself stays eval's (no ``gates`` block). A failed row as it is."""
     if outcome.exit_code:
         return outcome
     doc = json.loads((out_dir / f"{outcome.name}.json").read_text(encoding="utf-8"))
     verdicts = gates.check(rules, doc)
-    summary = summary_row(outcome.name, gates.with_gates(doc, verdicts))
+    summary = table_row(outcome.name, gates.with_gates(doc, verdicts))
     lines = [v.line() for v in verdicts if not v.passed]
     return replace(outcome, summary=summary, exit_code=gates.EXIT_CODE if lines else 0,
                    error="; ".join(lines))

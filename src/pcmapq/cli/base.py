@@ -10,7 +10,7 @@ from typing import Annotated
 import typer
 
 from pcmapq import __version__
-from pcmapq.terminal import HELP_WIDTH, OneLineUsageErrors
+from pcmapq.cli.terminal import HELP_WIDTH, OneLineUsageErrors
 
 #: Each command's help, by name, in the order ``pcmapq --help`` lists them.
 HELP = {

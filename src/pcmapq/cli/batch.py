@@ -10,13 +10,15 @@ from typing import Annotated
 import typer
 from rich.console import Console
 
-from pcmapq import gates, options, terminal
+from pcmapq import options
+from pcmapq.cli import terminal
 from pcmapq.cli.commands import HELP, RowsFailOver, RowsFailUnder, app
-from pcmapq.core.errors import InputError
-from pcmapq.io.writers import OutputSet, write_atomic
-from pcmapq.terminal import (
+from pcmapq.cli.terminal import (
     report_errors,
 )
+from pcmapq.core.errors import InputError
+from pcmapq.io.writers import OutputSet, write_atomic
+from pcmapq.results import gates
 
 
 @app.command("batch", help=HELP["batch"])

@@ -9,7 +9,7 @@ import typer
 
 from pcmapq import options
 from pcmapq.cli.base import HELP, new_app
-from pcmapq.config import Settings
+from pcmapq.settings import Settings
 
 #: The documented defaults, read from the one place that defines them.
 DEFAULTS = Settings()

@@ -9,9 +9,9 @@ from typing import Annotated
 import typer
 from rich.console import Console
 
-from pcmapq import terminal
+from pcmapq.cli import terminal
 from pcmapq.cli.commands import HELP, app
-from pcmapq.terminal import (
+from pcmapq.cli.terminal import (
     report_errors,
 )
 
@@ -32,8 +32,8 @@ def compare_command(
     quiet: Annotated[bool, typer.Option(
         "--quiet", "-q", help="Print nothing but warnings and errors.")] = False,
 ) -> None:
-    from pcmapq.compare import check_same_truth, read_results
     from pcmapq.report.summary import print_summary, write_summary
+    from pcmapq.results.compare import check_same_truth, read_results
 
     err = Console(stderr=True)
     with report_errors(err), terminal.show_warnings(err):

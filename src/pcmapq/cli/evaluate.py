@@ -10,11 +10,12 @@ from typing import Annotated
 import typer
 from rich.console import Console
 
-from pcmapq import gates, options, terminal
+from pcmapq import options
+from pcmapq.cli import terminal
 from pcmapq.cli.commands import DEFAULTS, HELP, FailOver, FailUnder, MaxMemory, app, memory_limit
-from pcmapq.config import (
-    DETECTOR_NAMES,
-    Settings,
+from pcmapq.cli.terminal import (
+    report_errors,
+    step_progress,
 )
 from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.io import PointMap
@@ -26,10 +27,11 @@ from pcmapq.raster.footprint import FOOTPRINT_RULES
 from pcmapq.report import export
 from pcmapq.report.style import ARROW_SCALE
 from pcmapq.report.table import print_table
-from pcmapq.result import Result
-from pcmapq.terminal import (
-    report_errors,
-    step_progress,
+from pcmapq.results import gates
+from pcmapq.results.result import Result
+from pcmapq.settings import (
+    DETECTOR_NAMES,
+    Settings,
 )
 
 

@@ -10,9 +10,12 @@ import numpy as np
 import typer
 from rich.console import Console
 
-from pcmapq import options, terminal
+from pcmapq import options
+from pcmapq.cli import terminal
 from pcmapq.cli.commands import HELP, MaxMemory, app, memory_limit
-from pcmapq.config import NoRefConfig
+from pcmapq.cli.terminal import (
+    report_errors,
+)
 from pcmapq.core import memory
 from pcmapq.evaluation.inspect_map import inspect_map, summary_lines, to_json
 from pcmapq.evaluation.pipeline import needed_memory
@@ -27,9 +30,7 @@ from pcmapq.mapping import (
 )
 from pcmapq.metrics.noref import DEPTH_RADIUS, LIDAR_RADIUS, MAX_NN, MIN_KNN
 from pcmapq.metrics.posed import place_subset, read_orthogonal_subset
-from pcmapq.terminal import (
-    report_errors,
-)
+from pcmapq.settings import NoRefConfig
 
 #: The crop option of inspect, named in messages.
 CROP = "--crop"

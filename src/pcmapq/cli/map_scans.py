@@ -9,8 +9,13 @@ from typing import Annotated
 import typer
 from rich.console import Console
 
-from pcmapq import options, terminal
+from pcmapq import options
+from pcmapq.cli import terminal
 from pcmapq.cli.commands import HELP, app
+from pcmapq.cli.terminal import (
+    report_errors,
+    scan_bar,
+)
 from pcmapq.core.errors import InputError
 from pcmapq.io.writers import OutputSet, write_cloud
 from pcmapq.mapping import (
@@ -22,10 +27,6 @@ from pcmapq.mapping import (
     scans_for_poses,
     write_kitti_poses,
     write_tum_poses,
-)
-from pcmapq.terminal import (
-    report_errors,
-    scan_bar,
 )
 
 

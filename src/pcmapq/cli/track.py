@@ -10,16 +10,17 @@ from typing import Annotated
 import typer
 from rich.console import Console
 
-from pcmapq import options, terminal
+from pcmapq import options
+from pcmapq.cli import terminal
 from pcmapq.cli.commands import DEFAULTS, HELP, MaxMemory, app, memory_limit
-from pcmapq.core.errors import InputError
-from pcmapq.io.writers import OutputSet, write_atomic
-from pcmapq.raster.footprint import FOOTPRINT_RULES
-from pcmapq.terminal import (
+from pcmapq.cli.terminal import (
     report_errors,
     scan_bar,
     step_progress,
 )
+from pcmapq.core.errors import InputError
+from pcmapq.io.writers import OutputSet, write_atomic
+from pcmapq.raster.footprint import FOOTPRINT_RULES
 
 
 @app.command("track", help=HELP["track"])

@@ -15,7 +15,6 @@ from pathlib import Path
 
 import numpy as np
 
-from pcmapq.config import Settings, SourceConfig
 from pcmapq.core import memory
 from pcmapq.core.bounds import bounds
 from pcmapq.core.errors import EvaluationError, InputError
@@ -27,6 +26,7 @@ from pcmapq.io.extent import crop
 from pcmapq.io.occupancy import NO_RESOLUTION
 from pcmapq.raster.draw import OCCUPIED, points_to_grid
 from pcmapq.raster.slice import wall_band
+from pcmapq.settings import Settings, SourceConfig
 
 #: The crop option of each side, named in messages.
 MAP_CROP, TRUTH_CROP = "--map-crop", "--truth-crop"

@@ -14,10 +14,10 @@ from typing import Any
 import numpy as np
 
 from pcmapq import __version__
-from pcmapq.config import NoRefConfig
 from pcmapq.core.stats import significant
 from pcmapq.evaluation.noref_figures import input_figures
 from pcmapq.io import OccupancyMap, PointMap
+from pcmapq.settings import NoRefConfig
 
 
 def inspect_map(source: OccupancyMap | PointMap, config: NoRefConfig = NoRefConfig(),

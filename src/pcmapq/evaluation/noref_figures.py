@@ -11,13 +11,13 @@ from typing import Any
 
 import numpy as np
 
-from pcmapq.config import NoRefConfig, Settings
 from pcmapq.core.voxels import voxel_centroids
 from pcmapq.evaluation.inputs import truth_raster
 from pcmapq.io import OccupancyMap, PointMap
 from pcmapq.metrics.inspection import noref_figures
 from pcmapq.metrics.noref2d import grid_scores
 from pcmapq.raster.draw import OCCUPIED, UNKNOWN
+from pcmapq.settings import NoRefConfig, Settings
 
 
 def input_figures(source: OccupancyMap | PointMap, config: NoRefConfig = NoRefConfig(),

@@ -14,7 +14,6 @@ from pcmapq.align.parts import broken_off, place_parts
 from pcmapq.align.planar import RigidTarget
 from pcmapq.align.regions import regions
 from pcmapq.align.rigid3d import Registration3D
-from pcmapq.config import Settings
 from pcmapq.core import memory
 from pcmapq.core.bounds import bounds
 from pcmapq.core.errors import EvaluationError, InputError
@@ -42,7 +41,8 @@ from pcmapq.metrics.distances import distances, distances_3d, nearest_distance
 from pcmapq.raster.draw import OCCUPIED, UNKNOWN, points_to_grid, warp_state
 from pcmapq.raster.footprint import footprint_rule, map_footprint
 from pcmapq.raster.seen import seen_on
-from pcmapq.result import OTHER, DetectorResult, Overlap, Result
+from pcmapq.results.result import OTHER, DetectorResult, Overlap, Result
+from pcmapq.settings import Settings
 
 Progress = Callable[[str], None]
 

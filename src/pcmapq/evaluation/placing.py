@@ -12,7 +12,6 @@ import numpy as np
 from pcmapq.align import Alignment, align
 from pcmapq.align.planar import RigidTarget
 from pcmapq.align.rigid3d import Registration3D, align_3d, apply
-from pcmapq.config import Settings
 from pcmapq.core.bounds import radius
 from pcmapq.core.errors import EvaluationError
 from pcmapq.core.transform import Similarity2D
@@ -20,6 +19,7 @@ from pcmapq.evaluation.inputs import MAP_CROP
 from pcmapq.evaluation.same_place import OVERSIZE
 from pcmapq.io import OccupancyMap, PointMap
 from pcmapq.io.extent import hint
+from pcmapq.settings import Settings
 
 
 def align_clouds_3d(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap,

@@ -4,7 +4,6 @@ results of :func:`pcmapq.evaluation.pipeline.score` without the truth's work for
 from __future__ import annotations
 
 from pcmapq.align.planar import RigidTarget
-from pcmapq.config import Settings
 from pcmapq.core import memory
 from pcmapq.evaluation.inputs import MAP_CROP, TRUTH_CROP, plan_points, truth_cells, truth_grid
 from pcmapq.evaluation.pipeline import (
@@ -21,7 +20,8 @@ from pcmapq.features import SideBySide
 from pcmapq.io import OccupancyMap, PointMap
 from pcmapq.io.extent import check_span, hint
 from pcmapq.metrics.distances import nearest_distance
-from pcmapq.result import Result
+from pcmapq.results.result import Result
+from pcmapq.settings import Settings
 
 
 def prepare_truth(truth: OccupancyMap | PointMap, settings: Settings,

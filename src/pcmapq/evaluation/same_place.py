@@ -12,13 +12,13 @@ import numpy as np
 
 from pcmapq.align import Alignment
 from pcmapq.align.parts import Part
-from pcmapq.config import Settings
 from pcmapq.core.bounds import radius
 from pcmapq.core.morphology import outline
 from pcmapq.evaluation.inputs import MAP_CROP, OUTLINE_M
 from pcmapq.io import OccupancyMap, PointMap
 from pcmapq.io.extent import far_points
-from pcmapq.result import INCONSISTENT, OTHER, SAME, Overlap
+from pcmapq.results.result import INCONSISTENT, OTHER, SAME, Overlap
+from pcmapq.settings import Settings
 
 #: Confidence terms (see :func:`confidence`): the distinctiveness worth full confidence, the
 #: truth recalls and the agreements worth none and full confidence.

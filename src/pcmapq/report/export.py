@@ -25,7 +25,6 @@ from pathlib import Path
 
 import numpy as np
 
-from pcmapq.config import Settings
 from pcmapq.core.cells import FREE, OCCUPIED
 from pcmapq.core.frames import Frames, Levelling
 from pcmapq.core.grid import MetricGrid
@@ -37,7 +36,8 @@ from pcmapq.io.ply import CHUNK
 from pcmapq.io.writers import OutputSet, write_ros_map
 from pcmapq.metrics.distances import accuracy_2d, accuracy_3d, nearest_distance
 from pcmapq.raster.draw import warp_state
-from pcmapq.result import Result
+from pcmapq.results.result import Result
+from pcmapq.settings import Settings
 
 #: map_server grey values of an occupied, a free and an unknown cell (negate 0).
 ROS_OCCUPIED, ROS_FREE, ROS_UNKNOWN = 0, 254, 205

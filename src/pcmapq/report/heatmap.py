@@ -16,7 +16,7 @@ from pcmapq.core.morphology import distance_to
 from pcmapq.raster.pool import max_pool, min_pool
 from pcmapq.report.plot import WIDTH_IN, extent, frame, plt, pooling  # Agg backend
 from pcmapq.report.style import TEXT_PT, TITLE_PT
-from pcmapq.result import Result
+from pcmapq.results.result import Result
 
 #: Grey of the walls under a heatmap's coloured cells.
 UNDER_GREY = (0.8, 0.8, 0.8)

@@ -17,7 +17,7 @@ from pcmapq.report.style import ARROW_SCALE, FIGURE_WIDTH_PX
 from pcmapq.report.text import number, score
 from pcmapq.report.viewer import STYLE as VIEWER_STYLE
 from pcmapq.report.viewer import nearest_distances, viewer_html
-from pcmapq.result import DetectorResult, Result
+from pcmapq.results.result import DetectorResult, Result
 
 STYLE = """
 body { font-family: -apple-system, 'Segoe UI', Helvetica, Arial, sans-serif; margin: 2em auto;

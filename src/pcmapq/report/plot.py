@@ -56,7 +56,7 @@ from pcmapq.report.style import (  # noqa: E402
     TRUTH_DARK,
 )
 from pcmapq.report.text import score  # noqa: E402
-from pcmapq.result import DetectorResult, Result  # noqa: E402
+from pcmapq.results.result import DetectorResult, Result  # noqa: E402
 
 NICE = (1, 2, 5)
 #: Figure width, inches: the report's figure width at DPI.

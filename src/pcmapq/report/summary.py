@@ -5,109 +5,24 @@ the paper's Figure 7). Metres and degrees; an undefined figure stays None: an em
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 from pathlib import Path
 
-from pcmapq.config import DETECTOR_NAMES
 from pcmapq.core.errors import InputError
 from pcmapq.io.writers import OutputSet, one_line, write_atomic
-from pcmapq.result import DECIMALS
+from pcmapq.results.figures import HEADERS, SCORES, TAIL, columns
+from pcmapq.results.result import DECIMALS
+from pcmapq.settings import DETECTOR_NAMES
 
-#: The figures of a detector, in column order (``harris_quality`` ...).
-SCORES = ("quality", "precision", "f1")
-#: Columns before the F-scores: the name and inputs, each detector's scores (quality of every
-#: detector, then precision, then f1), coverage, the alignment, the wall distances (metres).
-HEAD = ("name", "map", "truth",
-        *(f"{d}_{s}" for s in SCORES for d in DETECTOR_NAMES),
-        "coverage", "fitness", "confidence", "verdict", "x_m", "y_m", "yaw_deg", "scale",
-        "largest_offset_m", "accuracy_mean_m", "accuracy_median_m", "completeness_mean_m",
-        "completeness_median_m", "chamfer_m")
-#: Columns after the F-scores: the gates' verdict ("" without gates, "pass", or "fail: " and
-#: the failing keys) and how the evaluation ended (0 and "" when it finished).
-TAIL = ("gates", "exit_code", "error")
-#: An F-score column: the F-score of the walls within tau metres (``f_score@0.05m``).
-FSCORE = "f_score@{tau:g}m"
-#: Markdown headers of the columns (units in brackets); an F-score's is ``F@0.05 m``.
-HEADERS = {"name": "name", "map": "map", "truth": "truth",
-           **{f"{d}_{s}": f"{d} {s}" for s in SCORES for d in DETECTOR_NAMES},
-           "coverage": "coverage", "fitness": "fitness", "confidence": "confidence",
-           "verdict": "verdict", "x_m": "x (m)", "y_m": "y (m)", "yaw_deg": "yaw (deg)",
-           "scale": "scale", "largest_offset_m": "largest region offset (m)",
-           "accuracy_mean_m": "accuracy mean (m)", "accuracy_median_m": "accuracy median (m)",
-           "completeness_mean_m": "completeness mean (m)",
-           "completeness_median_m": "completeness median (m)", "chamfer_m": "Chamfer (m)",
-           "gates": "gates", "exit_code": "exit code", "error": "error"}
 #: Decimals of the markdown table: scale 4, degrees 2, everything else 3 (as the terminal).
 MD_DECIMALS = {"scale": 4, "yaw_deg": 2}
 #: Bar colours of the detectors in the figure.
 COLOURS = {"harris": "#4477aa", "hough": "#ee6677", "sift": "#228833"}
 
 
-def summary_row(name: str, result: dict) -> dict[str, object]:
-    """One flat row of a result JSON document (``pcmapq eval --json``): the inputs' paths,
-    each detector's quality, precision and f1 (None when undefined or not run), coverage, the
-    alignment (fitness, confidence, verdict, x, y metres, yaw degrees, scale), the largest
-    offset of a region of the consistency map (metres), the wall distances
-    (metres), the F-score at each tau and the verdict of its gates (:func:`gates_verdict`);
-    exit_code 0, error "". A document missing one of
-    these is a ValueError naming the key."""
-    row: dict[str, object] = {"name": name, "map": _get(result, "map", "path"),
-                              "truth": _get(result, "truth", "path")}
-    detectors = _get(result, "detectors")
-    align = _get(result, "alignment")
-    dist = _get(result, "distances")
-    for score in SCORES:
-        for det in DETECTOR_NAMES:
-            row[f"{det}_{score}"] = (_number(detectors[det], score, f"detectors.{det}")
-                                     if det in detectors else None)
-    row["coverage"] = _number(result, "coverage")
-    for key in ("fitness", "confidence"):
-        row[key] = _number(align, key, "alignment")
-    # a result written before verdicts and regions has neither: left empty
-    row["verdict"] = align.get("verdict")
-    for key in ("x_m", "y_m", "yaw_deg", "scale"):
-        row[key] = _number(align, key, "alignment")
-    row["largest_offset_m"] = (result.get("consistency") or {}).get("largest_offset_m")
-    for side in ("accuracy", "completeness"):
-        stats = _get(dist, f"{side}_m")
-        for key in ("mean", "median"):
-            row[f"{side}_{key}_m"] = _number(stats, key, f"distances.{side}_m")
-    row["chamfer_m"] = _number(dist, "chamfer_m", "distances")
-    for f in _get(dist, "f_score"):
-        row[FSCORE.format(tau=_number(f, "tau_m", "f_score"))] = _number(f, "f", "f_score")
-    return {**row, "gates": gates_verdict(result.get("gates")), "exit_code": 0, "error": ""}
-
-
-def gates_verdict(gates: list[dict] | None) -> str:
-    """A result's ``gates`` block (``pcmapq eval --fail-under/--fail-over``) in a word: "" when
-    none, "pass", or "fail: " and the keys that failed."""
-    if not gates:
-        return ""
-    failed = [g["key"] for g in gates if not g["passed"]]
-    return "fail: " + ", ".join(failed) if failed else "pass"
-
-
-def failed_row(name: str, map_path: str, truth_path: str, exit_code: int,
-               error: str) -> dict[str, object]:
-    """The row of an evaluation that failed: its inputs, exit code and one-line error, every
-    figure None."""
-    row: dict[str, object] = dict.fromkeys(HEAD)
-    return {**row, "name": name, "map": str(map_path), "truth": str(truth_path),
-            "gates": "", "exit_code": int(exit_code), "error": " ".join(str(error).split())}
-
-
-def columns(rows: Sequence[dict[str, object]]) -> list[str]:
-    """The table's columns: :data:`HEAD`, the F-score of every tau any row has (ascending),
-    :data:`TAIL`."""
-    taus = sorted({float(k[len("f_score@"):-1]) for row in rows for k in row
-                   if k.startswith("f_score@")})
-    return [*HEAD, *(FSCORE.format(tau=t) for t in taus), *TAIL]
-
-
 def table_csv(rows: Sequence[dict[str, object]]) -> str:
     """The rows as CSV, one per map in the order given, :func:`columns` order: floats with
-    :data:`~pcmapq.result.DECIMALS` decimals, an empty cell for None."""
+    :data:`~pcmapq.results.result.DECIMALS` decimals, an empty cell for None."""
     import csv
     import io
 
@@ -235,28 +150,6 @@ def write_summary(rows: Sequence[dict[str, object]], out_dir: Path) -> list[Path
         write_atomic(out_dir / "figure.png", figure_bytes(summary_figure(rows), "png"),
                      outputs)
         return outputs.commit()
-
-
-def _get(doc: dict, *keys: str) -> object:
-    """``doc[k0][k1]...``; a ValueError naming the dotted key when it is absent."""
-    value: object = doc
-    for i, key in enumerate(keys):
-        if not isinstance(value, dict) or key not in value:
-            raise ValueError(f"no '{'.'.join(keys[:i + 1])}'")
-        value = value[key]
-    return value
-
-
-def _number(doc: dict, key: str, where: str = "") -> float | None:
-    """``doc[key]`` as a float, or None; a ValueError when it is absent or not a number."""
-    if not isinstance(doc, dict) or key not in doc:
-        raise ValueError(f"no '{where + '.' if where else ''}{key}'")
-    value = doc[key]
-    if value is None:
-        return None
-    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
-        raise ValueError(f"'{where + '.' if where else ''}{key}' is not a number: {value!r}")
-    return float(value)
 
 
 def _csv_cell(value: object) -> str:

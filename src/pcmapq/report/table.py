@@ -11,7 +11,7 @@ from rich.table import Table
 
 from pcmapq.core.stats import FIELDS, Stats
 from pcmapq.report.text import LEGEND, metres, number, score, verdict, words, wrap
-from pcmapq.result import DetectorResult, Result
+from pcmapq.results.result import DetectorResult, Result
 
 #: Width of the labels of the key-value lines, characters.
 LABEL = 12

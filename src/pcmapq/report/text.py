@@ -6,7 +6,7 @@ from __future__ import annotations
 import re
 from collections.abc import Sequence
 
-from pcmapq.result import INCONSISTENT, OTHER, Result
+from pcmapq.results.result import INCONSISTENT, OTHER, Result
 
 #: What the terms of the table mean, in one short paragraph (their definitions:
 #: docs/metrics.md).

@@ -14,7 +14,7 @@ from pcmapq.report.html import STYLE, _img, _table
 from pcmapq.report.plot import WIDTH_IN, png_bytes, vectorial_figure
 from pcmapq.report.summary import COLOURS
 from pcmapq.report.text import number
-from pcmapq.result import Result
+from pcmapq.results.result import Result
 
 #: The panels: a title and the columns drawn in it (those the rows have).
 FAMILIES = (

@@ -28,7 +28,7 @@ from scipy.spatial import cKDTree
 
 from pcmapq.report.plot import density, grown, shade
 from pcmapq.report.style import EXTRA, MAP_LIGHT, MATCHED, MISSING, TRUTH_DARK
-from pcmapq.result import DetectorResult, Result
+from pcmapq.results.result import DetectorResult, Result
 
 #: Longest side, pixels, of the embedded wall pictures: sharp on a 1350-pixel-wide viewer
 #: zoomed in 1.5-fold, and a few hundred kB on the largest maps.

@@ -17,12 +17,12 @@ from pathlib import Path
 
 import numpy as np
 
-from pcmapq.config import Settings
 from pcmapq.evaluation.inputs import TRUTH_CROP, load_input
 from pcmapq.evaluation.pipeline import PreparedTruth
 from pcmapq.evaluation.prepared import prepare_truth
 from pcmapq.io.writers import OutputSet, write_atomic
-from pcmapq.result import Result
+from pcmapq.results.result import Result
+from pcmapq.settings import Settings
 from pcmapq.track.drop import Drop, worst_drop
 from pcmapq.track.outputs import step_rows, track_csv, track_json
 from pcmapq.track.runs import Run, open_run, planar_of, planar_poses

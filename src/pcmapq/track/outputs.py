@@ -9,7 +9,7 @@ from dataclasses import asdict
 from pathlib import Path
 
 from pcmapq import __version__
-from pcmapq.result import DECIMALS
+from pcmapq.results.result import DECIMALS
 from pcmapq.track.drop import Drop
 from pcmapq.track.timeline import Step
 

@@ -25,18 +25,18 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from pcmapq.align import align
-from pcmapq.config import Settings
 from pcmapq.core.errors import EvaluationError, InputError
 from pcmapq.core.frames import Frames
 from pcmapq.core.transform import Similarity2D
 from pcmapq.core.voxels import evenly, voxel_centroids
 from pcmapq.evaluation.pipeline import MapSide, PreparedTruth
 from pcmapq.evaluation.prepared import finish_prepared, place_prepared, score_prepared
-from pcmapq.report.summary import summary_row
-from pcmapq.result import Result
+from pcmapq.metrics.trajectory import ape, rpe
+from pcmapq.results.figures import table_row
+from pcmapq.results.result import Result
+from pcmapq.settings import Settings
 from pcmapq.track.runs import Run
 from pcmapq.track.steps import travelled
-from pcmapq.trajectory import ape, rpe
 
 #: The summary columns a step does not repeat (they name the inputs or a batch's outcome).
 NOT_PER_STEP = ("name", "map", "truth", "gates", "exit_code", "error")
@@ -66,7 +66,7 @@ class PoseOptions:
 class Step:
     """One step: the map of the first ``scans`` scans; ``time_s`` since the first scan (None
     without timestamps) and ``distance_m`` travelled at its last scan; ``figures`` the flat
-    columns of :func:`~pcmapq.report.summary.summary_row` plus ``slide_m``,
+    columns of :func:`~pcmapq.results.figures.table_row` plus ``slide_m``,
     ``local_offset_m`` and the trajectory errors (None when undefined); ``note`` why a step
     was not scored ("" when it was);
     ``start`` the pose its ICP started from (None: the global search); ``frames`` the frames
@@ -111,11 +111,12 @@ def pose_errors(estimate: np.ndarray, reference: np.ndarray,
 
 
 def figures_of(result: Result) -> dict[str, float | None]:
-    """A result's flat figures: :func:`summary_row` without the inputs and outcome, the
+    """A result's flat figures: :func:`~pcmapq.results.figures.table_row` without the inputs and
+    outcome, the
     detectors' mean precision (``precision``: is what the map shows right? the figure whose
     fall dates a fault) and the wall precision at each tau (``wall_precision@0.1m``: share of
     the map's wall cells within tau of a truth wall)."""
-    row = summary_row("", result.to_dict(features=False))
+    row = table_row("", result.to_dict(features=False))
     figures = {k: v for k, v in row.items() if k not in NOT_PER_STEP}
     precisions = [d.matching.precision for d in result.detectors.values()
                   if d.matching.precision is not None]

@@ -14,7 +14,7 @@ from pathlib import Path
 
 from pcmapq.core.errors import InputError
 from pcmapq.io.writers import one_line
-from pcmapq.report.summary import summary_row
+from pcmapq.results.figures import table_row
 
 #: What makes two truths the same, beside their path: the truth grid's keys in the JSON.
 TRUTH_GRID = ("shape", "resolution_m", "origin")
@@ -85,7 +85,7 @@ def _read(path: Path, name: str) -> Saved:
     try:
         if not isinstance(doc, dict) or "pcmapq" not in doc:
             raise ValueError("no 'pcmapq' section")
-        row = summary_row(name, doc)
+        row = table_row(name, doc)
         _truth_key(doc)
     except (ValueError, TypeError, KeyError) as exc:
         raise InputError(f"{path}: not a pcmapq eval result: {one_line(exc)}") from None

@@ -1,7 +1,7 @@
 """Pass/fail gates on a result's figures, for CI: ``--fail-under KEY=VALUE,...`` fails a figure
 below its bound (qualities, precisions, coverage), ``--fail-over KEY=VALUE,...`` one above it
 (distances, metres). Plain functions over the result's JSON document
-(:meth:`pcmapq.result.Result.to_dict`), so that every row of a batch is judged alike.
+(:meth:`pcmapq.results.result.Result.to_dict`), so that every row of a batch is judged alike.
 
 A key is a short name (``harris.quality``, ``accuracy.mean``, ``f_score@0.1``, ``coverage``,
 ``alignment.confidence``; :func:`short_names`) or any dotted path of the JSON
@@ -17,24 +17,20 @@ import re
 from dataclasses import dataclass
 from typing import Any
 
-from pcmapq.config import DETECTOR_NAMES
 from pcmapq.core.errors import InputError
-from pcmapq.core.stats import FIELDS as STAT_FIELDS
+from pcmapq.results.figures import BY_NAME, FIGURES
 
 #: The exit code of a run whose figures fail a gate (0 scored, 1 evaluation failed, 2 usage).
 EXIT_CODE = 3
 #: The two directions and the option of each.
 UNDER, OVER = "under", "over"
 OPTIONS = {UNDER: "--fail-under", OVER: "--fail-over"}
-#: A detector's scores, each in [0, 1].
-DETECTOR_FIELDS = ("quality", "precision", "f1")
+#: Other names of figures that gates have always read.
+ALIASES = {"chamfer.mean": "chamfer", "chamfer_3d.mean": "chamfer_3d"}
 #: The top-level keys of the result's JSON (``alignment_3d``, ``distances_3d``: two 3D clouds).
 TOP_LEVEL = ("pcmapq", "settings", "map", "truth", "alignment", "consistency", "frames",
              "coverage", "footprint", "scored_against", "distances", "noref", "detectors",
              "matches", "missing", "extra", "alignment_3d", "distances_3d")
-#: The figures of ``alignment`` a short name reaches (they are their own JSON paths).
-ALIGNMENT_FIELDS = ("confidence", "fitness", "rmse_m", "truth_recall", "agreement",
-                    "distinctiveness", "x_m", "y_m", "yaw_deg", "scale")
 _F_SCORE = re.compile(r"^(f_score(?:_3d)?)(?:@(.*))?$")
 
 
@@ -120,32 +116,23 @@ def parse_rules(under: str | None, over: str | None) -> list[Gate]:
     return parse_gates(under, UNDER) + parse_gates(over, OVER)
 
 
-def short_names(detectors: tuple[str, ...] = DETECTOR_NAMES) -> list[str]:
-    """Every short key (``f_score@TAU`` stands for any tau)."""
-    stats = [f"{d}.{s}" for d in ("accuracy", "completeness") for s in STAT_FIELDS]
-    return ([f"{d}.{f}" for d in detectors for f in DETECTOR_FIELDS] + stats
-            + ["chamfer", "chamfer.mean", "f_score", "f_score@TAU", "coverage"]
-            + [f"alignment.{f}" for f in ALIGNMENT_FIELDS]
-            + [f"{name}_3d{rest}" for name, _, rest in
-               (s.partition(".") for s in stats + ["chamfer", "f_score@TAU"])])
+def short_names() -> list[str]:
+    """Every short key: each named figure (:data:`~pcmapq.results.figures.FIGURES`), the
+    aliases, and the F-score forms (``f_score@TAU`` stands for any tau)."""
+    return [f.name for f in FIGURES if f.number] + list(ALIASES) + ["f_score", "f_score@TAU",
+                                                         "f_score_3d@TAU"]
 
 
 def json_path(key: str, doc: dict) -> tuple[str | int, ...]:
-    """The JSON path a key names in ``doc``: a short name expanded, a dotted path split
-    (digits index lists). ``f_score@TAU`` names the F-score at tau metres; ``f_score`` alone,
-    the only one (an error when the result has several)."""
+    """The JSON path a key names in ``doc``: a figure's name (or alias) its figure's path, a
+    dotted path split (digits index lists). ``f_score@TAU`` names the F-score at tau metres;
+    ``f_score`` alone, the only one (an error when the result has several)."""
     if (m := _F_SCORE.match(key)) is not None:
         block = "distances_3d" if m[1].endswith("_3d") else "distances"
         return (block, "f_score", _tau_index(key, m[2], doc.get(block)), "f")
-    head, _, rest = key.partition(".")
-    base = head.removesuffix("_3d")
-    block = "distances_3d" if head.endswith("_3d") else "distances"
-    if head in DETECTOR_NAMES and rest in DETECTOR_FIELDS:
-        return ("detectors", head, rest)
-    if base in ("accuracy", "completeness") and rest in STAT_FIELDS:
-        return (block, f"{base}_m", rest)
-    if base == "chamfer" and rest in ("", "mean"):
-        return (block, "chamfer_m")
+    name = ALIASES.get(key, key)
+    if name in BY_NAME:
+        return BY_NAME[name].path
     return tuple(int(s) if s.isdigit() else s for s in key.split("."))
 
 
@@ -176,7 +163,8 @@ def with_gates(doc: dict, outcomes: list[Outcome]) -> dict:
 
 
 def to_json(doc: dict) -> str:
-    """A JSON document as :meth:`pcmapq.result.Result.to_json` writes one (strict, indented)."""
+    """A JSON document as :meth:`~pcmapq.results.result.Result.to_json` writes one (strict,
+    indented)."""
     return json.dumps(doc, indent=2, allow_nan=False) + "\n"
 
 

@@ -15,11 +15,11 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from pcmapq.config import NoRefConfig, Settings
 from pcmapq.evaluation.inspect_map import inspect_map
 from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.io import OccupancyMap, PointMap, load_map
-from pcmapq.result import Result
+from pcmapq.results.result import Result
+from pcmapq.settings import NoRefConfig, Settings
 from pcmapq.track import Tracked, open_run, step_ends, track_run, travelled
 from pcmapq.track.runs import reference_poses_of
 

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import io
 import json
 from dataclasses import asdict, dataclass
 from pathlib import Path
@@ -17,7 +16,7 @@ from pcmapq.core.stats import Stats, significant
 from pcmapq.core.transform import Similarity2D
 from pcmapq.features import Features
 from pcmapq.match import Matching
-from pcmapq.metrics.distances import Distances, FScore
+from pcmapq.metrics.distances import Distances
 
 if TYPE_CHECKING:  # the alignment modules load Open3D; a Result only holds their outputs
     from pcmapq.align import Alignment
@@ -172,7 +171,7 @@ class Result:
                           "verdict": self.overlap.verdict,
                           "parts": [{**asdict(p), "centre_m": list(p.centre_m),
                                      "pose": p.pose.to_dict()} for p in self.overlap.parts]},
-            "consistency": _consistency_dict(self.consistency),
+            "consistency": consistency_dict(self.consistency),
             "frames": self.frames.to_dict(),
             "coverage": self.overlap.coverage,
             "footprint": self.footprint_rule,
@@ -224,37 +223,31 @@ class Result:
         """The Result that :meth:`to_json` wrote: ``from_json(r.to_json()).to_json() ==
         r.to_json()``. What the JSON does not hold is absent: the rasters are None, feature
         strengths and pair costs NaN, descriptors and segments None."""
-        return _from_dict(json.loads(text))
+        from pcmapq.results.read import result_of
+
+        return result_of(json.loads(text))
+
+    def figures(self) -> dict[str, float | str | None]:
+        """Every figure by its one name (``harris.quality``, ``accuracy.mean``, ``coverage``,
+        ``alignment.confidence``, ``f_score@0.05`` ...; :mod:`pcmapq.results.figures`), as
+        gates, tables, track and compare read them: metres and degrees, None when undefined."""
+        from pcmapq.results.figures import figures
+
+        return figures(self.to_dict(features=False))
 
     def vectors_csv(self) -> str:
-        """One row per matched pair (the JSON's ``matches``): its truth and map features'
-        positions and the displacement between them, metres (truth frame), then which of its
-        two features are counted (1) or support-level (0). A pair counts towards ``matched``
-        when its truth feature is counted and towards ``matched_map`` when its map feature
-        is, so the rows outnumber either count when some pairs have one side uncounted."""
-        out = io.StringIO()
-        out.write("detector,truth_x_m,truth_y_m,map_x_m,map_y_m,dx_m,dy_m,displacement_m,"
-                  "truth_counted,map_counted\n")
-        for name, det in self.detectors.items():
-            m = det.matching
-            rows = np.column_stack([det.truth_xy, det.map_xy, m.displacement, det.distances])
-            counted = np.column_stack([det.truth.strong[m.truth_idx], det.map.strong[m.map_idx]])
-            for row, flags in zip(rows + 0.0, counted.astype(int), strict=True):
-                out.write(",".join([name, *(f"{v:.{DECIMALS}f}" for v in row),
-                                    *(str(f) for f in flags)]) + "\n")
-        return out.getvalue()
+        """The vectorial map as CSV, one row per matched pair
+        (:func:`pcmapq.results.csv_files.vectors_csv`)."""
+        from pcmapq.results.csv_files import vectors_csv
 
+        return vectors_csv(self)
 
     def regions_csv(self) -> str:
-        """One row per region of the consistency map (the JSON's ``consistency.regions``):
-        where the region is, the offset and turn that fit it to the truth on its own, its
-        points and its fitness before and after, truth frame, metres and degrees."""
-        out = io.StringIO()
-        out.write(",".join(REGION_COLUMNS) + "\n")
-        for row in _consistency_dict(self.consistency)["regions"]:
-            out.write(",".join(str(int(v)) if isinstance(v, bool | int) else f"{v:.{DECIMALS}f}"
-                               for v in (row[k] for k in REGION_COLUMNS)) + "\n")
-        return out.getvalue()
+        """The consistency map as CSV, one row per region
+        (:func:`pcmapq.results.csv_files.regions_csv`)."""
+        from pcmapq.results.csv_files import regions_csv
+
+        return regions_csv(self)
 
 
 #: The columns of a region, in the JSON and the regions CSV.
@@ -262,7 +255,7 @@ REGION_COLUMNS = ("x_m", "y_m", "dx_m", "dy_m", "offset_m", "turn_deg", "points"
                   "fitness_before", "fitness_after", "held")
 
 
-def _consistency_dict(c: Consistency | None) -> dict:
+def consistency_dict(c: Consistency | None) -> dict:
     """The consistency map as JSON: the tile, the largest held offset and where, the map's
     fitness at its pose and with each region aligned on its own, and the regions."""
     if c is None:
@@ -281,100 +274,10 @@ def _consistency_dict(c: Consistency | None) -> dict:
             "regions": regions}
 
 
-def _consistency_of(doc: dict | None, tolerance: float) -> Consistency | None:
-    """The consistency map read back from its JSON (None when there was none)."""
-    from pcmapq.align.regions import Consistency
-
-    if not doc or doc.get("tile_m") is None:
-        return None
-    rows = doc["regions"]
-
-    def column(key: str, dtype=np.float64) -> np.ndarray:
-        return np.array([r[key] for r in rows], dtype=dtype)
-
-    return Consistency(doc["tile_m"], tolerance,
-                       np.column_stack([column("x_m"), column("y_m")]).reshape(-1, 2),
-                       np.column_stack([column("dx_m"), column("dy_m")]).reshape(-1, 2),
-                       column("turn_deg"), column("points", int), column("fitness_before"),
-                       column("fitness_after"), column("held", bool))
-
-
 def _distances_dict(d: Distances) -> dict:
     return {"computed_on": d.basis, "accuracy_m": d.accuracy.to_dict(),
             "completeness_m": d.completeness.to_dict(), "chamfer_m": d.chamfer_m,
             "f_score": [asdict(f) for f in d.fscores]}
-
-
-def _distances_of(doc: dict) -> Distances:
-    return Distances(Stats.from_dict(doc["accuracy_m"]), Stats.from_dict(doc["completeness_m"]),
-                     doc["chamfer_m"], tuple(FScore(**f) for f in doc["f_score"]),
-                     doc.get("computed_on", ""))
-
-
-def _xy(rows: list[dict], key: str) -> np.ndarray:
-    """The ``key`` points of JSON rows as (N, 2) metres."""
-    return np.array([r[key] for r in rows], dtype=np.float64).reshape(-1, 2)
-
-
-def _detector_of(doc: dict, matches: list[dict], missing: list[dict],
-                 extra: list[dict]) -> DetectorResult:
-    """One detector read back: the truth's features are the matched ones then the missing
-    ones, the map's the matched ones then the extra ones."""
-    n, k, e = len(matches), len(missing), len(extra)
-    t_strong = np.array([m["counted"]["truth"] for m in matches] + [True] * k, dtype=bool)
-    m_strong = np.array([m["counted"]["map"] for m in matches] + [True] * e, dtype=bool)
-    truth_xy = np.vstack([_xy(matches, "truth_xy_m"), _xy(missing, "truth_xy_m")])
-    map_xy = np.vstack([_xy(matches, "map_xy_m"), _xy(extra, "map_xy_m")])
-    pairs = np.arange(n)
-    matching = Matching(
-        truth_idx=pairs, map_idx=pairs, displacement=map_xy[:n] - truth_xy[:n],
-        cost=np.full(n, np.nan), quality=doc["quality"], precision=doc["precision"],
-        f1=doc["f1"], truth_features=doc["truth_features"], map_features=doc["map_features"],
-        matched=doc["matched"], matched_map=doc["matched_map"],
-        missing=np.arange(n, n + k), extra=np.arange(n, n + e))
-    return DetectorResult(Features(truth_xy, np.full(n + k, np.nan), t_strong),
-                          Features(map_xy, np.full(n + e, np.nan), m_strong), matching)
-
-
-def _from_dict(doc: dict) -> Result:
-    """:meth:`Result.from_json` of a parsed document."""
-    from pcmapq.align import Alignment  # runtime imports: reading a 3D result loads Open3D
-    from pcmapq.align.parts import Part
-    from pcmapq.align.rigid3d import Registration3D
-
-    a, t = doc["alignment"], doc["truth"]
-    frames = Frames.from_dict(doc["frames"])
-    origin = t["origin"]
-    grid = MetricGrid(t["resolution_m"], (origin["x_m"], origin["y_m"],
-                                          float(np.radians(origin["yaw_deg"]))),
-                      tuple(t["shape"]))
-    reg = doc.get("alignment_3d")
-    detectors = {}
-    for name, d in doc["detectors"].items():
-        rows = {key: [r for r in doc[key] if r["detector"] == name]
-                for key in ("matches", "missing", "extra")}
-        detectors[name] = _detector_of(d, rows["matches"], rows["missing"], rows["extra"])
-    return Result(
-        map_path=Path(doc["map"]["path"]), map_kind=doc["map"]["kind"],
-        truth_path=Path(t["path"]), truth_kind=t["kind"], grid=grid,
-        alignment=Alignment(frames.planar, a["fitness"], a["rmse_m"], a["tolerance_m"],
-                            a["method"], a["distinctiveness"]),
-        overlap=Overlap(None, doc["coverage"], a["truth_recall"], a["agreement"],
-                        a["confidence"], a["verdict"],
-                        tuple(Part(**{**p, "centre_m": tuple(p["centre_m"]),
-                                 "pose": Similarity2D.from_dict(p["pose"])})
-                              for p in a["parts"])),
-        distances=_distances_of(doc["distances"]),
-        registration_3d=None if reg is None else Registration3D(
-            np.asarray(reg["matrix"], dtype=np.float64), reg["fitness"], reg["rmse_m"]),
-        distances_3d=_distances_of(doc["distances_3d"]) if "distances_3d" in doc else None,
-        threshold=next((d["threshold_m"] for d in doc["detectors"].values()),
-                       ((doc["settings"] or {}).get("matching") or {}).get("threshold", 0.5)),
-        full=doc["scored_against"] == "whole truth", detectors=detectors,
-        truth_occupied=None, map_occupied=None, frames=frames,
-        footprint_rule=doc["footprint"], settings=doc["settings"],
-        command=doc["pcmapq"]["command"], noref=doc.get("noref"), truth_sha256=t.get("sha256"),
-        consistency=_consistency_of(doc.get("consistency"), a["tolerance_m"]))
 
 
 def _rounded(value):
