@@ -30,7 +30,9 @@ from typer.testing import CliRunner
 
 from pcmapq.cli import app
 from pcmapq.evaluation.inputs import TRUTH_CROP, load_input
-from pcmapq.evaluation.pipeline import score
+from pcmapq.evaluation.placing import place
+from pcmapq.evaluation.scoring import score
+from pcmapq.evaluation.truth import prepare_truth
 from pcmapq.io.carmen import beam_angles, read_laser_scans
 from pcmapq.io.writers import write_ros_map
 from pcmapq.settings import Settings
@@ -434,8 +436,8 @@ def test_every_m_steps_at_the_first_scan_reaching_each_multiple(runs: Runs) -> N
 def test_a_step_equals_a_from_scratch_evaluation(runs: Runs, which: str, tmp_path) -> None:
     """A step of the drifted run (the first, found by the global search; the first holding a
     drifted scan; the last) is the result of scoring the map of its first scans, read from
-    their own log, with :func:`pcmapq.evaluation.pipeline.score` (the truth not prepared) and
-    ICP from the step's start: the same figures, to 1e-9."""
+    their own log, as :func:`pcmapq.evaluation.pipeline.evaluate` scores it (the truth
+    prepared for one map) with ICP from the step's start: the same figures, to 1e-9."""
     tracked = runs.track_run("drifted")
     step = tracked.steps[{"first": 0, "drifted": runs.k_step(), "last": -1}[which]]
     assert step.scored and (step.start is None) == (which == "first")
@@ -447,7 +449,9 @@ def test_a_step_equals_a_from_scratch_evaluation(runs: Runs, which: str, tmp_pat
     settings = replace(settings, noref=replace(settings.noref, enabled=False))
     if step.start is not None:
         settings = replace(settings, alignment=replace(settings.alignment, init=step.start))
-    result = score(source, load_input(runs.data.corrected, settings.truth, TRUTH_CROP), settings)
+    prepared = prepare_truth(load_input(runs.data.corrected, settings.truth, TRUTH_CROP),
+                             settings, loaded=(source,), maps=(0,), background=True)
+    result = score(place(source, prepared, settings), prepared, settings)
     got = figures_of(result)
     want = {k: v for k, v in step.figures.items()
             if k not in ("slide_m", "local_offset_m") and k not in TRAJECTORY}

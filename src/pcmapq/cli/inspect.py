@@ -18,7 +18,7 @@ from pcmapq.cli.terminal import (
 )
 from pcmapq.core import memory
 from pcmapq.evaluation.inspect_map import inspect_map, summary_lines, to_json
-from pcmapq.evaluation.pipeline import needed_memory
+from pcmapq.evaluation.truth import needed_memory
 from pcmapq.io import OccupancyMap, PointMap, load_map
 from pcmapq.io.extent import Box, check_span, hint
 from pcmapq.io.extent import crop as crop_input

@@ -1,25 +1,140 @@
-"""The map put into the truth's frame before it is drawn: two 3D clouds registered in 3D,
-then the 2D alignment of the plans (the global search and ICP of :func:`pcmapq.align.align`),
-or the plan scored as it is after a 3D registration; and the check, before the search, that
-the map's size can be the truth's at all."""
+"""A map placed on a prepared truth (:func:`place`): two 3D clouds registered in 3D, then the
+2D alignment of the plans (the global search and ICP of :func:`pcmapq.align.align`, or the
+plan as it is after a 3D registration), the map drawn on the truth's grid with its footprint,
+and the verdict whether it shows the truth's place at all (a map of another place is refused
+unless ``--force``). The check, before the search, that the map's size can be the truth's."""
 
 from __future__ import annotations
 
-from dataclasses import replace
+from collections.abc import Callable
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from pcmapq.align import Alignment, align
+from pcmapq.align.parts import place_parts
 from pcmapq.align.planar import RigidTarget
 from pcmapq.align.rigid3d import Registration3D, align_3d, apply
-from pcmapq.core.bounds import radius
-from pcmapq.core.errors import EvaluationError
+from pcmapq.core.bounds import bounds, radius
+from pcmapq.core.errors import EvaluationError, InputError
+from pcmapq.core.frames import Levelling
+from pcmapq.core.grid import MetricGrid
 from pcmapq.core.transform import Similarity2D
-from pcmapq.evaluation.inputs import MAP_CROP
-from pcmapq.evaluation.same_place import OVERSIZE
+from pcmapq.evaluation.inputs import MAP_CROP, min_hits, plan_points
+from pcmapq.evaluation.same_place import OVERSIZE, overlap, refusal, verdict
+from pcmapq.evaluation.truth import PreparedTruth
+from pcmapq.features import Features
 from pcmapq.io import OccupancyMap, PointMap
-from pcmapq.io.extent import hint
+from pcmapq.io.extent import check_span, hint
+from pcmapq.metrics.distances import nearest_distance
+from pcmapq.raster.draw import OCCUPIED, UNKNOWN, points_to_grid, warp_state
+from pcmapq.raster.footprint import footprint_rule, map_footprint
+from pcmapq.raster.seen import seen_on
+from pcmapq.results.result import OTHER, Overlap
 from pcmapq.settings import Settings
+
+Progress = Callable[[str], None]
+
+
+@dataclass(frozen=True)
+class Placed:
+    """One map placed on a prepared truth: ``given`` (the map as loaded), ``source`` (in the
+    truth frame after a 3D registration), its plan points ``xy`` (N, 2) metres in its own plan
+    frame, the alignment, its ``occupied`` cells on the truth's grid, ``to_map`` (each cell's
+    distance to them, metres), the overlap, the footprint ``rule`` it followed and ``target``:
+    the truth's points as its alignment used them. ``features``: its features by detector,
+    once :func:`pcmapq.evaluation.scoring.score` has found them."""
+
+    given: OccupancyMap | PointMap
+    source: OccupancyMap | PointMap
+    registration: Registration3D | None
+    xy: np.ndarray
+    level: Levelling | None
+    alignment: Alignment
+    occupied: np.ndarray
+    to_map: np.ndarray
+    cover: Overlap
+    rule: str
+    target: RigidTarget | None = None
+    features: dict[str, Features] | None = None
+
+
+def place(source: OccupancyMap | PointMap, prepared: PreparedTruth, settings: Settings,
+          progress: Progress = lambda step: None) -> Placed:
+    """Align ``source`` to the prepared truth, draw it on the truth's grid and measure the
+    overlap. A map that does not seem to show the truth's place is refused (EvaluationError)
+    unless ``settings.alignment.force``."""
+    check_span(source, MAP_CROP)
+    rule = map_footprint_rule(source, settings)
+    progress("aligning")
+    option, truth = settings.alignment, prepared.source
+    given = source
+    source, registration = align_clouds_3d(source, truth, settings)
+    map_xy, map_level = plan_points(source, settings)
+    target = prepared.aligner
+    if target is None or not target.fits(option.params):
+        target = RigidTarget(prepared.xy, option.params)
+    alignment = align_plan(source, map_xy, prepared.xy, registration, settings, target)
+
+    progress("rasterising")
+    map_occ, footprint = map_raster(source, map_xy, alignment.transform, prepared.grid,
+                                    settings, rule)
+    to_map = nearest_distance(map_occ, prepared.grid)
+    cover = overlap(prepared.occupied, to_map, footprint, alignment, prepared.grid.resolution)
+    parts = ()
+    if cover.confidence < option.min_confidence and alignment.distinctiveness is not None:
+        progress("placing the map's parts on their own")
+        parts = tuple(place_parts(map_xy, prepared.xy, alignment.transform, option.params,
+                                  target))
+    cover = replace(cover, parts=parts,
+                    verdict=verdict(cover.confidence, option.min_confidence, parts))
+    if cover.verdict == OTHER and not option.force:
+        raise EvaluationError(refusal(source, truth.path, alignment, cover, settings, map_xy,
+                                      prepared.xy))
+    return Placed(given, source, registration, map_xy, map_level, alignment, map_occ, to_map,
+                  cover, rule, target)
+
+
+def map_footprint_rule(source: OccupancyMap | PointMap, settings: Settings) -> str:
+    """The footprint rule this map follows: ``settings.footprint.rule`` with ``auto`` resolved (see
+    :func:`pcmapq.raster.footprint.footprint_rule`); a rule the map cannot follow is bad input."""
+    image = isinstance(source, OccupancyMap)
+    try:
+        return footprint_rule(settings.footprint.rule, source.state == UNKNOWN if image else None,
+                              source.grid.resolution if image else 0.0,
+                              views=not image and source.seen is not None)
+    except ValueError as err:
+        raise InputError(f"{source.path}: {err}") from None
+
+
+def map_raster(source: OccupancyMap | PointMap, map_xy: np.ndarray, transform: Similarity2D,
+               grid: MetricGrid, settings: Settings,
+               rule: str | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """The aligned map drawn into the truth's grid: its occupied cells and its footprint (the
+    area it observed under ``rule``, by default :func:`map_footprint_rule`'s, see
+    :mod:`pcmapq.raster.footprint`), both bool."""
+    image = isinstance(source, OccupancyMap)
+    rule = map_footprint_rule(source, settings) if rule is None else rule
+    seen = None
+    if image:
+        state = warp_state(source.state, source.grid, transform, grid)
+        occupied, known = state == OCCUPIED, state != UNKNOWN
+        rows, cols = source.grid.shape
+        corners = source.grid.pixels_to_xy(
+            np.array([[-0.5, -0.5], [cols - 0.5, -0.5], [cols - 0.5, rows - 0.5],
+                      [-0.5, rows - 0.5]]))
+    else:
+        occupied = points_to_grid(transform.apply(map_xy), grid, min_hits(source, settings))
+        known = None
+        if rule == "seen" and source.seen is not None:
+            seen = seen_on(source.seen, transform, grid)
+        (x0, y0), (x1, y1) = bounds(map_xy)
+        corners = np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]])
+    footprint = map_footprint(rule, occupied, grid, settings.footprint.margin, known=known,
+                              rectangle=transform.apply(corners), seen=seen)
+    return occupied, footprint
+
+
 
 
 def align_clouds_3d(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap,

@@ -13,7 +13,7 @@ Rules (``--footprint``, documented in docs/method.md):
   its readings in angular order (a beam with no return cuts the view back to the scanner), so
   a room the robot looked into is observed and one behind a wall it never passed is not. The
   map's cells outside it (readings that drew no wall, see :func:`joined_readings`) are not
-  added to it, and their features are not counted (``pipeline.assemble``);
+  added to it, and their features are not counted (``evaluation.scoring.score``);
 - ``all``: the map's whole rectangle (an image's extent, a cloud's bounding box, in its frame);
 - ``auto`` (default): ``known`` for an image with unknown regions, ``seen`` for a map with
   views, ``walls`` otherwise. An

@@ -96,9 +96,8 @@ class Result:
     (``pcmapq eval ...``, defaults left out), None from the library. noref: each input's
     no-reference figures, ``{"map": ..., "truth": ...}``
     (:func:`pcmapq.evaluation.noref_figures.input_figures`), None when not asked for.
-    truth_sha256: the truth file's SHA-256 (hex; None from the library's
-    :func:`~pcmapq.evaluation.pipeline.score`), so that results of one truth are known as such
-    however its path was written.
+    truth_sha256: the truth file's SHA-256 (hex; None for a result made without its file), so
+    that results of one truth are known as such however its path was written.
     truth_occupied, map_occupied (and the overlap's footprint): the rasters on ``grid``; None
     in a result read back by :meth:`from_json`, which holds everything the JSON holds and no
     more.

@@ -18,8 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from pcmapq.evaluation.inputs import TRUTH_CROP, load_input
-from pcmapq.evaluation.pipeline import PreparedTruth
-from pcmapq.evaluation.prepared import prepare_truth
+from pcmapq.evaluation.truth import PreparedTruth, prepare_truth
 from pcmapq.io.writers import OutputSet, write_atomic
 from pcmapq.results.result import Result
 from pcmapq.settings import Settings

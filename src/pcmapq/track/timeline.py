@@ -29,8 +29,9 @@ from pcmapq.core.errors import EvaluationError, InputError
 from pcmapq.core.frames import Frames
 from pcmapq.core.transform import Similarity2D
 from pcmapq.core.voxels import evenly, voxel_centroids
-from pcmapq.evaluation.pipeline import MapSide, PreparedTruth
-from pcmapq.evaluation.prepared import finish_prepared, place_prepared, score_prepared
+from pcmapq.evaluation.placing import Placed, place
+from pcmapq.evaluation.scoring import score
+from pcmapq.evaluation.truth import PreparedTruth
 from pcmapq.metrics.trajectory import ape, rpe
 from pcmapq.results.figures import table_row
 from pcmapq.results.result import Result
@@ -127,19 +128,19 @@ def figures_of(result: Result) -> dict[str, float | None]:
 
 
 def place_step(source, prepared: PreparedTruth, settings: Settings,
-               start: Similarity2D | None) -> tuple[MapSide, Similarity2D | None]:
-    """Align and draw one step's map (:func:`~pcmapq.evaluation.prepared.place_prepared`), ICP from
+               start: Similarity2D | None) -> tuple[Placed, Similarity2D | None]:
+    """Align and draw one step's map (:func:`~pcmapq.evaluation.placing.place`), ICP from
     ``start`` (None: the global search); a start whose pose is refused is followed by a global
     search. The placed map and the start it used."""
     option = settings.alignment
     if start is None or not option.enabled:
-        return place_prepared(source, prepared, settings), option.init
+        return place(source, prepared, settings), option.init
     try:
-        return place_prepared(source, prepared, _settings_from(settings, start)), start
+        return place(source, prepared, _settings_from(settings, start)), start
     except EvaluationError:
         if option.force:
             raise
-        return place_prepared(source, prepared, settings), None
+        return place(source, prepared, settings), None
 
 
 def _settings_from(settings: Settings, start: Similarity2D | None) -> Settings:
@@ -203,14 +204,14 @@ def track(run: Run, prepared: PreparedTruth, settings: Settings, ends: np.ndarra
             if settings.alignment.enabled:
                 start = side.alignment.transform
             pending.append((index, scorers.submit(
-                _finish, at, source, recent, side, prepared, _settings_from(settings, used),
+                _finish, at, recent, side, prepared, _settings_from(settings, used),
                 used, extra)))
             collect(scoring)
         collect(0)
     return _with_slide([s for s in steps if s is not None], run.poses)
 
 
-def local_offset(recent: np.ndarray, side: MapSide, prepared: PreparedTruth,
+def local_offset(recent: np.ndarray, side: Placed, prepared: PreparedTruth,
                  settings: Settings) -> float | None:
     """How far the readings ``recent`` (N, 3, map frame, metres) lie off the truth where the
     placed map ``side`` puts them: aligned alone to the truth (ICP from the map's pose, rigid,
@@ -233,13 +234,13 @@ def local_offset(recent: np.ndarray, side: MapSide, prepared: PreparedTruth,
     return float(np.sqrt(np.mean(np.sum(moved**2, axis=1))))
 
 
-def _finish(at: tuple, source, recent: np.ndarray, side: MapSide, prepared: PreparedTruth,
+def _finish(at: tuple, recent: np.ndarray, side: Placed, prepared: PreparedTruth,
             settings: Settings, used: Similarity2D | None, extra: dict) -> Step:
     """A placed step's features matched and scored, and the offset of its ``recent`` readings
     (:func:`local_offset`): its :class:`Step` (``slide_m`` unset)."""
     extra = {"local_offset_m": local_offset(recent, side, prepared, settings), **extra}
     try:
-        result = finish_prepared(source, side, prepared, settings)
+        result = score(side, prepared, settings)
     except (EvaluationError, InputError) as err:
         return Step(*at, {"slide_m": None, **extra}, str(err), used)
     return Step(*at, {**figures_of(result), "slide_m": None, **extra}, "", used,
@@ -271,5 +272,5 @@ def result_at(run: Run, prepared: PreparedTruth, settings: Settings, step: Step)
     it computed it (the same map, the same start: the same result)."""
     if step.result is not None:
         return step.result
-    return score_prepared(next(run.maps([step.scans])), prepared,
-                          _settings_from(settings, step.start))
+    settings = _settings_from(settings, step.start)
+    return score(place(next(run.maps([step.scans])), prepared, settings), prepared, settings)

@@ -1,0 +1,110 @@
+"""A placed map scored against its prepared truth (:func:`score`): features matched one to one
+inside the footprint, wall distances, the consistency map of its regions, and the optional
+no-reference and 3D figures, gathered in a :class:`~pcmapq.results.result.Result`."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+
+from pcmapq.align.parts import broken_off
+from pcmapq.align.regions import regions
+from pcmapq.core.frames import Frames
+from pcmapq.core.grid import MetricGrid
+from pcmapq.evaluation.noref_figures import input_figures
+from pcmapq.evaluation.placing import Placed, Progress
+from pcmapq.evaluation.truth import FEATURE_THREADS, PreparedTruth
+from pcmapq.features import Features, SideBySide, default_params
+from pcmapq.io import OccupancyMap, PointMap
+from pcmapq.match import match
+from pcmapq.metrics.distances import distances, distances_3d
+from pcmapq.results.result import OTHER, DetectorResult, Result
+from pcmapq.settings import Settings
+
+
+def score(placed: Placed, prepared: PreparedTruth, settings: Settings,
+          progress: Progress = lambda step: None) -> Result:
+    """The result of a map placed on the prepared truth: its features (found here unless
+    ``placed`` has them) matched one to one against the truth's inside the footprint, the wall
+    distances, the consistency map, the optional no-reference and 3D figures."""
+    if placed.features is None:
+        progress("drawing the walls' centre lines and detecting features")
+        sides = SideBySide(settings.matching.detectors, settings.matching.params)
+        placed = replace(placed, features=sides.features(placed.occupied, prepared.grid,
+                                                          threads=FEATURE_THREADS))
+    side, loaded, rule = placed, placed.given, placed.rule
+    truth, grid, alignment = prepared.source, prepared.grid, side.alignment
+    registration, footprint = side.registration, side.cover.footprint
+    frames = Frames(alignment.transform, side.level, prepared.level,
+                    None if registration is None else registration.transform)
+    detectors = {}
+    full, threshold = settings.footprint.full, settings.matching.threshold
+    for name in settings.matching.detectors:
+        truth_f, map_f = prepared.features[name], side.features[name]
+        if not full:  # truth features the map never saw are not missing
+            truth_f = truth_f.counted_where(inside(truth_f, footprint, grid))
+            if rule == "seen":  # nor are the features of walls its scans only dotted extra
+                map_f = map_f.counted_where(inside(map_f, footprint, grid))
+        detectors[name] = DetectorResult(truth_f, map_f,
+                                         match(name, truth_f, map_f, threshold,
+                                               settings.matching.params.get(name)))
+    consistency = None
+    if side.cover.verdict != OTHER and side.target is not None and side.target.lines is not None:
+        progress("aligning the map's regions on their own")
+        consistency = regions(side.xy, alignment.transform, side.target.lines,
+                              alignment.tolerance_m,
+                              starts=broken_off(side.cover.parts, side.xy, alignment.transform))
+    noref = None
+    if settings.noref.enabled:
+        progress("no-reference figures")
+        scale = alignment.transform.scale if settings.alignment.scale else 1.0
+        corners = harris_corners(truth, prepared.features, settings)
+        noref = {"map": input_figures(loaded, settings.noref, scale=scale),
+                 "truth": input_figures(truth, settings.noref, corners=corners)}
+    cloud_distances = None
+    if registration is not None:
+        progress("distances in 3D")
+        cloud_distances = distances_3d(side.source.points, truth.points,
+                                       settings.raster.cloud_resolution, settings.distances.taus)
+    return Result(map_path=Path(loaded.path), map_kind=side.source.kind,
+                  truth_path=Path(truth.path), truth_kind=truth.kind, grid=grid,
+                  alignment=alignment, overlap=side.cover,
+                  distances=distances(prepared.occupied, side.occupied, footprint, grid,
+                                      settings.distances.taus, side.to_map, prepared.to_truth,
+                                      _band_words(side.source, truth, settings)),
+                  registration_3d=registration, distances_3d=cloud_distances,
+                  threshold=threshold, full=full, detectors=detectors,
+                  footprint_rule=rule, frames=frames, settings=settings.to_dict(),
+                  truth_occupied=prepared.occupied, map_occupied=side.occupied, noref=noref,
+                  consistency=consistency)
+
+
+def inside(features: Features, area: np.ndarray, grid: MetricGrid) -> np.ndarray:
+    """(N,) bool: which features lie in the cells where ``area`` is true."""
+    uv = np.floor(grid.xy_to_pixels(features.xy) + 0.5).astype(int)
+    rows, cols = area.shape
+    ok = (uv[:, 0] >= 0) & (uv[:, 0] < cols) & (uv[:, 1] >= 0) & (uv[:, 1] < rows)
+    return ok & area[np.clip(uv[:, 1], 0, rows - 1), np.clip(uv[:, 0], 0, cols - 1)]
+
+
+def harris_corners(truth: OccupancyMap | PointMap, found: dict[str, Features],
+                   settings: Settings) -> int | None:
+    """The strong Harris corners an image truth's no-reference figures count, taken from the
+    features the method found on it when it ran Harris with the default parameters (the same
+    detection on the same cells); None otherwise."""
+    if not isinstance(truth, OccupancyMap) or "harris" not in found or \
+            settings.matching.params.get("harris") != default_params()["harris"]:
+        return None
+    return int(np.count_nonzero(found["harris"].strong))
+
+
+def _band_words(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap,
+                settings: Settings) -> str:
+    """How a 3D cloud's cells were made, for the wall distances' basis; '' when neither input
+    is a 3D cloud."""
+    if not any(isinstance(s, PointMap) and s.is_3d for s in (source, truth)):
+        return ""
+    r = settings.raster
+    return f" (a 3D cloud: its wall band, {r.band_low:g} to {r.band_high:g} m above its floor)"

@@ -1,0 +1,110 @@
+"""The truth prepared once for any map (:func:`prepare_truth`): its plan points, its grid in
+its own metric frame, its occupied cells, features and distance field. ``pcmapq eval``
+prepares it for one map, ``pcmapq track`` for every step of a run."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from concurrent.futures import Future, ThreadPoolExecutor
+from dataclasses import dataclass
+
+import numpy as np
+
+from pcmapq.align.planar import RigidTarget
+from pcmapq.core import memory
+from pcmapq.core.frames import Levelling
+from pcmapq.core.grid import MetricGrid
+from pcmapq.evaluation.inputs import MAP_CROP, TRUTH_CROP, plan_points, truth_cells, truth_grid
+from pcmapq.features import Features, SideBySide
+from pcmapq.io import OccupancyMap, PointMap
+from pcmapq.io.extent import check_span, hint
+from pcmapq.metrics.distances import nearest_distance
+from pcmapq.settings import Settings
+
+#: Threads that find a truth's features when nothing else runs beside them.
+FEATURE_THREADS = 2
+
+
+@dataclass(frozen=True)
+class PreparedTruth:
+    """The truth as every score against it needs it, whatever the map: its plan points ``xy``
+    (N, 2) metres with the ``level`` that made them, the ``grid`` everything is drawn on, its
+    ``occupied`` cells, its :attr:`features` by detector (``found``: them, or their job on a
+    background thread), ``to_truth``: each cell's distance to the nearest truth wall, metres;
+    ``aligner``: its points prepared for the rigid alignment; ``maps``: how many maps may be
+    scored on its grid at once in the memory allowed; ``sides``: the detectors' runner (to
+    stop a background job whose map is refused)."""
+
+    source: OccupancyMap | PointMap
+    xy: np.ndarray
+    level: Levelling | None
+    grid: MetricGrid
+    occupied: np.ndarray
+    found: dict[str, Features] | Future
+    to_truth: np.ndarray | None = None
+    aligner: RigidTarget | None = None
+    maps: int = 1
+    sides: SideBySide | None = None
+
+    @property
+    def features(self) -> dict[str, Features]:
+        """The truth's features by detector (waiting for the background job, if any)."""
+        return self.found.result() if isinstance(self.found, Future) else self.found
+
+    def cancel(self) -> None:
+        """Stop the background feature job, if any (its map was refused or failed)."""
+        if self.sides is not None:
+            self.sides.cancel()
+
+
+def prepare_truth(truth: OccupancyMap | PointMap, settings: Settings,
+                  memory_limit: int | None = None, maps: tuple[int, ...] = (1,),
+                  loaded: Sequence[OccupancyMap | PointMap] = (),
+                  background: bool = False) -> PreparedTruth:
+    """Everything of the truth that does not depend on the map.
+
+    maps: how many maps the caller would score on its grid at once beyond the first, most
+    wanted first; the first whose estimated memory fits in ``memory_limit`` bytes (None: the
+    default) is kept as ``PreparedTruth.maps``; InputError (one line) when none fits.
+    loaded: inputs held in memory beside the truth (``eval``'s map), counted in the estimate.
+    background: find the features on a thread of their own while the caller places its map
+    (:meth:`PreparedTruth.features` waits for them); otherwise here, on two threads."""
+    check_span(truth, TRUTH_CROP)
+    for source in loaded:
+        check_span(source, MAP_CROP)
+    xy, level = plan_points(truth, settings)
+    grid = truth_grid(truth, xy, settings)
+    need = {n: needed_memory((*loaded, truth), grid, n) for n in maps}
+    limit = memory.default_limit() if memory_limit is None else memory_limit
+    fits = [n for n in maps if need[n] <= limit]
+    least = min(maps)
+    what = (f"{loaded[0].path} against {truth.path}" if loaded else
+            f"{truth.path} with {least} map{'s' * (least > 1)} scored on its grid")
+    memory.guard(need[fits[0] if fits else least], memory_limit, what,
+                 lambda: hint(truth, TRUTH_CROP, grid.resolution)
+                 or next((h for s in loaded if (h := hint(s, MAP_CROP))), None))
+    occupied = truth_cells(truth, xy, grid, settings)
+    sides = SideBySide(settings.matching.detectors, settings.matching.params)
+    if background:
+        pool = ThreadPoolExecutor(1)
+        found: dict[str, Features] | Future = pool.submit(sides.features, occupied, grid)
+        pool.shutdown(wait=False)  # its thread ends with the job
+    else:
+        found = sides.features(occupied, grid, threads=FEATURE_THREADS)
+    option = settings.alignment
+    aligner = RigidTarget(xy, option.params) if option.enabled and not option.scale else None
+    return PreparedTruth(truth, xy, level, grid, occupied, found, nearest_distance(occupied, grid),
+                         aligner, fits[0] if fits else least, sides)
+
+
+def needed_memory(inputs: Sequence[OccupancyMap | PointMap], grid: MetricGrid,
+                  more_maps: int = 0) -> int:
+    """Estimated peak memory, bytes, of scoring a map against a truth (``inputs``: both, or
+    the truth alone for what it needs whatever the map) on the truth's ``grid``, with
+    ``more_maps`` maps more scored on it at once: see :mod:`pcmapq.core.memory`."""
+    images = sum(int(np.prod(s.grid.shape)) for s in inputs if isinstance(s, OccupancyMap))
+    points = sum(len(s.points) for s in inputs if isinstance(s, PointMap))
+    cells = int(np.prod(grid.shape))
+    extent = cells * grid.resolution**2
+    one_map = memory.needed_bytes(0, cells, extent, 0) - memory.BASE
+    return memory.needed_bytes(images, cells, extent, points) + more_maps * one_map
