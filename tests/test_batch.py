@@ -97,8 +97,8 @@ def test_manifest_rows(inputs):
     assert rows[0].settings.distances.taus == (0.1, 0.2)
     assert rows[0].settings.alignment == Settings().alignment
     assert rows[3].command({"--json": Path("/o/scaled.json")}) == shlex.join(
-        ["pcmapq", "eval", str(rows[3].map), str(rows[3].truth), "--scale", "auto",
-         "--json", "/o/scaled.json", "--tau", "0.1,0.2", "--footprint", "walls"])
+        ["pcmapq", "eval", str(rows[3].map), str(rows[3].truth), "--json", "/o/scaled.json",
+         "--scale", "auto", "--tau", "0.1,0.2", "--footprint", "walls"])
 
 
 def test_noref_columns_are_evals_options(inputs):

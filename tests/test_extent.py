@@ -10,7 +10,6 @@ from pathlib import Path
 import numpy as np
 import open3d as o3d
 import pytest
-import typer
 from typer.testing import CliRunner
 
 from pcmapq.cli import app
@@ -19,8 +18,8 @@ from pcmapq.core.grid import MetricGrid
 from pcmapq.evaluation.inputs import check_structure
 from pcmapq.io import OccupancyMap, PointMap, load_map
 from pcmapq.io.extent import MAX_SPAN, check_span, crop, hint, main_group
-from pcmapq.options import parse_box
 from pcmapq.raster.draw import FREE, OCCUPIED, UNKNOWN
+from pcmapq.settings.table import OptionError, parse_box
 
 SAMPLE = Path(__file__).resolve().parents[1] / "data" / "sample"
 
@@ -118,9 +117,9 @@ def test_one_straight_wall_has_nothing_to_align_and_an_l_has():
 
 @pytest.mark.parametrize("text", ["0,0,1", "0,0,1,x", "1,0,0,1", "0,0,1,nan", "0,1,1,1"])
 def test_a_bad_box_is_a_usage_error(text):
-    with pytest.raises(typer.BadParameter, match="expected a box x0,y0,x1,y1") as err:
+    with pytest.raises(OptionError, match="expected a box x0,y0,x1,y1") as err:
         parse_box(text, "--map-crop")
-    assert err.value.param_hint == "--map-crop"
+    assert err.value.option == "--map-crop"
 
 
 def _eval(*args: str) -> tuple[int, str, str]:

@@ -14,47 +14,30 @@ import shlex
 from dataclasses import dataclass
 from pathlib import Path
 
-import typer
 import yaml
 
-from pcmapq import options
 from pcmapq.core.errors import InputError
 from pcmapq.settings import Settings
+from pcmapq.settings.build import build, option_words
+from pcmapq.settings.file import read_settings
+from pcmapq.settings.table import (
+    BATCH,
+    EVAL,
+    FLAG,
+    INT,
+    SWITCH,
+    TEXT,
+    OptionError,
+    options_of,
+)
 
 #: Names a row cannot take: the batch's own table and figure are written beside the rows.
 RESERVED = ("table", "figure")
 MANIFEST_SUFFIXES = (".csv", ".yaml", ".yml")
 
 
-@dataclass(frozen=True)
-class Column:
-    """A per-row option: how its text is read. kind: 'float', 'int', 'bool' (a flag of eval),
-    'switch' (eval's ``--x/--no-x``) or 'text' (parsed with the settings); lo, hi: bounds."""
-
-    kind: str
-    lo: float = -math.inf
-    hi: float = math.inf
-
-
-#: The per-row options, in ``pcmapq eval``'s order (its command line lists them so), split
-#: where eval's output options (``--json``, ``--plot``, ``--report``) stand.
-BEFORE_OUTPUTS = {
-    "map_resolution": Column("text"), "scale": Column("text"),
-    "truth_resolution": Column("float", 1e-6),
-    "map_occupied_thresh": Column("float", 0.0, 1.0), "map_free_thresh": Column("float", 0.0, 1.0),
-    "map_negate": Column("switch"),
-    "truth_occupied_thresh": Column("float", 0.0, 1.0),
-    "truth_free_thresh": Column("float", 0.0, 1.0), "truth_negate": Column("switch"),
-    "map_crop": Column("text"), "truth_crop": Column("text"), "init": Column("text"),
-    "no_align": Column("bool"), "force": Column("bool"),
-    "threshold": Column("float", 1e-6), "band_low": Column("float"),
-    "band_high": Column("float"), "min_hits": Column("int", 1), "detectors": Column("text"),
-}
-AFTER_OUTPUTS = {"voxel_3d": Column("float", 0.01), "tau": Column("text"),
-                 "footprint": Column("text"), "full": Column("bool"),
-                 "noref": Column("switch"), "noref_radius": Column("float", 1e-6),
-                 "noref_voxel": Column("float", 0.0)}
-OPTIONS = {**BEFORE_OUTPUTS, **AFTER_OUTPUTS}
+#: The per-row options: eval's settings options, by name (the option table's).
+OPTIONS = {o.name: o for o in options_of(BATCH)}
 #: Every column a manifest may have.
 COLUMNS = ("name", "map", "truth", *OPTIONS)
 
@@ -69,22 +52,26 @@ class Row:
     truth: Path
     settings: Settings
     options: dict[str, object]
+    config: Path | None = None
 
     def command(self, outputs: dict[str, Path]) -> str:
         """The ``pcmapq eval`` command line that makes this row's result and writes
-        ``outputs`` (``{"--json": path, ...}``), as eval records its own (defaults left out)."""
+        ``outputs`` (``{"--json": path, ...}``), as eval records its own (defaults left out):
+        its outputs, the batch's settings file, then the row's options."""
         words = ["pcmapq", "eval", str(self.map), str(self.truth)]
-        words += _words(self.options, BEFORE_OUTPUTS)
         for option in ("--json", "--plot", "--report"):
             if option in outputs:
                 words += [option, str(outputs[option])]
-        words += _words(self.options, AFTER_OUTPUTS)
+        words += [] if self.config is None else ["--config", str(self.config)]
+        words += option_words(self.options, EVAL)
         return shlex.join(words)
 
 
-def read_rows(manifest: Path, defaults: dict[str, object]) -> list[Row]:
+def read_rows(manifest: Path, defaults: dict[str, object],
+              config: Path | None = None) -> list[Row]:
     """The rows of a CSV or YAML manifest. Relative paths in it are relative to its folder;
-    ``defaults`` (column -> text, e.g. from ``--set``) fill the cells a row leaves empty."""
+    ``defaults`` (column -> text, e.g. from ``--set``) fill the cells a row leaves empty;
+    ``config``: a settings file every row starts from."""
     suffix = manifest.suffix.lower()
     if suffix not in MANIFEST_SUFFIXES:
         raise InputError(f"{manifest}: a manifest is .csv, .yaml or .yml")
@@ -97,13 +84,15 @@ def read_rows(manifest: Path, defaults: dict[str, object]) -> list[Row]:
     if not cells:
         raise InputError(f"{manifest}: no rows")
     base = Path(os.path.abspath(manifest.parent))
-    rows = [make_row({**defaults, **row}, base, f"{manifest}: row {i}")
+    start = _start(config)
+    rows = [make_row({**defaults, **row}, base, f"{manifest}: row {i}", start)
             for i, row in enumerate(cells, 1)]
     check_names(rows, str(manifest))
     return rows
 
 
-def glob_rows(patterns: list[str], truth: Path, defaults: dict[str, object]) -> list[Row]:
+def glob_rows(patterns: list[str], truth: Path, defaults: dict[str, object],
+              config: Path | None = None) -> list[Row]:
     """One row per map matching ``patterns`` (globs or paths, relative to the current folder,
     sorted, each map once), all against ``truth``; a row's name is its map's stem."""
     maps: list[str] = []
@@ -113,7 +102,9 @@ def glob_rows(patterns: list[str], truth: Path, defaults: dict[str, object]) -> 
             raise InputError(f"{pattern}: matches no file")
         maps += [m for m in found if m not in maps]
     here = Path(os.path.abspath("."))
-    rows = [make_row({**defaults, "map": m, "truth": str(truth)}, here, m) for m in maps]
+    start = _start(config)
+    rows = [make_row({**defaults, "map": m, "truth": str(truth)}, here, m, start)
+            for m in maps]
     check_names(rows, " ".join(patterns))
     return rows
 
@@ -133,9 +124,11 @@ def parse_assignments(pairs: list[str]) -> dict[str, object]:
     return values
 
 
-def make_row(cells: dict[str, object], base: Path, where: str) -> Row:
+def make_row(cells: dict[str, object], base: Path, where: str,
+             start: tuple[Path, Settings] | None = None) -> Row:
     """A row from its cells (column -> text or YAML value; None or '' is unset); paths
-    relative to ``base``; errors name ``where``."""
+    relative to ``base``; errors name ``where``; ``start``: a settings file and its settings,
+    which the row's options override."""
     given = {_column(k, where): _text(v, where, k) for k, v in cells.items()}
     given = {k: v for k, v in given.items() if v != ""}
     for required in ("map", "truth"):
@@ -147,20 +140,21 @@ def make_row(cells: dict[str, object], base: Path, where: str) -> Row:
     try:
         return Row(name, map_path,
                    Path(os.path.abspath(base / Path(given["truth"]).expanduser())),
-                   settings(values), values)
-    except typer.BadParameter as exc:
-        hint = str(exc.param_hint or "").lstrip("-").replace("-", "_")
-        raise InputError(f"{where}: {hint}: {exc.message}") from None
+                   build(values, EVAL, None if start is None else start[1]), values,
+                   None if start is None else start[0])
+    except OptionError as exc:
+        column = exc.option.lstrip("-").replace("-", "_")
+        raise InputError(f"{where}: {column}: {exc.message}") from None
     except InputError as exc:
         raise InputError(f"{where}: {exc}") from None
 
 
-def settings(values: dict[str, object]) -> Settings:
-    """A row's Settings, built as ``pcmapq eval`` builds them from the same options."""
-    built = options.eval_settings(values)
-    options.check_eval_options(scans=None, max_scans=None, no_align=bool(values.get("no_align")),
-                               auto_scale=built.alignment.scale)
-    return built
+def _start(config: Path | None) -> tuple[Path, Settings] | None:
+    """A settings file (absolute, as the workers read it) and its settings, or None."""
+    if config is None:
+        return None
+    path = Path(os.path.abspath(config))
+    return path, read_settings(path, Settings())
 
 
 def check_names(rows: list[Row], where: str) -> None:
@@ -245,36 +239,20 @@ TRUE, FALSE = ("true", "yes", "1", "on"), ("false", "no", "0", "off")
 
 def _value(column: str, text: str, where: str) -> object:
     """A cell's text as its column's type, within its bounds."""
-    spec = OPTIONS[column]
-    if spec.kind in ("bool", "switch"):
+    option = OPTIONS[column]
+    if option.kind in (FLAG, SWITCH):
         if text.lower() not in TRUE + FALSE:
             raise InputError(f"{where}: {column}: expected true or false, got {text!r}")
         return text.lower() in TRUE
-    if spec.kind == "text":
+    if option.kind == TEXT:
         return text
     try:
-        number = int(text) if spec.kind == "int" else float(text)
+        number = int(text) if option.kind == INT else float(text)
     except ValueError:
         number = math.nan
-    if not (math.isfinite(number) and spec.lo <= number <= spec.hi):
-        bounds = "" if spec.lo == -math.inf else f" >= {spec.lo:g}" if spec.hi == math.inf \
-            else f" in [{spec.lo:g}, {spec.hi:g}]"
-        kind = "an integer" if spec.kind == "int" else "a finite number"
+    if not (math.isfinite(number) and option.lo <= number <= option.hi):
+        bounds = "" if option.lo == -math.inf else f" >= {option.lo:g}" \
+            if option.hi == math.inf else f" in [{option.lo:g}, {option.hi:g}]"
+        kind = "an integer" if option.kind == INT else "a finite number"
         raise InputError(f"{where}: {column}: expected {kind}{bounds}, got {text!r}")
     return number
-
-
-def _words(values: dict[str, object], columns: dict[str, Column]) -> list[str]:
-    """The options among ``columns`` that a row gives, as eval's command line shows them."""
-    words: list[str] = []
-    for column, spec in columns.items():
-        if column not in values:
-            continue
-        option, value = "--" + column.replace("_", "-"), values[column]
-        if spec.kind == "bool":
-            words += [option] if value else []
-        elif spec.kind == "switch":
-            words.append(option if value else "-no-".join(option.rsplit("-", 1)))
-        else:
-            words += [option, str(value)]
-    return words

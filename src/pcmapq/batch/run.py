@@ -24,8 +24,8 @@ from pcmapq.batch.manifest import Row
 from pcmapq.core.errors import EvaluationError, InputError
 from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.io.digest import sha256_file
+from pcmapq.io.targets import input_files
 from pcmapq.io.writers import OutputSet, one_line, write_atomic
-from pcmapq.options import input_files
 from pcmapq.report.style import ARROW_SCALE
 from pcmapq.report.summary import write_summary
 from pcmapq.results import gates

@@ -26,6 +26,8 @@ HELP = {
              "any row failed, else 3 if a row failed a gate.",
     "track": "Score a SLAM run's map as it grows, every N scans or D metres, against the "
              "truth: when did the map go wrong, and where was the robot then?",
+    "config": "Write the settings (every option of eval, batch, track and inspect) as a YAML "
+              "file to pass to --config.",
 }
 
 

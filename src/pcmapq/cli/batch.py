@@ -10,14 +10,15 @@ from typing import Annotated
 import typer
 from rich.console import Console
 
-from pcmapq import options
 from pcmapq.cli import terminal
 from pcmapq.cli.commands import HELP, RowsFailOver, RowsFailUnder, app
+from pcmapq.cli.options import CONFIG_HELP
 from pcmapq.cli.terminal import (
     report_errors,
 )
 from pcmapq.core.errors import InputError
-from pcmapq.io.writers import OutputSet, write_atomic
+from pcmapq.io import targets
+from pcmapq.io.writers import OutputSet, same_file, write_atomic
 from pcmapq.results import gates
 
 
@@ -32,6 +33,9 @@ def batch_command(
         "figure.png.")],
     truth: Annotated[Path | None, typer.Option(
         help="The ground truth of every map given as MAP... (a glob's maps).")] = None,
+    config: Annotated[Path | None, typer.Option(
+        metavar="FILE", help=CONFIG_HELP.replace("options given here", "a row's options and "
+                                                 "--set"))] = None,
     set_options: Annotated[list[str] | None, typer.Option(
         "--set", metavar="KEY=VALUE", help="An eval option for every row, by its manifest "
         "column (threshold=0.3, scale=auto ...); a row's own cell wins. Repeatable.")] = None,
@@ -72,9 +76,9 @@ def batch_command(
                 raise InputError("--truth gives the truth of maps given as MAP...; a "
                                  "manifest's rows name their own ('truth' column, or --set "
                                  "truth=FILE)")
-            rows = glob_rows(sources, truth, defaults)
+            rows = glob_rows(sources, truth, defaults, config)
         elif len(sources) == 1:
-            rows = read_rows(Path(sources[0]), defaults)
+            rows = read_rows(Path(sources[0]), defaults, config)
         else:
             raise typer.BadParameter("give one manifest, or maps with --truth",
                                      param_hint="MANIFEST | MAP...")
@@ -82,8 +86,8 @@ def batch_command(
             raise InputError(f"{out}: --out: not a folder")
         if json_path not in (None, "-"):
             out.mkdir(parents=True, exist_ok=True)  # --json may go into it
-            options.check_outputs({"--json": json_path}, None, inputs=())
-            if any(options.same_file(Path(json_path), out / f"{r.name}.json") for r in rows):
+            targets.check_outputs({"--json": json_path}, None, inputs=())
+            if any(same_file(Path(json_path), out / f"{r.name}.json") for r in rows):
                 raise InputError(f"{json_path}: --json would overwrite a row's result")
         with row_bar(err, len(rows), enabled=not quiet and json_path != "-") as tick:
             outcomes = run_batch(rows, out, plot=plot, report=report, force=force,

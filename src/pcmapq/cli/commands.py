@@ -1,5 +1,5 @@
 """The ``pcmapq`` Typer application (:mod:`pcmapq.cli.base`) that the commands register on, and
-what they share: the documented defaults, the CI gates, the memory limit."""
+what they share: the CI gates, the memory limit."""
 
 from __future__ import annotations
 
@@ -7,15 +7,11 @@ from typing import Annotated
 
 import typer
 
-from pcmapq import options
+from pcmapq.cli import options
 from pcmapq.cli.base import HELP, new_app
-from pcmapq.settings import Settings
-
-#: The documented defaults, read from the one place that defines them.
-DEFAULTS = Settings()
 
 app = new_app()
-__all__ = ["DEFAULTS", "HELP", "app"]
+__all__ = ["HELP", "app"]
 
 
 #: The CI gates of eval (one result) and batch (every row; docs/ci.md).

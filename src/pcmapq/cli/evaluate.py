@@ -5,37 +5,36 @@ from __future__ import annotations
 import sys
 from dataclasses import replace
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Any
 
 import typer
 from rich.console import Console
 
-from pcmapq import options
-from pcmapq.cli import terminal
-from pcmapq.cli.commands import DEFAULTS, HELP, FailOver, FailUnder, MaxMemory, app, memory_limit
+from pcmapq.cli import options, terminal
+from pcmapq.cli.commands import HELP, FailOver, FailUnder, MaxMemory, app, memory_limit
 from pcmapq.cli.terminal import (
     report_errors,
     step_progress,
 )
+from pcmapq.core.errors import InputError
 from pcmapq.evaluation.pipeline import evaluate
-from pcmapq.io import PointMap
+from pcmapq.io import PointMap, targets
 from pcmapq.io.writers import OutputSet, write_atomic
 from pcmapq.mapping import (
     build_map_kiss,
 )
-from pcmapq.raster.footprint import FOOTPRINT_RULES
 from pcmapq.report import export
 from pcmapq.report.style import ARROW_SCALE
 from pcmapq.report.table import print_table
 from pcmapq.results import gates
 from pcmapq.results.result import Result
 from pcmapq.settings import (
-    DETECTOR_NAMES,
     Settings,
 )
 
 
 @app.command("eval", help=HELP["eval"])
+@options.settings_options("eval")
 def eval_command(
     ctx: typer.Context,
     paths: Annotated[list[Path], typer.Argument(
@@ -47,68 +46,6 @@ def eval_command(
         "score it.")] = None,
     max_scans: Annotated[int | None, typer.Option(
         help="With --scans: use only the first N scans.", min=1)] = None,
-    map_resolution: Annotated[str | None, typer.Option(
-        metavar="<metres|auto>",
-        help="Metres per pixel of a map image without YAML (overrides its YAML); 'auto' "
-        "estimates the map's scale (same as --scale auto).")] = None,
-    scale: Annotated[str, typer.Option(
-        metavar="<fixed|auto>",
-        help="'fixed': the map's metres are metres; 'auto': estimate its scale too (a "
-        "similarity), for maps whose resolution is unknown.")] = "fixed",
-    truth_resolution: Annotated[float | None, typer.Option(
-        help="Metres per pixel of a truth image without YAML; cell size for a cloud truth "
-        "(default 0.05).", min=1e-6, callback=options.finite)] = None,
-    map_occupied_thresh: Annotated[float | None, typer.Option(
-        help="Map image: occupied if p > this (map_server's occupied_thresh; overrides the "
-        "YAML's, default 0.65).", min=0.0, max=1.0, show_default=False,
-        callback=options.finite)] = None,
-    map_free_thresh: Annotated[float | None, typer.Option(
-        help="Map image: free if p < this (map_server's free_thresh; overrides the YAML's, "
-        "default 0.196).", min=0.0, max=1.0, show_default=False, callback=options.finite)] = None,
-    map_negate: Annotated[bool | None, typer.Option(
-        "--map-negate/--map-no-negate", help="Map image: p = v / 255 instead of (255 - v) / 255 "
-        "(map_server's negate; overrides the YAML's).", show_default=False)] = None,
-    truth_occupied_thresh: Annotated[float | None, typer.Option(
-        help="Truth image: as --map-occupied-thresh.", min=0.0, max=1.0,
-        show_default=False, callback=options.finite)] = None,
-    truth_free_thresh: Annotated[float | None, typer.Option(
-        help="Truth image: as --map-free-thresh.", min=0.0, max=1.0, show_default=False,
-        callback=options.finite)
-    ] = None,
-    truth_negate: Annotated[bool | None, typer.Option(
-        "--truth-negate/--truth-no-negate", help="Truth image: as --map-negate.",
-        show_default=False)] = None,
-    map_crop: Annotated[str | None, typer.Option(
-        metavar="<x0,y0,x1,y1>", help="Keep only the map's part inside this box, metres, in "
-        "its own frame (outlier points far away).")] = None,
-    truth_crop: Annotated[str | None, typer.Option(
-        metavar="<x0,y0,x1,y1>", help="Keep only the truth's part inside this box, metres, in "
-        "its own frame.")] = None,
-    init: Annotated[str | None, typer.Option(
-        help="Initial guess x,y,yaw (m, m, deg), map -> truth; skips the global search.")] = None,
-    no_align: Annotated[bool, typer.Option(
-        "--no-align", help="Trust the map's frame: no alignment at all.")] = False,
-    force: Annotated[bool, typer.Option(
-        help="Evaluate even when the map does not seem to show the truth's place.")] = False,
-    threshold: Annotated[float, typer.Option(
-        help="Largest distance between matched features, metres.", min=1e-6,
-        callback=options.finite)
-    ] = DEFAULTS.matching.threshold,
-    band_low: Annotated[float, typer.Option(
-        help="Wall band of a 3D cloud: lower bound, metres above the floor.",
-        callback=options.finite)
-    ] = DEFAULTS.raster.band_low,
-    band_high: Annotated[float, typer.Option(
-        help="Wall band of a 3D cloud: upper bound, metres above the floor.",
-        callback=options.finite)
-    ] = DEFAULTS.raster.band_high,
-    min_hits: Annotated[int | None, typer.Option(
-        help="Points needed to mark a cloud's cell occupied (default: 2 for a 3D cloud, 1 for "
-        "a 2D one).", min=1, show_default=False)] = None,
-    detectors: Annotated[str, typer.Option(
-        metavar="<" + ",".join(DEFAULTS.matching.detectors) + ">",
-        help="Comma-separated detectors to run, any of "
-        f"{', '.join(DETECTOR_NAMES)}.")] = ",".join(DEFAULTS.matching.detectors),
     json_path: Annotated[str | None, typer.Option(
         "--json", help="Write the result as JSON to this path ('-' for stdout only).")] = None,
     vectors: Annotated[Path | None, typer.Option(
@@ -127,21 +64,6 @@ def eval_command(
     arrow_scale: Annotated[float, typer.Option(
         help="Displacement arrows of --plot and --report are drawn this many times their "
         "length, in every panel of every run.", min=1e-6, callback=options.finite)] = ARROW_SCALE,
-    voxel_3d: Annotated[float, typer.Option(
-        "--voxel-3d", help="Working voxel of the 3D registration of two 3D clouds, metres "
-        "(0.5-1 for outdoor maps).", min=0.01,
-        callback=options.finite)] = DEFAULTS.alignment.voxel_3d,
-    tau: Annotated[str, typer.Option(
-        help="Distance thresholds of the F-score, metres, comma-separated.")
-    ] = ",".join(f"{t:g}" for t in DEFAULTS.distances.taus),
-    footprint: Annotated[str, typer.Option(
-        metavar="<" + "|".join(r for r in FOOTPRINT_RULES if r != "seen") + ">",
-        help="The area the map observed: 'known' cells of an image, the area its 'walls' "
-        "enclose, 'all' of its rectangle; 'auto': known cells for an image with unknown "
-        "regions, walls for a binary image or a cloud.")] = DEFAULTS.footprint.rule,
-    full: Annotated[bool, typer.Option(
-        "--full", help="Score against the whole truth, not only the part the map covers.")
-    ] = False,
     max_memory: MaxMemory = None,
     aligned: Annotated[Path | None, typer.Option(
         help="Write the map moved into the truth's frame: .ply/.pcd for a cloud map (a 3D "
@@ -154,53 +76,34 @@ def eval_command(
     distances: Annotated[Path | None, typer.Option(
         help="Write the map's points in the truth's frame with their distance to the truth "
         "(.ply: scalar field scalar_distance_m, metres, and a colour).")] = None,
-    noref: Annotated[bool, typer.Option(
-        "--noref/--no-noref", help="Also report each input's no-reference figures, as "
-        "'pcmapq inspect' does (MME, MPV, MOM of a 3D cloud; occupancy figures of a 2D map).")
-    ] = DEFAULTS.noref.enabled,
-    noref_radius: Annotated[float, typer.Option(
-        help="Neighbourhood of the 3D no-reference figures, metres (0.2 for depth-camera "
-        "maps, with --noref-voxel 0.02).", min=1e-6, callback=options.finite)
-    ] = DEFAULTS.noref.radius,
-    noref_voxel: Annotated[float, typer.Option(
-        help="A 3D cloud is first reduced to one point per cell of this size for its "
-        "no-reference figures, metres (0: as it is).", min=0.0, callback=options.finite)
-    ] = DEFAULTS.noref.voxel,
     fail_under: FailUnder = None,
     fail_over: FailOver = None,
     quiet: Annotated[bool, typer.Option(
         "--quiet", "-q", help="Print nothing but warnings and errors (and the JSON of "
         "--json -).")] = False,
+
+    **settings_values: Any,
 ) -> None:
     if len(paths) != (1 if scans else 2):
         raise typer.BadParameter("give MAP and TRUTH, or --scans DIR and TRUTH",
                                  param_hint="MAP TRUTH")
     truth_path = paths[-1]
-    settings = options.eval_settings(dict(
-        map_resolution=map_resolution, scale=scale, truth_resolution=truth_resolution,
-        map_occupied_thresh=map_occupied_thresh, map_free_thresh=map_free_thresh,
-        map_negate=map_negate, truth_occupied_thresh=truth_occupied_thresh,
-        truth_free_thresh=truth_free_thresh, truth_negate=truth_negate, map_crop=map_crop,
-        truth_crop=truth_crop, init=init, no_align=no_align, force=force, threshold=threshold,
-        band_low=band_low, band_high=band_high, min_hits=min_hits, detectors=detectors,
-        voxel_3d=voxel_3d, tau=tau, footprint=footprint, full=full, noref=noref,
-        noref_radius=noref_radius, noref_voxel=noref_voxel))
-    auto = settings.alignment.scale
     json_path, vectors, regions, plot, report, aligned, transform, distances = (
-        options.kept(p) for p in (json_path, vectors, regions, plot, report, aligned, transform,
+        targets.kept(p) for p in (json_path, vectors, regions, plot, report, aligned, transform,
                                   distances))
     exports = {"--aligned": aligned, "--transform": transform, "--distances": distances}
     err = Console(stderr=True)
     out = Console(quiet=quiet or json_path == "-")  # not a terminal: COLUMNS or 80 wide
     with report_errors(err), terminal.show_warnings(err), \
             step_progress(err, enabled=not quiet and json_path != "-") as progress:
+        settings = options.settings_of(ctx, "eval", settings_values)
         rules = gates.parse_rules(fail_under, fail_over)
-        options.check_eval_options(scans=scans, max_scans=max_scans, no_align=no_align,
-                                   auto_scale=auto)
-        options.check_outputs({"--json": json_path, "--vectors": vectors,
+        if max_scans is not None and scans is None:
+            raise InputError("--max-scans N: only with --scans DIR (the scans to map)")
+        targets.check_outputs({"--json": json_path, "--vectors": vectors,
                                "--regions": regions, "--plot": plot,
                                "--report": report, **exports}, None if scans else paths[0],
-                              inputs=paths)
+                              inputs=(*paths, settings_values.get("config")))
         if scans is None:
             map_path: Path | PointMap = paths[0]
         else:

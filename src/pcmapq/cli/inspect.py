@@ -4,14 +4,13 @@ from __future__ import annotations
 
 import sys
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Any
 
 import numpy as np
 import typer
 from rich.console import Console
 
-from pcmapq import options
-from pcmapq.cli import terminal
+from pcmapq.cli import options, terminal
 from pcmapq.cli.commands import HELP, MaxMemory, app, memory_limit
 from pcmapq.cli.terminal import (
     report_errors,
@@ -19,7 +18,7 @@ from pcmapq.cli.terminal import (
 from pcmapq.core import memory
 from pcmapq.evaluation.inspect_map import inspect_map, summary_lines, to_json
 from pcmapq.evaluation.truth import needed_memory
-from pcmapq.io import OccupancyMap, PointMap, load_map
+from pcmapq.io import OccupancyMap, PointMap, load_map, targets
 from pcmapq.io.extent import Box, check_span, hint
 from pcmapq.io.extent import crop as crop_input
 from pcmapq.io.writers import OutputSet, write_atomic
@@ -28,9 +27,7 @@ from pcmapq.mapping import (
     read_pose_matrix,
     read_poses,
 )
-from pcmapq.metrics.noref import DEPTH_RADIUS, LIDAR_RADIUS, MAX_NN, MIN_KNN
 from pcmapq.metrics.posed import place_subset, read_orthogonal_subset
-from pcmapq.settings import NoRefConfig
 
 #: The crop option of inspect, named in messages.
 CROP = "--crop"
@@ -50,6 +47,7 @@ def checked(source: OccupancyMap | PointMap, box: Box | None,
 
 
 @app.command("inspect", help=HELP["inspect"])
+@options.settings_options("inspect")
 def inspect_command(
     ctx: typer.Context,
     map_path: Annotated[Path | None, typer.Argument(
@@ -62,61 +60,46 @@ def inspect_command(
     poses: Annotated[Path | None, typer.Option(
         help="With --scans: one pose per scan, a KITTI or TUM file or a folder of 4x4 text "
         "files (name order); the map is in the first scan's frame.")] = None,
-    radius: Annotated[float, typer.Option(
-        help=f"Neighbourhood radius of MME, MPV and MOM, metres ({LIDAR_RADIUS:g} for LiDAR "
-        f"maps, {DEPTH_RADIUS:g} for depth cameras).", min=1e-6,
-        callback=options.finite)] = LIDAR_RADIUS,
-    min_knn: Annotated[int, typer.Option(
-        help="A point counts when it has more than this many neighbours.", min=0)] = MIN_KNN,
-    max_nn: Annotated[int, typer.Option(
-        help="Nearest neighbours of the normals that pick MOM's orthogonal planes.", min=3)
-    ] = MAX_NN,
-    voxel: Annotated[float, typer.Option(
-        help="First reduce a 3D cloud to one point (the centroid) per cell of this size, "
-        "metres; 0: as it is, as map-metrics ('pcmapq eval' uses 0.1).", min=0.0,
-        callback=options.finite)] = 0.0,
     orth_subset: Annotated[Path | None, typer.Option(
         help="MOM's orthogonal planes (a map-metrics .npy or .npz) in the map's frame, or in "
         "the frame of the scan at --orth-pose; otherwise pcmapq extracts them.")] = None,
     orth_pose: Annotated[Path | None, typer.Option(
         help="With --orth-subset: the 4x4 pose of the scan whose frame the planes are in "
         "(with --poses, placed relative to the first pose, as the map).")] = None,
-    map_resolution: Annotated[float | None, typer.Option(
-        help="Metres per pixel of an image without YAML.", min=1e-6, callback=options.finite)
-    ] = None,
-    crop: Annotated[str | None, typer.Option(
-        metavar="<x0,y0,x1,y1>", help="Keep only the part of the map inside this box, metres, "
-        "in its own frame (as eval's --map-crop).")] = None,
     max_memory: MaxMemory = None,
     json_path: Annotated[str | None, typer.Option(
         "--json", help="Write the figures as JSON to this path ('-' for stdout only).")] = None,
     quiet: Annotated[bool, typer.Option(
         "--quiet", "-q", help="Print nothing but warnings and errors.")] = False,
+
+    **settings_values: Any,
 ) -> None:
     err = Console(stderr=True)
-    json_path = options.kept(json_path)
+    json_path = targets.kept(json_path)
     with report_errors(err), terminal.show_warnings(err):
+        settings = options.settings_of(ctx, "inspect", settings_values)
         if (map_path is None) == (scans is None) or (scans is None) != (poses is None):
             raise typer.BadParameter("give MAP, or --scans DIR with --poses FILE",
                                      param_hint="MAP")
         if orth_pose is not None and orth_subset is None:
             raise typer.BadParameter("--orth-pose places --orth-subset: give both",
                                      param_hint="--orth-pose")
-        options.check_outputs({"--json": json_path}, None,
-                              inputs=(map_path, scans, poses, orth_subset, orth_pose))
+        targets.check_outputs({"--json": json_path}, None,
+                              inputs=(map_path, scans, poses, orth_subset, orth_pose,
+                                      settings_values.get("config")))
         first = np.eye(4)
         if scans is not None and poses is not None:
             trajectory = read_poses(poses)
             first = trajectory[0]
             source = PointMap(scans, posed_map(scans, trajectory), True, kind="scans")
         else:
-            source = load_map(map_path, map_resolution, memory_limit=memory_limit(max_memory))
-        source = checked(source, options.parse_box(crop, CROP), memory_limit(max_memory))
+            source = load_map(map_path, settings.map.resolution,
+                              memory_limit=memory_limit(max_memory))
+        source = checked(source, settings.map.crop, memory_limit(max_memory))
         planes = None if orth_subset is None else read_orthogonal_subset(orth_subset)
         if planes is not None and orth_pose is not None:
             planes = place_subset(planes, read_pose_matrix(orth_pose), first)
-        config = NoRefConfig(radius=radius, min_knn=min_knn, max_nn=max_nn, voxel=voxel)
-        record = inspect_map(source, config, planes, options.command_line(ctx))
+        record = inspect_map(source, settings.noref, planes, options.command_line(ctx))
         if json_path not in (None, "-"):
             with OutputSet() as outputs:
                 write_atomic(Path(json_path), to_json(record), outputs)

@@ -9,14 +9,14 @@ from typing import Annotated
 import typer
 from rich.console import Console
 
-from pcmapq import options
-from pcmapq.cli import terminal
+from pcmapq.cli import options, terminal
 from pcmapq.cli.commands import HELP, app
 from pcmapq.cli.terminal import (
     report_errors,
     scan_bar,
 )
 from pcmapq.core.errors import InputError
+from pcmapq.io import targets
 from pcmapq.io.writers import OutputSet, write_cloud
 from pcmapq.mapping import (
     build_map_from_poses,
@@ -57,12 +57,12 @@ def map_command(
         "--quiet", "-q", help="Print nothing but warnings and errors.")] = False,
 ) -> None:
     err = Console(stderr=True)
-    poses_out, tum_out = options.kept(poses_out), options.kept(tum_out)
+    poses_out, tum_out = targets.kept(poses_out), targets.kept(tum_out)
     with report_errors(err), terminal.show_warnings(err):
         if calib is not None and poses is None:
             raise InputError(f"{calib}: --calib places scans with --poses only (KISS-ICP's "
                              "map is in the first scanner's frame already)")
-        options.check_outputs({"--out": out, "--poses-out": poses_out, "--tum-out": tum_out},
+        targets.check_outputs({"--out": out, "--poses-out": poses_out, "--tum-out": tum_out},
                               None, inputs=(source, poses, calib))
         with scan_bar(err, enabled=not quiet) as tick:
             if poses is None:

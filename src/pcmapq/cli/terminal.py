@@ -88,7 +88,7 @@ def show_warnings(console: Console) -> Iterator[None]:
     """pcmapq's warnings (``warnings.warn`` in pcmapq's code): one line each on stderr, as they
     come, every time. A library's warning (a NumPy RuntimeWarning, ...) is not pcmapq's to
     print: dropped."""
-    package = str(Path(__file__).parent)
+    package = str(Path(__file__).parents[1])  # pcmapq, not pcmapq.cli
 
     def show(message: Warning | str, category: type[Warning], filename: str, *_: object) -> None:
         if category is UserWarning and filename.startswith(package):

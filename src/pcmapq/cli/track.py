@@ -5,25 +5,25 @@ from __future__ import annotations
 import sys
 from dataclasses import asdict
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Any
 
 import typer
 from rich.console import Console
 
-from pcmapq import options
-from pcmapq.cli import terminal
-from pcmapq.cli.commands import DEFAULTS, HELP, MaxMemory, app, memory_limit
+from pcmapq.cli import options, terminal
+from pcmapq.cli.commands import HELP, MaxMemory, app, memory_limit
 from pcmapq.cli.terminal import (
     report_errors,
     scan_bar,
     step_progress,
 )
 from pcmapq.core.errors import InputError
+from pcmapq.io import targets
 from pcmapq.io.writers import OutputSet, write_atomic
-from pcmapq.raster.footprint import FOOTPRINT_RULES
 
 
 @app.command("track", help=HELP["track"])
+@options.settings_options("track")
 def track_command(
     ctx: typer.Context,
     paths: Annotated[list[Path], typer.Argument(
@@ -58,34 +58,13 @@ def track_command(
     correct_scale: Annotated[bool, typer.Option(
         "--correct-scale", help="APE/RPE: correct the scale too (evo's -s).")] = False,
     delta: Annotated[int, typer.Option(help="RPE: pairs this many scans apart.", min=1)] = 1,
-    truth_resolution: Annotated[float | None, typer.Option(
-        help="As eval's.", min=1e-6, callback=options.finite)] = None,
-    init: Annotated[str | None, typer.Option(
-        help="Initial guess x,y,yaw (m, m, deg), map -> truth, of the first step; skips the "
-        "global search.")] = None,
-    no_align: Annotated[bool, typer.Option(
-        "--no-align", help="Trust the run's frame: no alignment at any step.")] = False,
-    force: Annotated[bool, typer.Option(
-        help="Score every step, even one that does not seem to show the truth's place.")
-    ] = False,
-    threshold: Annotated[float, typer.Option(
-        help="Largest distance between matched features, metres.", min=1e-6,
-        callback=options.finite)] = DEFAULTS.matching.threshold,
-    detectors: Annotated[str, typer.Option(
-        metavar="<" + ",".join(DEFAULTS.matching.detectors) + ">",
-        help="As eval's.")] = ",".join(DEFAULTS.matching.detectors),
-    footprint: Annotated[str, typer.Option(
-        metavar="<" + "|".join(FOOTPRINT_RULES) + ">",
-        help="As eval's; 'auto' is 'seen': the area the scans so far saw.")
-    ] = DEFAULTS.footprint.rule,
-    tau: Annotated[str, typer.Option(
-        help="Distance thresholds of the F-score and wall precision, metres.")
-    ] = ",".join(f"{t:g}" for t in DEFAULTS.distances.taus),
     max_memory: MaxMemory = None,
     json_path: Annotated[str | None, typer.Option(
         "--json", help="Also write track.json to this path ('-' for stdout only).")] = None,
     quiet: Annotated[bool, typer.Option(
         "--quiet", "-q", help="Print nothing but warnings and errors.")] = False,
+
+    **settings_values: Any,
 ) -> None:
     from pcmapq.io.carmen import is_carmen
     from pcmapq.report.timeline import drop_words
@@ -95,20 +74,19 @@ def track_command(
     if len(paths) != 2:
         raise typer.BadParameter("give RUN and TRUTH", param_hint="RUN TRUTH")
     run_path, truth_path = paths
-    settings = options.eval_settings(dict(
-        truth_resolution=truth_resolution, init=init, no_align=no_align, force=force,
-        threshold=threshold, detectors=detectors, footprint=footprint, tau=tau))
     err = Console(stderr=True)
-    json_path = options.kept(json_path)
+    json_path = targets.kept(json_path)
     shown = not quiet and json_path != "-"
     with report_errors(err), terminal.show_warnings(err), \
             step_progress(err, enabled=shown) as progress:
+        settings = options.settings_of(ctx, "track", settings_values)
         if every is not None and every_m is not None:
             raise typer.BadParameter("give one of --every and --every-m", param_hint="--every")
         if out.exists() and not out.is_dir():
             raise InputError(f"{out}: --out: not a folder")
-        options.check_outputs({"--json": json_path}, None,
-                              inputs=(*paths, poses, reference_poses, calib))
+        targets.check_outputs({"--json": json_path}, None,
+                              inputs=(*paths, poses, reference_poses, calib,
+                                      settings_values.get("config")))
         if calib is not None and (reference_poses is None or is_carmen(reference_poses)):
             raise InputError(f"{calib}: --calib moves the poses of a --reference-poses KITTI "
                              "or TUM file into the scanner's frame; none is given")

@@ -1,0 +1,106 @@
+"""The command line's options: the settings options of a command made from the option table
+(:mod:`pcmapq.settings.table`) with ``--config FILE``, the Settings a command's parsed options
+give, and the command line rebuilt from them."""
+
+from __future__ import annotations
+
+import functools
+import inspect
+import math
+import shlex
+from collections.abc import Callable
+from pathlib import Path
+from typing import Annotated, Any
+
+import typer
+
+from pcmapq.settings import Settings
+from pcmapq.settings.build import base_settings, build, get_path
+from pcmapq.settings.file import read_settings
+from pcmapq.settings.table import FLAG, FLOAT, INT, SWITCH, Option, OptionError, options_of
+
+#: Python types of the option kinds, as typer reads them.
+TYPES = {FLOAT: float | None, INT: int | None, SWITCH: bool | None, FLAG: bool}
+#: ``--config``: a settings file (``pcmapq config --dump`` writes one).
+CONFIG_HELP = ("Settings file (YAML, as 'pcmapq config --dump' writes): its settings replace "
+               "the defaults; options given here override it.")
+
+
+def command_line(ctx: typer.Context) -> str:
+    """The command as given, rebuilt from its parsed parameters (defaults left out), so a saved
+    result says how it was made: ``pcmapq eval MAP TRUTH --option value ...``."""
+    words = ["pcmapq", ctx.info_name or "eval"]
+    for param in ctx.command.params:
+        value = ctx.params.get(param.name)
+        source = ctx.get_parameter_source(param.name)
+        if source is None or source.name == "DEFAULT" or value is None:
+            continue
+        if param.param_type_name == "argument":
+            words += [str(v) for v in (value if isinstance(value, (list, tuple)) else [value])]
+        elif isinstance(value, bool) and param.is_flag:
+            if value or param.secondary_opts:
+                words.append(param.opts[0] if value else param.secondary_opts[0])
+        else:
+            words += [param.opts[0], str(value)]
+    return shlex.join(words)
+
+
+def finite(param: typer.CallbackParam, value: float | None) -> float | None:
+    """A float option's callback: refuse 'inf' and 'nan', which click's FLOAT reads."""
+    if value is not None and not math.isfinite(value):
+        raise typer.BadParameter(f"expected a finite number, got {value}",
+                                 param_hint=param.opts[0] if param.opts else None)
+    return value
+
+
+def settings_options(command: str) -> Callable:
+    """A decorator that gives a typer command ``--config`` and the settings options of
+    ``command`` from the option table, after its own: the command takes them as
+    ``**settings_values`` and builds its Settings with :func:`settings_of`."""
+    defaults = base_settings(command)
+
+    def wrap(func: Callable) -> Callable:
+        signature = inspect.signature(func, eval_str=True)
+        own = [p for p in signature.parameters.values() if p.kind != p.VAR_KEYWORD]
+        extra = [inspect.Parameter("config", inspect.Parameter.KEYWORD_ONLY, default=None,
+                                   annotation=Annotated[Path | None, typer.Option(
+                                       help=CONFIG_HELP, metavar="FILE")])]
+        extra += [_parameter(o, command, defaults) for o in options_of(command)]
+
+        @functools.wraps(func)
+        def command_function(*args: Any, **kwargs: Any) -> Any:
+            return func(*args, **kwargs)
+
+        command_function.__signature__ = signature.replace(  # type: ignore[attr-defined]
+            parameters=own + extra)
+        return command_function
+    return wrap
+
+
+def settings_of(ctx: typer.Context, command: str, values: dict[str, Any]) -> Settings:
+    """The Settings of ``command``: its defaults, or the ``--config`` file over them, with the
+    table's options given on the command line applied. A value that cannot be read is a
+    usage error naming its option."""
+    given = {name: value for name, value in values.items() if name != "config" and
+             getattr(ctx.get_parameter_source(name), "name", "") in ("COMMANDLINE", "ENVIRONMENT")}
+    config = values.get("config")
+    base = base_settings(command) if config is None else read_settings(config,
+                                                                       base_settings(command))
+    try:
+        return build(given, command, base)
+    except OptionError as exc:
+        raise typer.BadParameter(exc.message, param_hint=exc.option) from None
+
+
+def _parameter(option: Option, command: str, defaults: Settings) -> inspect.Parameter:
+    """The typer parameter of one table option; its default is the setting's default."""
+    default = option.show(get_path(defaults, option.path))
+    kind = TYPES.get(option.kind, str | None)
+    decls = [option.option] if option.kind == FLAG else [option.flag] if option.flag else []
+    bounds = {k: v for k, v in (("min", option.lo), ("max", option.hi)) if math.isfinite(v)}
+    info = typer.Option(*decls, help=option.help_for(command), metavar=option.metavar,
+                        show_default=default is not None and default is not False,
+                        callback=finite if option.kind == FLOAT else None,
+                        **(bounds if option.kind in (FLOAT, INT) else {}))
+    return inspect.Parameter(option.name, inspect.Parameter.KEYWORD_ONLY,
+                             default=default, annotation=Annotated[kind, info])

@@ -1,0 +1,96 @@
+"""Settings built from options: a base (the defaults, or a settings file) with the options a
+user gave applied by the option table (:mod:`pcmapq.settings.table`), then the checks of
+options that cannot work together."""
+
+from __future__ import annotations
+
+import typing
+from dataclasses import is_dataclass, replace
+from typing import Any
+
+from pcmapq.core.errors import InputError
+from pcmapq.settings import NoRefConfig, Settings
+from pcmapq.settings.table import FLAG, SWITCH, Option, options_of
+
+
+def base_settings(command: str) -> Settings:
+    """A command's defaults: eval's, but ``inspect``'s no-reference figures of a cloud as it
+    is (no voxel), as map-metrics computes them."""
+    return Settings(noref=NoRefConfig()) if command == "inspect" else Settings()
+
+
+def get_path(settings: Any, path: str) -> Any:
+    """The setting at a dotted ``path`` (None past a group that is None)."""
+    value = settings
+    for step in path.split("."):
+        if value is None:
+            return None
+        value = getattr(value, step)
+    return value
+
+
+def set_path(settings: Any, path: str, value: Any) -> Any:
+    """``settings`` with the setting at a dotted ``path`` replaced; a group that is None (map
+    image thresholds) is made with its defaults first."""
+    step, _, rest = path.partition(".")
+    if not rest:
+        return replace(settings, **{step: value})
+    group = getattr(settings, step)
+    if group is None:
+        group = _group_type(type(settings), step)()
+    return replace(settings, **{step: set_path(group, rest, value)})
+
+
+def build(values: dict[str, Any], command: str, base: Settings | None = None) -> Settings:
+    """``base`` (default: :func:`base_settings`) with each option of ``command`` in ``values``
+    (by name; None or absent: not given) read and applied, in table order; then
+    :func:`check`. OptionError on a value that cannot be read."""
+    settings = base_settings(command) if base is None else base
+    for option in options_of(command):
+        if values.get(option.name) is not None:
+            settings = apply(settings, option, values[option.name])
+    check(settings)
+    return settings
+
+
+def apply(settings: Settings, option: Option, value: Any) -> Settings:
+    """``settings`` with one option's value (as the command line gives it) applied."""
+    setting = option.read(value)
+    settings = set_path(settings, option.path, setting)
+    for path, also in option.also(setting).items():
+        settings = set_path(settings, path, also)
+    return settings
+
+
+def check(settings: Settings) -> None:
+    """Refuse settings that cannot work together (InputError, one line)."""
+    if not settings.alignment.enabled and settings.alignment.scale:
+        raise InputError("--no-align and --scale auto (or --map-resolution auto) cannot go "
+                         "together: estimating the scale is part of the alignment")
+
+
+def option_words(values: dict[str, Any], command: str) -> list[str]:
+    """The options among ``values`` (by name, as given) as the command line shows them, in
+    table order: a flag alone when set, a switch as ``--x`` or ``--no-x``."""
+    words: list[str] = []
+    for option in options_of(command):
+        value = values.get(option.name)
+        if value is None:
+            continue
+        if option.kind == FLAG:
+            words += [option.option] if value else []
+        elif option.kind == SWITCH:
+            on, off = (option.flag or "").split("/")
+            words.append(on if value else off)
+        else:
+            words += [option.option, str(value)]
+    return words
+
+
+def _group_type(owner: type, name: str) -> type:
+    """The dataclass a field ``name`` of ``owner`` holds (``Thresholds | None``)."""
+    hint = typing.get_type_hints(owner)[name]
+    kinds = [k for k in typing.get_args(hint) or (hint,) if is_dataclass(k)]
+    if not kinds:
+        raise TypeError(f"{owner.__name__}.{name} is not a group of settings")
+    return kinds[0]
