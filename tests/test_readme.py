@@ -1,7 +1,8 @@
-"""The README's examples run as written: every `pcmapq` command of its shell blocks (with the
-`echo ... > FILE` lines that make their inputs) and its Python block, from a folder laid out
-like the repository beside ../shared; the blocks reading ../shared/data skip where it is
-absent. The sample's verdict shown in the README is the one the command prints."""
+"""The guide's examples run as written: every `pcmapq` command of the shell blocks of the
+README, docs/getting-started.md and docs/commands/*.md (with the `echo ... > FILE` lines that
+make their inputs) and their Python block, from a folder laid out like the repository beside
+../shared; the blocks reading ../shared/data skip where it is absent. The sample's verdict shown
+in the README is the one the command prints."""
 
 from __future__ import annotations
 
@@ -18,8 +19,12 @@ from .conftest import SHARED_DATA
 
 ROOT = Path(__file__).resolve().parents[1]
 README = (ROOT / "README.md").read_text()
-#: Fenced blocks: (language, body).
-BLOCKS = re.findall(r"^```(\w*)\n(.*?)^```", README, flags=re.S | re.M)
+#: The pages whose examples run: the README, getting started and one page per command.
+PAGES = [ROOT / "README.md", ROOT / "docs" / "getting-started.md",
+         *sorted((ROOT / "docs" / "commands").glob("*.md"))]
+#: Fenced blocks of every page: (language, body).
+BLOCKS = [block for page in PAGES
+          for block in re.findall(r"^```(\w*)\n(.*?)^```", page.read_text(), flags=re.S | re.M)]
 
 
 def commands(body: str) -> list[str]:
@@ -94,7 +99,7 @@ def test_shell_examples_run_as_written(block, repo):
 
 @pytest.mark.parametrize("body", PYTHON, ids=["python"])
 def test_python_example_runs_as_written(body, repo, capsys):
-    exec(compile(body, "README.md", "exec"), {})  # the README's evaluate(...): the pipeline
+    exec(compile(body, "docs/getting-started.md", "exec"), {})  # its evaluate(...): the pipeline
     quality, accuracy = capsys.readouterr().out.split()
     assert 0.5 < float(quality) <= 1.0 and float(accuracy) > 0
     assert (repo / "result.json").stat().st_size > 0
