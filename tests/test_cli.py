@@ -191,3 +191,22 @@ def test_memory_guard_stops_before_the_work(tmp_path):
     line, = proc.stderr.strip().splitlines()
     assert "needs about 0.5 GB of memory, more than the limit of 0.1 GB" in line
     assert "--truth-resolution" in line and "Traceback" not in proc.stderr
+
+
+def test_margin_grows_the_part_of_the_truth_a_partial_map_is_scored_against():
+    """--margin (an option added by its line in the option table alone): a partial map (the
+    sample cut at x = 8 m) is scored against more truth features with a wider margin around
+    its footprint, so its quality cannot rise; the JSON and the command line record it."""
+    def scored(margin: str) -> dict:
+        proc = run("eval", str(SAMPLE / "scan.ply"), str(SAMPLE / "truth.png"), "--map-crop",
+                   "-100,-100,8,100", "--detectors", "harris", "--no-noref", "--margin", margin,
+                   "--json", "-")
+        assert proc.returncode == 0, proc.stderr
+        return json.loads(proc.stdout)
+
+    narrow, wide = scored("0"), scored("2")
+    assert (narrow["settings"]["footprint"]["margin"], wide["settings"]["footprint"]["margin"]) \
+        == (0.0, 2.0)
+    assert "--margin 2.0" in wide["pcmapq"]["command"]
+    n, w = narrow["detectors"]["harris"], wide["detectors"]["harris"]
+    assert w["truth_features"] > n["truth_features"] and w["quality"] <= n["quality"]

@@ -241,6 +241,10 @@ OPTIONS: tuple[Option, ...] = (
            metavar="<" + "|".join(r for r in FOOTPRINT_RULES if r != "seen") + ">",
            read=parse_footprint, commands=(EVAL, BATCH, TRACK),
            helps={TRACK: "As eval's; 'auto' is 'seen': the area the scans so far saw."}),
+    Option("margin", "footprint.margin", FLOAT,
+           "The map's footprint is grown by this much, metres: truth features that far "
+           "outside the area the map observed still count as missing.", 0.0,
+           commands=(EVAL, BATCH, TRACK)),
     Option("full", "footprint.full", FLAG,
            "Score against the whole truth, not only the part the map covers."),
     Option("noref", "noref.enabled", SWITCH,
