@@ -25,8 +25,9 @@ from pcmapq.core.transform import Similarity2D
 from pcmapq.io.writers import write_ros_map
 from pcmapq.testing import synth
 
-#: Dask's worker environment (``distributed.nanny.pre-spawn-environ``) unset, as the README
-#: advises: its MALLOC_TRIM_THRESHOLD_ and one-thread BLAS/OpenMP slow pcmapq down.
+#: Dask's worker environment (``distributed.nanny.pre-spawn-environ``) unset, as
+#: docs/commands/batch.md advises: its MALLOC_TRIM_THRESHOLD_ and one-thread BLAS/OpenMP slow
+#: pcmapq down.
 UNSET = {f"distributed.nanny.pre-spawn-environ.{k}": None for k in (
     "MALLOC_TRIM_THRESHOLD_", "OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS")}
 #: The truth's plan (metres) and the resolution of every image, metres per pixel.
@@ -75,7 +76,7 @@ def main(n: int) -> None:
         runs = [timed("1 local worker", rows, folder / "w1", workers=1),
                 timed("2 local workers", rows, folder / "w2", workers=2)]
         for label, config in (("Dask's default worker environment", {}),
-                              ("worker environment unset (README)", UNSET)):
+                              ("worker environment unset (docs/commands/batch.md)", UNSET)):
             with dask.config.set(config), LocalCluster(
                     n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
                     dashboard_address=None) as cluster:

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import replace
+from pathlib import Path
 
 import pytest
 import typer
@@ -138,3 +139,18 @@ def test_inspect_takes_its_noref_settings_from_the_table_with_no_voxel_by_defaul
     ctx = command("inspect").make_context("inspect", ["m.ply", "--radius", "0.2"])
     settings = settings_of(ctx, "inspect", ctx.params)
     assert settings.noref.radius == 0.2 and settings.noref.voxel == 0.0
+
+
+def test_the_command_pages_list_the_tables_options():
+    """docs/commands/*.md show each command's settings options as the table has them
+    (python tools/options_doc.py writes them)."""
+    from pcmapq.report.docs_tables import BLOCK, FIGURE_BLOCK, update
+
+    docs = Path(__file__).resolve().parents[1] / "docs"
+    pages = [*sorted((docs / "commands").glob("*.md")), docs / "ci.md"]
+    shown = {m[2] for page in pages for m in BLOCK.finditer(page.read_text())}
+    assert shown == {EVAL, BATCH, "track", "inspect"}
+    assert FIGURE_BLOCK.search((docs / "ci.md").read_text())
+    for page in pages:
+        assert update(page.read_text()) == page.read_text(), \
+            f"{page.name}: run python tools/options_doc.py"

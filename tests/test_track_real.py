@@ -122,10 +122,10 @@ def test_calib_without_reference_poses_is_refused(tmp_path) -> None:
 
 @pytest.mark.e2e
 def test_a_log_scored_against_itself_ends_at_one(tmp_path) -> None:
-    """The README's FHW run against itself (docs/metrics.md, 'A run scored against itself'):
-    at the last step the map is the truth, every quality and precision 1; its coverage under
-    the 'seen' footprint stays below 1 by the far walls drawn as dots (0.953), and is 1 with
-    --footprint all."""
+    """The FHW run of docs/commands/track.md against itself (docs/metrics.md, 'A run scored
+    against itself'): at the last step the map is the truth, every quality and precision 1;
+    its coverage under the 'seen' footprint stays below 1 by the far walls drawn as dots
+    (0.953), and is 1 with --footprint all."""
     log = shared("carmen", "fhw-corrected.log.gz")
     for footprint, coverage in (("auto", (0.9, 0.99)), ("all", (1.0, 1.0))):
         out = tmp_path / footprint

@@ -6,13 +6,8 @@ Three stages with correspondence distances 2, 1 and 0.5 ``voxel``, the last on c
 downsampled at ``voxel / 2``; target normals from each target point's 20 nearest neighbours.
 small_gicp runs on one thread, so the result is the same bit for bit from run to run.
 
-Chosen by measurement (docs/benchmarks.md, same RANSAC guess, CPU seconds of the refinement on
-20 KITTI scans at 0.3 m): small_gicp 4.7 s; the NumPy Gauss-Newton ICP with Tukey weights it
-replaced 12.9 s; Open3D's point-to-plane ICP with a Tukey kernel 3.3-5.1 s, but repeatable only
-with Open3D held to one thread for the whole process, and its results are the NumPy ones: from
-the identity 50 iterations a stage leave KITTI at fitness 0.900 (small_gicp 0.926), and the
-pair turned by 150 degrees ends 1.25 degrees off the truth (0.23 with 20-neighbour normals;
-small_gicp 0.09).
+small_gicp over Open3D's ICP: repeatable without holding Open3D to one thread, and closer to
+the truth on the KITTI pairs (docs/benchmarks.md, "Choices behind the code").
 """
 
 from __future__ import annotations

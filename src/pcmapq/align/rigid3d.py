@@ -18,8 +18,7 @@ stay small and sums precise with UTM coordinates); ``T`` is given back in the in
    RMSE of those inlier distances, metres.
 
 Repeated runs give identical results. Cost grows with the clouds; on outdoor maps a ``voxel`` of
-0.5-1 m is the practical choice (20 KITTI scans: 4 s of CPU at 0.5 m, 9 s at 0.3; about half
-of it ICP, most of the rest normals and FPFH).
+0.5-1 m is the practical choice (docs/benchmarks.md, "3D registration").
 """
 
 from __future__ import annotations

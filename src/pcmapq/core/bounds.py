@@ -1,8 +1,8 @@
 """Bounding boxes: of many points, column by column, and of the nonzero cells of an image;
 the radius of points about their centroid.
 
-NumPy reduces an (N, d) array over axis 0 with a strided inner loop: for 158,000 points of
-three columns about 4 ms, against 0.16 ms for the columns one at a time. The box is the same.
+NumPy reduces an (N, d) array over axis 0 with a strided inner loop, which the columns one at
+a time avoid (the box is the same, for a fraction of the time).
 """
 
 from __future__ import annotations

@@ -37,7 +37,7 @@ MIN_CELLS = 10
 #: on free space (at most 15 % in every real map of ../shared/data, 5 % in data/sample/truth.png).
 #: More is a picture read inverted (``negate: 1`` on a black-walls image, free space read above
 #: occupied_thresh) or a filled area, not walls; it is refused (exit 1) before the alignment,
-#: whose cost grows with the occupied cells (the inverted sample took 10 times the CPU time).
+#: whose cost grows with the occupied cells.
 MAX_OCCUPIED_SHARE = 0.5
 #: Walls narrower than this across their main direction, metres, are one straight line.
 LINE_WIDTH = 0.5

@@ -136,8 +136,7 @@ def gaussian(image: np.ndarray, sigma_px: float) -> np.ndarray:
 
 
 #: Cells of a strip of :func:`by_strips`: strips of a few MB keep a step's temporaries in the
-#: CPU's cache (256 rows of an 8000-cell image: Harris and ridges about 25 % faster than
-#: strips of 1024 rows).
+#: CPU's cache.
 STRIP_CELLS = 1 << 21
 
 

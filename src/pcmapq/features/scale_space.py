@@ -107,7 +107,7 @@ def _dog(stack: np.ndarray) -> np.ndarray:
 
 
 #: Cells of a strip of :func:`_peaks`: a few strips of this size stay in the CPU's cache,
-#: which makes the test several times faster on a large image than whole-image passes.
+#: where whole-image passes of a large image do not.
 STRIP_CELLS = 1 << 18
 
 

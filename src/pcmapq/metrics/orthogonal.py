@@ -28,10 +28,9 @@ from pcmapq.metrics.noref import MAX_NN, flat, neighbourhood_sums
 WARD_CUT = 0.1
 ORTHOGONAL_COS = 0.1
 MIN_CLUSTER = 5
-#: Ward clustering holds N^2 / 2 distances and takes N^2 time (400 MB and about 3 s for 10,000
-#: points): more planar points than this are clustered through an evenly spaced sample of this
-#: many. One scan stays below it (7,336 in KITTI 00's first scan at 0.3 m), so an extraction
-#: from a scan is map-metrics' own.
+#: Ward clustering holds N^2 / 2 distances and takes N^2 time: more planar points than this are
+#: clustered through an evenly spaced sample of this many. One scan stays below it (7,336 in
+#: KITTI 00's first scan at 0.3 m), so an extraction from a scan is map-metrics' own.
 MAX_WARD_POINTS = 10_000
 
 

@@ -32,10 +32,9 @@ def wall_distances(target: np.ndarray, source: np.ndarray, resolution: float,
 
     The distances are the full grid's (a float32 transform, 4 bytes a cell), so each shown value
     is one the statistics count; a transform on the pooled target would be cheaper but off by
-    up to a pooled cell's diagonal (24 mm on the Gazebo truth, pooled 9-fold; 1 to 1.5 s and
-    0.3 GB saved there). The smallest, because a block's distance to the target is that of its
-    nearest wall cell, as a cell's is; the block's other wall cells are at most its diagonal
-    farther.
+    up to a pooled cell's diagonal. The smallest, because a block's distance to the target is
+    that of its nearest wall cell, as a cell's is; the block's other wall cells are at most its
+    diagonal farther.
     """
     cells = distance_to(target)
     np.copyto(cells, np.float32(np.nan), where=~source)

@@ -182,3 +182,4 @@ def _number(doc: object, key: str, where: str = "") -> float | None:
     if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
         raise ValueError(f"'{where + '.' if where else ''}{key}' is not a number: {value!r}")
     return float(value)
+

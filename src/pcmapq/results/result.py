@@ -143,7 +143,7 @@ class Result:
                 if (note := self.note(name)) is not None]
 
     def to_dict(self, features: bool = True) -> dict:
-        """The JSON document (see README): plain types, floats rounded to DECIMALS.
+        """The JSON document (docs/formats.md): plain types, floats rounded to DECIMALS.
         ``features=False``: the figures alone, with the lists of matched, missing and extra
         features left empty (a figures row needs none of them; Intel's final map has about
         3000, and rounding them was most of the work)."""

@@ -145,7 +145,8 @@ class NoRefConfig:
 #: ``eval``'s voxel for the 3D no-reference figures, metres: a tenth of LiDAR's radius. It bounds
 #: their cost on dense clouds and puts maps of unlike density on one footing (MME depends on it).
 EVAL_NOREF_VOXEL = 0.1
-#: ``eval``'s Ward tree for MOM's planes: 2,000 normals, 0.06 s and 16 MB (10,000: 3 s, 400 MB).
+#: ``eval``'s Ward tree for MOM's planes: 2,000 normals, a small share of the run (the tree's
+#: memory and time grow with the square of the normals).
 EVAL_MAX_WARD = 2_000
 
 
@@ -195,7 +196,7 @@ class Settings:
                                     {name: DETECTORS[name].params(**p)
                                      for name, p in m["params"].items()}),
             distances=DistancesConfig(tuple(doc["distances"]["taus"])),
-            noref=NoRefConfig(**doc.get("noref", {"enabled": False})))  # older: none
+            noref=NoRefConfig(**doc["noref"]))
 
 
 def _plain(value):

@@ -201,7 +201,8 @@ OPTIONS: tuple[Option, ...] = (
            metavar="<x0,y0,x1,y1>", read=lambda t: parse_box(t, "--truth-crop"),
            show=show_list),
     Option("init", "alignment.init", TEXT,
-           "Initial guess x,y,yaw (m, m, deg), map -> truth; skips the global search.",
+           "Initial guess x,y,yaw (m, m, deg), map -> truth; skips the global search (ICP "
+           "still refines).", metavar="<x,y,yaw>",
            read=parse_init, show=show_init, commands=(EVAL, BATCH, TRACK),
            helps={TRACK: "Initial guess x,y,yaw (m, m, deg), map -> truth, of the first "
                          "step; skips the global search."}),
@@ -231,7 +232,7 @@ OPTIONS: tuple[Option, ...] = (
            "Working voxel of the 3D registration of two 3D clouds, metres (0.5-1 for outdoor "
            "maps).", 0.01, flag="--voxel-3d"),
     Option("tau", "distances.taus", TEXT,
-           "Distance thresholds of the F-score, metres, comma-separated.",
+           "Distance thresholds of the F-score, metres, comma-separated.", metavar="<M,M,...>",
            read=parse_taus, show=show_list, commands=(EVAL, BATCH, TRACK),
            helps={TRACK: "Distance thresholds of the F-score and wall precision, metres."}),
     Option("footprint", "footprint.rule", TEXT,
