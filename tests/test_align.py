@@ -279,11 +279,12 @@ def test_thinned_map_runs_light_icp_and_lands(campus):
     ICP_POINTS of its points against the truth at THINNED_TRUTH_VOXEL, and the point-to-line
     finish on all of them. Thinned to 0.16 m voxels, the campus lands within 0.05 m and 0.05
     degrees (0.6 mm, as before the point-to-point stages were lightened)."""
-    from pcmapq.align.planar import ICP_POINTS, THINNED_TRUTH_VOXEL, _icp_inputs, _thinned
+    from pcmapq.align.planar import ICP_POINTS, THINNED_TRUTH_VOXEL, _icp_inputs
+    from pcmapq.core.voxels import thinned
 
     t_true, map_xy, truth_xy = campus
     params = AlignParams(max_points=50_000)
-    map_ds, map_voxel = _thinned(map_xy, params.voxel, params.max_points)
+    map_ds, map_voxel = thinned(map_xy, params.voxel, params.max_points)
     assert map_voxel > params.voxel and len(map_ds) > ICP_POINTS
     icp_map, schedule = _icp_inputs(map_ds, True, ((1.0, 0.2), (0.2, 0.05)))
     assert len(icp_map) == ICP_POINTS and np.ptp(icp_map, axis=0) == pytest.approx(

@@ -198,7 +198,7 @@ def test_local_batch_is_eval_bit_for_bit(inputs, local):
 def test_a_row_that_raises(inputs, tmp_path, monkeypatch):
     """An unexpected exception in a row is the row's failure (exit 1, one line), not the
     batch's."""
-    import pcmapq.batch.run as run_module
+    import pcmapq.batch.row as run_module
 
     def explode(*_args, **_kwargs):
         raise RuntimeError("boom\nsecond line")
@@ -291,7 +291,7 @@ def test_dask_worker_killed_mid_task(inputs, local, cluster, tmp_path):
         import os
         import signal
 
-        import pcmapq.batch.run as run_module
+        import pcmapq.batch.row as run_module
 
         original = run_module.evaluate
 

@@ -14,16 +14,10 @@ import pytest
 
 from pcmapq.core.grid import MetricGrid
 from pcmapq.evaluation.pipeline import evaluate
+from pcmapq.report.canvas import extent, overlay, shade, thinned
 from pcmapq.report.heatmap import distance_heatmap, wall_distances
 from pcmapq.report.html import report_html
-from pcmapq.report.plot import (
-    extent,
-    overlay,
-    png_bytes,
-    shade,
-    thinned,
-    vectorial_figure,
-)
+from pcmapq.report.plot import png_bytes, vectorial_figure
 from pcmapq.report.style import ARROW_SCALE, DPI, FIGURE_WIDTH_PX, MAP_LIGHT
 from pcmapq.report.text import number
 from pcmapq.settings import MatchingConfig, Settings

@@ -19,7 +19,8 @@ from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.features import Features
 from pcmapq.match import Matching
 from pcmapq.report.html import report_html
-from pcmapq.report.viewer import STYLE, VIEWER_PX, viewer_html
+from pcmapq.report.viewer import VIEWER_PX, viewer_html
+from pcmapq.report.viewer_page import STYLE
 from pcmapq.results.result import DetectorResult, Result
 from pcmapq.settings import MatchingConfig, Settings
 from pcmapq.testing import synth

@@ -10,7 +10,8 @@ from typer.testing import CliRunner
 
 from pcmapq.cli import app
 from pcmapq.core.errors import InputError
-from pcmapq.io.occupancy import load_occupancy, read_yaml
+from pcmapq.io.map_yaml import read_yaml
+from pcmapq.io.occupancy import load_occupancy
 
 SAMPLE = Path(__file__).resolve().parents[1] / "data" / "sample"
 

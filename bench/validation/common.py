@@ -16,7 +16,8 @@ import numpy as np
 
 from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.io import PointMap
-from pcmapq.io.occupancy import MapMeta, read_levels
+from pcmapq.io.map_yaml import MapMeta
+from pcmapq.io.occupancy import read_levels
 from pcmapq.report.text import score
 from pcmapq.results.result import Result
 from pcmapq.settings import Settings

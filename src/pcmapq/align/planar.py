@@ -29,7 +29,7 @@ from pcmapq.align.point_to_point import DEFAULT_SCHEDULE, IcpTarget, refine_poin
 from pcmapq.align.pyramid import descend
 from pcmapq.align.similarity_icp import SimilarityTarget, refine_similarity, similarity_schedule
 from pcmapq.core.transform import Similarity2D, wrapped
-from pcmapq.core.voxels import evenly, voxel_centroids, voxel_count
+from pcmapq.core.voxels import evenly, thinned, voxel_centroids
 
 #: The truth keeps this many times the map's ``max_points``: a sparse target would put map points
 #: on its walls farther than the tolerance from its nearest point.
@@ -108,7 +108,7 @@ class RigidTarget:
     def __init__(self, truth_xy: np.ndarray, params: AlignParams = AlignParams()) -> None:
         """truth_xy: (M, 2) metres, truth frame; params: those of the alignments to come."""
         self.voxel, self.max_points = params.voxel, params.max_points
-        self.points, _ = _thinned(np.asarray(truth_xy, dtype=np.float64).reshape(-1, 2),
+        self.points, _ = thinned(np.asarray(truth_xy, dtype=np.float64).reshape(-1, 2),
                                   params.voxel, TRUTH_POINTS * params.max_points)
         self.tree = cKDTree(self.points) if len(self.points) else None
         self.lines = LineTarget(self.points, self.tree) if len(self.points) else None
@@ -151,7 +151,7 @@ def _align_rigid(map_xy: np.ndarray, target: RigidTarget, params: AlignParams,
     the first widened to twice the search's cell; see :func:`_icp_inputs` for a thinned map),
     then point-to-line on the winner."""
     voxel, tolerance = params.voxel, params.tolerance
-    map_ds, map_voxel = _thinned(map_xy, voxel, params.max_points)
+    map_ds, map_voxel = thinned(map_xy, voxel, params.max_points)
     truth_ds, tree = target.points, target.tree
     start = Similarity2D() if init is None else init
     if len(map_ds) == 0 or len(truth_ds) == 0:
@@ -290,17 +290,6 @@ def _scored(map_xy: np.ndarray, tree: cKDTree, tf: Similarity2D, tolerance: floa
     """``tf`` scored on the map (N, 2, map frame) against the truth tree; method unset."""
     fitness, rmse = _score_tree(map_xy, tree, tf, tolerance)
     return Alignment(tf, fitness, rmse, tolerance, "")
-
-
-def _thinned(xy: np.ndarray, voxel: float, max_points: int) -> tuple[np.ndarray, float]:
-    """Voxel centroids of ``xy`` (N, 2, metres) at ``voxel`` metres; when more than
-    ``max_points``, at the voxel grown by the ratio (about ``max_points`` remain on walls).
-    Returns them and the voxel used, metres. Beyond ``max_points`` points the voxels are counted
-    first, so a cloud to be thinned is grouped once, at the grown voxel."""
-    if len(xy) > max_points and (count := voxel_count(xy, voxel)) > max_points:
-        grown = voxel * count / max_points
-        return voxel_centroids(xy, grown), grown
-    return voxel_centroids(xy, voxel), voxel
 
 
 def _map_at_scale(map_xy: np.ndarray, tf: Similarity2D, voxel: float) -> np.ndarray:

@@ -9,7 +9,7 @@ from contextlib import contextmanager
 from rich.console import Console
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
-from pcmapq.batch.run import Outcome
+from pcmapq.batch.row import Outcome
 
 
 @contextmanager

@@ -164,3 +164,14 @@ def evenly(points: np.ndarray, count: int) -> np.ndarray:
     if len(points) <= count:
         return points
     return points[np.linspace(0, len(points) - 1, count).astype(np.int64)]
+
+
+def thinned(xy: np.ndarray, voxel: float, max_points: int) -> tuple[np.ndarray, float]:
+    """Voxel centroids of ``xy`` (N, 2, metres) at ``voxel`` metres; when more than
+    ``max_points``, at the voxel grown by the ratio (about ``max_points`` remain on walls).
+    Returns them and the voxel used, metres. Beyond ``max_points`` points the voxels are counted
+    first, so a cloud to be thinned is grouped once, at the grown voxel."""
+    if len(xy) > max_points and (count := voxel_count(xy, voxel)) > max_points:
+        grown = voxel * count / max_points
+        return voxel_centroids(xy, grown), grown
+    return voxel_centroids(xy, voxel), voxel

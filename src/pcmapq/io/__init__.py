@@ -11,13 +11,8 @@ from pathlib import Path
 from pcmapq.core.errors import InputError
 from pcmapq.io.carmen import is_carmen, load_carmen
 from pcmapq.io.clouds import CLOUD_SUFFIXES, PointMap, load_cloud
-from pcmapq.io.occupancy import (
-    IMAGE_SUFFIXES,
-    YAML_SUFFIXES,
-    OccupancyMap,
-    Thresholds,
-    load_occupancy,
-)
+from pcmapq.io.map_yaml import YAML_SUFFIXES, Thresholds
+from pcmapq.io.occupancy import IMAGE_SUFFIXES, OccupancyMap, load_occupancy
 
 __all__ = ["OccupancyMap", "PointMap", "Thresholds", "load_map"]
 

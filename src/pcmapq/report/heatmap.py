@@ -14,7 +14,8 @@ from matplotlib.figure import Figure
 
 from pcmapq.core.morphology import distance_to
 from pcmapq.raster.pool import max_pool, min_pool
-from pcmapq.report.plot import WIDTH_IN, extent, frame, plt, pooling  # Agg backend
+from pcmapq.report.canvas import extent, frame, pooling
+from pcmapq.report.plot import WIDTH_IN, plt  # Agg backend
 from pcmapq.report.style import TEXT_PT, TITLE_PT
 from pcmapq.results.result import Result
 

@@ -15,8 +15,8 @@ from pcmapq.report.heatmap import distance_heatmap
 from pcmapq.report.plot import png_bytes, vectorial_figure
 from pcmapq.report.style import ARROW_SCALE, FIGURE_WIDTH_PX
 from pcmapq.report.text import number, score
-from pcmapq.report.viewer import STYLE as VIEWER_STYLE
 from pcmapq.report.viewer import nearest_distances, viewer_html
+from pcmapq.report.viewer_page import STYLE as VIEWER_STYLE
 from pcmapq.results.result import DetectorResult, Result
 
 STYLE = """

@@ -10,7 +10,7 @@ from pcmapq.align.params import AlignParams
 from pcmapq.core.transform import Similarity2D
 from pcmapq.features import DETECTORS, default_params
 from pcmapq.io.extent import Box
-from pcmapq.io.occupancy import Thresholds
+from pcmapq.io.map_yaml import Thresholds
 from pcmapq.metrics.distances import DEFAULT_TAUS
 from pcmapq.metrics.noref import LIDAR_RADIUS, MAX_NN, MIN_KNN
 from pcmapq.metrics.orthogonal import MAX_WARD_POINTS

@@ -14,7 +14,7 @@ import yaml
 
 from pcmapq.core.errors import InputError
 from pcmapq.core.transform import Similarity2D
-from pcmapq.io.occupancy import Thresholds
+from pcmapq.io.map_yaml import Thresholds
 from pcmapq.io.writers import one_line
 from pcmapq.settings import Settings
 from pcmapq.settings.build import check
