@@ -20,6 +20,7 @@ import numpy as np
 from pcmapq.align import AlignParams, align
 from pcmapq.align.similarity_icp import fit_similarity
 from pcmapq.core.transform import Similarity2D
+from pcmapq.testing.realdata.halmstad import keypoint_pairs
 
 DATA = Path(__file__).resolve().parents[2] / "shared" / "data" / "halmstad"
 SKIP = {"E5_08"}
@@ -36,17 +37,6 @@ def occupied_pixels(mask: np.ndarray) -> np.ndarray:
     """Centres (N, 2) of the true pixels, x = column, y = rows - 1 - row."""
     v, u = np.nonzero(mask)
     return np.column_stack([u, mask.shape[0] - 1 - v]).astype(np.float64)
-
-
-def keypoint_pairs(data: Path, name: str, building: str) -> tuple[np.ndarray, np.ndarray]:
-    """(map keypoints, layout keypoints), (K, 2) pixels, paired row by row; pairs with a missing
-    side (None rows of object arrays) are dropped."""
-    notes = data / "annotations"
-    pairs = np.load(notes / f"association_{name}_{building}_layout.npy", allow_pickle=True)
-    pairs = np.array([p for p in pairs if p[0] is not None and p[1] is not None], dtype=int)
-    map_keys = np.load(notes / f"keypoints_{name}.npy", allow_pickle=True).astype(np.float64)
-    layout_keys = np.load(notes / f"keypoints_{building}_layout.npy", allow_pickle=True)
-    return map_keys[pairs[:, 0]], layout_keys.astype(np.float64)[pairs[:, 1]]
 
 
 def run(data: Path) -> list[tuple[str, Similarity2D, Similarity2D, float, float]]:

@@ -14,14 +14,12 @@ import pytest
 from typer.testing import CliRunner
 
 from pcmapq.cli import app
+from pcmapq.testing.paths import REPO, SHARED_DATA
 
-from .conftest import SHARED_DATA
-
-ROOT = Path(__file__).resolve().parents[1]
-README = (ROOT / "README.md").read_text()
+README = (REPO / "README.md").read_text()
 #: The pages whose examples run: the README, getting started and one page per command.
-PAGES = [ROOT / "README.md", ROOT / "docs" / "getting-started.md",
-         *sorted((ROOT / "docs" / "commands").glob("*.md"))]
+PAGES = [REPO / "README.md", REPO / "docs" / "getting-started.md",
+         *sorted((REPO / "docs" / "commands").glob("*.md"))]
 #: Fenced blocks of every page: (language, body).
 BLOCKS = [block for page in PAGES
           for block in re.findall(r"^```(\w*)\n(.*?)^```", page.read_text(), flags=re.S | re.M)]
@@ -52,7 +50,7 @@ def repo(tmp_path, monkeypatch) -> Path:
     README writes them; the examples' outputs land here."""
     work = tmp_path / "repo"
     work.mkdir()
-    (work / "data").symlink_to(ROOT / "data")
+    (work / "data").symlink_to(REPO / "data")
     (tmp_path / "shared").mkdir()
     (tmp_path / "shared" / "data").symlink_to(SHARED_DATA)
     monkeypatch.chdir(work)
@@ -65,6 +63,7 @@ def echo(words: list[str]) -> None:
     Path(words[split + 1]).write_text(" ".join(words[1:split]) + "\n")
 
 
+@pytest.mark.unit
 def test_the_readme_has_examples():
     assert len(SHELL) >= 3 and len(PYTHON) == 1
     assert sum(len(block) for block in SHELL) >= 10
@@ -105,9 +104,10 @@ def test_python_example_runs_as_written(body, repo, capsys):
     assert (repo / "result.json").stat().st_size > 0
 
 
-API = (ROOT / "docs" / "api.md").read_text()
+API = (REPO / "docs" / "api.md").read_text()
 
 
+@pytest.mark.unit
 def test_the_api_page_runs_as_written(repo, capsys):
     """docs/api.md's example: evaluate, inspect and track through `import pcmapq`, printing
     what the commands print."""

@@ -1,6 +1,7 @@
 """Write the settings options of every command page (docs/commands/*.md) from the option
 table, and the figures' names in docs/ci.md from the table of figures:
-``python tools/options_doc.py``. tests/test_settings_table.py checks they are current."""
+``python tools/options_doc.py``. tests/unit/settings/test_option_table.py checks they are
+current."""
 
 from __future__ import annotations
 

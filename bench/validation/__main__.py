@@ -12,7 +12,8 @@ import sys
 import time
 from pathlib import Path
 
-from . import reference
+from pcmapq.testing import reference
+
 from .common import DATA, Record
 from .document import DOC, SECTIONS, write, write_one
 

@@ -1,12 +1,8 @@
-"""What the sections share: the data folder, cases and the record of their figures, timed runs
-of the pipeline, and how figures are written."""
+"""What the sections share: the data folder, cases and the record of their figures, and how
+figures are written (timed runs of the pipeline: :mod:`pcmapq.testing.runs`)."""
 
 from __future__ import annotations
 
-import contextlib
-import resource
-import shutil
-import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -14,15 +10,10 @@ from typing import Generic, Protocol, TypeVar
 
 import numpy as np
 
-from pcmapq.evaluation.pipeline import evaluate
-from pcmapq.io import PointMap
 from pcmapq.io.map_yaml import MapMeta
 from pcmapq.io.occupancy import read_levels
 from pcmapq.report.text import score
 from pcmapq.results.result import Result
-from pcmapq.settings import Settings
-
-from .reference import summary
 
 ROOT = Path(__file__).resolve().parents[2]
 DATA = ROOT.parent / "shared" / "data"
@@ -65,65 +56,6 @@ class Section:
     files: dict[str, bytes] = field(default_factory=dict)
 
 
-@dataclass(frozen=True)
-class Run:
-    """One timed evaluation: the result, seconds per progress step, in all, and the peak
-    resident memory (GB) of the process during it."""
-
-    result: Result
-    steps: dict[str, float]
-    seconds: float
-    peak_gb: float
-
-    def summary(self) -> dict:
-        return summary(self.result.to_dict())
-
-
-def reset_peak() -> None:
-    """Measure the peak resident memory afresh from now (Linux: /proc/self/clear_refs)."""
-    with contextlib.suppress(OSError):
-        Path("/proc/self/clear_refs").write_text("5")
-
-
-def peak_rss_gb() -> float:
-    """Peak resident memory of this process since :func:`reset_peak`, GB (Linux's VmHWM; the
-    peak of the whole process where /proc is absent)."""
-    with contextlib.suppress(OSError):
-        for line in Path("/proc/self/status").read_text().splitlines():
-            if line.startswith("VmHWM:"):
-                return int(line.split()[1]) / 1e6
-    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1e6
-
-
-def timed_evaluate(map_path: Path | PointMap, truth_path: Path,
-                   settings: Settings | None = None) -> Run:
-    """``evaluate`` with the time of each step, measured by its progress callback."""
-    marks: list[tuple[str, float]] = []
-    reset_peak()
-    start = time.perf_counter()
-    result = evaluate(map_path, truth_path, settings,
-                      lambda step: marks.append((step, time.perf_counter())))
-    end = time.perf_counter()
-    marks.append(("", end))
-    steps = {}
-    for i, ((step, t0), (_, t1)) in enumerate(zip(marks, marks[1:], strict=False)):
-        steps[step + (" + distances" if i == len(marks) - 2 else "")] = t1 - t0
-    return Run(result, steps, end - start, peak_rss_gb())
-
-
-def with_yaml(image: Path, folder: Path, resolution: float, **thresholds: float) -> Path:
-    """A copy of ``image`` in ``folder`` with a map_server YAML beside it (origin 0, the given
-    thresholds over ROS's defaults); returns the YAML's path."""
-    copy = folder / image.name
-    shutil.copyfile(image, copy)
-    meta = {"occupied_thresh": 0.65, "free_thresh": 0.196, **thresholds}
-    yaml_path = copy.with_suffix(".yaml")
-    yaml_path.write_text(f"image: {copy.name}\nresolution: {resolution}\norigin: [0, 0, 0]\n"
-                         f"negate: 0\noccupied_thresh: {meta['occupied_thresh']}\n"
-                         f"free_thresh: {meta['free_thresh']}\n")
-    return yaml_path
-
-
 def commonest_greys(image: Path, count: int = 3) -> list[int]:
     """The ``count`` most frequent grey values of an image as pcmapq's loader reads it (0..255),
     darkest first."""
@@ -156,17 +88,6 @@ def q_p(result: Result, name: str) -> str:
 def qualities(result: Result) -> str:
     """'harris q / p, hough q / p, sift q / p' of a result."""
     return ", ".join(f"{name} {q_p(result, name)}" for name in result.detectors)
-
-
-def f_at(result: Result, tau: float, three_d: bool = False) -> float | None:
-    """The F-score at distance threshold ``tau`` metres (of the 3D distances if asked)."""
-    dist = result.distances_3d if three_d else result.distances
-    return next((f.f for f in dist.fscores if abs(f.tau_m - tau) < 1e-9), None)
-
-
-def yaw_error(yaw_deg: float, expected_deg: float) -> float:
-    """Smallest absolute difference of two angles, degrees."""
-    return abs((yaw_deg - expected_deg + 180.0) % 360.0 - 180.0)
 
 
 def span(values: list[float], digits: int = 2) -> str:

@@ -31,9 +31,9 @@ from pcmapq.io.carmen import endpoints, read_flaser
 from pcmapq.report.plot import figure_bytes, vectorial_figure
 from pcmapq.settings import AlignmentConfig, MatchingConfig, Settings
 from pcmapq.testing import synth
+from pcmapq.testing.drift import increments, integrate
 
 from .common import Case, Record, Section
-from .drift import increments, integrate
 
 #: Scored with --force (a verdict of another place is reported, not raised), no detectors.
 SETTINGS = Settings(alignment=AlignmentConfig(force=True), matching=MatchingConfig(detectors=()))

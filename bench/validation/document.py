@@ -68,8 +68,8 @@ def opening() -> str:
         "again; `python -m bench.validation --only SECTION` prints one section (" + only
         + "); `--check` runs every case and compares its figures with its stored reference "
         "(`tests/reference/validation/<case>.json`, numbers within 1e-6), and "
-        "`tests/test_validation.py` does so for the cheap ones. How results differ from those of "
-        "earlier code: [CHANGELOG.md](../CHANGELOG.md).",
+        "`tests/realdata/test_validation.py` does so for the cheap ones. How results differ "
+        "from those of earlier code: [CHANGELOG.md](../CHANGELOG.md).",
     ])
 
 

@@ -43,7 +43,8 @@ WIDE_OUTLINES = 0.25
 #: The real maps' variants: thickened by 1 and 2 cells, thinned to their skeleton.
 THICKENED = (1, 2)
 SKELETON = "thinned to its skeleton"
-#: Lowest quality and precision the synthetic drawings must reach (tests/test_drawing.py).
+#: Lowest quality and precision the synthetic drawings must reach
+#: (tests/unit/features/test_drawing.py).
 BAR = 0.95
 
 
@@ -217,8 +218,8 @@ def section(data: Path, record: Record) -> Section:
         f"each; and at {USUAL_RESOLUTION} m, outlines {WIDE_OUTLINES} m apart), at {res} "
         f"cells, scored against the usual drawing ({USUAL_THICKNESS} m walls at "
         f"{USUAL_RESOLUTION} m) with no alignment, in both directions "
-        "(`tests/test_drawing.py`). Cells: strong features of the variant, then quality / "
-        "precision with the variant as the map, then as the truth. The detectors see the "
+        "(`tests/unit/features/test_drawing.py`). Cells: strong features of the variant, then "
+        "quality / precision with the variant as the map, then as the truth. The detectors see the "
         "walls' centre lines drawn at one width (docs/method.md, Features).", "",
         header(cols), *plans[0].rows("usual"), "",
         f"Lowest quality or precision over the {len(plans[0].variants) - 1} drawings but the "

@@ -3,34 +3,19 @@ accuracy next to the published figures, the footprint rule, time and memory per 
 
 from __future__ import annotations
 
-from dataclasses import replace
 from pathlib import Path
 
 import cv2
 
-from pcmapq.settings import AlignmentConfig, Settings, SourceConfig
+from pcmapq.testing.realdata.gazebo import BOUND_M, MAP, RESOLUTION, SETTINGS, TRUTH, run
 
-from .common import Case, Record, Run, Section, cm, qualities, timed_evaluate
+from .common import Case, Record, Section, cm, qualities
 
-#: Gazebo truth: 529 px per metre (../shared/README.md).
-RESOLUTION = 1.0 / 529.0
 #: Published map-to-truth nearest-occupied distances of this pair, cm, after per-axis rescaling
 #: of the map to the truth's size, and their sample count (../shared/README.md, from the data
 #: set's source).
 PUBLISHED_CM = {"mean": 4.06, "median": 3.15, "std": 3.64, "max": 18.5}
 PUBLISHED_SAMPLES = 56_605
-#: Bound of the check (tests/test_validation.py): mean accuracy, metres.
-BOUND_M = 0.08
-SETTINGS = Settings(truth=SourceConfig(resolution=RESOLUTION),
-                    alignment=AlignmentConfig(scale=True))
-MAP, TRUTH = "SLAM_Gen_Map.png", "Ground_Truth.png"
-
-
-def run(data: Path, footprint: str = "auto") -> Run:
-    """The Gazebo SLAM map scored against its truth, scale estimated."""
-    folder = data / "gazebo"
-    settings = replace(SETTINGS, footprint=replace(SETTINGS.footprint, rule=footprint))
-    return timed_evaluate(folder / MAP, folder / TRUTH, settings)
 
 
 def cases(data: Path) -> list[Case]:
@@ -59,7 +44,7 @@ def section(data: Path, record: Record) -> Section:
         f"{1 / RESOLUTION:.0f} px per metre, {cell_mm:.3f} mm cells): "
         f"`Settings(truth=SourceConfig(resolution=1/{1 / RESOLUTION:.0f}), "
         "alignment=AlignmentConfig(scale=True))`, one scale for both "
-        "axes (`tests/test_validation.py` checks the bounds).", "",
+        "axes (`tests/realdata/test_validation.py` checks the bounds).", "",
         f"Alignment: scale {tf.scale:.4f} (a map pixel is {tf.scale * cell_mm:.3f} mm; the "
         f"images' size ratios are {cols / map_cols:.4f} across, {rows / map_rows:.4f} down), "
         f"yaw {tf.yaw_deg:.3f} deg, fitness {r.alignment.fitness:.3f}, inlier RMSE "

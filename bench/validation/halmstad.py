@@ -4,7 +4,6 @@ per building."""
 
 from __future__ import annotations
 
-import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -12,71 +11,21 @@ import numpy as np
 
 from bench import bench_scale
 from pcmapq.core.transform import Similarity2D
-from pcmapq.io import OccupancyMap, load_map
-from pcmapq.io.occupancy import classify, read_levels
+from pcmapq.io.occupancy import classify
 from pcmapq.raster.draw import OCCUPIED
 from pcmapq.report.text import number
-from pcmapq.results.result import Result
-from pcmapq.settings import AlignmentConfig, Settings, SourceConfig
-
-from .common import (
-    ROS,
-    Case,
-    Record,
-    Run,
-    Section,
-    commonest_greys,
-    f_at,
-    header,
-    q_p,
-    row,
-    timed_evaluate,
-    with_yaml,
-    yaw_error,
+from pcmapq.testing.realdata.halmstad import (
+    DARK,
+    MAPS,
+    PLAN_RESOLUTION,
+    keypoint_residual,
+    paths,
+    pipeline,
+    walls_read_occupied,
 )
+from pcmapq.testing.runs import Run, f_at, yaw_error
 
-#: Maps scored with the full pipeline (one per building).
-MAPS = ("E5_09", "F5_01", "HIH_01", "KPT4A_01")
-#: Assumed resolution of every layout image, metres per pixel.
-PLAN_RESOLUTION = 0.05
-SETTINGS = Settings(alignment=AlignmentConfig(scale=True),
-                    truth=SourceConfig(resolution=PLAN_RESOLUTION))
-#: A layout's wall cores: pixels darker than this grey.
-DARK = 50
-
-
-def walls_read_occupied(image: Path, dark: float = DARK) -> float:
-    """Share of an image's dark pixels (grey < ``dark``, opaque) that pcmapq's loader, with
-    ROS's default thresholds, reads as occupied."""
-    levels, channels, scale, transparent = read_levels(image)
-    state = classify(levels, channels, scale, transparent, ROS)
-    grey = levels / channels * scale
-    walls = (grey < dark) & ~transparent
-    return float((state[walls] == OCCUPIED).mean()) if walls.any() else 0.0
-
-
-def halmstad_truth(layout: Path, folder: Path) -> Path:
-    """The layout as pcmapq should read it: the image itself when ROS's thresholds read its
-    walls as occupied, else a copy with a YAML whose occupied threshold does."""
-    if walls_read_occupied(layout) >= 0.95:
-        return layout
-    return with_yaml(layout, folder, PLAN_RESOLUTION, occupied_thresh=0.55)
-
-
-def keypoint_residual(result: Result, map_path: Path, map_keys: np.ndarray,
-                      layout_keys: np.ndarray) -> float:
-    """Median distance, layout pixels, between the annotated map keypoints carried by the
-    pipeline's alignment and their layout partners. Keypoints: (K, 2) pixels, x = column,
-    y = rows - 1 - row."""
-    source = load_map(map_path, None, PLAN_RESOLUTION)
-    if not isinstance(source, OccupancyMap):
-        raise TypeError(f"{map_path}: not an image")
-    rows = source.grid.shape[0]
-    uv = np.column_stack([map_keys[:, 0], rows - 1 - map_keys[:, 1]])
-    truth_uv = result.grid.xy_to_pixels(
-        result.transform.apply(source.grid.pixels_to_xy(uv)))
-    got = np.column_stack([truth_uv[:, 0], result.grid.shape[0] - 1 - truth_uv[:, 1]])
-    return float(np.median(np.linalg.norm(got - layout_keys, axis=1)))
+from .common import ROS, Case, Record, Section, commonest_greys, header, q_p, row
 
 
 @dataclass(frozen=True)
@@ -91,20 +40,6 @@ class Alignments:
                        "yaw_deg": round(got.yaw_deg, 6), "scale": round(got.scale, 6),
                        "residual_px": round(residual, 6)}
                 for name, _, got, residual, _ in self.rows}
-
-
-def paths(data: Path, name: str) -> tuple[Path, Path]:
-    """A map's image and its building's layout."""
-    building = name.rsplit("_", 1)[0]
-    folder = data / "halmstad" / "maps" / building
-    return folder / "pseudo_occupancy" / f"{name}.png", folder / "layout" / f"{building}_layout.png"
-
-
-def pipeline(data: Path, name: str) -> Run:
-    """One map through the pipeline against its layout."""
-    map_path, layout = paths(data, name)
-    with tempfile.TemporaryDirectory(prefix="pcmapq_halmstad_") as tmp:
-        return timed_evaluate(map_path, halmstad_truth(layout, Path(tmp)), SETTINGS)
 
 
 def cases(data: Path) -> list[Case]:

@@ -17,8 +17,9 @@ from pcmapq.mapping import (
     lidar_poses_from_camera,
     read_kitti_poses,
 )
+from pcmapq.testing.runs import Run, f_at, timed_evaluate
 
-from .common import Case, Record, Run, Section, f_at, q_p, timed_evaluate
+from .common import Case, Record, Section, q_p
 
 #: Scans of the maps (the first ones of kitti00/velodyne).
 SCANS = 10
@@ -87,7 +88,7 @@ def section(data: Path, record: Record) -> Section:
         f"({maps.build_seconds[0]:.1f} s), and `pcmapq map --poses poses.txt --calib Tr.txt` "
         f"({maps.build_seconds[1]:.1f} s; the map built in the first LiDAR frame, inv(Tr) P_k "
         "Tr), then `pcmapq eval kiss.ply ref.ply` (both 3D, so registered in 3D; "
-        f"{maps.run.seconds:.1f} s; `tests/test_cli_mapping.py` runs the same on fewer "
+        f"{maps.run.seconds:.1f} s; `tests/realdata/test_map_kitti_cli.py` runs the same on fewer "
         f"scans). 3D fitness {reg.fitness:.2f} (RMSE {reg.rmse_m:.3f} m); x {tf.tx:.3f} m, "
         f"y {tf.ty:.3f} m, yaw {tf.yaw_deg:.2f} degrees; 3D accuracy mean "
         f"{d3.accuracy.mean:.3f} m (median {d3.accuracy.median:.3f}, 95th percentile "

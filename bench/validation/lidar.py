@@ -8,14 +8,14 @@ import numpy as np
 
 from pcmapq.core.transform import Similarity2D
 from pcmapq.settings import Settings
+from pcmapq.testing.realdata.lidar import pair
+from pcmapq.testing.runs import Run, f_at
 
-from .common import Case, Record, Run, Section, f_at, header, q_p, row, timed_evaluate
+from .common import Case, Record, Section, header, q_p, row
 
 
 def cases(data: Path) -> list[Case]:
-    folder = data / "registration"
-    return [Case("lidar-pair",
-                 lambda: timed_evaluate(folder / "source.ply", folder / "target.ply"))]
+    return [Case("lidar-pair", lambda: pair(data))]
 
 
 def section(data: Path, record: Record) -> Section:
@@ -38,7 +38,7 @@ def section(data: Path, record: Record) -> Section:
         f"({settings.raster.band_low}-{settings.raster.band_high} m above the floor) in 2D: "
         "`pcmapq eval "
         "source.ply target.ply`, default settings "
-        "(`tests/test_real_data.py::test_lidar_pair_aligns_to_its_known_transform`).", "",
+        "(`tests/realdata/test_real_maps.py::test_lidar_pair_aligns_to_its_known_transform`).", "",
         header(["", "x [m]", "y [m]", "yaw [deg]"]),
         row(["true (from the 4x4)", f"{want.tx:.4f}", f"{want.ty:.4f}", f"{want.yaw_deg:.3f}"]),
         row(["pcmapq (3D, projected to 2D)", f"{got.tx:.4f}", f"{got.ty:.4f}",

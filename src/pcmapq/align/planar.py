@@ -45,7 +45,7 @@ THINNED_TRUTH_VOXEL = 0.4
 #: A rough-stage result whose fitness is at least this share of the best one's goes through the
 #: fine stages too, beyond the ``finalists``: clutter can drag the rough stage of the right
 #: start below a wrong pose's, which the fine stages then overtake
-#: (``tests/test_placement.py``, a plan under 800 boxes).
+#: (``tests/e2e/test_placement.py``, a plan under 800 boxes).
 CLOSE_FINALISTS = 0.9
 #: ... when it is another pose than every finalist's: farther than these, metres and degrees.
 SAME_POSE_M, SAME_POSE_DEG = 1.0, 5.0

@@ -196,7 +196,7 @@ class Settings:
                                     {name: DETECTORS[name].params(**p)
                                      for name, p in m["params"].items()}),
             distances=DistancesConfig(tuple(doc["distances"]["taus"])),
-            noref=NoRefConfig(**doc["noref"]))
+            noref=NoRefConfig(**doc.get("noref", {"enabled": False})))  # saved before noref
 
 
 def _plain(value):

@@ -266,3 +266,14 @@ def lidar_cloud(segments: np.ndarray, *, wall_height: float = 2.6, spacing: floa
     pts += rng.normal(0.0, noise, size=pts.shape)
     junk = rng.uniform([*lo, 0.0], [*hi, wall_height], size=(outliers, 3))
     return np.vstack([pts, junk])
+
+
+def room_corner(seed: int) -> np.ndarray:
+    """Three orthogonal 2 m walls meeting at the origin, 1500 points each, 2 mm noise."""
+    rng = np.random.default_rng(seed)
+    walls = []
+    for axis in range(3):
+        w = rng.uniform(0, 2, (1500, 3))
+        w[:, axis] = rng.normal(0, 0.002, len(w))
+        walls.append(w)
+    return np.vstack(walls)

@@ -1,0 +1,122 @@
+"""The report's interactive map checked as a user sees it: the circles a page holds, and a probe
+run in headless Chromium that zooms, pans, hovers, clicks and toggles as a user would."""
+
+from __future__ import annotations
+
+import html
+import json
+import re
+import subprocess
+
+import numpy as np
+
+from pcmapq.core.grid import MetricGrid
+
+CIRCLE = re.compile(r"<circle ([^>]*)/>")
+ATTR = re.compile(r'([\w-]+)="([^"]*)"')
+
+
+def circles(page: str) -> list[dict[str, str]]:
+    """The attributes of every circle of ``page``."""
+    return [dict(ATTR.findall(c)) for c in CIRCLE.findall(page)]
+
+
+#: Run in the page after the viewer's script: zoom, pan, hover, click and toggle as a user
+#: would (dispatched DOM events), and write what the page shows into <pre id="probe">.
+PROBE = """
+<script>
+(function () {
+  const svg = document.getElementById('viewer-svg');
+  const tip = document.getElementById('viewer-tip');
+  const out = {};
+  const box = () => svg.getAttribute('viewBox').split(' ').map(Number);
+  const user = (x, y) => {
+    const p = new DOMPoint(x, y).matrixTransform(svg.getScreenCTM().inverse());
+    return [p.x, p.y];
+  };
+  const r = svg.getBoundingClientRect();
+  const cx = r.left + r.width * 0.3, cy = r.top + r.height * 0.6;
+  out.before = box();
+  out.under = user(cx, cy);
+  svg.dispatchEvent(new WheelEvent('wheel', {deltaY: -500, clientX: cx, clientY: cy,
+                                             bubbles: true, cancelable: true}));
+  out.zoomed = box();
+  out.underAfter = user(cx, cy);
+  const px = svg.getScreenCTM().a;
+  const ev = (type, x, y) => svg.dispatchEvent(new PointerEvent(type, {clientX: x, clientY: y,
+                                                                       bubbles: true}));
+  ev('pointerdown', cx, cy); ev('pointermove', cx + 40, cy + 20); ev('pointerup', cx + 40, cy + 20);
+  svg.dispatchEvent(new MouseEvent('click', {clientX: cx + 40, clientY: cy + 20, bubbles: true}));
+  out.afterPan = getComputedStyle(tip).display;  // the click that ends a drag pins nothing
+  out.panned = box();
+  out.pxPerUnit = px;
+  document.getElementById('viewer-reset').click();
+  out.reset = box();
+  const f = document.querySelector(FEATURE);
+  f.scrollIntoView({block: 'center'});
+  const fr = f.getBoundingClientRect();
+  const fx = fr.left + fr.width / 2, fy = fr.top + fr.height / 2;
+  out.hit = document.elementFromPoint(fx, fy) === f;
+  out.radiusPx = fr.width / 2;
+  f.dispatchEvent(new MouseEvent('mouseover', {clientX: fx, clientY: fy, bubbles: true}));
+  out.hover = tip.textContent;
+  out.hoverShown = getComputedStyle(tip).display;
+  f.dispatchEvent(new MouseEvent('mouseout', {clientX: fx, clientY: fy, bubbles: true}));
+  out.afterOut = getComputedStyle(tip).display;
+  f.dispatchEvent(new MouseEvent('click', {clientX: fx, clientY: fy, bubbles: true}));
+  out.clicked = tip.textContent;
+  out.pinnedShown = getComputedStyle(tip).display;
+  const visible = (sel) => Array.from(document.querySelectorAll(sel))
+    .map((c) => c.getBoundingClientRect().width > 0);  // 0 when not rendered
+  const [name, status] = TOGGLE;
+  const group = `circle[data-detector="${name}"][data-status="${status}"]`;
+  out.toggledBefore = visible(group);
+  document.querySelector(`input[data-layer="f-${name}-${status}"]`).click();
+  out.toggledAfter = visible(group);
+  out.othersAfter = visible(`circle:not([data-detector="${name}"]), ` +
+                            `circle[data-detector="${name}"]:not([data-status="${status}"])`);
+  const pre = document.createElement('pre');
+  pre.id = 'probe';
+  pre.textContent = JSON.stringify(out);
+  document.body.appendChild(pre);
+})();
+</script>
+"""
+
+
+def probed(page: str, feature: str, toggle: tuple[str, str], tmp_path) -> dict:
+    """What PROBE found in ``page`` (HTML) in headless Chromium, hovering and clicking the
+    circle ``feature`` (a CSS selector) and unticking the ``toggle`` (detector, status)."""
+    path = tmp_path / "page.html"
+    path.write_text(page.replace("</body>", PROBE.replace("FEATURE", json.dumps(feature))
+                                 .replace("TOGGLE", json.dumps(toggle)) + "</body>"))
+    run = subprocess.run(["chromium", "--headless", "--no-sandbox", "--disable-gpu",
+                          "--disable-quic", "--no-first-run", "--disable-background-networking",
+                          "--disable-component-update", "--disable-sync",
+                          f"--user-data-dir={tmp_path / 'profile'}", "--window-size=1400,1000",
+                          "--dump-dom", path.as_uri()],
+                         capture_output=True, timeout=120, check=True, text=True)
+    probe = re.search(r'<pre id="probe">(.*?)</pre>', run.stdout, re.S)
+    assert probe, run.stderr[-2000:]
+    return json.loads(html.unescape(probe.group(1)))
+
+
+def check_view(out: dict, grid: MetricGrid) -> None:
+    """The view before (the whole grid), zoomed 2.1-fold about the cursor, then panned by the
+    pointer's 40, 20 pixels, reset; the feature on top where it is drawn, 4 pixels in radius."""
+    before, zoomed, panned = (np.array(out[k]) for k in ("before", "zoomed", "panned"))
+    rows, cols = grid.shape
+    np.testing.assert_allclose(before, [-0.5, -0.5, cols, rows])
+    np.testing.assert_allclose(zoomed[2:], before[2:] * 1.0015 ** -500, rtol=1e-6)
+    step = 1 / out["pxPerUnit"]  # one screen pixel, grid cells
+    np.testing.assert_allclose(out["underAfter"], out["under"], atol=step)
+    np.testing.assert_allclose(panned, zoomed - [40 * step, 20 * step, 0, 0], atol=1e-6)
+    np.testing.assert_allclose(out["reset"], before)
+    assert out["hit"] and 3.5 <= out["radiusPx"] <= 4.5
+    assert (out["afterPan"], out["hoverShown"], out["afterOut"], out["pinnedShown"]) == \
+        ("none", "block", "none", "block")
+
+
+def selector(name: str, status: str, x: float, y: float) -> str:
+    return f'circle[data-detector="{name}"][data-status="{status}"][data-x="{x + 0.0:.3f}"]' \
+           f'[data-y="{y + 0.0:.3f}"]'

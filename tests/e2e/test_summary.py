@@ -1,0 +1,173 @@
+"""The comparison table and figure of many results (report/summary.py): rows from real result
+JSONs, nulls kept as nulls (empty cell, 'n/a', a gap in the figure), failed rows, outputs
+written whole and the same bytes every time."""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+
+import pytest
+
+from pcmapq.core.errors import InputError
+from pcmapq.evaluation.pipeline import evaluate
+from pcmapq.report import summary
+from pcmapq.report.summary import summary_figure, table_csv, table_md, write_summary
+from pcmapq.results.figures import HEAD, failed_row, table_row
+from pcmapq.settings import DETECTOR_NAMES, MatchingConfig, Settings
+from pcmapq.testing import synth
+from pcmapq.testing.files import write_image_map
+from pcmapq.testing.paths import SAMPLE
+
+
+@pytest.fixture(scope="module")
+def summary_docs(plan, truth_png, tmp_path_factory) -> dict[str, dict]:
+    """Result JSON documents, as ``eval --json`` writes them: the sample; and a synthetic map
+    with 30 % of its walls dropped, scored with harris and sift only (hough null)."""
+    degraded = write_image_map(synth.drop_walls(plan, 0.3, seed=1),
+                               tmp_path_factory.mktemp("degraded") / "degraded.png")
+    return {
+        "sample": json.loads(evaluate(SAMPLE / "scan.ply", SAMPLE / "truth.yaml").to_json()),
+        "degraded": json.loads(evaluate(degraded, truth_png, Settings(
+            matching=MatchingConfig(("harris", "sift")))).to_json()),
+    }
+
+
+@pytest.fixture(scope="module")
+def table_rows(summary_docs) -> list[dict[str, object]]:
+    return [table_row(name, doc) for name, doc in summary_docs.items()] + [
+        failed_row("broken", "maps/broken.ply", "truth.yaml", 2,
+                   "maps/broken.ply: not a point cloud | nor an image\n(second line)")]
+
+
+def test_a_row_holds_the_documents_figures(summary_docs):
+    doc = summary_docs["sample"]
+    row = table_row("sample", doc)
+    assert list(row)[:len(HEAD)] == list(HEAD)
+    assert row["map"] == doc["map"]["path"] and row["truth"] == doc["truth"]["path"]
+    for det in DETECTOR_NAMES:
+        for score in ("quality", "precision", "f1"):
+            assert row[f"{det}_{score}"] == doc["detectors"][det][score]
+    a, d = doc["alignment"], doc["distances"]
+    assert [row[k] for k in ("fitness", "confidence", "x_m", "y_m", "yaw_deg", "scale")] == \
+        [a[k] for k in ("fitness", "confidence", "x_m", "y_m", "yaw_deg", "scale")]
+    assert row["coverage"] == doc["coverage"]
+    assert row["accuracy_mean_m"] == d["accuracy_m"]["mean"]
+    assert row["completeness_median_m"] == d["completeness_m"]["median"]
+    assert row["chamfer_m"] == d["chamfer_m"]
+    assert [row[f"f_score@{f['tau_m']:g}m"] for f in d["f_score"]] == \
+        [f["f"] for f in d["f_score"]]
+    assert (row["exit_code"], row["error"]) == (0, "")
+
+
+def test_a_detector_not_run_is_null_not_zero(summary_docs):
+    row = table_row("degraded", summary_docs["degraded"])
+    assert row["hough_quality"] is None and row["hough_f1"] is None
+    assert 0.0 < row["harris_quality"] < 1.0  # the dropped walls cost features
+
+
+def test_a_document_missing_a_figure_is_refused_by_name(summary_docs):
+    doc = json.loads(json.dumps(summary_docs["sample"]))
+    del doc["alignment"]["confidence"]
+    with pytest.raises(ValueError, match="alignment.confidence"):
+        table_row("x", doc)
+    doc = json.loads(json.dumps(summary_docs["sample"]))
+    doc["coverage"] = "high"
+    with pytest.raises(ValueError, match="coverage"):
+        table_row("x", doc)
+
+
+def test_csv_has_empty_cells_for_nulls_and_the_failures_exit_code(table_rows):
+    table = list(csv.DictReader(io.StringIO(table_csv(table_rows))))
+    assert [r["name"] for r in table] == ["sample", "degraded", "broken"]
+    sample, degraded, broken = table
+    assert float(sample["harris_quality"]) == table_rows[0]["harris_quality"]
+    assert degraded["hough_quality"] == "" and degraded["hough_precision"] == ""
+    assert float(degraded["sift_quality"]) == table_rows[1]["sift_quality"]
+    assert broken["exit_code"] == "2" and broken["harris_quality"] == ""
+    assert broken["error"] == "maps/broken.ply: not a point cloud | nor an image (second line)"
+    assert sample["exit_code"] == "0" and sample["error"] == ""
+
+
+def test_markdown_table_shows_nulls_and_failures(table_rows):
+    lines = table_md(table_rows).splitlines()
+    header = [c.strip() for c in lines[0].strip("|").split("|")]
+    assert "accuracy mean (m)" in header and "yaw (deg)" in header and "F@0.05 m" in header
+    cells = {line.split("|")[1].strip(): [c.strip() for c in line.strip("|").split("|")]
+             for line in lines[2:]}
+    assert len(lines) == 2 + len(table_rows)
+    assert cells["degraded"][header.index("hough quality")] == "n/a"
+    assert cells["sample"][header.index("status")] == "ok"
+    assert cells["broken"][header.index("harris quality")] == ""
+    assert lines[-1].endswith("| failed (exit 2): maps/broken.ply: not a point cloud \\| "
+                              "nor an image (second line) |")
+
+
+@pytest.mark.parametrize("panel, score", enumerate(("quality", "precision", "f1")))
+def test_figure_draws_a_bar_per_defined_score_and_marks_the_gaps(table_rows, panel, score):
+    """A panel per score (quality, precision, f1: a map with precision 0.82 shows it)."""
+    fig = summary_figure(table_rows)
+    assert len(fig.axes) == 3
+    ax = fig.axes[panel]
+    assert ax.get_ylabel().startswith(score)
+    bars = {c.get_label(): c for c in ax.containers}
+    assert list(bars) == list(DETECTOR_NAMES)
+    for det, container in bars.items():
+        expected = [r[f"{det}_{score}"] for r in table_rows
+                    if r[f"{det}_{score}"] is not None and not r["exit_code"]]
+        assert [p.get_height() for p in container.patches] == pytest.approx(expected)
+    assert len(bars["hough"].patches) == 1  # the degraded map's and the failed one's: gaps
+    texts = [t.get_text() for t in ax.texts]
+    assert texts.count("n/a") == 1 and texts.count("failed (exit 2)") == 1
+    labels = [t.get_text() for t in fig.axes[-1].get_xticklabels()]
+    assert labels == ["sample", "degraded", "broken"]
+
+
+def test_outputs_are_the_same_bytes_every_time(table_rows, tmp_path):
+    first = write_summary(table_rows, tmp_path / "a")
+    second = write_summary(table_rows, tmp_path / "b" / "nested")
+    assert [p.name for p in first] == ["table.csv", "table.md", "figure.png"]
+    for a, b in zip(first, second, strict=True):
+        assert a.read_bytes() == b.read_bytes()
+    assert first[2].read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_outputs_are_written_whole_or_not_at_all(table_rows, tmp_path, monkeypatch):
+    def broken_figure(_rows):
+        raise RuntimeError("no figure")
+
+    monkeypatch.setattr(summary, "summary_figure", broken_figure)
+    with pytest.raises(RuntimeError):
+        write_summary(table_rows, tmp_path)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_an_unwritable_folder_is_an_input_error(table_rows, tmp_path):
+    (tmp_path / "file").write_text("x")
+    with pytest.raises(InputError, match="file"):
+        write_summary(table_rows, tmp_path / "file" / "out")
+
+
+def test_one_name_per_figure_reaches_the_same_value_everywhere(summary_docs):
+    """A figure's name gives the same value through Result.figures(), a gate and a table
+    column: the JSON path, the gate key and the column come from one table."""
+    from pcmapq.results import gates
+    from pcmapq.results.figures import FIGURES
+    from pcmapq.results.result import Result
+
+    doc = summary_docs["sample"]
+    values = Result.from_json(json.dumps(doc)).figures()
+    row = table_row("sample", doc)
+    for fig in FIGURES:
+        if fig.name not in values:
+            continue
+        if fig.column:
+            assert row[fig.column] == values[fig.name], fig.name
+        if fig.number and values[fig.name] is not None:
+            outcome, = gates.check([gates.Gate(fig.name, 0.0, gates.OVER)], doc)
+            assert outcome.value == values[fig.name], fig.name
+    taus = [f["tau_m"] for f in doc["distances"]["f_score"]]
+    assert [values[f"f_score@{t:g}"] for t in taus] == [f["f"] for f in doc["distances"]["f_score"]]
+    assert values["harris.quality"] == doc["detectors"]["harris"]["quality"]
+    assert values["accuracy.mean"] == doc["distances"]["accuracy_m"]["mean"]

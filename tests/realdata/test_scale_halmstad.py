@@ -1,0 +1,39 @@
+"""A Halmstad robot map against its building's layout, both in pixels, scale unknown: the
+annotated keypoints land where the layout has them."""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+
+from pcmapq.align import AlignParams, align
+from pcmapq.testing.paths import shared
+
+
+def occupied_pixels(mask: np.ndarray) -> np.ndarray:
+    """Centres (N, 2) of the true pixels, x = column, y = rows - 1 - row (origin lower-left, as
+    the Halmstad annotations)."""
+    v, u = np.nonzero(mask)
+    return np.column_stack([u, mask.shape[0] - 1 - v]).astype(np.float64)
+
+
+def test_halmstad_e5_09_against_layout():
+    """A robot map of building E5 against the building's layout, both in pixels: the annotated
+    map keypoints must land within 20 px (median) of their layout partners. The reference, a
+    least-squares similarity on the keypoints: scale 0.829, yaw 91.2 deg, median residual 4 px."""
+    root = ("halmstad", "maps", "E5")
+    notes = ("halmstad", "annotations")
+    robot = cv2.imread(str(shared(*root, "pseudo_occupancy", "E5_09.png")), cv2.IMREAD_GRAYSCALE)
+    layout = cv2.imread(str(shared(*root, "layout", "E5_layout.png")), cv2.IMREAD_UNCHANGED)
+    pairs = np.load(shared(*notes, "association_E5_09_E5_layout.npy"), allow_pickle=True)
+    pairs = np.array([p for p in pairs if p[0] is not None and p[1] is not None], dtype=int)
+    map_keys = np.load(shared(*notes, "keypoints_E5_09.npy")).astype(np.float64)[pairs[:, 0]]
+    layout_keys = np.load(shared(*notes, "keypoints_E5_layout.npy")).astype(np.float64)
+    layout_keys = layout_keys[pairs[:, 1]]
+    map_xy = occupied_pixels(robot == 0)
+    truth_xy = occupied_pixels(layout[..., :3].mean(axis=2) < 100)
+    # Lengths in layout pixels: 1 px voxels, 4 px inlier tolerance.
+    result = align(map_xy, truth_xy, AlignParams(tolerance=4.0, voxel=1.0), scale=True)
+    residual = np.linalg.norm(result.transform.apply(map_keys) - layout_keys, axis=1)
+    assert np.median(residual) < 20.0
+    assert abs(result.transform.scale - 0.829) < 0.02 and abs(result.transform.yaw_deg - 91) < 2

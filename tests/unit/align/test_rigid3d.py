@@ -1,0 +1,78 @@
+"""3D rigid registration (FPFH + RANSAC + point-to-plane ICP) with no initial guess."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from pcmapq.align.features3d import feature_matches, keypoints
+from pcmapq.align.rigid3d import align_3d
+from pcmapq.core.errors import EvaluationError, InputError
+from pcmapq.testing.poses import apply, errors, rigid
+
+
+def room(seed: int = 0) -> np.ndarray:
+    """An asymmetric room 12 x 8 x 3 m (floor, walls) with boxes inside, 2 cm point noise."""
+    rng = np.random.default_rng(seed)
+    n = 6000
+    u, v = rng.uniform(size=(2, n))
+    faces = [
+        np.column_stack([12 * u, 8 * v, 0 * u]),            # floor
+        np.column_stack([12 * u, 0 * u, 3 * v]),            # walls
+        np.column_stack([12 * u, 8 + 0 * u, 3 * v]),
+        np.column_stack([0 * u, 8 * u, 3 * v]),
+        np.column_stack([12 + 0 * u, 8 * u, 3 * v]),
+    ]
+    for (x, y, w, d, h) in [(2, 2, 1.0, 0.6, 0.8), (7, 5, 2.0, 1.0, 1.2), (9.5, 1.0, 0.5, 0.5, 2)]:
+        top = np.column_stack([x + w * u[:1500], y + d * v[:1500], h + 0 * u[:1500]])
+        side = np.column_stack([x + 0 * u[:1500], y + d * u[:1500], h * v[:1500]])
+        front = np.column_stack([x + w * u[:1500], y + 0 * u[:1500], h * v[:1500]])
+        faces += [top, side, front]
+    points = np.vstack(faces)
+    return points + rng.normal(scale=0.02, size=points.shape)
+
+
+def test_synthetic_room_any_pose() -> None:
+    target = room(0)
+    truth = rigid((20.0, -10.0, 130.0), (3.0, -7.0, 0.5))
+    source = apply(np.linalg.inv(truth), room(1))  # other samples of the same room
+    transform, fitness, rmse = align_3d(source, target, voxel=0.2)
+    shift, angle = errors(transform, truth)
+    assert shift < 0.02 and angle < 0.2
+    assert fitness > 0.95 and rmse < 0.1
+
+
+def test_initial_guess_skips_the_global_search() -> None:
+    target = room(0)
+    truth = rigid((0.0, 0.0, 3.0), (0.2, -0.1, 0.0))
+    source = apply(np.linalg.inv(truth), room(1))
+    result = align_3d(source, target, voxel=0.2, init=np.eye(4))
+    shift, angle = errors(result.transform, truth)
+    assert shift < 0.02 and angle < 0.2
+
+
+def test_keypoints_and_matches_are_small_and_mutual() -> None:
+    points = room(0)
+    keys = keypoints(points, 0.5)
+    assert np.all(np.diff(keys) > 0) and len(keys) < len(points)
+    features = np.random.default_rng(0).uniform(size=(50, 33))
+    pairs = feature_matches(features, features[::-1])
+    assert np.array_equal(pairs[:, 1], 49 - pairs[:, 0]) and len(pairs) == 50
+
+
+def test_rejects_bad_input() -> None:
+    with pytest.raises(InputError, match="N x 3"):
+        align_3d(np.zeros((5, 2)), room(0))
+    with pytest.raises(InputError, match="no usable points"):
+        align_3d(np.zeros((5, 3)), room(0))
+    with pytest.raises(EvaluationError, match="too few points"):
+        align_3d(np.array([[1.0, 1.0, 1.0]]), room(0))
+
+
+def test_far_from_the_origin() -> None:
+    """UTM-like target coordinates (thousands of km) work: the clouds are centred first."""
+    truth = rigid((0.0, 0.0, 70.0), (4.5e5, 5.4e6, 120.0))
+    target = apply(truth, room(0))
+    result = align_3d(room(1), target, voxel=0.2)
+    shift, angle = errors(result.transform, truth)
+    assert shift < 0.02 and angle < 0.2

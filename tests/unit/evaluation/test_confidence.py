@@ -1,0 +1,37 @@
+"""The confidence that one pose places the map (pcmapq.evaluation.same_place): the smaller of its
+terms, and the distinctiveness of known search scores."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from pcmapq.align.coarse import Search, distinctiveness
+from pcmapq.core.transform import Similarity2D
+from pcmapq.evaluation.same_place import confidence
+
+
+def test_confidence_is_the_smaller_term():
+    """min(distinct / 0.2, (recall - 0.4) / 0.4), clipped; no search: the recall term."""
+    assert confidence(0.1, 0.6) == pytest.approx(0.5)
+    assert confidence(0.05, 0.8) == pytest.approx(0.25)
+    assert confidence(0.3, 0.7) == pytest.approx(0.75)
+    assert confidence(None, 0.7) == pytest.approx(0.75)
+    assert confidence(0.5, 1.0) == 1.0 and confidence(0.0, 1.0) == 0.0
+    assert confidence(None, 0.2) == 0.0
+
+
+def test_distinctiveness_of_known_scores():
+    """Best score near the pose 0.8, best elsewhere 0.6 (turned by 90 degrees, or moved by a
+    whole map radius): 1 - 0.6 / 0.8 = 0.25; a far pose scoring above the near one gives 0."""
+    poses = np.array([[0.8, 0.0, 5.0, 5.0],    # at the pose
+                      [0.7, 0.1, 5.2, 5.0],    # near it: 6 degrees, 0.2 m
+                      [0.6, np.pi / 2, 5.0, 5.0],
+                      [0.5, 0.0, 15.0, 5.0]])
+    search = Search([], poses, np.zeros(2), 10.0)
+    tf = Similarity2D(5.0, 5.0, 0.0)
+    assert distinctiveness(search, tf) == pytest.approx(0.25)
+    assert distinctiveness(search, Similarity2D(15.0, 5.0, 0.0)) == 0.0
+    scaled = Search([], np.column_stack([poses, np.log([1.0, 1.0, 1.0, 1.0])]), np.zeros(2), 10)
+    assert distinctiveness(scaled, tf) == pytest.approx(0.25)
+    assert distinctiveness(scaled, Similarity2D(5.0, 5.0, 0.0, 1.5)) == 0.0  # other scale

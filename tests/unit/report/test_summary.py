@@ -1,0 +1,32 @@
+"""The comparison table of many results (report/summary.py, results/figures.py): a failed row has
+no figures, the CSV's columns are the union of the taus in order, the gates' verdict in a word."""
+
+from __future__ import annotations
+
+from pcmapq.report.summary import table_csv
+from pcmapq.results.figures import HEAD, failed_row
+
+
+def test_failed_row_has_no_figures():
+    row = failed_row("b", "m.ply", "t.yaml", 1, "m.ply: alignment failed")
+    assert set(HEAD) <= set(row)
+    assert all(row[k] is None for k in HEAD if k not in ("name", "map", "truth"))
+    assert (row["exit_code"], row["error"]) == (1, "m.ply: alignment failed")
+
+
+def test_csv_columns_are_the_union_of_taus_in_order():
+    a = {**failed_row("a", "a", "t", 1, "x"), "f_score@0.5m": 0.5}
+    b = {**failed_row("b", "b", "t", 1, "x"), "f_score@0.05m": 0.1}
+    header = table_csv([a, b]).splitlines()[0].split(",")
+    assert header[len(HEAD):] == ["f_score@0.05m", "f_score@0.5m", "gates", "exit_code",
+                                       "error"]
+
+
+def test_gates_verdict_in_a_word():
+    from pcmapq.results.figures import gates_verdict
+    assert gates_verdict(None) == ""
+    assert gates_verdict([{"key": "coverage", "passed": True}]) == "pass"
+    assert gates_verdict([{"key": "harris.quality", "passed": False},
+                          {"key": "coverage", "passed": True},
+                          {"key": "accuracy.mean", "passed": False}]) == \
+        "fail: harris.quality, accuracy.mean"
