@@ -164,6 +164,40 @@ def _poses_text(kind: str) -> str:
     return "".join(" ".join(repr(float(v)) for v in row) + "\n" for row in rows)
 
 
+def _file_bytes(name: str, write: Callable[[Path], object]) -> bytes:
+    """The bytes a writer puts into a file named ``name`` (written in a temporary folder)."""
+    with tempfile.TemporaryDirectory() as folder:
+        path = Path(folder) / name
+        write(path)
+        return path.read_bytes()
+
+
+def _las_bytes(suffix: str) -> bytes:
+    import laspy
+
+    def write(path: Path) -> None:
+        points = np.random.default_rng(7).uniform(-4, 4, (40, 3))
+        las = laspy.LasData(laspy.LasHeader(point_format=3, version="1.2"))
+        las.x, las.y, las.z = points.T
+        las.write(path)
+    return _file_bytes(f"m{suffix}", write)
+
+
+# LAZ and E57 are not fuzzed: lazrs (Rust) and libE57Format (C++) end the process on some
+# corrupt files, which no Python code can catch.
+
+
+def _mcap_bytes() -> bytes:
+    from pcmapq.core.grid import MetricGrid
+    from pcmapq.testing.recordings import write_recording
+
+    state = np.full((12, 16), FREE, dtype=np.int8)
+    state[0, :], state[:, 0], state[5:7, 5:9] = OCCUPIED, OCCUPIED, UNKNOWN
+    grid = MetricGrid(0.05, (0.0, 0.0, 0.0), state.shape)
+    return _file_bytes("m.mcap", lambda path: write_recording(path, [(1.0, state, grid)],
+                                                              "mcap"))
+
+
 def _after(marker: bytes) -> Callable[[bytes], int]:
     """The header ends after the line holding ``marker``."""
     def end(data: bytes) -> int:
@@ -203,6 +237,8 @@ def make_seeds() -> dict[str, Seed]:
              "m.yaml", "m.yaml"),
         Seed("pgm_image", {"m.pgm": _pgm_bytes(), "m.yaml": YAML.format(image="m.pgm").encode()},
              "m.pgm", "m.pgm", header=_after(b"255")),
+        Seed("las", {"m.las": _las_bytes(".las")}, "m.las", "m.las", header=lambda d: 0),
+        Seed("mcap_grid", {"m.mcap": _mcap_bytes()}, "m.mcap", "m.mcap", header=lambda d: 0),
         Seed("kitti_poses", {"p.txt": _poses_text("kitti").encode()}, "p.txt", "p.txt",
              reader="poses"),
         Seed("tum_poses", {"p.txt": _poses_text("tum").encode()}, "p.txt", "p.txt",

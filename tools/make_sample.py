@@ -1,9 +1,12 @@
-"""Write the shipped sample: a building plan as a ROS map (truth.png + truth.yaml) and a 3D
-LiDAR-like scan of the same building in the robot's own frame (scan.ply).
+"""Write the shipped sample: a building plan as a ROS map (truth.png + truth.yaml), a 3D
+LiDAR-like scan of the same building in the robot's own frame (scan.ply), and a ROS 2
+recording of the maps a SLAM system would publish while exploring it (run/).
 
 The scan differs from the plan in known ways, so the sample's result can be checked by eye:
 it is turned and shifted (p_truth = R(yaw) * p_scan + t with the values in SCAN_POSE), one wall
-is moved by 0.3 m, furniture-like boxes stand in the rooms, and it has noise and outliers.
+is moved by 0.3 m, furniture-like boxes stand in the rooms, and it has noise and outliers. The
+recording's /map grows from west to east every 10 s in a frame of its own (RUN_ORIGIN); from
+DRIFT_AT seconds on, what it adds lies DRIFT_PX cells north of where it should.
 
     python tools/make_sample.py [OUT_DIR]     (default: data/sample)
 """
@@ -17,13 +20,20 @@ import cv2
 import numpy as np
 import open3d as o3d
 
+from pcmapq.core.cells import UNKNOWN
+from pcmapq.core.grid import MetricGrid
 from pcmapq.core.transform import Similarity2D
+from pcmapq.io import load_map
 from pcmapq.testing import synth
+from pcmapq.testing.recordings import write_recording
 
 #: The scan frame's pose in the truth frame: x, y metres, yaw degrees.
 SCAN_POSE = (6.0, 8.0, 37.0)
 RESOLUTION = 0.05
 MOVED_WALL, MOVED_BY = 5, (0.3, 0.0)  # the room wall at x = 8.0 m moves to 8.3 m
+#: The recording: its maps' origin (x, y metres, yaw radians), one map every STEP_S seconds,
+#: the drift from DRIFT_AT seconds on, cells north.
+RUN_ORIGIN, STEP_S, MAPS, DRIFT_AT, DRIFT_PX = (2.0, -3.0, 0.5), 10.0, 7, 30.0, 14
 
 
 def main(out: Path) -> None:
@@ -46,8 +56,30 @@ def main(out: Path) -> None:
     cloud[:, 2] -= 0.8  # the sensor's frame: floor 0.8 m below it
     pcd = o3d.t.geometry.PointCloud(o3d.core.Tensor(cloud.astype(np.float32)))
     o3d.t.io.write_point_cloud(str(out / "scan.ply"), pcd)
-    print(f"wrote {out}/truth.png, truth.yaml, scan.ply ({len(cloud)} points); "
+    write_run(out)
+    print(f"wrote {out}/truth.png, truth.yaml, scan.ply ({len(cloud)} points), run/; "
           f"scan pose in truth frame: x {x} m, y {y} m, yaw {yaw} deg")
+
+
+def write_run(out: Path) -> None:
+    """The recording: the truth's cells published as a growing /map (west to east), drifted
+    north from DRIFT_AT seconds on, zstd-compressed messages in a ROS 2 MCAP bag."""
+    import shutil
+
+    truth = load_map(out / "truth.yaml")
+    rows, cols = truth.state.shape
+    grid = MetricGrid(truth.grid.resolution, RUN_ORIGIN, (rows, cols))
+    edges = np.linspace(0.45 * cols, cols, MAPS).astype(int)
+    drift_from = edges[int(DRIFT_AT / STEP_S) - 1]
+    maps = []
+    for k, edge in enumerate(edges):
+        state = truth.state.copy()
+        if k * STEP_S >= DRIFT_AT:
+            state[:, drift_from:] = np.roll(state[:, drift_from:], -DRIFT_PX, axis=0)
+        state[:, edge:] = UNKNOWN
+        maps.append((k * STEP_S, state, grid))
+    shutil.rmtree(out / "run", ignore_errors=True)
+    write_recording(out / "run", maps, "ros2-mcap", compress=True)
 
 
 if __name__ == "__main__":

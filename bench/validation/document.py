@@ -22,6 +22,7 @@ from . import (
     kitti,
     lidar,
     noref,
+    recording,
     same_place,
     track,
 )
@@ -34,6 +35,7 @@ SECTIONS: dict[str, ModuleType] = {
     "drawings": drawings, "fr79": fr79, "lidar": lidar, "kitti": kitti, "gazebo": gazebo,
     "halmstad": halmstad, "floorplans": floorplans, "carmen": carmen, "noref": noref,
     "same_place": same_place, "corpus": corpus, "consistency": consistency, "track": track,
+    "recording": recording,
 }
 
 

@@ -22,9 +22,9 @@ def one_line(proc) -> str:
     ("--json", "r.txt", "--json writes .json, not '.txt'"),
     ("--vectors", "missing/v.csv", "folder '{tmp}/missing' does not exist"),
     ("--report", "folder.html", "--report: is a folder"),
-    ("--aligned", "a.png", "--aligned writes .ply or .pcd, not '.png'"),
+    ("--aligned", "a.png", "--aligned writes .ply, .pcd, .las or .laz, not '.png'"),
     ("--transform", "T.npy", "--transform writes .txt, not '.npy'"),
-    ("--distances", "d.pcd", "--distances writes .ply, not '.pcd'"),
+    ("--distances", "d.pcd", "--distances writes .ply, .las or .laz, not '.pcd'"),
 ])
 def test_bad_output_paths_stop_before_any_work(option, name, problem, tmp_path):
     """The map does not exist: the output's line comes first, so nothing was read."""
@@ -111,6 +111,6 @@ def test_map_refuses_calib_without_poses_and_bad_outputs(tmp_path):
     (tmp_path / "Tr.txt").write_text(" ".join(["1 0 0 0 0 1 0 0 0 0 1 0"]) + "\n")
     line = one_line(run("map", str(tmp_path / "scans"), "--calib", str(tmp_path / "Tr.txt"),
                         "--out", str(tmp_path / "m.ply")))
-    assert "Tr.txt: --calib places scans with --poses only" in line
+    assert "Tr.txt: --calib places scans with --poses or --pose-topic only" in line
     line = one_line(run("map", str(tmp_path / "scans"), "--out", str(tmp_path / "m.las")))
     assert "m.las: --out writes .ply or .pcd, not '.las'" in line

@@ -19,12 +19,12 @@ from pcmapq.testing.paths import SAMPLE
 @pytest.fixture(scope="module")
 def sample_json(tmp_path_factory) -> tuple[dict, Path, Path]:
     out = tmp_path_factory.mktemp("out")
-    before = {p.name: p.read_bytes() for p in SAMPLE.iterdir()}
+    before = {p: p.read_bytes() for p in SAMPLE.rglob("*") if p.is_file()}
     proc = run("eval", str(SAMPLE / "scan.ply"), str(SAMPLE / "truth.png"),
                "--json", str(out / "r.json"), "--vectors", str(out / "v.csv"),
                "--plot", str(out / "p.png"), "--report", str(out / "r.html"))
     assert proc.returncode == 0, proc.stderr
-    assert {p.name: p.read_bytes() for p in SAMPLE.iterdir()} == before  # inputs untouched
+    assert {p: p.read_bytes() for p in SAMPLE.rglob("*") if p.is_file()} == before  # untouched
     assert (out / "p.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert (out / "r.html").read_text().startswith("<!DOCTYPE html>")
     assert sorted(p.name for p in out.iterdir()) == ["p.png", "r.html", "r.json", "v.csv"]

@@ -2,10 +2,10 @@
 
 One module per command (:mod:`~pcmapq.cli.evaluate`, :mod:`~pcmapq.cli.map_scans`,
 :mod:`~pcmapq.cli.inspect`, :mod:`~pcmapq.cli.compare`, :mod:`~pcmapq.cli.batch`,
-:mod:`~pcmapq.cli.track`, :mod:`~pcmapq.cli.config`), each registering itself on
-:data:`~pcmapq.cli.commands.app`, which is imported on first use (``from pcmapq.cli import
-app``): :func:`main`, the ``pcmapq`` command, answers ``--help`` and ``--version`` without it
-(:mod:`pcmapq.cli.base`).
+:mod:`~pcmapq.cli.track`, :mod:`~pcmapq.cli.info`, :mod:`~pcmapq.cli.config`), each
+registering itself on :data:`~pcmapq.cli.commands.app`, which is imported on first use
+(``from pcmapq.cli import app``): :func:`main`, the ``pcmapq`` command, answers ``--help`` and
+``--version`` without it (:mod:`pcmapq.cli.base`).
 """
 
 from __future__ import annotations
@@ -23,7 +23,7 @@ def __getattr__(name: str) -> Any:
     if name == "app":
         # registered in the order of HELP, the order --help lists them in
         from pcmapq.cli import (  # noqa: F401, I001
-            evaluate, map_scans, inspect, compare, batch, track, config)
+            evaluate, map_scans, inspect, compare, batch, track, info, config)
         from pcmapq.cli.commands import app
 
         globals()["app"] = app

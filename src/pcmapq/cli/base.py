@@ -26,6 +26,9 @@ HELP = {
              "any row failed, else 3 if a row failed a gate.",
     "track": "Score a SLAM run's map as it grows, every N scans or D metres, against the "
              "truth: when did the map go wrong, and where was the robot then?",
+    "info": "What pcmapq sees in an input: a recording's topics, types, counts and time span; "
+            "a cloud's points, bounds and fields; an image's size, resolution, thresholds and "
+            "occupied share.",
     "config": "Write the settings (every option of eval, batch, track and inspect) as a YAML "
               "file to pass to --config.",
 }

@@ -19,6 +19,7 @@ from pcmapq.cli.terminal import (
 from pcmapq.core.errors import InputError
 from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.io import PointMap, targets
+from pcmapq.io.clouds import flat
 from pcmapq.io.writers import OutputSet, write_atomic
 from pcmapq.mapping import (
     build_map_kiss,
@@ -46,6 +47,9 @@ def eval_command(
         "score it.")] = None,
     max_scans: Annotated[int | None, typer.Option(
         help="With --scans: use only the first N scans.", min=1)] = None,
+    scan_topic: Annotated[str | None, typer.Option(
+        help="With --scans of a ROS recording: its PointCloud2 or LaserScan topic (default: "
+        "the only one).")] = None,
     json_path: Annotated[str | None, typer.Option(
         "--json", help="Write the result as JSON to this path ('-' for stdout only).")] = None,
     vectors: Annotated[Path | None, typer.Option(
@@ -98,8 +102,9 @@ def eval_command(
             step_progress(err, enabled=not quiet and json_path != "-") as progress:
         settings = options.settings_of(ctx, "eval", settings_values)
         rules = gates.parse_rules(fail_under, fail_over)
-        if max_scans is not None and scans is None:
-            raise InputError("--max-scans N: only with --scans DIR (the scans to map)")
+        if (max_scans is not None or scan_topic is not None) and scans is None:
+            raise InputError(f"{'--max-scans N' if max_scans is not None else '--scan-topic'}"
+                             ": only with --scans DIR (the scans to map)")
         targets.check_outputs({"--json": json_path, "--vectors": vectors,
                                "--regions": regions, "--plot": plot,
                                "--report": report, **exports}, None if scans else paths[0],
@@ -108,8 +113,8 @@ def eval_command(
             map_path: Path | PointMap = paths[0]
         else:
             progress("mapping the scans with KISS-ICP")
-            points, _ = build_map_kiss(scans, max_scans=max_scans)
-            map_path = PointMap(scans, points, True, kind="scans")
+            points, _ = build_map_kiss(scans, max_scans=max_scans, topic=scan_topic)
+            map_path = PointMap(scans, points, not flat(points), kind="scans")
         limit = memory_limit(max_memory)
         result = replace(evaluate(map_path, truth_path, settings, progress, limit),
                          command=options.command_line(ctx))

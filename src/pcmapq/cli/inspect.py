@@ -19,6 +19,7 @@ from pcmapq.core import memory
 from pcmapq.evaluation.inspect_map import inspect_map, summary_lines, to_json
 from pcmapq.evaluation.truth import needed_memory
 from pcmapq.io import OccupancyMap, PointMap, load_map, targets
+from pcmapq.io.clouds import flat
 from pcmapq.io.extent import Box, check_span, hint
 from pcmapq.io.extent import crop as crop_input
 from pcmapq.io.writers import OutputSet, write_atomic
@@ -91,10 +92,12 @@ def inspect_command(
         if scans is not None and poses is not None:
             trajectory = read_poses(poses)
             first = trajectory[0]
-            source = PointMap(scans, posed_map(scans, trajectory), True, kind="scans")
+            placed = posed_map(scans, trajectory)
+            source = PointMap(scans, placed, not flat(placed), kind="scans")
         else:
             source = load_map(map_path, settings.map.resolution,
-                              memory_limit=memory_limit(max_memory))
+                              memory_limit=memory_limit(max_memory), topic=settings.map.topic,
+                              topic_option="--topic")
         source = checked(source, settings.map.crop, memory_limit(max_memory))
         planes = None if orth_subset is None else read_orthogonal_subset(orth_subset)
         if planes is not None and orth_pose is not None:

@@ -23,6 +23,7 @@ from pcmapq.mapping import (
     build_map_kiss,
     describe_scans,
     open_scans,
+    recorded_poses,
     scanner_poses,
     scans_for_poses,
     write_kitti_poses,
@@ -33,8 +34,9 @@ from pcmapq.mapping import (
 @app.command("map", help=HELP["map"])
 def map_command(
     source: Annotated[Path, typer.Argument(
-        help="Scan sequence: a folder of KITTI .bin / .ply / .pcd / .npy scans, a ROS bag or "
-        "an MCAP file.")],
+        help="Scan sequence: a folder of KITTI .bin / .ply / .pcd / .npy scans, or a ROS "
+        "recording (.bag, .db3, .mcap, a ROS 2 bag folder) of PointCloud2 or LaserScan "
+        "messages.")],
     out: Annotated[Path, typer.Option(help="The map, .ply or .pcd (voxel centroids).")],
     poses_out: Annotated[Path | None, typer.Option(
         help="Write the scan poses in KITTI format (12 numbers a line), as evo reads them.")
@@ -45,6 +47,12 @@ def map_command(
     poses: Annotated[Path | None, typer.Option(
         help="Build the map from these poses (KITTI or TUM file) instead of running KISS-ICP.")
     ] = None,
+    scan_topic: Annotated[str | None, typer.Option(
+        help="A recording's PointCloud2 or LaserScan topic (default: the only one).")] = None,
+    pose_topic: Annotated[str | None, typer.Option(
+        help="Build the map from a recording's nav_msgs/Odometry or geometry_msgs/PoseStamped "
+        "topic instead of running KISS-ICP: each scan placed at the pose interpolated at its "
+        "time (with --calib T, the scanner -> pose-frame transform: P_k T).")] = None,
     calib: Annotated[Path | None, typer.Option(
         help="With --poses: scanner -> pose-frame transform T (12 or 16 numbers, or a KITTI "
         "calib.txt with Tr:); the map is then built in the first scanner's frame, "
@@ -59,26 +67,29 @@ def map_command(
     err = Console(stderr=True)
     poses_out, tum_out = targets.kept(poses_out), targets.kept(tum_out)
     with report_errors(err), terminal.show_warnings(err):
-        if calib is not None and poses is None:
-            raise InputError(f"{calib}: --calib places scans with --poses only (KISS-ICP's "
-                             "map is in the first scanner's frame already)")
+        if calib is not None and poses is None and pose_topic is None:
+            raise InputError(f"{calib}: --calib places scans with --poses or --pose-topic only "
+                             "(KISS-ICP's map is in the first scanner's frame already)")
+        if poses is not None and pose_topic is not None:
+            raise InputError("--poses and --pose-topic: give one of the two")
         targets.check_outputs({"--out": out, "--poses-out": poses_out, "--tum-out": tum_out},
                               None, inputs=(source, poses, calib))
         with scan_bar(err, enabled=not quiet) as tick:
-            if poses is None:
+            if poses is None and pose_topic is None:
                 if max_scans is not None and not quiet:
-                    every = open_scans(source)
+                    every = open_scans(source, topic=scan_topic)
                     first = replace(every, count=min(max_scans, len(every)),
                                     files=every.files[:max_scans])
                     err.print(f"mapping {describe_scans(first, len(every))}", markup=False,
                               highlight=False, soft_wrap=True)
                 points, trajectory = build_map_kiss(source, max_scans=max_scans, voxel=voxel,
-                                                    progress=tick)
+                                                    progress=tick, topic=scan_topic)
             else:
-                trajectory = scanner_poses(poses, calib)
-                every = open_scans(source)
+                trajectory = (scanner_poses(poses, calib) if poses is not None else
+                              recorded_poses(source, scan_topic, pose_topic, calib))
+                every = open_scans(source, topic=scan_topic)
                 scans = scans_for_poses(every, len(trajectory), max_scans=max_scans,
-                                        poses_path=poses)
+                                        poses_path=poses or pose_topic)
                 if max_scans is not None and not quiet:
                     err.print(f"mapping {describe_scans(scans, len(every))}", markup=False,
                               highlight=False, soft_wrap=True)
@@ -97,4 +108,3 @@ def map_command(
     if not quiet:
         for line in wrote:
             err.print(line, markup=False, highlight=False, soft_wrap=True)
-

@@ -27,9 +27,10 @@ from pcmapq.io.writers import OutputSet, write_atomic
 def track_command(
     ctx: typer.Context,
     paths: Annotated[list[Path], typer.Argument(
-        metavar="RUN TRUTH", help="The run: a CARMEN log (.log/.log.gz), or scans (a folder of "
-        ".bin/.ply/.pcd/.npy scans, a ROS bag, an MCAP file); then the ground truth, as "
-        "eval's.")],
+        metavar="RUN TRUTH", help="The run: a CARMEN log (.log/.log.gz), scans (a folder of "
+        ".bin/.ply/.pcd/.npy scans, a ROS bag, an MCAP file), or a ROS recording of the maps a "
+        "SLAM system published (nav_msgs/OccupancyGrid, scored on the recording's time "
+        "axis); then the ground truth, as eval's.")],
     out: Annotated[Path, typer.Option(
         help="Folder of the results: track.csv, track.json, track.png, track.html.")],
     poses: Annotated[Path | None, typer.Option(
@@ -47,6 +48,18 @@ def track_command(
         help="Score the map every N scans (default 20).", min=1, show_default=False)] = None,
     every_m: Annotated[float | None, typer.Option(
         help="Score the map every D metres travelled instead.", min=1e-6,
+        callback=options.finite)] = None,
+    scan_topic: Annotated[str | None, typer.Option(
+        help="A recording's PointCloud2 or LaserScan topic (default: the only one).")] = None,
+    pose_topic: Annotated[str | None, typer.Option(
+        help="A recording's nav_msgs/Odometry or geometry_msgs/PoseStamped topic: the run's "
+        "poses, interpolated at each scan's time (instead of KISS-ICP's).")] = None,
+    map_topic: Annotated[str | None, typer.Option(
+        help="A recording's OccupancyGrid topic to score (default: the only one, or /map).")
+    ] = None,
+    every_s: Annotated[float | None, typer.Option(
+        help="A recording's maps: score at most one every S seconds (and the last); default "
+        "every map published that differs from the one before.", min=1e-6,
         callback=options.finite)] = None,
     step: Annotated[int | None, typer.Option(
         help="The step the report shows (default: where the worst drop starts, else the "
@@ -66,10 +79,9 @@ def track_command(
 
     **settings_values: Any,
 ) -> None:
-    from pcmapq.io.carmen import is_carmen
+    from pcmapq.io.bags import has_grids
     from pcmapq.report.timeline import drop_words
-    from pcmapq.track import PoseOptions, step_ends, track_run, travelled, write_track
-    from pcmapq.track.runs import open_run, reference_poses_of
+    from pcmapq.track import PoseOptions, Recording, track_recording, write_track
 
     if len(paths) != 2:
         raise typer.BadParameter("give RUN and TRUTH", param_hint="RUN TRUTH")
@@ -87,25 +99,35 @@ def track_command(
         targets.check_outputs({"--json": json_path}, None,
                               inputs=(*paths, poses, reference_poses, calib,
                                       settings_values.get("config")))
-        if calib is not None and (reference_poses is None or is_carmen(reference_poses)):
-            raise InputError(f"{calib}: --calib moves the poses of a --reference-poses KITTI "
-                             "or TUM file into the scanner's frame; none is given")
-        with scan_bar(err, enabled=shown) as tick:
-            run = open_run(run_path, poses, progress=tick)
-        reference = (None if reference_poses is None
-                     else reference_poses_of(reference_poses, len(run), calib))
-        ends = step_ends(len(run), (every or 20) if every_m is None else None, every_m,
-                         travelled(run.poses))
-        if step is not None and step >= len(ends):
-            raise typer.BadParameter(f"{step}: the run has {len(ends)} steps, 0 to "
-                                     f"{len(ends) - 1}", param_hint="--step")
-        tracked = track_run(run, truth_path, settings, ends, reference=reference,
-                            pose_options=PoseOptions(align_poses, correct_scale, delta),
-                            reference_path=reference_poses, show=step, progress=progress,
-                            tick=lambda done: progress(f"scoring: {done} of {len(run)} scans"),
-                            memory_limit=memory_limit(max_memory))
-        rule = {"every_scans": None if every_m is not None else (every or 20),
-                "every_m": every_m}
+        limit = memory_limit(max_memory)
+        if has_grids(run_path, map_topic):
+            given = [o for o, v in (("--poses", poses), ("--reference-poses", reference_poses),
+                                    ("--calib", calib), ("--every", every),
+                                    ("--every-m", every_m), ("--scan-topic", scan_topic),
+                                    ("--pose-topic", pose_topic)) if v is not None]
+            if given:
+                raise InputError(f"{run_path}: a recording's published maps are scored on its "
+                                 f"time axis: {', '.join(given)} apply to a run's scans "
+                                 "(--every-s thins the maps)")
+            tracked = track_recording(Recording(run_path, map_topic, every_s), truth_path,
+                                      settings, show=step, progress=progress,
+                                      memory_limit=limit)
+            _check_step(step, len(tracked.steps), "recording")
+            rule: dict = {"every_s": every_s, "map_topic": map_topic}
+            total = f"{tracked.steps[-1].scans} maps published"
+        else:
+            if every_s is not None or map_topic is not None:
+                raise InputError(f"{run_path}: --every-s and --map-topic apply to a ROS "
+                                 "recording of published maps (nav_msgs/OccupancyGrid)")
+            tracked, rule = _track_scans(run_path, truth_path, settings, poses=poses,
+                                         reference_poses=reference_poses, calib=calib,
+                                         every=every, every_m=every_m, step=step,
+                                         topics=(scan_topic, pose_topic),
+                                         pose_options=PoseOptions(align_poses, correct_scale,
+                                                                  delta),
+                                         progress=progress, limit=limit,
+                                         bar=lambda: scan_bar(err, enabled=shown))
+            total = f"{len(tracked.run)} scans"
         wrote = write_track(tracked, out, rule, options.command_line(ctx))
         if json_path not in (None, "-"):
             with OutputSet() as outputs:
@@ -116,7 +138,7 @@ def track_command(
         sys.stdout.write(wrote[1].read_text())
     elif not quiet:
         drop = None if tracked.drop is None else asdict(tracked.drop)
-        err.print(f"{len(tracked.steps)} steps ({scored} scored) of {len(run)} scans; "
+        err.print(f"{len(tracked.steps)} steps ({scored} scored) of {total}; "
                   f"{drop_words(tracked.rows, drop)}; wrote {out}/track.csv, "
                   "track.json, track.png, track.html", markup=False, highlight=False,
                   soft_wrap=True)
@@ -124,3 +146,41 @@ def track_command(
         err.print(f"pcmapq: error: {run_path}: no step could be scored; the last: "
                   f"{tracked.steps[-1].note}", markup=False, highlight=False, soft_wrap=True)
         raise typer.Exit(1)
+
+
+def _track_scans(run_path: Path, truth_path: Path, settings, *, poses: Path | None,
+                 reference_poses: Path | None, calib: Path | None, every: int | None,
+                 every_m: float | None, step: int | None, topics: tuple, pose_options,
+                 progress, limit: int | None, bar):
+    """A run's scans tracked (:func:`pcmapq.track.track_run`) and the rule of its steps."""
+    from pcmapq.io.carmen import is_carmen
+    from pcmapq.track import step_ends, track_run, travelled
+    from pcmapq.track.runs import open_run, reference_poses_of
+
+    if calib is not None and (reference_poses is None or is_carmen(reference_poses)):
+        raise InputError(f"{calib}: --calib moves the poses of a --reference-poses KITTI "
+                         "or TUM file into the scanner's frame; none is given")
+    with bar() as tick:
+        if poses is not None and topics[1] is not None:
+            raise InputError("--poses and --pose-topic: give one of the two")
+        run = open_run(run_path, poses, progress=tick, scan_topic=topics[0],
+                       pose_topic=topics[1])
+    reference = (None if reference_poses is None
+                 else reference_poses_of(reference_poses, len(run), calib))
+    ends = step_ends(len(run), (every or 20) if every_m is None else None, every_m,
+                     travelled(run.poses))
+    _check_step(step, len(ends), "run")
+    tracked = track_run(run, truth_path, settings, ends, reference=reference,
+                        pose_options=pose_options, reference_path=reference_poses, show=step,
+                        progress=progress,
+                        tick=lambda done: progress(f"scoring: {done} of {len(run)} scans"),
+                        memory_limit=limit)
+    return tracked, {"every_scans": None if every_m is not None else (every or 20),
+                     "every_m": every_m}
+
+
+def _check_step(step: int | None, steps: int, what: str) -> None:
+    """Refuse a --step the run does not have."""
+    if step is not None and step >= steps:
+        raise typer.BadParameter(f"{step}: the {what} has {steps} steps, 0 to {steps - 1}",
+                                 param_hint="--step")

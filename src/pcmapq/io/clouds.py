@@ -27,9 +27,10 @@ from pcmapq.core.errors import InputError
 from pcmapq.io import pcd, ply
 from pcmapq.io.ply import CHUNK, VertexBlock, vertex_block
 from pcmapq.io.stderr import stderr_captured
+from pcmapq.io.survey import read_e57, read_las
 from pcmapq.io.writers import one_line
 
-CLOUD_SUFFIXES = (".ply", ".pcd", ".xyz", ".txt", ".npy", ".bin")
+CLOUD_SUFFIXES = (".ply", ".pcd", ".xyz", ".txt", ".npy", ".bin", ".las", ".laz", ".e57")
 
 #: z range (metres) above which a cloud counts as 3D.
 FLAT_TOLERANCE = 1e-6
@@ -72,8 +73,15 @@ class PointMap:
     seen: SeenCells | None = None
 
 
+def flat(points: np.ndarray) -> bool:
+    """Whether points (N, 3) are a 2D cloud: z constant within :data:`FLAT_TOLERANCE` (a
+    laser scanner's scans, a 2D map)."""
+    return not (len(points) and float(np.ptp(points[:, 2])) > FLAT_TOLERANCE)
+
+
 def load_cloud(path: Path, memory_limit: int | None = None) -> PointMap:
-    """Load a point cloud, choosing the reader by extension; a PLY, PCD, .npy or KITTI .bin whose
+    """Load a point cloud, choosing the reader by extension (LAS, LAZ and E57:
+    :mod:`pcmapq.io.survey`); a PLY, PCD, .npy, KITTI .bin, LAS or E57 whose
     header (or size) declares more points than ``memory_limit`` bytes hold (None: the default
     limit, see :mod:`pcmapq.core.memory`) is refused unread."""
     readers: dict[str, Callable[[Path], np.ndarray]] = {
@@ -81,6 +89,8 @@ def load_cloud(path: Path, memory_limit: int | None = None) -> PointMap:
         ".pcd": lambda p: read_open3d(p, memory_limit), ".xyz": read_text, ".txt": read_text,
         ".npy": lambda p: read_npy(p, memory_limit),
         ".bin": lambda p: read_kitti_bin(p, memory_limit),
+        ".las": lambda p: read_las(p, memory_limit), ".laz": lambda p: read_las(p, memory_limit),
+        ".e57": lambda p: read_e57(p, memory_limit),
     }
     try:
         block = vertex_block(path) if path.suffix.lower() == ".ply" else None

@@ -11,9 +11,15 @@ CHUNK = 1 << 20
 
 
 def sha256_file(path: str | Path) -> str:
-    """The SHA-256 of a file's bytes, hex."""
+    """The SHA-256 of a file's bytes, hex; of a folder (a ROS 2 bag), of its files' names and
+    bytes in name order."""
     digest = hashlib.sha256()
-    with open(path, "rb") as f:
-        while block := f.read(CHUNK):
-            digest.update(block)
+    path = Path(path)
+    files = sorted(p for p in path.rglob("*") if p.is_file()) if path.is_dir() else [path]
+    for file in files:
+        if path.is_dir():
+            digest.update(str(file.relative_to(path)).encode() + b"\0")
+        with open(file, "rb") as f:
+            while block := f.read(CHUNK):
+                digest.update(block)
     return digest.hexdigest()

@@ -1,6 +1,7 @@
 """File formats other tools read: point clouds with a scalar field and colours (binary PLY, as
-CloudCompare, Open3D and MeshLab read it; binary PCD, as PCL and Open3D read it) and transform
-matrices as plain text (``np.loadtxt``, CloudCompare's "Apply transformation" file).
+CloudCompare, Open3D and MeshLab read it; binary PCD, as PCL and Open3D read it; LAS and LAZ,
+the scalar field an extra dimension, as CloudCompare and PDAL read them) and transform matrices
+as plain text (``np.loadtxt``, CloudCompare's "Apply transformation" file).
 
 Clouds are written from chunks of records, so a cloud of any size needs one chunk of memory;
 every file is written whole or not at all (:func:`pcmapq.io.writers.atomic_file`).
@@ -20,7 +21,9 @@ from pcmapq.io.writers import OutputSet, atomic_file
 #: ``scalar_<name>`` as the scalar field ``<name>``.
 DISTANCE_FIELD = "scalar_distance_m"
 #: Extensions :func:`write_records` writes.
-CLOUD_SUFFIXES = (".ply", ".pcd")
+CLOUD_SUFFIXES = (".ply", ".pcd", ".las", ".laz")
+#: LAS coordinates are integers of this many metres (a millimetre).
+LAS_SCALE = 0.001
 
 _PLY_TYPES = {"f4": "float", "u1": "uchar"}
 
@@ -54,12 +57,19 @@ def records(xyz: np.ndarray, dtype: np.dtype, scalar: np.ndarray | None = None,
 def write_records(path: Path, count: int, chunks: Iterable[np.ndarray], dtype: np.dtype,
                   comment: str = "", outputs: OutputSet | None = None) -> None:
     """Write ``count`` records of ``dtype`` (:func:`record_dtype`), given as chunks, as a binary
-    PLY (every field a vertex property) or a binary PCD (x, y, z only), by ``path``'s
+    PLY (every field a vertex property), a binary PCD (x, y, z only) or LAS / LAZ (a scalar
+    an extra dimension named without its ``scalar_`` prefix, colours as RGB), by ``path``'s
     extension; ``comment`` (one line) goes into the header; with ``outputs``, the file appears
     when that set is committed."""
     suffix = path.suffix.lower()
     if suffix not in CLOUD_SUFFIXES:
-        raise InputError(f"{path}: a cloud is written as .ply or .pcd")
+        raise InputError(f"{path}: a cloud is written as .ply, .pcd, .las or .laz")
+    if suffix in (".las", ".laz"):
+        with atomic_file(path, outputs) as f:
+            written = _write_las(f, suffix == ".laz", chunks, dtype)
+        if written != count:
+            raise InputError(f"{path}: {written} points written, {count} announced")
+        return
     if suffix == ".pcd" and dtype.names != ("x", "y", "z"):
         raise InputError(f"{path}: a cloud with a scalar field is written as .ply")
     header = _ply_header(count, dtype, comment) if suffix == ".ply" else _pcd_header(count)
@@ -98,3 +108,31 @@ def _pcd_header(count: int) -> str:
             "SIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\n"
             f"WIDTH {count}\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS {count}\n"
             "DATA binary\n")
+
+
+def _write_las(f, compress: bool, chunks: Iterable[np.ndarray], dtype: np.dtype) -> int:
+    """Records as LAS 1.4 (point format 6, or 7 with colours) into the open binary file ``f``,
+    chunk by chunk; the count written."""
+    import laspy
+
+    colour = "red" in dtype.names
+    scalar = [n for n in dtype.names if n not in ("x", "y", "z", "red", "green", "blue")]
+    header = laspy.LasHeader(point_format=7 if colour else 6, version="1.4")
+    header.scales = np.full(3, LAS_SCALE)
+    header.offsets = np.zeros(3)
+    for name in scalar:
+        header.add_extra_dim(laspy.ExtraBytesParams(name=name.removeprefix("scalar_"),
+                                                    type=np.float32))
+    written = 0
+    with laspy.open(f, mode="w", header=header, do_compress=compress, closefd=False) as out:
+        for chunk in chunks:
+            points = laspy.ScaleAwarePointRecord.zeros(len(chunk), header=header)
+            points.x, points.y, points.z = chunk["x"], chunk["y"], chunk["z"]
+            for name in scalar:
+                points[name.removeprefix("scalar_")] = chunk[name]
+            if colour:  # LAS colours are 16-bit
+                for name in ("red", "green", "blue"):
+                    points[name] = chunk[name].astype(np.uint16) * 257
+            out.write_points(points)
+            written += len(chunk)
+    return written

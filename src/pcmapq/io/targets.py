@@ -17,11 +17,11 @@ from pcmapq.io.writers import same_file
 #: What each output option writes, by extension (``--aligned``: see :func:`output_suffixes`).
 OUTPUT_SUFFIXES = {"--json": (".json",), "--vectors": (".csv",), "--regions": (".csv",),
                    "--plot": (".png", ".svg", ".pdf"), "--report": (".html", ".htm"),
-                   "--transform": (".txt",), "--distances": (".ply",),
+                   "--transform": (".txt",), "--distances": (".ply", ".las", ".laz"),
                    "--out": (".ply", ".pcd"), "--poses-out": (".txt", ".kitti"),
                    "--tum-out": (".txt", ".tum")}
 #: ``--aligned`` of an image map (a map_server image, its YAML beside it) and of a cloud.
-ALIGNED_IMAGE, ALIGNED_CLOUD = (".png", ".pgm"), (".ply", ".pcd")
+ALIGNED_IMAGE, ALIGNED_CLOUD = (".png", ".pgm"), (".ply", ".pcd", ".las", ".laz")
 
 
 def output_suffixes(option: str, map_path: Path | None) -> tuple[str, ...]:

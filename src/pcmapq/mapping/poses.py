@@ -209,6 +209,20 @@ def scanner_poses(path: str | Path, calib: str | Path | None = None) -> np.ndarr
     return poses
 
 
+def recorded_poses(source: str | Path, scan_topic: str | None, pose_topic: str,
+                   calib: str | Path | None = None) -> np.ndarray:
+    """One pose per scan of a recording (K, 4, 4): its pose topic interpolated at the scans'
+    times; with ``calib`` (T, scanner -> pose frame) the scanner's, ``P_k @ T``."""
+    from pcmapq.io.bag_scans import pose_track, poses_at, scan_times
+    from pcmapq.io.bags import is_bag
+
+    source, calib = Path(source), None if calib is None else Path(calib)
+    if not is_bag(source):
+        raise InputError(f"{source}: --pose-topic reads the poses of a ROS recording")
+    trajectory = poses_at(scan_times(source, scan_topic), *pose_track(source, pose_topic))
+    return trajectory if calib is None else trajectory @ read_calib(calib)
+
+
 # ---------------------------------------------------------------------------------------------
 
 def _read_text(path: Path) -> str:

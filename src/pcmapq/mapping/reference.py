@@ -27,7 +27,7 @@ __all__ = ["build_map_from_poses", "describe_scans", "scans_for_poses"]
 
 def scans_for_poses(source: str | Path | ScanSequence, pose_count: int, *,
                     max_scans: int | None = None, topic: str | None = None,
-                    poses_path: Path | None = None) -> ScanSequence:
+                    poses_path: Path | str | None = None) -> ScanSequence:
     """The scans ``pose_count`` poses place: every scan of the sequence, which must have one
     pose each, or its first ``max_scans`` (the poses must cover them). Otherwise InputError,
     one line naming the poses file (``poses_path``) and the counts."""

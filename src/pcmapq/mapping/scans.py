@@ -9,16 +9,14 @@ coordinate are dropped.
   scans, in natural file-name order (``2.ply`` before ``10.ply``). A folder holding none but
   with a ``velodyne/`` sub-folder (the KITTI sequence layout) reads that sub-folder. PLY/PCD
   per-point times are taken from a field named t, timestamp, timestamps, time or stamps.
-- A ROS 1 ``.bag``, a ROS 2 bag (``.db3``/``.mcap`` inside a folder with ``metadata.yaml``) or a
-  standalone ``.mcap``: read with KISS-ICP's own loaders (``sensor_msgs/PointCloud2``; name the
-  ``topic`` when there are several). They need ``rosbags`` or ``mcap-ros2-support``.
+- A ROS 1 ``.bag``, a ROS 2 bag (a folder with ``metadata.yaml``, or its ``.db3``/``.mcap``) or
+  a standalone ``.mcap``, read with rosbags (:mod:`pcmapq.io.bags`): ``sensor_msgs/PointCloud2``
+  (with a per-point time field if it has one) or ``sensor_msgs/LaserScan`` messages; name the
+  ``topic`` when there are several.
 """
 
 from __future__ import annotations
 
-import contextlib
-import importlib.util
-import io
 import re
 from collections.abc import Iterator
 from dataclasses import dataclass
@@ -29,6 +27,9 @@ import numpy as np
 import open3d as o3d
 
 from pcmapq.core.errors import InputError
+from pcmapq.io.bag_scans import scan_topic
+from pcmapq.io.bag_scans import scans as bag_scans
+from pcmapq.io.bags import is_bag
 from pcmapq.io.clouds import read_kitti_bin, read_npy, with_z
 from pcmapq.io.writers import one_line
 
@@ -48,7 +49,8 @@ class ScanSequence:
     """An ordered, finite sequence of scans; iterate it once per :func:`open_scans`.
 
     path: the source given. count: number of scans (after ``max_scans``). kind: "folder",
-    "rosbag" or "mcap". files: the scan files of a folder (empty for bags).
+    "rosbag" or "mcap". files: the scan files of a folder (empty for bags); a bag's scan topic
+    is kept as its ``_dataset``.
     """
 
     path: Path
@@ -65,12 +67,10 @@ class ScanSequence:
             for file in self.files:
                 yield read_scan(file)
             return
-        for index in range(self.count):
-            try:
-                points, stamps = self._dataset[index]
-            except StopIteration:
+        for index, (_, points, stamps) in enumerate(bag_scans(self.path, self._dataset)):
+            if index >= self.count:
                 return
-            yield _clean(self.path, np.asarray(points), np.asarray(stamps))
+            yield _clean(self.path, points, stamps)
 
 
 def open_scans(source: str | Path, *, max_scans: int | None = None, topic: str | None = None,
@@ -86,11 +86,11 @@ def open_scans(source: str | Path, *, max_scans: int | None = None, topic: str |
         if max_scans is not None:
             files = files[:max_scans]
         return ScanSequence(path, len(files), "folder", tuple(files))
-    suffix = path.suffix.lower()
-    if path.is_dir() or suffix in (".bag", ".db3"):
-        return _open_bag(path, "rosbag", "rosbags", topic, max_scans)
-    if suffix == ".mcap":
-        return _open_bag(path, "mcap", "mcap_ros2", topic, max_scans)
+    if is_bag(path):
+        chosen = scan_topic(path, topic)
+        count = chosen.count if max_scans is None else min(chosen.count, max_scans)
+        kind = "mcap" if path.suffix.lower() == ".mcap" else "rosbag"
+        return ScanSequence(path, count, kind, (), chosen.name)
     raise InputError(f"{path}: not a scan folder, .bag, ROS 2 bag or .mcap file")
 
 
@@ -145,30 +145,6 @@ def _clean(path: Path, points: np.ndarray, stamps: np.ndarray) -> Scan:
         keep &= np.isfinite(stamps)
         return points[keep], stamps[keep]
     return points[keep], np.empty(0)
-
-
-def _open_bag(path: Path, loader: str, module: str, topic: str | None,
-              max_scans: int | None) -> ScanSequence:
-    """A ROS bag or MCAP through KISS-ICP's loader; its prints and exits become InputError."""
-    from kiss_icp.datasets import dataset_factory
-
-    if importlib.util.find_spec(module) is None:
-        package = "rosbags" if loader == "rosbag" else "mcap-ros2-support"
-        raise InputError(f"{path}: reading a {loader} needs the '{package}' package "
-                         f"(pip install {package})")
-    messages = io.StringIO()
-    try:
-        with contextlib.redirect_stdout(messages):
-            dataset = dataset_factory(loader, path, topic=topic)
-    except SystemExit:
-        text = " ".join(messages.getvalue().split())
-        raise InputError(f"{path}: {text or 'cannot read'}") from None
-    except Exception as exc:  # noqa: BLE001 - third-party loaders raise anything
-        raise InputError(f"{path}: cannot read: {one_line(exc)}") from None
-    if getattr(dataset, "topic", None) is None:
-        raise InputError(f"{path}: no sensor_msgs/PointCloud2 topic")
-    count = len(dataset) if max_scans is None else min(len(dataset), max_scans)
-    return ScanSequence(path, count, loader, (), dataset)
 
 
 def _natural_key(path: Path) -> list[Any]:

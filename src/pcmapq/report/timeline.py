@@ -71,15 +71,29 @@ def drop_words(rows: list[dict], drop: dict | None) -> str:
              ", the last step scored")
     return (f"{figure} fell {drop['size']:.3f}, from {rows[peak][figure]:.3f} at step {peak} "
             f"to {rows[low][figure]:.3f} at step {low}{after}; the fall starts at step "
-            f"{start} ({rows[start]['distance_m']:.0f} m)")
+            f"{start} ({where(rows[start])})")
+
+
+def recorded(rows: list[dict]) -> bool:
+    """Whether the rows are a recording's published maps (on its time axis, no distance)."""
+    return all(r["distance_m"] is None for r in rows)
+
+
+def where(row: dict) -> str:
+    """Where a step stands on its run's axis: ``120 m`` travelled, or ``45.2 s`` into a
+    recording."""
+    return f"{row['time_s']:.1f} s" if row["distance_m"] is None else \
+        f"{row['distance_m']:.0f} m"
 
 
 def timeline_figure(rows: list[dict], drop: dict | None, title: str = "") -> Figure:
-    """The figures of the rows against ``distance_m``, one panel per family that has data; a
+    """The figures of the rows against ``distance_m`` (a recording's: ``time_s``), one panel
+    per family that has data; a
     gap where a step was not scored; the worst drop (``drop``: peak, start, low step indices)
     shaded from its peak to its lowest step, a line where it starts; ``title`` above (the
     run)."""
-    distance = np.array([r["distance_m"] for r in rows], dtype=float)
+    axis = "time_s" if recorded(rows) else "distance_m"
+    distance = np.array([r[axis] for r in rows], dtype=float)
     panels = [(title, [c for c in cols if any(r.get(c) is not None for r in rows)])
               for title, cols in FAMILIES]
     panels = [(t, cols) for t, cols in panels if cols]
@@ -105,7 +119,8 @@ def timeline_figure(rows: list[dict], drop: dict | None, title: str = "") -> Fig
             ax.axvspan(distance[drop["peak"]], distance[drop["low"]], color="#ee6677",
                        alpha=0.12, lw=0)
             ax.axvline(distance[drop["start"]], color="#ee6677", lw=1.2)
-    axes[-1].set_xlabel("distance travelled [m]")
+    axes[-1].set_xlabel("time since the recording's start [s]" if axis == "time_s" else
+                        "distance travelled [m]")
     marks = ("" if drop is None else
              "\nshaded: from the peak to the lowest step; red line: where the fall starts")
     fig.suptitle((f"{title}\n" if title else "") + drop_words(rows, drop) + marks,
@@ -119,6 +134,8 @@ def path_figure(result: Result, path_xy: np.ndarray) -> Figure:
     from matplotlib import patheffects
 
     fig = vectorial_figure(result)
+    if len(path_xy) == 0:  # a recording's maps: no path
+        return fig
     edge = [patheffects.withStroke(linewidth=3.2, foreground="white")]
     for ax in fig.axes:
         if ax.get_title():
@@ -142,11 +159,12 @@ def timeline_html(rows: list[dict], drop: dict | None, shown: int, result: Resul
     was not scored; ``asked``: chosen with ``--step``) and a table of every step."""
     step = rows[shown]
     scored = sum(bool(r["scored"]) for r in rows)
+    unit = "maps published" if recorded(rows) else "scans"
     facts = "".join(f"<tr><td>{html.escape(k)}</td><td>{html.escape(v)}</td></tr>"
                     for k, v in inputs.items())
     parts = [f"<h1>pcmapq track</h1><p class='sub'>{html.escape(inputs.get('run', ''))}"
              f" against {html.escape(inputs.get('truth', ''))}: {len(rows)} steps, {scored} "
-             f"scored, of {rows[-1]['scans']} scans</p>",
+             f"scored, of {rows[-1]['scans']} {unit}</p>",
              f"<table class='facts'>{facts}</table>",
              f"<p>command: <code>{html.escape(command or '(called from Python)')}</code></p>",
              "<h2>Quality over the run</h2>",
@@ -154,19 +172,22 @@ def timeline_html(rows: list[dict], drop: dict | None, shown: int, result: Resul
              _img(curves or png_bytes(timeline_figure(rows, drop)), "figures against distance")]
     what = ("the step asked" if asked else "where the worst drop starts"
             if drop is not None and drop["start"] == shown else "the last step; no drop")
-    parts.append(f"<h2>Step {shown} ({what}): {step['scans']} of {rows[-1]['scans']} scans, "
+    parts.append(f"<h2>Step {shown} ({what}): map {step['scans']} of {rows[-1]['scans']}, "
+                 f"published at {where(step)}</h2>" if recorded(rows) else
+                 f"<h2>Step {shown} ({what}): {step['scans']} of {rows[-1]['scans']} scans, "
                  f"{step['distance_m']:.0f} m travelled</h2>")
     if result is not None and path_xy is not None:
         parts.append(_img(png_bytes(path_figure(result, path_xy)),
                           f"vectorial map at step {shown}"))
     else:
         parts.append(f"<p class='note'>not scored: {html.escape(str(step['note']))}</p>")
-    columns = [c for c in TABLE if c in step]
+    columns = [("time_s" if c == "distance_m" and recorded(rows) else c) for c in TABLE
+               if c in step]
     marks = {shown: " (shown)"} | ({} if drop is None else
                                    {drop["peak"]: " (peak)", drop["start"]: " (fall starts)",
                                     drop["low"]: " (lowest)"})
     parts.append("<h2>Steps</h2><div class='steps'>" + _table(columns, [
-        [_cell(r[c], TABLE[c]) + (marks.get(r["step"], "") if c == "step" else "")
+        [_cell(r[c], TABLE.get(c, 1)) + (marks.get(r["step"], "") if c == "step" else "")
          for c in columns] for r in rows], BREAKS) + "</div>")
     return ("<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'><meta "
             "name='viewport' content='width=device-width, initial-scale=1'><title>pcmapq "

@@ -29,11 +29,17 @@ class SourceConfig:
         its YAML (``--map-occupied-thresh`` ...).
     crop: keep only the part inside this box ``(x0, y0, x1, y1)``, metres, in the input's own
         frame (``--map-crop``, ``--truth-crop``; see :mod:`pcmapq.io.extent`).
+    topic: a ROS recording's OccupancyGrid topic (``--map-topic``, ``--truth-topic``; None:
+        its only one, or ``/map``).
+    at: the recording's map at this time, seconds of its clock (the last published at or
+        before it; ``--at`` for the map); None: its last.
     """
 
     resolution: float | None = None
     thresholds: Thresholds | None = None
     crop: Box | None = None
+    topic: str | None = None
+    at: float | None = None
 
 
 @dataclass(frozen=True)
@@ -180,7 +186,8 @@ class Settings:
             t = d["thresholds"]
             crop = d.get("crop")
             return SourceConfig(d["resolution"], None if t is None else Thresholds(**t),
-                                None if crop is None else tuple(crop))
+                                None if crop is None else tuple(crop), d.get("topic"),
+                                d.get("at"))
 
         a, m = doc["alignment"], doc["matching"]
         init = a["init"]

@@ -196,6 +196,18 @@ OPTIONS: tuple[Option, ...] = (
            "Keep only the part of the map inside this box, metres, in its own frame (as "
            "eval's --map-crop).", metavar="<x0,y0,x1,y1>",
            read=lambda t: parse_box(t, "--crop"), show=show_list, commands=(INSPECT,)),
+    Option("map_topic", "map.topic", TEXT,
+           "A ROS recording map: its OccupancyGrid topic (default: the only one, or /map).",
+           metavar="<topic>"),
+    Option("at", "map.at", FLOAT,
+           "A ROS recording map: the map published at this time, seconds of the recording's "
+           "clock (the last one at or before it; default: the last)."),
+    Option("truth_topic", "truth.topic", TEXT,
+           "A ROS recording truth: its OccupancyGrid topic (default: the only one, or /map).",
+           metavar="<topic>"),
+    Option("topic", "map.topic", TEXT,
+           "A ROS recording map: its OccupancyGrid topic (default: the only one, or /map).",
+           metavar="<topic>", commands=(INSPECT,)),
     Option("truth_crop", "truth.crop", TEXT,
            "Keep only the truth's part inside this box, metres, in its own frame.",
            metavar="<x0,y0,x1,y1>", read=lambda t: parse_box(t, "--truth-crop"),

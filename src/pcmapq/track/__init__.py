@@ -24,6 +24,7 @@ from pcmapq.results.result import Result
 from pcmapq.settings import Settings
 from pcmapq.track.drop import Drop, worst_drop
 from pcmapq.track.outputs import step_rows, track_csv, track_json
+from pcmapq.track.recording import Recording, grid_result, score_grids
 from pcmapq.track.runs import Run, open_run, planar_of, planar_poses
 from pcmapq.track.steps import step_ends, travelled
 from pcmapq.track.timeline import (
@@ -35,8 +36,9 @@ from pcmapq.track.timeline import (
     track,
 )
 
-__all__ = ["PoseOptions", "Step", "Tracked", "open_run", "planar_of", "planar_poses",
-           "step_ends", "track", "track_run", "travelled", "worst_drop", "write_track"]
+__all__ = ["PoseOptions", "Recording", "Step", "Tracked", "open_run", "planar_of",
+           "planar_poses", "step_ends", "track", "track_recording", "track_run", "travelled",
+           "worst_drop", "write_track"]
 
 #: The files a tracked run writes into its folder.
 FILES = ("track.csv", "track.json", "track.png", "track.html")
@@ -49,7 +51,7 @@ class Tracked:
     and the robot's path in the truth frame up to it (None when that step was not scored);
     ``reference``: the file of the reference poses, ``pose_options`` how they compare."""
 
-    run: Run
+    run: Run | Recording
     truth: PreparedTruth
     settings: Settings
     steps: list[Step]
@@ -100,6 +102,29 @@ def track_run(run: Run, truth_path: Path, settings: Settings, ends: np.ndarray, 
                    reference_path if reference is not None else None, pose_options)
 
 
+def track_recording(recording: Recording, truth_path: Path, settings: Settings, *,
+                    show: int | None = None, progress: Callable[[str], None] = lambda s: None,
+                    memory_limit: int | None = None) -> Tracked:
+    """Score every OccupancyGrid of a recording (:mod:`~pcmapq.track.recording`) against the
+    truth at ``truth_path``, as :func:`track_run` scores a growing map: the worst drop, the
+    step shown (``show``, default where the worst drop starts, else the last) with its full
+    result; no robot path."""
+    settings = replace(settings, noref=replace(settings.noref, enabled=False))
+    progress("preparing the truth")
+    truth = prepare_truth(load_input(truth_path, settings.truth, TRUTH_CROP,
+                                     memory_limit=memory_limit), settings, memory_limit)
+    steps = score_grids(recording, truth, settings, progress)
+    drop = worst_drop(steps)
+    shown = show if show is not None else drop.start if drop is not None else len(steps) - 1
+    shown = min(max(shown, 0), len(steps) - 1)
+    result = None
+    if steps[shown].scored:
+        progress("drawing the step shown")
+        result = grid_result(recording, truth, settings, steps[shown])
+    return Tracked(recording, truth, settings, steps, drop, shown, result,
+                   None if result is None else np.zeros((0, 2)), show is not None)
+
+
 def inputs_of(tracked: Tracked, every: dict) -> dict[str, str]:
     """What a tracked run scored, in words, by name: the run, its poses, the truth, the
     reference poses and how they compare, the step rule."""
@@ -114,7 +139,9 @@ def inputs_of(tracked: Tracked, every: dict) -> dict[str, str]:
         words["reference poses"] = (f"{tracked.reference}; {how}, RPE over {options.delta} "
                                     f"scan{'s' * (options.delta > 1)}")
     words["steps"] = (f"every {every['every_scans']} scans" if every.get("every_scans")
-                      else f"every {every['every_m']:g} m travelled") + ", and the last"
+                      else f"every {every['every_m']:g} m travelled" if every.get("every_m")
+                      else f"every map published, at most one per {every['every_s']:g} s"
+                      if every.get("every_s") else "every map published") + ", and the last"
     return words
 
 

@@ -30,7 +30,15 @@ from pcmapq.core.errors import InputError
 from pcmapq.features.walls import CLOSING
 from pcmapq.io import PointMap
 from pcmapq.io.carmen import DEFAULT_MAX_RANGE, LaserScans, endpoints, is_carmen, read_laser_scans
-from pcmapq.mapping import ScanSequence, VoxelMap, build_map_kiss, open_scans, scanner_poses
+from pcmapq.io.clouds import flat
+from pcmapq.mapping import (
+    ScanSequence,
+    VoxelMap,
+    build_map_kiss,
+    open_scans,
+    recorded_poses,
+    scanner_poses,
+)
 from pcmapq.mapping.reference import scans_for_poses
 from pcmapq.raster.footprint import joined_readings, view_outlines
 from pcmapq.raster.seen import NO_VIEW, add_views
@@ -143,7 +151,9 @@ class ScanRun:
             if wanted and index + 1 == wanted[0]:
                 wanted.pop(0)
                 seen, views = add_views(seen, np.stack(views)), []
-                yield (PointMap(self.path, grid.points(), is_3d=True, kind="scans", seen=seen),
+                points = grid.points()
+                yield (PointMap(self.path, points, is_3d=not flat(points), kind="scans",
+                                seen=seen),
                        recent.points())
                 recent = VoxelMap(self.voxel)
             if not wanted:
@@ -154,12 +164,16 @@ Run = LaserRun | ScanRun
 
 
 def open_run(source: Path, poses: Path | None = None, *,
-             progress: Callable[[int, int], None] | None = None) -> Run:
+             progress: Callable[[int, int], None] | None = None,
+             scan_topic: str | None = None, pose_topic: str | None = None) -> Run:
     """The run at ``source`` (a CARMEN log, or scans) with the poses of ``poses`` (a KITTI or
     TUM file, one pose per scan, the scanner's: a warning when they move as a camera's, see
-    :func:`~pcmapq.mapping.scanner_poses`), else the log's own, else KISS-ICP's
-    (``progress(done, total)`` while it runs). InputError, one line, when the counts differ."""
-    estimate = None if poses is None else scanner_poses(poses)
+    :func:`~pcmapq.mapping.scanner_poses`), or of a recording's ``pose_topic`` at its scans'
+    times, else the log's own, else KISS-ICP's (``progress(done, total)`` while it runs); a
+    recording's scans are its ``scan_topic``'s. InputError, one line, when the counts differ."""
+    estimate = (scanner_poses(poses) if poses is not None else
+                recorded_poses(source, scan_topic, pose_topic) if pose_topic is not None
+                else None)
     if is_carmen(source):
         scans = read_laser_scans(source)
         if estimate is None:
@@ -169,12 +183,13 @@ def open_run(source: Path, poses: Path | None = None, *,
                              f"scans of {source} (one pose per scan)")
         return LaserRun(source, scans, estimate, scans.stamps,
                         **({} if poses is None else {"poses_source": str(poses)}))
-    sequence = open_scans(source)
+    sequence = open_scans(source, topic=scan_topic)
     if estimate is None:
-        _, estimate = build_map_kiss(source, progress=progress)
-    sequence = scans_for_poses(sequence, len(estimate), poses_path=poses)
+        _, estimate = build_map_kiss(source, progress=progress, topic=scan_topic)
+    sequence = scans_for_poses(sequence, len(estimate), poses_path=poses or pose_topic)
     return ScanRun(source, sequence, estimate,
-                   poses_source="KISS-ICP's poses" if poses is None else str(poses))
+                   poses_source=str(poses) if poses is not None else
+                   f"{pose_topic} of {source}" if pose_topic is not None else "KISS-ICP's poses")
 
 
 def reference_poses_of(path: Path, count: int, calib: Path | None = None) -> np.ndarray:

@@ -33,7 +33,8 @@ from pcmapq.testing.paths import REPO
 #: A value other than the default for each text option, as typed.
 TEXTS = {"scale": "auto", "map_resolution": "0.1", "map_crop": "-5,-5,5,5",
          "truth_crop": "-6,-6,6,6", "crop": "-5,-5,5,5", "init": "1,2,3", "detectors": "sift",
-         "tau": "0.3,0.4", "footprint": "walls"}
+         "tau": "0.3,0.4", "footprint": "walls", "map_topic": "/slam/map",
+         "truth_topic": "/truth_map", "topic": "/slam/map"}
 
 
 def sample(option: Option, command: str) -> object:

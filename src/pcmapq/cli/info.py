@@ -1,0 +1,43 @@
+"""``pcmapq info``: what pcmapq sees in an input."""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+from typing import Annotated
+
+import typer
+from rich.console import Console
+
+from pcmapq.cli.commands import HELP, MaxMemory, app, memory_limit
+from pcmapq.cli.terminal import report_errors
+from pcmapq.io import targets
+from pcmapq.io.describe import describe, lines
+from pcmapq.io.writers import OutputSet, write_atomic
+
+
+@app.command("info", help=HELP["info"])
+def info_command(
+    path: Annotated[Path, typer.Argument(
+        metavar="FILE", help="Any input: an image or its YAML, a cloud (.ply/.pcd/.xyz/.npy/.bin/"
+        ".las/.laz/.e57), a CARMEN log, a ROS recording (.bag, .db3, .mcap or a ROS 2 bag "
+        "folder).")],
+    json_path: Annotated[str | None, typer.Option(
+        "--json", help="Write the record as JSON to this path ('-' for stdout only).")] = None,
+    max_memory: MaxMemory = None,
+) -> None:
+    err = Console(stderr=True)
+    json_path = targets.kept(json_path)
+    with report_errors(err):
+        targets.check_outputs({"--json": json_path}, None, inputs=(path,))
+        record = describe(path, memory_limit(max_memory))
+        text = json.dumps(record, indent=2) + "\n"
+        if json_path not in (None, "-"):
+            with OutputSet() as outputs:
+                write_atomic(Path(json_path), text, outputs)
+                outputs.commit()
+    if json_path == "-":
+        sys.stdout.write(text)
+    else:
+        print("\n".join(lines(record)))
