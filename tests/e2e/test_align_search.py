@@ -2,24 +2,8 @@
 
 from __future__ import annotations
 
-import numpy as np
-import pytest
-
 from pcmapq.align import AlignParams, align
-from pcmapq.core.transform import Similarity2D
-from pcmapq.testing import synth
 from pcmapq.testing.poses import pose_error
-
-
-@pytest.fixture(scope="module")
-def campus():
-    """A campus of 6 x 8 copies of the plan (164 m x 156 m, only its outline tells one copy
-    from the next), and its map: turned -12 degrees and moved, 3 cm noise."""
-    walls = synth.campus(6, 8)
-    t_true = Similarity2D(31.0, -17.0, np.radians(-12.0))
-    map_xy = synth.wall_points(synth.transform_segments(walls, t_true.inverse()), 0.1,
-                               noise=0.03)
-    return t_true, map_xy, synth.wall_points(walls, 0.1)
 
 
 def test_pyramid_finds_a_repeated_campus(campus):

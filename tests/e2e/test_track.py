@@ -36,6 +36,7 @@ from pcmapq.io.carmen import beam_angles, read_laser_scans
 from pcmapq.io.writers import write_ros_map
 from pcmapq.settings import Settings
 from pcmapq.testing import synth
+from pcmapq.testing.carmen import flaser_log
 from pcmapq.track import Tracked, open_run, step_ends, track_run, travelled
 from pcmapq.track.drop import MIN_DROP
 from pcmapq.track.outputs import HEAD
@@ -100,17 +101,6 @@ def ray_cast(poses: np.ndarray, walls: np.ndarray, beams: int = BEAMS) -> np.nda
     return np.where(hit, t, np.inf).min(axis=2)
 
 
-def flaser_log(path: Path, ranges: np.ndarray, poses: np.ndarray) -> Path:
-    """A CARMEN log of one FLASER line per scan, its pose as laser and odometry pose."""
-    lines = ["# message formats defined: PARAM SYNC ODOM FLASER RLASER\n"]
-    for i, (r, (x, y, theta)) in enumerate(zip(ranges, poses.tolist(), strict=True)):
-        t = PERIOD * i
-        lines.append(f"FLASER {len(r)} {' '.join(f'{v:.6f}' for v in r)} {x!r} {y!r} "
-                     f"{theta!r} {x!r} {y!r} {theta!r} {t:.3f} synth {t:.3f}\n")
-    path.write_text("".join(lines))
-    return path
-
-
 def flaser_prefix(log: Path, scans: int, path: Path) -> Path:
     """The first ``scans`` FLASER lines of ``log``, as their own log."""
     lines = [line for line in log.read_text().splitlines(keepends=True)
@@ -141,8 +131,8 @@ def data(tmp_path_factory) -> Data:
     ranges = ray_cast(poses, PLAN)
     grid = synth.plan_grid(PLAN, 0.05)
     png = write_ros_map(folder / "plan.png", synth.render(PLAN, grid), 0.05, grid.origin[:2])
-    return Data(folder, flaser_log(folder / "corrected.log", ranges, poses),
-                flaser_log(folder / "drifted.log", ranges, drifted), png, poses, drifted,
+    return Data(folder, flaser_log(folder / "corrected.log", ranges, poses, PERIOD),
+                flaser_log(folder / "drifted.log", ranges, drifted, PERIOD), png, poses, drifted,
                 ranges)
 
 
@@ -492,7 +482,7 @@ def test_a_run_with_no_scorable_step_fails_in_one_line(runs: Runs, quiet: bool) 
     poses = np.array([[0.0, 0.0, np.pi / 2], [0.5, 0.0, np.pi / 2], [1.0, 0.0, np.pi / 2]])
     ranges = ray_cast(poses, wall)
     ranges[~(ranges < 10.0)] = 0.0  # no reading: CARMEN's "nothing within range"
-    log = flaser_log(d.folder / "wall.log", ranges, poses)
+    log = flaser_log(d.folder / "wall.log", ranges, poses, PERIOD)
     out = d.folder / f"wall-{quiet}"
     got = runs.cli_run("track", log, d.corrected, "--every", "1", "--out", out,
                        *(["--quiet"] if quiet else []))

@@ -208,7 +208,7 @@ class Result:
                                for t in det.truth.xy[m.missing].tolist()]
             doc["extra"] += [{"detector": name, "map_xy_m": p}
                              for p in det.map.xy[m.extra].tolist()]
-        doc = _rounded(doc)
+        doc = rounded(doc)
         doc["noref"] = significant(self.noref)  # MPV, MOM: areas of 1e-3 m^2 and less
         return doc
 
@@ -279,12 +279,12 @@ def _distances_dict(d: Distances) -> dict:
             "f_score": [asdict(f) for f in d.fscores]}
 
 
-def _rounded(value):
+def rounded(value):
     """Round every float in a nested structure to DECIMALS (and turn -0.0 into 0.0)."""
     if isinstance(value, float):
         return round(value, DECIMALS) + 0.0
     if isinstance(value, dict):
-        return {k: _rounded(v) for k, v in value.items()}
+        return {k: rounded(v) for k, v in value.items()}
     if isinstance(value, list):
-        return [_rounded(v) for v in value]
+        return [rounded(v) for v in value]
     return value

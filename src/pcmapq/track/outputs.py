@@ -9,7 +9,7 @@ from dataclasses import asdict
 from pathlib import Path
 
 from pcmapq import __version__
-from pcmapq.results.result import DECIMALS
+from pcmapq.results.result import DECIMALS, rounded
 from pcmapq.track.drop import Drop
 from pcmapq.track.timeline import Step
 
@@ -48,14 +48,6 @@ def track_csv(rows: list[dict[str, object]]) -> str:
     return "\n".join(lines) + "\n"
 
 
-def _rounded(value: object) -> object:
-    if isinstance(value, float):
-        return round(value, DECIMALS) + 0.0
-    if isinstance(value, dict):
-        return {k: _rounded(v) for k, v in value.items()}
-    if isinstance(value, list):
-        return [_rounded(v) for v in value]
-    return value
 
 
 def track_json(rows: list[dict[str, object]], drop: Drop | None, *, run: Path, poses: str,
@@ -71,4 +63,4 @@ def track_json(rows: list[dict[str, object]], drop: Drop | None, *, run: Path, p
            "pose_errors": None if reference is None else pose_options, "every": every,
            "worst_drop": None if drop is None else asdict(drop),
            "settings": settings, "steps": rows}
-    return json.dumps(_rounded(doc), indent=2, allow_nan=False) + "\n"
+    return json.dumps(rounded(doc), indent=2, allow_nan=False) + "\n"

@@ -183,17 +183,6 @@ def test_gridded_map_equal_to_truth_aligns_exactly():
     assert np.hypot(tf.tx, tf.ty) < 1e-3 and abs(tf.yaw_deg) < 0.01
 
 
-@pytest.fixture(scope="module")
-def campus():
-    """A campus of 6 x 8 copies of the plan (164 m x 156 m, only its outline tells one copy
-    from the next), and its map: turned -12 degrees and moved, 3 cm noise."""
-    walls = synth.campus(6, 8)
-    t_true = Similarity2D(31.0, -17.0, np.radians(-12.0))
-    map_xy = synth.wall_points(synth.transform_segments(walls, t_true.inverse()), 0.1,
-                               noise=0.03)
-    return t_true, map_xy, synth.wall_points(walls, 0.1)
-
-
 def test_pyramid_bound_holds(campus):
     """A region's bound is at least the score of every child in it, and descend's best pose
     is where the map lies."""
