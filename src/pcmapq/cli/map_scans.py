@@ -53,6 +53,9 @@ def map_command(
         help="Build the map from a recording's nav_msgs/Odometry or geometry_msgs/PoseStamped "
         "topic instead of running KISS-ICP: each scan placed at the pose interpolated at its "
         "time (with --calib T, the scanner -> pose-frame transform: P_k T).")] = None,
+    frame: Annotated[str | None, typer.Option(
+        help="With --pose-topic /tf: the frame whose poses place the scans (default: the "
+        "scans' own frame), in the transform tree's root frame.")] = None,
     calib: Annotated[Path | None, typer.Option(
         help="With --poses: scanner -> pose-frame transform T (12 or 16 numbers, or a KITTI "
         "calib.txt with Tr:); the map is then built in the first scanner's frame, "
@@ -86,7 +89,7 @@ def map_command(
                                                     progress=tick, topic=scan_topic)
             else:
                 trajectory = (scanner_poses(poses, calib) if poses is not None else
-                              recorded_poses(source, scan_topic, pose_topic, calib))
+                              recorded_poses(source, scan_topic, pose_topic, calib, frame))
                 every = open_scans(source, topic=scan_topic)
                 scans = scans_for_poses(every, len(trajectory), max_scans=max_scans,
                                         poses_path=poses or pose_topic)

@@ -54,6 +54,9 @@ def track_command(
     pose_topic: Annotated[str | None, typer.Option(
         help="A recording's nav_msgs/Odometry or geometry_msgs/PoseStamped topic: the run's "
         "poses, interpolated at each scan's time (instead of KISS-ICP's).")] = None,
+    frame: Annotated[str | None, typer.Option(
+        help="With --pose-topic /tf: the frame whose poses place the scans (default: the "
+        "scans' own frame).")] = None,
     map_topic: Annotated[str | None, typer.Option(
         help="A recording's OccupancyGrid topic to score (default: the only one, or /map).")
     ] = None,
@@ -122,7 +125,7 @@ def track_command(
             tracked, rule = _track_scans(run_path, truth_path, settings, poses=poses,
                                          reference_poses=reference_poses, calib=calib,
                                          every=every, every_m=every_m, step=step,
-                                         topics=(scan_topic, pose_topic),
+                                         topics=(scan_topic, pose_topic, frame),
                                          pose_options=PoseOptions(align_poses, correct_scale,
                                                                   delta),
                                          progress=progress, limit=limit,
@@ -164,7 +167,7 @@ def _track_scans(run_path: Path, truth_path: Path, settings, *, poses: Path | No
         if poses is not None and topics[1] is not None:
             raise InputError("--poses and --pose-topic: give one of the two")
         run = open_run(run_path, poses, progress=tick, scan_topic=topics[0],
-                       pose_topic=topics[1])
+                       pose_topic=topics[1], frame=topics[2])
     reference = (None if reference_poses is None
                  else reference_poses_of(reference_poses, len(run), calib))
     ends = step_ends(len(run), (every or 20) if every_m is None else None, every_m,

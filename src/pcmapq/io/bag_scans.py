@@ -90,6 +90,16 @@ def cloud_points(msg: Any, path: Path, topic: str) -> tuple[np.ndarray, np.ndarr
     return points, times
 
 
+def scan_frame(path: Path, topic: str | None = None) -> str:
+    """The frame the recording's scans are in (their first message's ``header.frame_id``)."""
+    with opened(path) as reader:
+        chosen = pick(path, topics(reader), (CLOUD, LASER), topic, None, "--scan-topic")
+        connections = [c for c in reader.connections if c.topic == chosen.name]
+        for connection, _, raw in reader.messages(connections=connections):
+            return deserialised(reader, raw, connection, path).header.frame_id
+    raise InputError(f"{path}: {chosen.name} holds no message")
+
+
 def scan_times(path: Path, topic: str | None = None) -> np.ndarray:
     """The times of the recording's scans (seconds of its clock), without reading their
     points' data into arrays."""

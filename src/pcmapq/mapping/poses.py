@@ -210,16 +210,25 @@ def scanner_poses(path: str | Path, calib: str | Path | None = None) -> np.ndarr
 
 
 def recorded_poses(source: str | Path, scan_topic: str | None, pose_topic: str,
-                   calib: str | Path | None = None) -> np.ndarray:
+                   calib: str | Path | None = None, frame: str | None = None) -> np.ndarray:
     """One pose per scan of a recording (K, 4, 4): its pose topic interpolated at the scans'
-    times; with ``calib`` (T, scanner -> pose frame) the scanner's, ``P_k @ T``."""
-    from pcmapq.io.bag_scans import pose_track, poses_at, scan_times
-    from pcmapq.io.bags import is_bag
+    times, or with ``pose_topic`` a tf topic (``/tf``), the pose of ``frame`` (default: the
+    scans' own frame) in the transform tree's root; with ``calib`` (T, scanner -> pose
+    frame) the scanner's, ``P_k @ T``."""
+    from pcmapq.io.bag_scans import pose_track, poses_at, scan_frame, scan_times
+    from pcmapq.io.bag_tf import TF, frame_poses
+    from pcmapq.io.bags import is_bag, opened, topics
 
     source, calib = Path(source), None if calib is None else Path(calib)
     if not is_bag(source):
         raise InputError(f"{source}: --pose-topic reads the poses of a ROS recording")
-    trajectory = poses_at(scan_times(source, scan_topic), *pose_track(source, pose_topic))
+    times = scan_times(source, scan_topic)
+    with opened(source) as reader:
+        kinds = {t.name: t.msgtype for t in topics(reader)}
+    if kinds.get(pose_topic) == TF:
+        trajectory = frame_poses(source, frame or scan_frame(source, scan_topic), times)
+    else:
+        trajectory = poses_at(times, *pose_track(source, pose_topic))
     return trajectory if calib is None else trajectory @ read_calib(calib)
 
 

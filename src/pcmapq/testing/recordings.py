@@ -55,12 +55,15 @@ def write_recording(path: Path, maps: Sequence[tuple[float, np.ndarray, MetricGr
                     layout: str = "ros2-mcap", scans: Sequence[Scan | Cloud] = (),
                     map_topic: str = "/map", scan_topic: str = "/scan",
                     poses: Sequence[tuple[float, np.ndarray]] = (),
-                    pose_topic: str = "/odom", compress: bool = False) -> Path:
+                    pose_topic: str = "/odom", compress: bool = False,
+                    transforms: Sequence[tuple[float, str, str, np.ndarray]] = ()) -> Path:
     """Write ``maps`` ((seconds, state, grid) each) on ``map_topic`` and ``scans`` on
     ``scan_topic`` and ``poses`` ((seconds, 4 x 4 pose) each) as nav_msgs/Odometry on
     ``pose_topic`` as a recording of ``layout`` (:data:`LAYOUTS`; ``mcap``: the ROS 2 MCAP
     file alone) at ``path`` (a ``.bag`` file, a ROS 2 bag folder, or an ``.mcap`` file). The
-    path written. ``compress``: a ROS 2 recording's messages zstd-compressed."""
+    path written. ``compress``: a ROS 2 recording's messages zstd-compressed. ``transforms``:
+    (seconds, parent, child, 4 x 4 pose of the child in the parent) each, on ``/tf``; scans
+    are in the frame ``laser``."""
     from rosbags.typesys import Stores, get_typestore
 
     ros1 = layout == "ros1"
@@ -70,10 +73,13 @@ def write_recording(path: Path, maps: Sequence[tuple[float, np.ndarray, MetricGr
                        for t, state, grid in maps] +
                       [(s.time_s, scan_topic, _scan(store, s, ros1) if isinstance(s, Scan)
                         else _cloud(store, s, ros1)) for s in scans] +
-                      [(t, pose_topic, _odometry(store, t, pose, ros1)) for t, pose in poses],
+                      [(t, pose_topic, _odometry(store, t, pose, ros1)) for t, pose in poses] +
+                      [(t, "/tf", _tf(store, t, parent, child, pose, ros1))
+                       for t, parent, child, pose in transforms],
                       key=lambda m: (m[0], m[1]))
     clouds = any(isinstance(s, Cloud) for s in scans)
     kinds = {map_topic: "nav_msgs/msg/OccupancyGrid", pose_topic: "nav_msgs/msg/Odometry",
+             "/tf": "tf2_msgs/msg/TFMessage",
              scan_topic: "sensor_msgs/msg/PointCloud2" if clouds else "sensor_msgs/msg/LaserScan"}
     used = {topic for _, topic, _ in messages}
     if ros1:
@@ -153,7 +159,7 @@ def _cloud(store, cloud: Cloud, ros1: bool):
     data = np.column_stack(columns).astype("<f4")
     n = len(data)
     return types["sensor_msgs/msg/PointCloud2"](
-        header=_header(store, cloud.time_s, "lidar", ros1), height=1, width=n, fields=fields,
+        header=_header(store, cloud.time_s, "laser", ros1), height=1, width=n, fields=fields,
         is_bigendian=False, point_step=4 * len(names), row_step=4 * len(names) * n,
         data=data.view(np.uint8).ravel(), is_dense=True)
 
@@ -176,3 +182,19 @@ def _odometry(store, t: float, pose: np.ndarray, ros1: bool):
         header=_header(store, t, "odom", ros1), child_frame_id="lidar",
         pose=types["geometry_msgs/msg/PoseWithCovariance"](pose=msg_pose, covariance=covariance),
         twist=types["geometry_msgs/msg/TwistWithCovariance"](twist=twist, covariance=covariance))
+
+
+def _tf(store, t: float, parent: str, child: str, pose: np.ndarray, ros1: bool):
+    from scipy.spatial.transform import Rotation
+
+    types = store.types
+    x, y, z, w = Rotation.from_matrix(pose[:3, :3]).as_quat()
+    header = _header(store, t, parent, ros1)
+    transform = types["geometry_msgs/msg/Transform"](
+        translation=types["geometry_msgs/msg/Vector3"](x=float(pose[0, 3]), y=float(pose[1, 3]),
+                                                       z=float(pose[2, 3])),
+        rotation=types["geometry_msgs/msg/Quaternion"](x=float(x), y=float(y), z=float(z),
+                                                       w=float(w)))
+    stamped = types["geometry_msgs/msg/TransformStamped"](header=header, child_frame_id=child,
+                                                          transform=transform)
+    return types["tf2_msgs/msg/TFMessage"](transforms=[stamped])

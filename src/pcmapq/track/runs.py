@@ -165,14 +165,16 @@ Run = LaserRun | ScanRun
 
 def open_run(source: Path, poses: Path | None = None, *,
              progress: Callable[[int, int], None] | None = None,
-             scan_topic: str | None = None, pose_topic: str | None = None) -> Run:
+             scan_topic: str | None = None, pose_topic: str | None = None,
+             frame: str | None = None) -> Run:
     """The run at ``source`` (a CARMEN log, or scans) with the poses of ``poses`` (a KITTI or
     TUM file, one pose per scan, the scanner's: a warning when they move as a camera's, see
     :func:`~pcmapq.mapping.scanner_poses`), or of a recording's ``pose_topic`` at its scans'
     times, else the log's own, else KISS-ICP's (``progress(done, total)`` while it runs); a
     recording's scans are its ``scan_topic``'s. InputError, one line, when the counts differ."""
     estimate = (scanner_poses(poses) if poses is not None else
-                recorded_poses(source, scan_topic, pose_topic) if pose_topic is not None
+                recorded_poses(source, scan_topic, pose_topic, frame=frame)
+                if pose_topic is not None
                 else None)
     if is_carmen(source):
         scans = read_laser_scans(source)

@@ -135,3 +135,27 @@ def test_a_map_of_laser_scans_is_a_2d_cloud(tmp_path):
     path = write_recording(tmp_path / "run.mcap", [], "mcap", scans=scans, poses=poses)
     points = build_map_from_poses(open_scans(path), recorded_poses(path, None, "/odom"))
     assert len(points) > 0 and flat(points)
+
+
+@pytest.mark.parametrize("layout", ["ros2-sqlite", "mcap"])  # a ROS 1 bag: the real one
+def test_poses_from_tf_compose_the_tree_up_to_its_root(layout, tmp_path):
+    """Scans in frame ``laser``; /tf holds odom -> base (moving, one a second) and base ->
+    laser (fixed, published once): each scan's pose is odom <- base at its time (between two
+    transforms: interpolated) times base <- laser, and the map is the one those poses build."""
+    world, poses = world_and_poses()
+    mount = np.eye(4)
+    mount[:3, 3] = [0.2, 0.0, 0.3]
+    clouds, expected = [], []
+    for t, pose in poses:
+        scanner = pose @ mount
+        local = ((world - scanner[:3, 3]) @ scanner[:3, :3]).astype(np.float32).astype(float)
+        clouds.append(Cloud(t, local))
+        expected.append(scanner)
+    transforms = [(t, "odom", "base", pose) for t, pose in poses]
+    transforms.append((poses[0][0], "base", "laser", mount))
+    path = write_recording(tmp_path / name_of(layout), [], layout, scans=clouds,
+                           scan_topic="/points", transforms=transforms)
+    got = recorded_poses(path, None, "/tf")
+    assert np.abs(got - np.array(expected)).max() < 1e-9
+    with pytest.raises(InputError, match="no transform reaches frame 'camera'"):
+        recorded_poses(path, None, "/tf", frame="camera")
