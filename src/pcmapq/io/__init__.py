@@ -20,7 +20,8 @@ from pcmapq.io.occupancy import IMAGE_SUFFIXES, OccupancyMap, load_occupancy
 __all__ = ["OccupancyMap", "PointMap", "Thresholds", "load_map"]
 
 #: The formats named in the error for an unknown extension (others are accepted quietly).
-_ADVERTISED = (".png", ".pgm", ".yaml", ".ply", ".pcd", ".xyz", ".txt", ".npy", ".bin")
+_ADVERTISED = (".png", ".pgm", ".yaml", ".ply", ".pcd", ".xyz", ".txt", ".npy", ".bin", ".las",
+               ".laz", ".e57", ".bag", ".db3", ".mcap")
 
 
 def load_map(path: str | Path, resolution: float | None = None,

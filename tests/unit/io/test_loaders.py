@@ -320,7 +320,7 @@ def test_bad_input_is_one_line_naming_the_file(tmp_path: Path, name: str) -> Non
                    "or a YAML beside it"),
     ("empty.xyz", "empty.xyz: no points"),
     ("foo.abc", "foo.abc: unsupported format '.abc' (expected .png, .pgm, .yaml, .ply, .pcd, "
-                ".xyz, .txt, .npy, .bin)"),
+                ".xyz, .txt, .npy, .bin, .las, .laz, .e57, .bag, .db3, .mcap)"),
 ])
 def test_bad_input_messages(tmp_path: Path, name: str, expected: str) -> None:
     BAD_INPUTS[name](tmp_path)
