@@ -107,7 +107,6 @@ def test_python_example_runs_as_written(body, repo, capsys):
 API = (REPO / "docs" / "api.md").read_text()
 
 
-@pytest.mark.unit
 def test_the_api_page_runs_as_written(repo, capsys):
     """docs/api.md's example: evaluate, inspect and track through `import pcmapq`, printing
     what the commands print."""
