@@ -33,6 +33,12 @@ RowsFailOver = Annotated[str | None, typer.Option(
     "--fail-over", metavar="<KEY=VALUE,...>",
     help="CI gate for distances: exit 3 when a figure of any row is above its bound, e.g. "
     "accuracy.mean=0.05 (metres).")]
+#: A recording's scan topic and the tf frame of its scans' poses (map and track).
+ScanTopic = Annotated[str | None, typer.Option(
+    help="A recording's PointCloud2 or LaserScan topic (default: the only one).")]
+TfFrame = Annotated[str | None, typer.Option(
+    "--frame", help="With --pose-topic /tf: the frame whose poses place the scans (default: "
+    "the scans' own frame), in the transform tree's root frame.")]
 #: The memory limit of eval and track, in GB (:func:`memory_limit` in bytes).
 MaxMemory = Annotated[float | None, typer.Option(
     help="Stop (exit 2) before a run estimated to need more than this many GB "

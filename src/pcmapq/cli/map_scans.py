@@ -10,7 +10,7 @@ import typer
 from rich.console import Console
 
 from pcmapq.cli import options, terminal
-from pcmapq.cli.commands import HELP, app
+from pcmapq.cli.commands import HELP, ScanTopic, TfFrame, app
 from pcmapq.cli.terminal import (
     report_errors,
     scan_bar,
@@ -47,15 +47,12 @@ def map_command(
     poses: Annotated[Path | None, typer.Option(
         help="Build the map from these poses (KITTI or TUM file) instead of running KISS-ICP.")
     ] = None,
-    scan_topic: Annotated[str | None, typer.Option(
-        help="A recording's PointCloud2 or LaserScan topic (default: the only one).")] = None,
+    scan_topic: ScanTopic = None,
     pose_topic: Annotated[str | None, typer.Option(
         help="Build the map from a recording's nav_msgs/Odometry or geometry_msgs/PoseStamped "
         "topic instead of running KISS-ICP: each scan placed at the pose interpolated at its "
         "time (with --calib T, the scanner -> pose-frame transform: P_k T).")] = None,
-    frame: Annotated[str | None, typer.Option(
-        help="With --pose-topic /tf: the frame whose poses place the scans (default: the "
-        "scans' own frame), in the transform tree's root frame.")] = None,
+    frame: TfFrame = None,
     calib: Annotated[Path | None, typer.Option(
         help="With --poses: scanner -> pose-frame transform T (12 or 16 numbers, or a KITTI "
         "calib.txt with Tr:); the map is then built in the first scanner's frame, "

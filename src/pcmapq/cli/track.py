@@ -11,7 +11,7 @@ import typer
 from rich.console import Console
 
 from pcmapq.cli import options, terminal
-from pcmapq.cli.commands import HELP, MaxMemory, app, memory_limit
+from pcmapq.cli.commands import HELP, MaxMemory, ScanTopic, TfFrame, app, memory_limit
 from pcmapq.cli.terminal import (
     report_errors,
     scan_bar,
@@ -49,14 +49,11 @@ def track_command(
     every_m: Annotated[float | None, typer.Option(
         help="Score the map every D metres travelled instead.", min=1e-6,
         callback=options.finite)] = None,
-    scan_topic: Annotated[str | None, typer.Option(
-        help="A recording's PointCloud2 or LaserScan topic (default: the only one).")] = None,
+    scan_topic: ScanTopic = None,
     pose_topic: Annotated[str | None, typer.Option(
         help="A recording's nav_msgs/Odometry or geometry_msgs/PoseStamped topic: the run's "
         "poses, interpolated at each scan's time (instead of KISS-ICP's).")] = None,
-    frame: Annotated[str | None, typer.Option(
-        help="With --pose-topic /tf: the frame whose poses place the scans (default: the "
-        "scans' own frame).")] = None,
+    frame: TfFrame = None,
     map_topic: Annotated[str | None, typer.Option(
         help="A recording's OccupancyGrid topic to score (default: the only one, or /map).")
     ] = None,
