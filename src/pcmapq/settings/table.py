@@ -218,12 +218,13 @@ OPTIONS: tuple[Option, ...] = (
            read=parse_init, show=show_init, commands=(EVAL, BATCH, TRACK),
            helps={TRACK: "Initial guess x,y,yaw (m, m, deg), map -> truth, of the first "
                          "step; skips the global search."}),
-    Option("no_align", "alignment.enabled", FLAG, "Trust the map's frame: no alignment at all.",
-           read=lambda off: not off, show=lambda on: not on, commands=(EVAL, BATCH, TRACK),
-           helps={TRACK: "Trust the run's frame: no alignment at any step."}),
-    Option("force", "alignment.force", FLAG,
-           "Evaluate even when the map does not seem to show the truth's place.",
+    Option("no_align", "alignment.enabled", SWITCH, "Trust the map's frame: no alignment at all.",
+           flag="--no-align/--align", read=lambda off: not off, show=lambda on: not on,
            commands=(EVAL, BATCH, TRACK),
+           helps={TRACK: "Trust the run's frame: no alignment at any step."}),
+    Option("force", "alignment.force", SWITCH,
+           "Evaluate even when the map does not seem to show the truth's place.",
+           flag="--force/--no-force", commands=(EVAL, BATCH, TRACK),
            helps={TRACK: "Score every step, even one that does not seem to show the truth's "
                          "place."}),
     Option("threshold", "matching.threshold", FLOAT,
@@ -258,8 +259,9 @@ OPTIONS: tuple[Option, ...] = (
            "The map's footprint is grown by this much, metres: truth features that far "
            "outside the area the map observed still count as missing.", 0.0,
            commands=(EVAL, BATCH, TRACK)),
-    Option("full", "footprint.full", FLAG,
-           "Score against the whole truth, not only the part the map covers."),
+    Option("full", "footprint.full", SWITCH,
+           "Score against the whole truth, not only the part the map covers.",
+           flag="--full/--no-full"),
     Option("noref", "noref.enabled", SWITCH,
            "Also report each input's no-reference figures, as 'pcmapq inspect' does (MME, "
            "MPV, MOM of a 3D cloud; occupancy figures of a 2D map).", flag="--noref/--no-noref"),
