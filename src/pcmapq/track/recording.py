@@ -12,7 +12,6 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 
 from pcmapq.core.errors import EvaluationError, InputError
-from pcmapq.core.transform import Similarity2D
 from pcmapq.evaluation.scoring import score
 from pcmapq.evaluation.truth import PreparedTruth
 from pcmapq.io.bag_grids import grids
@@ -20,7 +19,7 @@ from pcmapq.io.bags import opened, span
 from pcmapq.io.occupancy import OccupancyMap
 from pcmapq.results.result import Result
 from pcmapq.settings import Settings
-from pcmapq.track.timeline import KEEP_BYTES, Step, figures_of, place_step
+from pcmapq.track.timeline import KEEP_BYTES, Step, figures_of, place_step, settings_from
 
 
 @dataclass(frozen=True)
@@ -70,7 +69,7 @@ def score_grids(recording: Recording, truth: PreparedTruth, settings: Settings,
         at = (len(steps), index + 1, t, None)
         try:
             side, used = place_step(grid, truth, settings, start)
-            result = score(side, truth, started(settings, used))
+            result = score(side, truth, settings_from(settings, used))
         except (EvaluationError, InputError) as err:
             steps.append(Step(*at, {"slide_m": None, "local_offset_m": None}, str(err), start))
             continue
@@ -93,13 +92,6 @@ def grid_result(recording: Recording, truth: PreparedTruth, settings: Settings,
     if step.result is not None:
         return step.result
     grid = next(g for i, _, g in recording.grids(settings) if i + 1 == step.scans)
-    settings = started(settings, step.start)
+    settings = settings_from(settings, step.start)
     side, _ = place_step(grid, truth, settings, None)
     return score(side, truth, settings)
-
-
-def started(settings: Settings, start: Similarity2D | None) -> Settings:
-    """The settings of a grid aligned by ICP from ``start`` (None: as given)."""
-    if start is None or not settings.alignment.enabled:
-        return settings
-    return replace(settings, alignment=replace(settings.alignment, init=start))

@@ -136,14 +136,14 @@ def place_step(source, prepared: PreparedTruth, settings: Settings,
     if start is None or not option.enabled:
         return place(source, prepared, settings), option.init
     try:
-        return place(source, prepared, _settings_from(settings, start)), start
+        return place(source, prepared, settings_from(settings, start)), start
     except EvaluationError:
         if option.force:
             raise
         return place(source, prepared, settings), None
 
 
-def _settings_from(settings: Settings, start: Similarity2D | None) -> Settings:
+def settings_from(settings: Settings, start: Similarity2D | None) -> Settings:
     """The settings a step was scored with: ICP from ``start`` (None: as given)."""
     if start is None or not settings.alignment.enabled:
         return settings
@@ -204,7 +204,7 @@ def track(run: Run, prepared: PreparedTruth, settings: Settings, ends: np.ndarra
             if settings.alignment.enabled:
                 start = side.alignment.transform
             pending.append((index, scorers.submit(
-                _finish, at, recent, side, prepared, _settings_from(settings, used),
+                _finish, at, recent, side, prepared, settings_from(settings, used),
                 used, extra)))
             collect(scoring)
         collect(0)
@@ -272,5 +272,5 @@ def result_at(run: Run, prepared: PreparedTruth, settings: Settings, step: Step)
     it computed it (the same map, the same start: the same result)."""
     if step.result is not None:
         return step.result
-    settings = _settings_from(settings, step.start)
+    settings = settings_from(settings, step.start)
     return score(place(next(run.maps([step.scans])), prepared, settings), prepared, settings)
