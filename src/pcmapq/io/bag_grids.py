@@ -16,7 +16,7 @@ from pcmapq.core import memory
 from pcmapq.core.cells import FREE, OCCUPIED, UNKNOWN
 from pcmapq.core.errors import InputError
 from pcmapq.core.grid import MetricGrid
-from pcmapq.io.bags import DEFAULT_MAP_TOPIC, GRID, deserialised, opened, pick, topics
+from pcmapq.io.bags import DEFAULT_MAP_TOPIC, GRID, topic_messages
 from pcmapq.io.map_yaml import MapMeta, Thresholds
 from pcmapq.io.occupancy import OccupancyMap
 from pcmapq.io.writers import one_line
@@ -28,22 +28,18 @@ def grids(path: Path, topic: str | None = None, thresholds: Thresholds | None = 
     """Every OccupancyGrid of the recording's map topic, in time order: (seconds, map). A grid
     the same as the one before (same cells, resolution and origin) is left out; one larger
     than ``memory_limit`` bytes allow (None: the default) is refused before it is drawn."""
-    with opened(path) as reader:
-        chosen = pick(path, topics(reader), (GRID,), topic, DEFAULT_MAP_TOPIC, option)
-        connections = [c for c in reader.connections if c.topic == chosen.name]
-        last = None
-        for connection, stamp, raw in reader.messages(connections=connections):
-            msg = deserialised(reader, raw, connection, path)
-            try:
-                key = _digest(msg)
-                if key == last:
-                    continue
-                last = key
-                grid = grid_map(msg, path, chosen.name, thresholds, memory_limit)
-            except (AttributeError, TypeError, ValueError) as exc:  # a message of another shape
-                raise InputError(f"{path}: {chosen.name}: not an OccupancyGrid as nav_msgs "
-                                 f"defines it: {one_line(exc)}") from None
-            yield stamp / 1e9, grid
+    last = None
+    for chosen, seconds, msg in topic_messages(path, (GRID,), topic, DEFAULT_MAP_TOPIC, option):
+        try:
+            key = _digest(msg)
+            if key == last:
+                continue
+            last = key
+            grid = grid_map(msg, path, chosen.name, thresholds, memory_limit)
+        except (AttributeError, TypeError, ValueError) as exc:  # a message of another shape
+            raise InputError(f"{path}: {chosen.name}: not an OccupancyGrid as nav_msgs "
+                             f"defines it: {one_line(exc)}") from None
+        yield seconds, grid
 
 
 def grid_at(path: Path, topic: str | None = None, at: float | None = None,

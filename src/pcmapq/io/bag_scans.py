@@ -6,6 +6,7 @@ Times are seconds of the recording's clock; metres."""
 from __future__ import annotations
 
 from collections.abc import Iterator
+from contextlib import closing
 from pathlib import Path
 from typing import Any
 
@@ -18,9 +19,9 @@ from pcmapq.io.bags import (
     ODOMETRY,
     POSE,
     Topic,
-    deserialised,
     opened,
     pick,
+    topic_messages,
     topics,
 )
 
@@ -28,12 +29,14 @@ from pcmapq.io.bags import (
 FIELD_TYPES = {1: "i1", 2: "u1", 3: "i2", 4: "u2", 5: "i4", 6: "u4", 7: "f4", 8: "f8"}
 #: Per-point time fields of a PointCloud2, in the order KISS-ICP's loaders try them.
 TIME_FIELDS = ("t", "timestamp", "timestamps", "time", "stamps")
+#: The message types of scans.
+SCANS = (CLOUD, LASER)
 
 
 def scan_topic(path: Path, topic: str | None = None) -> Topic:
     """The recording's scan topic: ``topic``, else its only PointCloud2 or LaserScan topic."""
     with opened(path) as reader:
-        return pick(path, topics(reader), (CLOUD, LASER), topic, None, "--scan-topic")
+        return pick(path, topics(reader), SCANS, topic, None, "--scan-topic")
 
 
 def scans(path: Path, topic: str | None = None
@@ -42,15 +45,11 @@ def scans(path: Path, topic: str | None = None
     metres in the sensor's frame, per-point times (N,) or (0,)). A PointCloud2 keeps its
     finite x, y, z and a time field if it has one; a LaserScan its returns within its range
     limits (z = 0), timed by ``time_increment``."""
-    with opened(path) as reader:
-        chosen = pick(path, topics(reader), (CLOUD, LASER), topic, None, "--scan-topic")
-        connections = [c for c in reader.connections if c.topic == chosen.name]
-        for connection, stamp, raw in reader.messages(connections=connections):
-            msg = deserialised(reader, raw, connection, path)
-            if chosen.msgtype == LASER:
-                yield stamp / 1e9, *laser_points(msg)
-            else:
-                yield stamp / 1e9, *cloud_points(msg, path, chosen.name)
+    for chosen, seconds, msg in topic_messages(path, SCANS, topic, None, "--scan-topic"):
+        if chosen.msgtype == LASER:
+            yield seconds, *laser_points(msg)
+        else:
+            yield seconds, *cloud_points(msg, path, chosen.name)
 
 
 def laser_points(msg: Any) -> tuple[np.ndarray, np.ndarray]:
@@ -92,38 +91,31 @@ def cloud_points(msg: Any, path: Path, topic: str) -> tuple[np.ndarray, np.ndarr
 
 def scan_frame(path: Path, topic: str | None = None) -> str:
     """The frame the recording's scans are in (their first message's ``header.frame_id``)."""
-    with opened(path) as reader:
-        chosen = pick(path, topics(reader), (CLOUD, LASER), topic, None, "--scan-topic")
-        connections = [c for c in reader.connections if c.topic == chosen.name]
-        for connection, _, raw in reader.messages(connections=connections):
-            return deserialised(reader, raw, connection, path).header.frame_id
-    raise InputError(f"{path}: {chosen.name} holds no message")
+    with closing(topic_messages(path, SCANS, topic, None, "--scan-topic")) as messages:
+        for _, _, msg in messages:
+            return msg.header.frame_id
+    raise InputError(f"{path}: {scan_topic(path, topic).name} holds no message")
 
 
 def scan_times(path: Path, topic: str | None = None) -> np.ndarray:
     """The times of the recording's scans (seconds of its clock), without reading their
     points' data into arrays."""
-    with opened(path) as reader:
-        chosen = pick(path, topics(reader), (CLOUD, LASER), topic, None, "--scan-topic")
-        connections = [c for c in reader.connections if c.topic == chosen.name]
-        return np.array([stamp / 1e9 for _, stamp, _ in
-                         reader.messages(connections=connections)], dtype=np.float64)
+    return np.array([seconds for _, seconds, _ in
+                     topic_messages(path, SCANS, topic, None, "--scan-topic", decode=False)],
+                    dtype=np.float64)
 
 
 def pose_track(path: Path, topic: str) -> tuple[np.ndarray, np.ndarray]:
     """A recording's nav_msgs/Odometry or geometry_msgs/PoseStamped topic: times (K,) seconds
     of its clock and poses (K, 4, 4), the frame the messages name -> world."""
-    with opened(path) as reader:
-        chosen = pick(path, topics(reader), (ODOMETRY, POSE), topic, None, "--pose-topic")
-        connections = [c for c in reader.connections if c.topic == chosen.name]
-        times, poses = [], []
-        for connection, stamp, raw in reader.messages(connections=connections):
-            msg = deserialised(reader, raw, connection, path)
-            pose = msg.pose.pose if chosen.msgtype == ODOMETRY else msg.pose
-            times.append(stamp / 1e9)
-            poses.append(_matrix(pose))
+    times, poses = [], []
+    for chosen, seconds, msg in topic_messages(path, (ODOMETRY, POSE), topic, None,
+                                               "--pose-topic"):
+        pose = msg.pose.pose if chosen.msgtype == ODOMETRY else msg.pose
+        times.append(seconds)
+        poses.append(pose_matrix(pose.position, pose.orientation))
     if not poses:
-        raise InputError(f"{path}: {chosen.name} holds no message")
+        raise InputError(f"{path}: {topic} holds no message")
     return np.array(times), np.array(poses)
 
 
@@ -147,12 +139,12 @@ def poses_at(times: np.ndarray, track_times: np.ndarray, track: np.ndarray) -> n
     return out
 
 
-def _matrix(pose: Any) -> np.ndarray:
-    """A geometry_msgs/Pose as a 4 x 4 matrix."""
+def pose_matrix(position: Any, q: Any) -> np.ndarray:
+    """A position and a unit quaternion (x, y, z; x, y, z, w: a geometry_msgs Pose's or
+    Transform's) as a 4 x 4 matrix."""
     from scipy.spatial.transform import Rotation
 
-    q = pose.orientation
     out = np.eye(4)
     out[:3, :3] = Rotation.from_quat([q.x, q.y, q.z, q.w]).as_matrix()
-    out[:3, 3] = [pose.position.x, pose.position.y, pose.position.z]
+    out[:3, 3] = [position.x, position.y, position.z]
     return out

@@ -9,10 +9,9 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from pcmapq.core.errors import InputError
-from pcmapq.io.bag_scans import poses_at
+from pcmapq.io.bag_scans import pose_matrix, poses_at
 from pcmapq.io.bags import deserialised, opened
 
 #: The transform messages' type.
@@ -37,7 +36,7 @@ def links(path: Path) -> dict[str, tuple[str, np.ndarray, np.ndarray]]:
                     raise InputError(f"{path}: frame {child!r} has two parents, {entry[0]!r} "
                                      f"and {parent!r}")
                 entry[1].append(stamp / 1e9)
-                entry[2].append(_matrix(t.transform))
+                entry[2].append(pose_matrix(t.transform.translation, t.transform.rotation))
     return {c: (p, np.array(ts), np.array(ms)) for c, (p, ts, ms) in found.items()}
 
 
@@ -61,12 +60,3 @@ def frame_poses(path: Path, frame: str, times: np.ndarray) -> np.ndarray:
 
 def _name(frame: str) -> str:
     return frame.lstrip("/")
-
-
-def _matrix(transform) -> np.ndarray:
-    """A geometry_msgs/Transform as a 4 x 4 matrix."""
-    q, v = transform.rotation, transform.translation
-    out = np.eye(4)
-    out[:3, :3] = Rotation.from_quat([q.x, q.y, q.z, q.w]).as_matrix()
-    out[:3, 3] = [v.x, v.y, v.z]
-    return out

@@ -116,6 +116,18 @@ def has_grids(path: Path, topic: str | None = None) -> bool:
         return any(t.msgtype == GRID for t in topics(reader))
 
 
+def topic_messages(path: Path, kinds: tuple[str, ...], topic: str | None, default: str | None,
+                   option: str, decode: bool = True) -> Iterator[tuple[Topic, float, Any]]:
+    """The messages of the topic :func:`pick` chooses, in time order: (the topic, seconds of
+    the recording's clock, the message; None without ``decode``)."""
+    with opened(path) as reader:
+        chosen = pick(path, topics(reader), kinds, topic, default, option)
+        connections = [c for c in reader.connections if c.topic == chosen.name]
+        for connection, stamp, raw in reader.messages(connections=connections):
+            yield (chosen, stamp / 1e9,
+                   deserialised(reader, raw, connection, path) if decode else None)
+
+
 def span(reader: Any) -> tuple[float, float]:
     """The recording's first and last message times, seconds."""
     return reader.start_time / 1e9, reader.end_time / 1e9
