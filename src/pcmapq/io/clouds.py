@@ -110,7 +110,7 @@ def load_cloud(path: Path, memory_limit: int | None = None) -> PointMap:
         points = points[np.isfinite(points).all(axis=1)]
     if len(points) == 0:
         raise InputError(f"{path}: no points")
-    is_3d = bool(np.ptp(points[:, 2]) > FLAT_TOLERANCE)
+    is_3d = not flat(points)
     if not is_3d:
         points[:, 2] = 0.0
     return PointMap(path, points, is_3d)

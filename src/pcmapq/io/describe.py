@@ -10,6 +10,7 @@ from typing import Any
 
 import numpy as np
 
+from pcmapq.core.bounds import bounds
 from pcmapq.core.cells import FREE, OCCUPIED, UNKNOWN
 from pcmapq.core.errors import InputError
 from pcmapq.io import load_map
@@ -75,12 +76,8 @@ def lines(record: dict[str, Any]) -> list[str]:
 
 
 def _cloud(path: Path, source: PointMap) -> dict[str, Any]:
-    lo, hi = np.inf * np.ones(3), -np.inf * np.ones(3)
-    pts = source.points
-    for start in range(0, len(pts), 1 << 22):  # a mapped PLY is read in chunks
-        block = np.asarray(pts[start:start + (1 << 22)], dtype=np.float64)
-        lo, hi = np.minimum(lo, block.min(axis=0)), np.maximum(hi, block.max(axis=0))
-    return {"file": str(path), "kind": source.kind, "points": int(len(pts)),
+    lo, hi = bounds(source.points)  # column by column: a mapped PLY is not copied
+    return {"file": str(path), "kind": source.kind, "points": int(len(source.points)),
             "is_3d": bool(source.is_3d), "fields": _fields(path),
             "bounds_m": {"min": [float(v) for v in lo], "max": [float(v) for v in hi]}}
 
