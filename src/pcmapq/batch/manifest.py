@@ -251,8 +251,6 @@ def _value(column: str, text: str, where: str) -> object:
     except ValueError:
         number = math.nan
     if not (math.isfinite(number) and option.lo <= number <= option.hi):
-        bounds = "" if option.lo == -math.inf else f" >= {option.lo:g}" \
-            if option.hi == math.inf else f" in [{option.lo:g}, {option.hi:g}]"
         kind = "an integer" if option.kind == INT else "a finite number"
-        raise InputError(f"{where}: {column}: expected {kind}{bounds}, got {text!r}")
+        raise InputError(f"{where}: {column}: expected {kind}{option.bounds}, got {text!r}")
     return number

@@ -111,9 +111,7 @@ def _check_option(doc: dict, option, path: Path) -> None:
         return
     where = f"{path}: {option.path}"
     if option.kind in (FLOAT, INT) and not option.lo <= value <= option.hi:
-        bounds = (f">= {option.lo:g}" if option.hi == math.inf
-                  else f"in [{option.lo:g}, {option.hi:g}]")
-        raise InputError(f"{where}: expected a number {bounds}, got {value!r}")
+        raise InputError(f"{where}: expected a number{option.bounds}, got {value!r}")
     if option.kind == TEXT:
         try:
             option.read(option.show(_setting(option.path, value)))

@@ -67,6 +67,13 @@ class Option:
         """The option as typed: ``--map-resolution``."""
         return (self.flag or "--" + self.name.replace("_", "-")).split("/")[0]
 
+    @property
+    def bounds(self) -> str:
+        """The option's bounds as a refusal says them: `` >= 0.01``, `` in [0, 1]``, or ''."""
+        if self.lo == -math.inf:
+            return ""
+        return f" >= {self.lo:g}" if self.hi == math.inf else f" in [{self.lo:g}, {self.hi:g}]"
+
     def help_for(self, command: str) -> str:
         return self.helps.get(command, self.help)
 
