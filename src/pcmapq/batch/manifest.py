@@ -23,7 +23,6 @@ from pcmapq.settings.file import read_settings
 from pcmapq.settings.table import (
     BATCH,
     EVAL,
-    FLAG,
     INT,
     SWITCH,
     TEXT,
@@ -240,7 +239,7 @@ TRUE, FALSE = ("true", "yes", "1", "on"), ("false", "no", "0", "off")
 def _value(column: str, text: str, where: str) -> object:
     """A cell's text as its column's type, within its bounds."""
     option = OPTIONS[column]
-    if option.kind in (FLAG, SWITCH):
+    if option.kind == SWITCH:
         if text.lower() not in TRUE + FALSE:
             raise InputError(f"{where}: {column}: expected true or false, got {text!r}")
         return text.lower() in TRUE

@@ -17,10 +17,10 @@ import typer
 from pcmapq.settings import Settings
 from pcmapq.settings.build import base_settings, build, get_path
 from pcmapq.settings.file import read_settings
-from pcmapq.settings.table import FLAG, FLOAT, INT, SWITCH, Option, OptionError, options_of
+from pcmapq.settings.table import FLOAT, INT, SWITCH, Option, OptionError, options_of
 
 #: Python types of the option kinds, as typer reads them.
-TYPES = {FLOAT: float | None, INT: int | None, SWITCH: bool | None, FLAG: bool}
+TYPES = {FLOAT: float | None, INT: int | None, SWITCH: bool | None}
 #: ``--config``: a settings file (``pcmapq config --dump`` writes one).
 CONFIG_HELP = ("Settings file (YAML, as 'pcmapq config --dump' writes): its settings replace "
                "the defaults; options given here override it.")
@@ -96,7 +96,7 @@ def _parameter(option: Option, command: str, defaults: Settings) -> inspect.Para
     """The typer parameter of one table option; its default is the setting's default."""
     default = option.show(get_path(defaults, option.path))
     kind = TYPES.get(option.kind, str | None)
-    decls = [option.option] if option.kind == FLAG else [option.flag] if option.flag else []
+    decls = [option.flag] if option.flag else []
     bounds = {k: v for k, v in (("min", option.lo), ("max", option.hi)) if math.isfinite(v)}
     info = typer.Option(*decls, help=option.help_for(command), metavar=option.metavar,
                         show_default=default is not None and default is not False,

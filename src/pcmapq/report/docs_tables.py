@@ -10,7 +10,7 @@ import re
 
 from pcmapq.results.figures import F_SCORE_COLUMN, FIGURES
 from pcmapq.settings.build import base_settings, get_path
-from pcmapq.settings.table import FLAG, FLOAT, INT, SWITCH, Option, options_of
+from pcmapq.settings.table import FLOAT, INT, SWITCH, Option, options_of
 
 BLOCK = re.compile(r"(<!-- options: (\w+) -->\n).*?(<!-- /options -->)", re.S)
 FIGURE_BLOCK = re.compile(r"(<!-- figures -->\n).*?(<!-- /figures -->)", re.S)
@@ -37,8 +37,6 @@ def update(page: str) -> str:
 def _typed(option: Option) -> str:
     if option.kind == SWITCH:
         return " / ".join(f"`{f}`" for f in (option.flag or "").split("/"))
-    if option.kind == FLAG:
-        return f"`{option.option}`"
     value = (option.metavar or ("N" if option.kind == INT else "P" if option.hi == 1.0 else
                                 "M" if option.kind == FLOAT else "TEXT"))
     return f"`{option.option} {value.strip('<>').replace('|', '/')}`"

@@ -10,7 +10,7 @@ from typing import Any
 
 from pcmapq.core.errors import InputError
 from pcmapq.settings import NoRefConfig, Settings
-from pcmapq.settings.table import FLAG, SWITCH, Option, options_of
+from pcmapq.settings.table import SWITCH, Option, options_of
 
 
 def base_settings(command: str) -> Settings:
@@ -71,15 +71,13 @@ def check(settings: Settings) -> None:
 
 def option_words(values: dict[str, Any], command: str) -> list[str]:
     """The options among ``values`` (by name, as given) as the command line shows them, in
-    table order: a flag alone when set, a switch as ``--x`` or ``--no-x``."""
+    table order: a switch as its ``--x`` or its ``--no-x``."""
     words: list[str] = []
     for option in options_of(command):
         value = values.get(option.name)
         if value is None:
             continue
-        if option.kind == FLAG:
-            words += [option.option] if value else []
-        elif option.kind == SWITCH:
+        if option.kind == SWITCH:
             on, off = (option.flag or "").split("/")
             words.append(on if value else off)
         else:

@@ -18,7 +18,7 @@ from pcmapq.io.map_yaml import Thresholds
 from pcmapq.io.writers import one_line
 from pcmapq.settings import Settings
 from pcmapq.settings.build import check
-from pcmapq.settings.table import FLAG, FLOAT, INT, OPTIONS, SWITCH, TEXT, OptionError
+from pcmapq.settings.table import FLOAT, INT, OPTIONS, SWITCH, TEXT, OptionError
 
 #: Groups that are null by default and take these keys when a file gives them.
 NULL_GROUPS = {"thresholds": {"occupied": None, "free": None, "negate": None},
@@ -117,7 +117,7 @@ def _check_option(doc: dict, option, path: Path) -> None:
             option.read(option.show(_setting(option.path, value)))
         except (OptionError, TypeError, ValueError) as exc:
             raise InputError(f"{where}: {getattr(exc, 'message', exc)}") from None
-    if option.kind in (FLAG, SWITCH) and not isinstance(value, bool):
+    if option.kind == SWITCH and not isinstance(value, bool):
         raise InputError(f"{where}: expected true or false, got {value!r}")
 
 

@@ -18,9 +18,9 @@ from pcmapq.core.transform import Similarity2D
 from pcmapq.raster.footprint import FOOTPRINT_RULES
 from pcmapq.settings import DETECTOR_NAMES
 
-#: Kinds of option: a number, an integer, text read by the option's parser, a flag
-#: (``--full``) or a switch (``--noref/--no-noref``).
-FLOAT, INT, TEXT, FLAG, SWITCH = "float", "int", "text", "flag", "switch"
+#: Kinds of option: a number, an integer, text read by the option's parser, or a switch
+#: (``--noref/--no-noref``: a yes or no the command line can give either way).
+FLOAT, INT, TEXT, SWITCH = "float", "int", "text", "switch"
 #: The commands that take settings.
 EVAL, BATCH, TRACK, INSPECT = "eval", "batch", "track", "inspect"
 

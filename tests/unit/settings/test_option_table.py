@@ -19,7 +19,6 @@ from pcmapq.settings.file import dump_settings, read_settings
 from pcmapq.settings.table import (
     BATCH,
     EVAL,
-    FLAG,
     FLOAT,
     INT,
     OPTIONS,
@@ -42,7 +41,7 @@ def sample(option: Option, command: str) -> object:
     default = option.show(get_path(base_settings(command), option.path))
     if option.kind == TEXT:
         return TEXTS[option.name]
-    if option.kind in (FLAG, SWITCH):
+    if option.kind == SWITCH:
         return not default
     lo = option.lo if math.isfinite(option.lo) else 0.0
     value = min(lo + 0.25, option.hi) if option.kind == FLOAT else int(lo) + 2
@@ -97,7 +96,7 @@ def test_the_command_line_overrides_the_file_which_overrides_the_defaults(tmp_pa
 def test_every_option_has_a_setting_and_a_sample():
     for option in OPTIONS:
         get_path(base_settings(option.commands[0]), option.path)  # the path exists
-        assert option.kind in (FLOAT, INT, TEXT, FLAG, SWITCH)
+        assert option.kind in (FLOAT, INT, TEXT, SWITCH)
         if option.kind == TEXT:
             assert option.name in TEXTS
     assert {o.name for o in options_of(BATCH)} == {o.name for o in options_of(EVAL)}
