@@ -28,24 +28,33 @@ from pcmapq.testing.paths import SAMPLE
 
 
 def test_eval_reports_the_figures_inspect_gives_for_map_and_truth():
-    """The sample: the scan's 3D figures at eval's 0.1 m voxel, the truth image's occupancy
-    figures; both equal to input_figures of the loaded inputs, and kept by the JSON."""
+    """The sample: the scan's 3D figures at eval's 0.1 m voxel over eval's sample of 20,000
+    points, the truth image's occupancy figures; both equal to input_figures of the loaded
+    inputs, and kept by the JSON; the sampled means within three standard errors of the whole
+    cloud's."""
     result = evaluate(SAMPLE / "scan.ply", SAMPLE / "truth.yaml")
     scan, truth = load_map(SAMPLE / "scan.ply"), load_map(SAMPLE / "truth.yaml")
     assert result.noref["map"] == input_figures(scan, Settings().noref)
     assert result.noref["truth"] == input_figures(truth, Settings().noref)
     cloud = result.noref["map"]["cloud"]
     assert cloud["voxel_m"] == 0.1 and cloud["points"] < len(scan.points)
+    assert cloud["sampled_points"] == 20_000 == cloud["mpv_points"] + 6  # 6 with few neighbours
     assert result.noref["map"]["grid"] is None and result.noref["truth"]["cloud"] is None
     assert result.noref["truth"]["grid"]["occupied_cells"] > 0
     # in the JSON, to six significant digits (MPV and MOM are small areas)
     assert Result.from_json(result.to_json()).noref == significant(result.noref)
     assert significant(cloud)["mme"] != cloud["mme"]  # the rounding is not a no-op here
     got = CliRunner().invoke(app, ["inspect", str(SAMPLE / "scan.ply"), "--voxel", "0.1",
-                                   "--json", "-"])
+                                   "--sample", "20000", "--json", "-"])
     assert got.exit_code == 0, got.stderr
-    # what the docs say: inspect --voxel 0.1
+    # what the docs say: inspect --voxel 0.1 --sample 20000
     assert json.loads(got.stdout)["cloud"] == significant(cloud)
+    whole = CliRunner().invoke(app, ["inspect", str(SAMPLE / "scan.ply"), "--voxel", "0.1",
+                                     "--json", "-"])
+    whole = json.loads(whole.stdout)["cloud"]
+    assert whole["sampled_points"] is None and whole["mpv_points"] > 100_000
+    for name in ("mme", "mpv"):
+        assert abs(whole[name] - cloud[name]) < 3 * cloud[f"{name}_se"]
     floats = [v for v in json.loads(got.stdout)["cloud"].values() if isinstance(v, float)]
     assert floats and all(v in (round(v, 6), float(f"{v:.6g}")) for v in floats)
 

@@ -38,16 +38,25 @@ def to_json(record: dict[str, Any]) -> str:
     return json.dumps(significant(record), indent=2, allow_nan=False) + "\n"
 
 
+def _se(value: float | None) -> str:
+    """`` ± standard error`` of a sampled mean, or ''."""
+    return "" if value is None else f" ± {_num(value)}"
+
+
 def summary_lines(record: dict[str, Any]) -> list[str]:
     """The record in a few labelled lines for the terminal, units in each."""
     lines = [f"map       {Path(record['map']['path']).name}, {record['map']['kind']}"]
     noref, grid = record["cloud"], record["grid"]
     if noref is not None:
         near = f"within {noref['radius_m']:g} m, more than {noref['min_knn']} neighbours"
-        lines += [f"points    {noref['points']:,} ({noref['mpv_points']:,} with neighbours "
-                  f"{near})",
-                  f"MME       {_num(noref['mme'])} nats (lower: crisper)",
-                  f"MPV       {_num(noref['mpv'])} m² (lower: thinner surfaces)",
+        drawn = noref.get("sampled_points")
+        among = "" if drawn is None else f" of {drawn:,} drawn at random"
+        lines += [f"points    {noref['points']:,} ({noref['mpv_points']:,}{among} with "
+                  f"neighbours {near})",
+                  f"MME       {_num(noref['mme'])}{_se(noref.get('mme_se'))} nats "
+                  "(lower: crisper)",
+                  f"MPV       {_num(noref['mpv'])}{_se(noref.get('mpv_se'))} m² "
+                  "(lower: thinner surfaces)",
                   f"MOM       {_num(noref['mom'])}"
                   + (f" ({noref['mom_note']})" if noref["mom"] is None else
                      f" m² (orthogonal planes {noref['orth_subset']})")]

@@ -6,14 +6,16 @@ occupancy figures of :mod:`pcmapq.metrics.noref2d`. docs/metrics.md says what ea
 
 from __future__ import annotations
 
+import threading
 from dataclasses import asdict, replace
 from typing import Any
 
 import numpy as np
 
-from pcmapq.core.voxels import voxel_centroids
+from pcmapq.core.voxels import VoxelMap
 from pcmapq.evaluation.inputs import truth_raster
 from pcmapq.io import OccupancyMap, PointMap
+from pcmapq.io.ply import CHUNK
 from pcmapq.metrics.inspection import noref_figures
 from pcmapq.metrics.noref2d import grid_scores
 from pcmapq.raster.draw import OCCUPIED, UNKNOWN
@@ -29,14 +31,24 @@ def input_figures(source: OccupancyMap | PointMap, config: NoRefConfig = NoRefCo
     the voxel reduction of ``config.voxel``). ``corners``: an image's Harris corners when
     already found (see :func:`pcmapq.metrics.noref2d.grid_scores`)."""
     if isinstance(source, PointMap) and source.is_3d:
-        points = np.asarray(source.points, dtype=np.float64) * scale
-        if config.voxel > 0:
-            points = voxel_centroids(points, config.voxel)
+        points = reduced(source.points, config.voxel, scale)
         planes = None if orth_subset is None else [p * scale for p in orth_subset]
         figures = noref_figures(points, config.radius, config.min_knn, config.max_nn, planes,
-                                max_ward=config.max_ward)
+                                max_ward=config.max_ward, sample=config.sample)
         return {"cloud": {**figures, "voxel_m": config.voxel}, "grid": None}
     return {"cloud": None, "grid": occupancy_figures(source, scale, corners)}
+
+
+def reduced(points: np.ndarray, voxel: float, scale: float = 1.0) -> np.ndarray:
+    """(M, 3) float64: ``points`` times ``scale``, metres, reduced to their centroid in each
+    voxel of ``voxel`` metres (0: all of them), read in chunks so that a cloud mapped onto its
+    file is never converted whole."""
+    if voxel <= 0:
+        return np.asarray(points, dtype=np.float64) * scale
+    centroids = VoxelMap(voxel)
+    for start in range(0, len(points), CHUNK):
+        centroids.add(np.asarray(points[start:start + CHUNK], dtype=np.float64) * scale)
+    return centroids.points()
 
 
 def occupancy_figures(source: OccupancyMap | PointMap, scale: float = 1.0,
@@ -57,3 +69,41 @@ def occupancy_figures(source: OccupancyMap | PointMap, scale: float = 1.0,
         figures.update(free_cells=None, occupied_free_ratio=None, enclosed_areas=None,
                        enclosed_area_m2=None)
     return figures
+
+
+class EarlyFigures:
+    """The 3D no-reference figures of an evaluation's clouds, found on a thread of their own
+    while the map is placed (they need neither the alignment nor the truth's features). The
+    thread is a daemon's, so a map refused before its figures are wanted does not wait for
+    them. Sides that are not 3D clouds, or a map whose scale is estimated, are left to
+    :func:`input_figures` after the alignment."""
+
+    def __init__(self, sides: dict[str, OccupancyMap | PointMap], settings: Settings) -> None:
+        config = settings.noref
+        self._sources = {} if not config.enabled else {
+            side: source for side, source in sides.items()
+            if isinstance(source, PointMap) and source.is_3d
+            and not (side == "map" and settings.alignment.scale)}
+        self._figures: dict[str, dict[str, Any]] = {}
+        self._error: BaseException | None = None
+        self._thread = threading.Thread(target=self._run, args=(config,), daemon=True,
+                                        name="pcmapq-noref")
+        if self._sources:
+            self._thread.start()
+
+    def _run(self, config: NoRefConfig) -> None:
+        try:
+            for side, source in self._sources.items():
+                self._figures[side] = input_figures(source, config)
+        except BaseException as exc:  # handed to the caller by get()
+            self._error = exc
+
+    def get(self, side: str) -> dict[str, Any] | None:
+        """The figures of ``side`` ("map" or "truth") when found here, waiting for them; None
+        when this side was left to the caller."""
+        if side not in self._sources:
+            return None
+        self._thread.join()
+        if self._error is not None:
+            raise self._error
+        return self._figures[side]

@@ -7,6 +7,7 @@ from dataclasses import replace
 from pathlib import Path
 
 from pcmapq.evaluation.inputs import load_pair
+from pcmapq.evaluation.noref_figures import EarlyFigures
 from pcmapq.evaluation.placing import Progress, map_footprint_rule, place
 from pcmapq.evaluation.scoring import score
 from pcmapq.evaluation.truth import prepare_truth
@@ -23,17 +24,18 @@ def evaluate(map_path: str | Path | PointMap, truth_path: str | Path,
     truth at ``truth_path``; stop (InputError) when the run would need more than
     ``memory_limit`` bytes (None: :func:`pcmapq.core.memory.default_limit`).
     ``truth_sha256``: the truth file's SHA-256 when the caller has it (a batch row's key),
-    else read here. The truth's features are found on a thread of their own while the map is
-    placed."""
+    else read here. The truth's features, and the 3D clouds' no-reference figures, are found on
+    threads of their own while the map is placed."""
     settings = Settings() if settings is None else settings
     progress("loading")
     source, truth = load_pair(map_path, truth_path, settings, memory_limit)
     map_footprint_rule(source, settings)  # a rule the map cannot follow: before any work
     prepared = prepare_truth(truth, settings, memory_limit, maps=(0,), loaded=(source,),
                              background=True)
+    early = EarlyFigures({"map": source, "truth": truth}, settings)
     try:
         result = score(place(source, prepared, settings, progress), prepared, settings,
-                       progress)
+                       progress, early)
     except BaseException:
         prepared.cancel()
         raise

@@ -13,7 +13,7 @@ from pcmapq.align.parts import broken_off
 from pcmapq.align.regions import regions
 from pcmapq.core.frames import Frames
 from pcmapq.core.grid import MetricGrid
-from pcmapq.evaluation.noref_figures import input_figures
+from pcmapq.evaluation.noref_figures import EarlyFigures, input_figures
 from pcmapq.evaluation.placing import Placed, Progress
 from pcmapq.evaluation.truth import FEATURE_THREADS, PreparedTruth
 from pcmapq.features import Features, SideBySide, default_params
@@ -25,10 +25,11 @@ from pcmapq.settings import Settings
 
 
 def score(placed: Placed, prepared: PreparedTruth, settings: Settings,
-          progress: Progress = lambda step: None) -> Result:
+          progress: Progress = lambda step: None, early: EarlyFigures | None = None) -> Result:
     """The result of a map placed on the prepared truth: its features (found here unless
     ``placed`` has them) matched one to one against the truth's inside the footprint, the wall
-    distances, the consistency map, the optional no-reference and 3D figures."""
+    distances, the consistency map, the optional no-reference and 3D figures (those ``early``
+    found while the map was placed taken from it)."""
     if placed.features is None:
         progress("drawing the walls' centre lines and detecting features")
         sides = SideBySide(settings.matching.detectors, settings.matching.params)
@@ -61,8 +62,10 @@ def score(placed: Placed, prepared: PreparedTruth, settings: Settings,
         progress("no-reference figures")
         scale = alignment.transform.scale if settings.alignment.scale else 1.0
         corners = harris_corners(truth, prepared.features, settings)
-        noref = {"map": input_figures(loaded, settings.noref, scale=scale),
-                 "truth": input_figures(truth, settings.noref, corners=corners)}
+        early = early or EarlyFigures({}, settings)
+        noref = {"map": early.get("map") or input_figures(loaded, settings.noref, scale=scale),
+                 "truth": early.get("truth") or input_figures(truth, settings.noref,
+                                                              corners=corners)}
     cloud_distances = None
     if registration is not None:
         progress("distances in 3D")

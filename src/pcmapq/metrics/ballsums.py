@@ -109,18 +109,18 @@ def _span(xs: np.ndarray, ys: np.ndarray, zs: np.ndarray, start: int, end: int, 
     return s1, sx, sy, sz, sxx, sxy, sxz, syy, syz, szz
 
 
-@numba.njit(cache=True, parallel=True)
+@numba.njit(cache=True, parallel=True, nogil=True)
 def _sums(xyz: np.ndarray, axes: np.ndarray, low: np.ndarray, rank: np.ndarray,
-          cell: np.ndarray, lo: np.ndarray, hi: np.ndarray, radius: float, p0: int,
+          cell: np.ndarray, lo: np.ndarray, hi: np.ndarray, radius: float, rows: np.ndarray,
           out: np.ndarray) -> None:
-    """Sums of the points ``p0 + row`` (sorted order) into ``out[row]``. ``xyz``: the sorted
+    """Sums of the points ``rows[k]`` (sorted order) into ``out[k]``. ``xyz``: the sorted
     map's coordinates (3, N); ``axes``: its rows along the grid's axes, longest last."""
     r2 = radius * radius
     xs, ys, zs = xyz[0], xyz[1], xyz[2]
     us, vs, ws = xyz[axes[0]], xyz[axes[1]], xyz[axes[2]]
     margin = 1e-6 * radius + 64.0 * np.finfo(np.float64).eps * max(np.abs(xyz).max(), radius)
     for row in numba.prange(out.shape[0]):
-        i = p0 + row
+        i = rows[row]
         u, v, w = us[i], vs[i], ws[i]
         c = rank[i]
         acc = np.zeros(10)
@@ -145,25 +145,35 @@ def _sums(xyz: np.ndarray, axes: np.ndarray, low: np.ndarray, rank: np.ndarray,
 
 
 def ball_sums(points: np.ndarray, radius: float, chunk_points: int = CHUNK_POINTS,
-              workers: int | None = None) -> Iterator[tuple[np.ndarray, np.ndarray]]:
-    """Yield (indices into ``points``, (k, 10) moment sums) over every point's neighbourhood
-    (points with |p - q| < ``radius`` metres): count, sums of x, y, z, xx, xy, xz, yy, yz, zz
-    of the neighbours' offsets from the point itself. Chunks of about ``chunk_points`` points,
-    in an order and with figures independent of ``workers`` (threads; default Numba's, at most
-    its ``NUMBA_NUM_THREADS``). Memory: the sorted map and one chunk's sums."""
+              workers: int | None = None,
+              queries: np.ndarray | None = None) -> Iterator[tuple[np.ndarray, np.ndarray]]:
+    """Yield (indices into ``points``, (k, 10) moment sums) over the neighbourhood (points with
+    |p - q| < ``radius`` metres) of every point, or of the points ``queries`` (indices into
+    ``points``) only: count, sums of x, y, z, xx, xy, xz, yy, yz, zz of the neighbours' offsets
+    from the point itself. Chunks of about ``chunk_points`` points, in an order and with figures
+    independent of ``workers`` (threads; default Numba's, at most its ``NUMBA_NUM_THREADS``);
+    a point's sums are the same whether it is one of ``queries`` or not. Memory: the sorted map
+    and one chunk's sums."""
     pts = np.asarray(points, dtype=np.float64)
     if len(pts) == 0:
         return
     grid = _Grid(pts, radius)
+    if queries is None:
+        rows = np.arange(len(pts), dtype=np.int64)
+    else:
+        sorted_at = np.empty(len(pts), dtype=np.int64)
+        sorted_at[grid.order] = np.arange(len(pts))
+        rows = np.sort(sorted_at[np.asarray(queries, dtype=np.int64)])
     threads = min(workers or numba.get_num_threads(), numba.config.NUMBA_NUM_THREADS)
     step = max(1, chunk_points)
-    for p0 in range(0, len(pts), step):
-        out = np.empty((min(step, len(pts) - p0), 10))
+    for p0 in range(0, len(rows), step):
+        chunk = rows[p0:p0 + step]
+        out = np.empty((len(chunk), 10))
         before = numba.get_num_threads()
         numba.set_num_threads(max(1, threads))
         try:
             _sums(grid.xyz, grid.axes, grid.low, grid.rank, grid.cell, grid.lo, grid.hi,
-                  float(radius), p0, out)
+                  float(radius), chunk, out)
         finally:
             numba.set_num_threads(before)
-        yield grid.order[p0:p0 + len(out)], out
+        yield grid.order[chunk], out

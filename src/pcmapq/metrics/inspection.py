@@ -10,28 +10,44 @@ from typing import Any
 import numpy as np
 
 from pcmapq.core.errors import EvaluationError
+from pcmapq.core.voxels import voxel_centroids
 from pcmapq.metrics.noref import LIDAR_RADIUS, MAX_NN, MIN_KNN, mom, scores
 from pcmapq.metrics.orthogonal import MAX_WARD_POINTS, extract_orthogonal_subset
+
+
+#: A sampled pass extracts MOM's planes from the map reduced at this share of the radius: every
+#: planar region still holds tens of points, at a tenth of the cost of the map's own pass.
+SAMPLED_MOM_VOXEL = 1 / 3
 
 
 def _finite(value: float) -> float | None:
     return value if math.isfinite(value) else None
 
 
+def _finite_or_none(value: float | None) -> float | None:
+    return None if value is None else _finite(value)
+
+
 def noref_figures(points: np.ndarray, radius: float = LIDAR_RADIUS, min_knn: int = MIN_KNN,
                   max_nn: int = MAX_NN, orth_subset: Sequence[np.ndarray] | None = None,
                   mom_source: np.ndarray | None = None,
-                  max_ward: int = MAX_WARD_POINTS) -> dict[str, Any]:
+                  max_ward: int = MAX_WARD_POINTS, sample: int = 0) -> dict[str, Any]:
     """MME (nats), MPV and MOM (m^2) of ``points`` (N, 3 metres) with their parameters.
 
     MOM uses ``orth_subset`` (planes in the map's frame) or else extracts one from
     ``mom_source`` (map-metrics: the first scan; None: the map itself); when none can be found,
     ``mom`` is None and ``mom_note`` says why (``max_ward``: see
-    :func:`~pcmapq.metrics.orthogonal.extract_orthogonal_subset`). Figures that are not finite
-    are None.
+    :func:`~pcmapq.metrics.orthogonal.extract_orthogonal_subset`). ``sample``: MME and MPV
+    over that many points drawn at random, with their standard errors, and MOM's planes
+    extracted from the map reduced to one point per cell of ``SAMPLED_MOM_VOXEL`` times the
+    radius (when neither planes nor a source are given; 0: every point, as map-metrics). Figures
+    that are not finite are None.
     """
+    coarse = sample and orth_subset is None and mom_source is None and len(points) > sample
+    if coarse:
+        mom_source = voxel_centroids(points, radius * SAMPLED_MOM_VOXEL)
     reuse = orth_subset is None and mom_source is None  # the planar points of this pass
-    s = scores(points, radius, min_knn, with_flat=reuse)
+    s = scores(points, radius, min_knn, with_flat=reuse, sample=sample)
     note = None
     planes = orth_subset
     source = "given" if planes is not None else "extracted"
@@ -46,6 +62,9 @@ def noref_figures(points: np.ndarray, radius: float = LIDAR_RADIUS, min_knn: int
     return {
         "mme": _finite(s.mme), "mpv": _finite(s.mpv), "mom": value, "mom_note": note,
         "points": s.total_points, "mme_points": s.mme_points, "mpv_points": s.mpv_points,
+        "sampled_points": s.sampled_points, "mme_se": _finite_or_none(s.mme_se),
+        "mpv_se": _finite_or_none(s.mpv_se),
         "radius_m": radius, "min_knn": min_knn, "max_nn": max_nn, "orth_subset": source,
         "orth_plane_points": None if planes is None else [len(p) for p in planes],
+        "orth_voxel_m": radius * SAMPLED_MOM_VOXEL if coarse else None,
     }

@@ -35,6 +35,8 @@ MAX_NN = 30
 #: MOM keeps an orthogonal-subset point whose neighbourhood holds more than this many map
 #: points (hard-coded in map-metrics, independent of ``min_knn``).
 MOM_MIN_NEIGHBOURS = 3
+#: The seed of a sampled pass's draw (:func:`sample_of`).
+SAMPLE_SEED = 0
 #: ln(2 pi e): MME's constant per dimension.
 LN_2PIE = math.log(2.0 * math.pi * math.e)
 
@@ -46,7 +48,10 @@ class NoRefScores:
     mme_points: points with more than ``min_knn`` neighbours and a positive determinant;
     mpv_points: points with more than ``min_knn`` neighbours; total_points: the map's size.
     flat: per point, whether its neighbourhood is flat (:func:`flat`), when asked for; else
-    None.
+    None (sampled: False for the points not drawn).
+    sampled_points: the points the means are over when drawn at random (:func:`scores`'
+    ``sample``), else None; mme_se, mpv_se: then the standard errors of the two means (nats,
+    m^2), else None.
     """
 
     mme: float
@@ -55,6 +60,9 @@ class NoRefScores:
     mpv_points: int
     total_points: int
     flat: np.ndarray | None = None
+    sampled_points: int | None = None
+    mme_se: float | None = None
+    mpv_se: float | None = None
 
 
 def strict_radius(radius: float) -> float:
@@ -96,18 +104,19 @@ def _cross(tree: cKDTree, other: cKDTree, r: float) -> sp.coo_matrix:
 
 
 def neighbourhood_sums(points: np.ndarray, radius: float, chunk_points: int = CHUNK_POINTS,
-                       workers: int | None = None) -> Iterator[tuple[np.ndarray, np.ndarray]]:
+                       workers: int | None = None, queries: np.ndarray | None = None
+                       ) -> Iterator[tuple[np.ndarray, np.ndarray]]:
     """Yield (indices into ``points``, (k, 10) moment sums) over every point's neighbourhood:
     count, sums of x, y, z and of the products xx, xy, xz, yy, yz, zz, in coordinates relative
     to an origin of each point's own (covariances: :func:`covariances`). Chunks of about
     ``chunk_points`` points; order and figures are the same bit for bit whatever ``workers``
-    (threads)."""
+    (threads). ``queries``: only these points' neighbourhoods (indices into ``points``)."""
     pts = np.asarray(points, dtype=np.float64)
     if pts.ndim != 2 or pts.shape[1] != 3:
         raise ValueError(f"points must be (N, 3), got {pts.shape}")
     if not radius > 0:
         raise ValueError(f"radius must be positive, got {radius}")
-    yield from ball_sums(pts, radius, chunk_points, workers)
+    yield from ball_sums(pts, radius, chunk_points, workers, queries)
 
 
 def entropies(cov: np.ndarray) -> np.ndarray:
@@ -136,32 +145,58 @@ def flat(sums: np.ndarray) -> np.ndarray:
     return out
 
 
+def sample_of(count: int, size: int) -> np.ndarray | None:
+    """Sorted indices of ``size`` of ``count`` points drawn at random without replacement
+    (seeded: the same draw every run), or None when ``size`` is 0 or not below ``count``."""
+    if size <= 0 or size >= count:
+        return None
+    return np.sort(np.random.default_rng(SAMPLE_SEED).choice(count, size, replace=False))
+
+
+def _standard_error(values: np.ndarray, population: int) -> float:
+    """Standard error of the mean of ``values``, drawn without replacement from ``population``
+    (finite-population correction)."""
+    n = len(values)
+    if n < 2:
+        return math.nan
+    return float(np.sqrt(np.var(values, ddof=1) / n * (1.0 - n / population)))
+
+
 def scores(points: np.ndarray, radius: float = LIDAR_RADIUS, min_knn: int = MIN_KNN,
            chunk_points: int = CHUNK_POINTS, workers: int | None = None,
-           with_flat: bool = False) -> NoRefScores:
+           with_flat: bool = False, sample: int = 0) -> NoRefScores:
     """MME and MPV of a map (N, 3 metres) in one pass: the means, over the points with more than
     ``min_knn`` neighbours (itself included) closer than ``radius`` metres, of the entropy
     0.5 ln det(2 pi e Sigma) (points with det <= 0 skipped) and of Sigma's smallest
     eigenvalue. 0.0 when no point qualifies, as map-metrics. ``with_flat``: also which points'
     neighbourhoods are flat (:func:`flat`), from the same pass (MOM's subset extraction needs
-    them)."""
+    them). ``sample``: the means over that many points drawn at random (:func:`sample_of`),
+    each with its whole neighbourhood in the map, and their standard errors (0: every point).
+    """
+    queries = sample_of(len(points), sample)
     ent_sum = var_sum = 0.0
     ent_n = var_n = 0
+    entropy, variance = [], []  # per point, kept when sampled
     flat_points = np.zeros(len(points), dtype=bool) if with_flat else None
-    for idx, sums in neighbourhood_sums(points, radius, chunk_points, workers):
+    for idx, sums in neighbourhood_sums(points, radius, chunk_points, workers, queries):
         if flat_points is not None:
             flat_points[idx] = flat(sums)
         cov = covariances(sums[sums[:, 0] > min_knn])
         ent = entropies(cov)
-        ok = ~np.isnan(ent)
-        ent_sum += float(ent[ok].sum())
-        ent_n += int(ok.sum())
-        var_sum += float(plane_variances(cov).sum())
-        var_n += len(cov)
+        ent, var = ent[~np.isnan(ent)], plane_variances(cov)
+        ent_sum, ent_n = ent_sum + float(ent.sum()), ent_n + len(ent)
+        var_sum, var_n = var_sum + float(var.sum()), var_n + len(var)
+        if queries is not None:
+            entropy.append(ent)
+            variance.append(var)
+    sampled = None if queries is None else len(queries)
+    se = (None, None) if sampled is None else (
+        _standard_error(np.concatenate(entropy), len(points)),
+        _standard_error(np.concatenate(variance), len(points)))
     return NoRefScores(mme=ent_sum / ent_n if ent_n else 0.0,
                        mpv=var_sum / var_n if var_n else 0.0,
                        mme_points=ent_n, mpv_points=var_n, total_points=len(points),
-                       flat=flat_points)
+                       flat=flat_points, sampled_points=sampled, mme_se=se[0], mpv_se=se[1])
 
 
 def mme(points: np.ndarray, radius: float = LIDAR_RADIUS, min_knn: int = MIN_KNN) -> float:
@@ -199,9 +234,14 @@ def mom(points: np.ndarray, orth_subset: Sequence[np.ndarray], radius: float = L
     the map's frame, metres), the median over its points with more than ``min_neighbours`` map
     points closer than ``radius`` of the neighbourhood's smallest covariance eigenvalue; the
     sum of those medians (NaN for a plane with no such point, as ``np.median([])``)."""
+    sizes = [len(plane) for plane in orth_subset]
+    if not sizes:
+        return 0.0
+    counts, cov = query_covariances(points, np.concatenate([np.asarray(p, dtype=np.float64)
+                                                           .reshape(-1, 3)
+                                                           for p in orth_subset]), radius)
     total = 0.0
-    for plane in orth_subset:
-        counts, cov = query_covariances(points, plane, radius)
-        values = plane_variances(cov[counts > min_neighbours])
+    for part in np.split(np.arange(sum(sizes)), np.cumsum(sizes)[:-1]):
+        values = plane_variances(cov[part][counts[part] > min_neighbours])
         total += float(np.median(values)) if len(values) else math.nan
     return total

@@ -278,6 +278,10 @@ OPTIONS: tuple[Option, ...] = (
     Option("noref_voxel", "noref.voxel", FLOAT,
            "A 3D cloud is first reduced to one point per cell of this size for its "
            "no-reference figures, metres (0: as it is).", 0.0),
+    Option("noref_sample", "noref.sample", INT,
+           "MME and MPV of a 3D cloud are means over this many of its points drawn at random "
+           "(seeded), their standard errors reported, and MOM's planes are found on the cloud "
+           "at a third of the radius (0: every point, as 'pcmapq inspect').", 0),
     Option("radius", "noref.radius", FLOAT,
            "Neighbourhood radius of MME, MPV and MOM, metres (1 for LiDAR maps, 0.2 for depth "
            "cameras).", 1e-6, commands=(INSPECT,)),
@@ -291,6 +295,10 @@ OPTIONS: tuple[Option, ...] = (
            "First reduce a 3D cloud to one point (the centroid) per cell of this size, "
            "metres; 0: as it is, as map-metrics ('pcmapq eval' uses 0.1).", 0.0,
            commands=(INSPECT,)),
+    Option("sample", "noref.sample", INT,
+           "MME and MPV over this many points drawn at random (seeded), with their standard "
+           "errors, and MOM's planes from the cloud at a third of the radius; 0: every point, "
+           "as map-metrics ('pcmapq eval' uses 20000).", 0, commands=(INSPECT,)),
 )
 
 
