@@ -6,16 +6,16 @@ occupancy figures of :mod:`pcmapq.metrics.noref2d`. docs/metrics.md says what ea
 
 from __future__ import annotations
 
+import os
 import threading
 from dataclasses import asdict, replace
 from typing import Any
 
 import numpy as np
 
-from pcmapq.core.voxels import VoxelMap
+from pcmapq.core.voxel_table import streamed_centroids
 from pcmapq.evaluation.inputs import truth_raster
 from pcmapq.io import OccupancyMap, PointMap
-from pcmapq.io.ply import CHUNK
 from pcmapq.metrics.inspection import noref_figures
 from pcmapq.metrics.noref2d import grid_scores
 from pcmapq.raster.draw import OCCUPIED, UNKNOWN
@@ -45,10 +45,7 @@ def reduced(points: np.ndarray, voxel: float, scale: float = 1.0) -> np.ndarray:
     file is never converted whole."""
     if voxel <= 0:
         return np.asarray(points, dtype=np.float64) * scale
-    centroids = VoxelMap(voxel)
-    for start in range(0, len(points), CHUNK):
-        centroids.add(np.asarray(points[start:start + CHUNK], dtype=np.float64) * scale)
-    return centroids.points()
+    return streamed_centroids(points, voxel, scale)
 
 
 def occupancy_figures(source: OccupancyMap | PointMap, scale: float = 1.0,
@@ -69,6 +66,11 @@ def occupancy_figures(source: OccupancyMap | PointMap, scale: float = 1.0,
         figures.update(free_cells=None, occupied_free_ratio=None, enclosed_areas=None,
                        enclosed_area_m2=None)
     return figures
+
+
+#: The figures' thread runs this much nicer than the evaluation (Linux schedules threads as
+#: tasks), so it takes the cores the evaluation leaves idle rather than sharing the busy ones.
+BACKGROUND_NICE = 10
 
 
 class EarlyFigures:
@@ -92,6 +94,10 @@ class EarlyFigures:
             self._thread.start()
 
     def _run(self, config: NoRefConfig) -> None:
+        try:
+            os.setpriority(os.PRIO_PROCESS, threading.get_native_id(), BACKGROUND_NICE)
+        except (AttributeError, OSError):  # not Linux: the thread keeps the process's priority
+            pass
         try:
             for side, source in self._sources.items():
                 self._figures[side] = input_figures(source, config)

@@ -1,0 +1,27 @@
+"""Voxel centroids of a large cloud in one streamed pass: the same as the one-shot reduction,
+bit for bit, whatever the chunks and the table's growth."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from pcmapq.core import voxel_table
+from pcmapq.core.errors import InputError
+from pcmapq.core.voxels import voxel_centroids
+
+
+@pytest.mark.parametrize("dtype", [np.float32, np.float64])
+def test_streamed_centroids_equal_voxel_centroids_bit_for_bit(dtype, monkeypatch):
+    rng = np.random.default_rng(1)
+    points = np.vstack([rng.normal(0, 30, (40_000, 3)),  # mostly one point a voxel
+                        rng.uniform(0, 0.5, (40_000, 3))]).astype(dtype)  # many a voxel
+    monkeypatch.setattr(voxel_table, "CHUNK", 7_000)  # chunks and many doublings of the table
+    got = voxel_table.streamed_centroids(points, 0.1, 2.5)
+    assert np.array_equal(got, voxel_centroids(points.astype(np.float64) * 2.5, 0.1))
+
+
+def test_a_cloud_beyond_the_keys_range_is_refused_in_one_line():
+    points = np.array([[0.0, 0.0, 0.0], [2e6, 0.0, 0.0]])
+    with pytest.raises(InputError, match="beyond"):
+        voxel_table.streamed_centroids(points, 0.1)
