@@ -14,7 +14,6 @@ from pcmapq.core.voxels import voxel_centroids
 from pcmapq.metrics.noref import LIDAR_RADIUS, MAX_NN, MIN_KNN, mom, scores
 from pcmapq.metrics.orthogonal import MAX_WARD_POINTS, extract_orthogonal_subset
 
-
 #: A sampled pass extracts MOM's planes from the map reduced at this share of the radius: every
 #: planar region still holds tens of points, at a tenth of the cost of the map's own pass.
 SAMPLED_MOM_VOXEL = 1 / 3
