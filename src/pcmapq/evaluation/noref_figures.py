@@ -74,18 +74,20 @@ BACKGROUND_NICE = 10
 
 
 class EarlyFigures:
-    """The 3D no-reference figures of an evaluation's clouds, found on a thread of their own
-    while the map is placed (they need neither the alignment nor the truth's features). The
-    thread is a daemon's, so a map refused before its figures are wanted does not wait for
-    them. Sides that are not 3D clouds, or a map whose scale is estimated, are left to
+    """The no-reference figures of an evaluation's 3D clouds and of an image map, found on a
+    thread of their own while the map is placed (they need neither the alignment nor the
+    truth's features). The thread is a daemon's, so a map refused before its figures are
+    wanted does not wait for them. A map whose scale is estimated, a 2D cloud, and an image
+    truth (whose corners the truth's own Harris features give) are left to
     :func:`input_figures` after the alignment."""
 
     def __init__(self, sides: dict[str, OccupancyMap | PointMap], settings: Settings) -> None:
         config = settings.noref
         self._sources = {} if not config.enabled else {
             side: source for side, source in sides.items()
-            if isinstance(source, PointMap) and source.is_3d
-            and not (side == "map" and settings.alignment.scale)}
+            if not (side == "map" and settings.alignment.scale)
+            and ((isinstance(source, PointMap) and source.is_3d)
+                 or (side == "map" and isinstance(source, OccupancyMap)))}
         self._figures: dict[str, dict[str, Any]] = {}
         self._error: BaseException | None = None
         self._thread = threading.Thread(target=self._run, args=(config,), daemon=True,

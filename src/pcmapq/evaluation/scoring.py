@@ -4,6 +4,7 @@ no-reference and 3D figures, gathered in a :class:`~pcmapq.results.result.Result
 
 from __future__ import annotations
 
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import replace
 from pathlib import Path
 
@@ -30,14 +31,31 @@ def score(placed: Placed, prepared: PreparedTruth, settings: Settings,
     ``placed`` has them) matched one to one against the truth's inside the footprint, the wall
     distances, the consistency map, the optional no-reference and 3D figures (those ``early``
     found while the map was placed taken from it)."""
-    if placed.features is None:
-        progress("drawing the walls' centre lines and detecting features")
-        sides = SideBySide(settings.matching.detectors, settings.matching.params)
-        placed = replace(placed, features=sides.features(placed.occupied, prepared.grid,
-                                                          threads=FEATURE_THREADS))
     side, loaded, rule = placed, placed.given, placed.rule
     truth, grid, alignment = prepared.source, prepared.grid, side.alignment
     registration, footprint = side.registration, side.cover.footprint
+    with ThreadPoolExecutor(2, thread_name_prefix="pcmapq-score") as pool:
+        # the consistency map and the 3D distances need only the placed map: found while the
+        # map's features are
+        consistency_job = cloud_job = None
+        if side.cover.verdict != OTHER and side.target is not None and \
+                side.target.lines is not None:
+            progress("aligning the map's regions on their own")
+            consistency_job = pool.submit(
+                regions, side.xy, alignment.transform, side.target.lines,
+                alignment.tolerance_m,
+                starts=broken_off(side.cover.parts, side.xy, alignment.transform))
+        if registration is not None:
+            progress("distances in 3D")
+            cloud_job = pool.submit(distances_3d, side.source.points, truth.points,
+                                    settings.raster.cloud_resolution, settings.distances.taus)
+        if placed.features is None:
+            progress("drawing the walls' centre lines and detecting features")
+            sides = SideBySide(settings.matching.detectors, settings.matching.params)
+            side = placed = replace(placed, features=sides.features(
+                placed.occupied, prepared.grid, threads=FEATURE_THREADS))
+        consistency = None if consistency_job is None else consistency_job.result()
+        cloud_distances = None if cloud_job is None else cloud_job.result()
     frames = Frames(alignment.transform, side.level, prepared.level,
                     None if registration is None else registration.transform)
     detectors = {}
@@ -51,12 +69,6 @@ def score(placed: Placed, prepared: PreparedTruth, settings: Settings,
         detectors[name] = DetectorResult(truth_f, map_f,
                                          match(name, truth_f, map_f, threshold,
                                                settings.matching.params.get(name)))
-    consistency = None
-    if side.cover.verdict != OTHER and side.target is not None and side.target.lines is not None:
-        progress("aligning the map's regions on their own")
-        consistency = regions(side.xy, alignment.transform, side.target.lines,
-                              alignment.tolerance_m,
-                              starts=broken_off(side.cover.parts, side.xy, alignment.transform))
     noref = None
     if settings.noref.enabled:
         progress("no-reference figures")
@@ -66,11 +78,6 @@ def score(placed: Placed, prepared: PreparedTruth, settings: Settings,
         noref = {"map": early.get("map") or input_figures(loaded, settings.noref, scale=scale),
                  "truth": early.get("truth") or input_figures(truth, settings.noref,
                                                               corners=corners)}
-    cloud_distances = None
-    if registration is not None:
-        progress("distances in 3D")
-        cloud_distances = distances_3d(side.source.points, truth.points,
-                                       settings.raster.cloud_resolution, settings.distances.taus)
     return Result(map_path=Path(loaded.path), map_kind=side.source.kind,
                   truth_path=Path(truth.path), truth_kind=truth.kind, grid=grid,
                   alignment=alignment, overlap=side.cover,

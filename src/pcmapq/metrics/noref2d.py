@@ -60,9 +60,9 @@ def enclosed_areas(state: np.ndarray, resolution: float,
     open_ = (state != OCCUPIED).astype(np.uint8)
     count, labels = cv2.connectedComponents(open_, connectivity=4)
     leaks = np.zeros(count, dtype=bool)
-    leaks[np.unique(labels[state == UNKNOWN])] = True
+    leaks[labels[state == UNKNOWN]] = True  # marked by indexing: no sort of the labels
     for edge in (labels[0], labels[-1], labels[:, 0], labels[:, -1]):
-        leaks[np.unique(edge)] = True
+        leaks[edge] = True
     leaks[0] = True  # label 0: the occupied cells
     cells = np.bincount(labels.ravel(), minlength=count)
     areas = cells[~leaks] * resolution * resolution
