@@ -31,6 +31,7 @@ from scipy.spatial import cKDTree
 from pcmapq.align.features3d import global_registration
 from pcmapq.align.refine3d import refine
 from pcmapq.core.errors import EvaluationError, InputError
+from pcmapq.core.transform import affine
 from pcmapq.core.voxels import voxel_centroids
 
 __all__ = ["Registration3D", "align_3d"]
@@ -92,9 +93,8 @@ def score(source: np.ndarray, target: np.ndarray, transform: np.ndarray, toleran
 
 
 def apply(transform: np.ndarray, points: np.ndarray) -> np.ndarray:
-    """``transform`` (4x4) applied to points (N, 3). (The rotation is made contiguous: BLAS
-    multiplies by a transposed view several times slower.)"""
-    return points @ np.ascontiguousarray(transform[:3, :3].T) + transform[:3, 3]
+    """``transform`` (4x4) applied to points (N, 3)."""
+    return affine(points, transform)
 
 
 def _translation(offset: np.ndarray) -> np.ndarray:

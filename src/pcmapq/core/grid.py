@@ -13,6 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from pcmapq.core.bounds import bounds
+from pcmapq.core.transform import affine
 
 
 @dataclass(frozen=True)
@@ -43,15 +44,11 @@ class MetricGrid:
 
     def pixels_to_xy(self, uv: np.ndarray) -> np.ndarray:
         """(N, 2) pixel coordinates (u = column, v = row) -> (N, 2) metric x, y in metres."""
-        m = self.pixel_to_xy_matrix()
-        uv = np.asarray(uv, dtype=np.float64).reshape(-1, 2)
-        return uv @ m[:2, :2].T + m[:2, 2]
+        return affine(np.asarray(uv, dtype=np.float64).reshape(-1, 2), self.pixel_to_xy_matrix())
 
     def xy_to_pixels(self, xy: np.ndarray) -> np.ndarray:
         """(N, 2) metric x, y in metres -> (N, 2) float pixel coordinates (u, v)."""
-        m = self.xy_to_pixel_matrix()
-        xy = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
-        return xy @ m[:2, :2].T + m[:2, 2]
+        return affine(np.asarray(xy, dtype=np.float64).reshape(-1, 2), self.xy_to_pixel_matrix())
 
     def cell_centres(self, mask: np.ndarray) -> np.ndarray:
         """Metric (x, y) of the centres of the cells where ``mask`` is true, (N, 2) metres."""

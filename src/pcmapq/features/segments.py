@@ -11,6 +11,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from pcmapq.core.grid import MetricGrid
+from pcmapq.core.transform import affine
 
 
 def directions(seg: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -33,7 +34,7 @@ class WallTest:
     def __call__(self, xy: np.ndarray) -> np.ndarray:
         rows, cols = self.image.shape
         m = self.to_pixels
-        uv = np.floor(xy.reshape(-1, 2) @ m[:2, :2].T + m[:2, 2] + 0.5).astype(np.int64)
+        uv = np.floor(affine(xy.reshape(-1, 2), m) + 0.5).astype(np.int64)
         inside = (uv[:, 0] >= 0) & (uv[:, 0] < cols) & (uv[:, 1] >= 0) & (uv[:, 1] < rows)
         out = np.zeros(len(uv), dtype=bool)
         out[inside] = self.image[uv[inside, 1], uv[inside, 0]] >= self.level

@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from pcmapq.core.errors import InputError
+from pcmapq.core.transform import affine
 from pcmapq.core.voxels import VoxelMap
 from pcmapq.mapping.scans import ScanSequence, open_scans
 from pcmapq.metrics.posed import place
@@ -80,7 +81,7 @@ def build_map_from_poses(source: str | Path | ScanSequence, poses: np.ndarray,
         ranges = np.linalg.norm(points, axis=1)
         points = points[(ranges >= min_range) & (ranges <= max_range)]
         place = poses[index] @ mount
-        grid.add(points @ place[:3, :3].T + place[:3, 3])
+        grid.add(affine(points, place))
         if progress is not None:
             progress(index + 1, len(scans))
     return grid.points()

@@ -16,6 +16,7 @@ import numpy as np
 from numpy.lib import format as npy
 
 from pcmapq.core.errors import InputError
+from pcmapq.core.transform import affine
 
 
 def place(clouds: Sequence[np.ndarray], poses: Sequence[np.ndarray]) -> np.ndarray:
@@ -28,7 +29,7 @@ def place(clouds: Sequence[np.ndarray], poses: Sequence[np.ndarray]) -> np.ndarr
     out = []
     for cloud, pose in zip(clouds, poses, strict=True):
         t = first @ np.asarray(pose, dtype=np.float64)
-        out.append(np.asarray(cloud, dtype=np.float64) @ t[:3, :3].T + t[:3, 3])
+        out.append(affine(np.asarray(cloud, dtype=np.float64), t))
     return np.vstack(out)
 
 
@@ -78,4 +79,4 @@ def place_subset(planes: Sequence[np.ndarray], pose: np.ndarray,
     """An orthogonal subset saved in the frame of the scan at ``pose``, moved into the map's
     frame (the first scan's, pose ``first_pose``), as map-metrics' ``read_orthogonal_subset``."""
     t = np.linalg.inv(np.asarray(first_pose, dtype=np.float64)) @ np.asarray(pose, np.float64)
-    return [np.asarray(p, dtype=np.float64) @ t[:3, :3].T + t[:3, 3] for p in planes]
+    return [affine(np.asarray(p, dtype=np.float64), t) for p in planes]

@@ -28,7 +28,7 @@ import numpy as np
 from pcmapq.core.cells import FREE, OCCUPIED
 from pcmapq.core.frames import Frames, Levelling
 from pcmapq.core.grid import MetricGrid
-from pcmapq.core.transform import Similarity2D
+from pcmapq.core.transform import Similarity2D, affine
 from pcmapq.evaluation.inputs import MAP_CROP, TRUTH_CROP, cropped, load_input
 from pcmapq.io import OccupancyMap, PointMap
 from pcmapq.io.export import DISTANCE_FIELD, record_dtype, records, write_matrix, write_records
@@ -97,7 +97,7 @@ def moved(points: np.ndarray, matrix: np.ndarray) -> Iterator[np.ndarray]:
     (float64)."""
     for start in range(0, len(points), CHUNK):
         part = np.asarray(points[start:start + CHUNK], dtype=np.float64)
-        yield part @ matrix[:3, :3].T + matrix[:3, 3]
+        yield affine(part, matrix)
 
 
 def plan_cloud(xy: np.ndarray) -> np.ndarray:

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from pcmapq.core.transform import Similarity2D
+from pcmapq.core.transform import Similarity2D, affine
 
 
 def pose_error(expected: Similarity2D, got: Similarity2D) -> tuple[float, float]:
@@ -27,7 +27,7 @@ def rigid(rotvec_deg: tuple[float, float, float], offset: tuple[float, float, fl
 
 def apply(transform: np.ndarray, points: np.ndarray) -> np.ndarray:
     """``points`` (N, 3) moved by a 4x4 transform."""
-    return points @ transform[:3, :3].T + transform[:3, 3]
+    return affine(points, transform)
 
 
 def errors(estimate: np.ndarray, truth: np.ndarray) -> tuple[float, float]:

@@ -27,6 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from pcmapq.core.errors import InputError
+from pcmapq.core.transform import affine
 from pcmapq.features.walls import CLOSING
 from pcmapq.io import PointMap
 from pcmapq.io.carmen import DEFAULT_MAX_RANGE, LaserScans, endpoints, is_carmen, read_laser_scans
@@ -142,7 +143,7 @@ class ScanRun:
             ranges = np.linalg.norm(points, axis=1)
             points = points[(ranges >= MIN_RANGE) & (ranges <= MAX_RANGE)]
             pose = self.poses[index]
-            placed = points @ pose[:3, :3].T + pose[:3, 3]
+            placed = affine(points, pose)
             grid.add(placed)
             recent.add(placed)
             views.append(view_outlines(pose[None, :2, 3], placed[:, :2],
