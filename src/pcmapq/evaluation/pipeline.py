@@ -8,7 +8,7 @@ from pathlib import Path
 
 from pcmapq.evaluation.inputs import load_pair
 from pcmapq.evaluation.noref_figures import EarlyFigures
-from pcmapq.evaluation.placing import Progress, map_footprint_rule, place
+from pcmapq.evaluation.placing import Progress, check_footprint_rule, place
 from pcmapq.evaluation.scoring import score
 from pcmapq.evaluation.truth import prepare_truth
 from pcmapq.io import PointMap
@@ -29,7 +29,7 @@ def evaluate(map_path: str | Path | PointMap, truth_path: str | Path,
     settings = Settings() if settings is None else settings
     progress("loading")
     source, truth = load_pair(map_path, truth_path, settings, memory_limit)
-    map_footprint_rule(source, settings)  # a rule the map cannot follow: before any work
+    check_footprint_rule(source, settings)  # a rule the map cannot follow: before any work
     prepared = prepare_truth(truth, settings, memory_limit, maps=(0,), loaded=(source,),
                              background=True)
     early = EarlyFigures({"map": source, "truth": truth}, settings)

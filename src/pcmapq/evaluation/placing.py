@@ -28,7 +28,7 @@ from pcmapq.io import OccupancyMap, PointMap
 from pcmapq.io.extent import check_span, hint
 from pcmapq.metrics.distances import nearest_distance
 from pcmapq.raster.draw import OCCUPIED, UNKNOWN, points_to_grid, warp_state
-from pcmapq.raster.footprint import footprint_rule, map_footprint
+from pcmapq.raster.footprint import check_rule, footprint_rule, map_footprint
 from pcmapq.raster.seen import seen_on
 from pcmapq.results.result import OTHER, Overlap
 from pcmapq.settings import Settings
@@ -93,6 +93,16 @@ def place(source: OccupancyMap | PointMap, prepared: PreparedTruth, settings: Se
                                       prepared.xy))
     return Placed(given, source, registration, map_xy, map_level, alignment, map_occ, to_map,
                   cover, rule, target)
+
+
+def check_footprint_rule(source: OccupancyMap | PointMap, settings: Settings) -> None:
+    """InputError (one line, naming the map) when the map cannot follow
+    ``settings.footprint.rule``, found before any work (``auto`` is resolved later)."""
+    try:
+        check_rule(settings.footprint.rule, isinstance(source, OccupancyMap),
+                   views=isinstance(source, PointMap) and source.seen is not None)
+    except ValueError as err:
+        raise InputError(f"{source.path}: {err}") from None
 
 
 def map_footprint_rule(source: OccupancyMap | PointMap, settings: Settings) -> str:

@@ -96,15 +96,8 @@ def footprint_rule(requested: str, unknown: np.ndarray | None, resolution: float
     ``auto`` resolved. ``unknown``: the image's unknown cells (None for a point cloud);
     ``resolution``: the image's metres per cell; ``views``: the cloud has its scans' views.
     Raises ValueError for ``known`` on a cloud, ``seen`` without views."""
-    if requested not in FOOTPRINT_RULES:
-        raise ValueError(f"unknown footprint rule {requested!r}; choose from "
-                         f"{', '.join(FOOTPRINT_RULES)}")
-    if requested == "seen" and not views:
-        raise ValueError("footprint 'seen' needs the scans' poses (a map that 'pcmapq track' "
-                         "builds): 'walls' or 'all'")
+    check_rule(requested, unknown is not None, views)
     if unknown is None:
-        if requested == "known":
-            raise ValueError("a point cloud has no known cells: footprint 'walls' or 'all'")
         return ("seen" if views else "walls") if requested == "auto" else requested
     if requested != "auto":
         return requested
@@ -112,6 +105,19 @@ def footprint_rule(requested: str, unknown: np.ndarray | None, resolution: float
         return "walls"
     share = float(unknown_regions(unknown, resolution).mean())
     return "known" if share >= UNKNOWN_SHARE else "walls"
+
+
+def check_rule(requested: str, image: bool, views: bool = False) -> None:
+    """ValueError (one line) when a map cannot follow the footprint rule ``requested``:
+    :func:`footprint_rule`'s refusals, found without resolving ``auto``."""
+    if requested not in FOOTPRINT_RULES:
+        raise ValueError(f"unknown footprint rule {requested!r}; choose from "
+                         f"{', '.join(FOOTPRINT_RULES)}")
+    if requested == "seen" and not views:
+        raise ValueError("footprint 'seen' needs the scans' poses (a map that 'pcmapq track' "
+                         "builds): 'walls' or 'all'")
+    if not image and requested == "known":
+        raise ValueError("a point cloud has no known cells: footprint 'walls' or 'all'")
 
 
 def map_footprint(rule: str, occupied: np.ndarray, grid: MetricGrid, margin: float = 0.3,
