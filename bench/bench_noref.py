@@ -18,7 +18,8 @@ table.
    (VmHWM).
 
 Seconds are wall clock, the best of ``--repeat`` runs for pcmapq and of one run for
-map-metrics (tens of seconds each); CPU seconds beside them (all threads).
+map-metrics (tens of seconds each); CPU seconds beside them (all threads). The whole commands,
+start-up included, each in a fresh process: bench_startup.py.
 """
 
 from __future__ import annotations
@@ -77,8 +78,8 @@ def _timed(fn: Callable[[], object], repeat: int) -> tuple[object, float, float]
     return best
 
 
-def _map_metrics() -> types.ModuleType | None:
-    """map-metrics' Python package, or None (saying why)."""
+def map_metrics() -> types.ModuleType | None:
+    """map-metrics' ``metrics`` module, or None (saying why on stderr)."""
     src = os.environ.get("MAP_METRICS_SRC")
     if src:
         sys.path.insert(0, src)
@@ -104,6 +105,21 @@ def _map_metrics() -> types.ModuleType | None:
     return mm
 
 
+def map_metrics_inputs() -> tuple[list, list[np.ndarray], list]:
+    """The depth data as map-metrics' own tests load it: the clouds read by Open3D, the poses,
+    and MOM's orthogonal subset placed by map-metrics' ``read_orthogonal_subset``."""
+    import open3d as o3d
+    from map_metrics.utils.orthogonal import read_orthogonal_subset
+
+    names = sorted(os.listdir(DEPTH / "pcs"))
+    pcs = [o3d.io.read_point_cloud(str(DEPTH / "pcs" / n)) for n in names]
+    ts = [np.loadtxt(DEPTH / "poses" / n, usecols=range(4))
+          for n in sorted(os.listdir(DEPTH / "poses"))]
+    orth = read_orthogonal_subset(DEPTH / "orth_subset/orth-0091.npy",
+                                  DEPTH / "poses/pose-0091.txt", ts)
+    return pcs, ts, orth
+
+
 def depth_rows(repeat: int, theirs: bool) -> list[str]:
     from pcmapq.mapping.poses import read_pose_matrix, read_poses
     from pcmapq.mapping.reference import posed_map
@@ -116,22 +132,15 @@ def depth_rows(repeat: int, theirs: bool) -> list[str]:
     s, wall, cpu = _timed(lambda: noref.scores(points, RADIUS, MIN_KNN), repeat)
     m, m_wall, m_cpu = _timed(lambda: noref.mom(points, planes, RADIUS), repeat)
     ours = {"MME": (s.mme, wall, cpu), "MPV": (s.mpv, wall, cpu), "MOM": (m, m_wall, m_cpu)}
-    mm = _map_metrics() if theirs else None
+    mm = map_metrics() if theirs else None
     rows = [f"{len(points)} points. pcmapq's MME and MPV come from one pass (its time in both "
             "rows).", "",
             "| metric | pcmapq | map-metrics | difference | pcmapq s (CPU) | map-metrics s (CPU) "
             "| times faster (wall) |", "|---|---|---|---|---|---|---|"]
     if mm is not None:
-        import open3d as o3d
         from map_metrics.config import DepthConfig
-        from map_metrics.utils.orthogonal import read_orthogonal_subset
 
-        names = sorted(os.listdir(DEPTH / "pcs"))
-        pcs = [o3d.io.read_point_cloud(str(DEPTH / "pcs" / n)) for n in names]
-        ts = [np.loadtxt(DEPTH / "poses" / n, usecols=range(4))
-              for n in sorted(os.listdir(DEPTH / "poses"))]
-        orth = read_orthogonal_subset(DEPTH / "orth_subset/orth-0091.npy",
-                                      DEPTH / "poses/pose-0091.txt", ts)
+        pcs, ts, orth = map_metrics_inputs()
         calls = {"MME": lambda: mm.mme(pcs, ts, DepthConfig),
                  "MPV": lambda: mm.mpv(pcs, ts, DepthConfig),
                  "MOM": lambda: mm.mom(pcs, ts, orth, DepthConfig)}

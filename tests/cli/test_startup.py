@@ -1,12 +1,16 @@
 """`pcmapq --help` and `--version` answer without loading the pipeline: the same output as the
 whole application, and none of the heavy libraries imported (they took 1.9 s and 360 MB
-before any work)."""
+before any work). A command imports its own module alone, and `pcmapq inspect` not Open3D
+(0.8 s) where it does not need it. Which libraries a run loads is read from `sys.modules` in a
+fresh process, never from its time."""
 
 from __future__ import annotations
 
+import json
 import subprocess
 import sys
 
+import numpy as np
 import pytest
 from typer.testing import CliRunner
 
@@ -16,6 +20,20 @@ from pcmapq.testing.paths import SAMPLE
 
 #: Libraries the pipeline needs and a listing must not import.
 HEAVY = ("open3d", "cv2", "kiss_icp", "numpy", "scipy", "skimage", "matplotlib")
+#: Libraries `pcmapq inspect` of a 3D map with its orthogonal planes given does not need.
+NOT_FOR_INSPECT = ("open3d", "kiss_icp", "skimage", "matplotlib", "dask")
+
+
+def imported(args: list[str], modules: tuple[str, ...]) -> tuple[list[str], str]:
+    """Which of ``modules`` ``pcmapq ARGS`` imports, run in a fresh process, and its output;
+    the run must exit 0."""
+    code = (f"import json, sys; from pcmapq.cli import main; sys.argv = ['pcmapq', *{args!r}]\n"
+            "try:\n    main()\nexcept SystemExit as exit:\n    assert not exit.code, exit.code\n"
+            f"print(json.dumps([m for m in {modules!r} if m in sys.modules]))")
+    got = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         timeout=300)
+    assert got.returncode == 0, got.stderr
+    return json.loads(got.stdout.strip().splitlines()[-1]), got.stdout
 
 
 @pytest.mark.unit
@@ -29,13 +47,44 @@ def test_the_listing_says_what_the_whole_application_says(args):
 
 @pytest.mark.parametrize("flag", ["--help", "--version"])
 def test_help_and_version_import_no_heavy_library(flag):
-    code = (f"import sys; from pcmapq.cli import main; sys.argv = ['pcmapq', {flag!r}]\n"
-            "try:\n    main()\nexcept SystemExit:\n    pass\n"
-            f"print(sorted({{m.split('.')[0] for m in sys.modules}} & set({HEAVY!r})))")
-    got = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                         timeout=120)
-    assert got.returncode == 0, got.stderr
-    assert got.stdout.strip().splitlines()[-1] == "[]", got.stdout
+    assert imported([flag], HEAVY)[0] == []
+
+
+def test_a_command_imports_its_own_module_alone():
+    """`pcmapq inspect --help`: neither the other commands' modules nor Open3D."""
+    others = tuple(f"pcmapq.cli.{m}" for m in ("evaluate", "map_scans", "batch", "track"))
+    found, output = imported(["inspect", "--help"], others + NOT_FOR_INSPECT)
+    assert found == [] and "--orth-subset" in output
+
+
+def test_inspect_of_binary_pcd_scans_loads_no_open3d(tmp_path):
+    """Scans in binary PCD files, placed at their poses, with MOM's planes given: read and
+    scored without Open3D."""
+    rng = np.random.default_rng(0)
+    scans = tmp_path / "pcs"
+    scans.mkdir()
+    planes = []
+    for axis in range(3):  # three faces of a box corner, 1 cm noise
+        face = rng.uniform(0, 2, (1500, 3))
+        face[:, axis] = rng.normal(0, 0.01, 1500)
+        planes.append(face)
+    for k in range(3):
+        points = np.concatenate(planes)[k::3].astype("<f4")
+        header = ("# .PCD v0.7\nVERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\n"
+                  f"COUNT 1 1 1\nWIDTH {len(points)}\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\n"
+                  f"POINTS {len(points)}\nDATA binary\n")
+        (scans / f"{k:03d}.pcd").write_bytes(header.encode() + points.tobytes())
+    poses = tmp_path / "poses.txt"
+    poses.write_text("1 0 0 0 0 1 0 0 0 0 1 0\n" * 3)
+    np.savez(tmp_path / "orth.npz", *[p[:50] for p in planes])
+    out = tmp_path / "figures.json"
+    found, _ = imported(["inspect", "--scans", str(scans), "--poses", str(poses), "--radius",
+                         "0.2", "--orth-subset", str(tmp_path / "orth.npz"), "--json", str(out),
+                         "--quiet"], NOT_FOR_INSPECT)
+    assert found == []
+    cloud = json.loads(out.read_text())["cloud"]
+    assert cloud["points"] == 4500 and cloud["orth_subset"] == "given"
+    assert cloud["mom"] is not None and 0 < cloud["mom"] < 1e-3, cloud
 
 
 def test_a_command_still_gets_the_whole_application():

@@ -44,7 +44,6 @@ from dataclasses import dataclass
 
 import cv2
 import numpy as np
-from skimage.morphology import skeletonize
 
 from pcmapq.core.bounds import nonzero_window
 from pcmapq.core.grid import MetricGrid
@@ -103,6 +102,8 @@ def centreline(occupied: np.ndarray, grid: MetricGrid, resolution: float, closin
 
     Returns the one-pixel bool centre lines, the bool object cores and their grid.
     """
+    from skimage.morphology import skeletonize  # loaded when walls are traced (0.04 s)
+
     frac, fine = resample(occupied, grid, resolution)
     wall = (frac > 1e-6).astype(np.uint8)
     kernel = disc(closing / resolution)

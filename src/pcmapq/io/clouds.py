@@ -6,8 +6,9 @@ dropped. A cloud whose z is constant (to 1e-6 m) is 2D: its z is set to 0.
 Binary PLY is read by :mod:`pcmapq.io.ply` (the values Open3D's reader gives, without its
 copies); a large one (more than ``MAP_POINTS`` vertices, 3D, every coordinate finite) is not
 read at all here but mapped: its points are a read-only array onto the file, in the file's own
-coordinate type, that the steps using them read chunk by chunk. ASCII PLY and PCD go through
-Open3D.
+coordinate type, that the steps using them read chunk by chunk. Binary PCD is read by
+:mod:`pcmapq.io.pcd`, its coordinates as stored (float ones as Open3D's reader gives them; it
+reads double ones as zeros). ASCII PLY, and ASCII or compressed PCD, go through Open3D.
 """
 
 from __future__ import annotations
@@ -31,6 +32,8 @@ from pcmapq.io.survey import read_e57, read_las
 from pcmapq.io.writers import one_line
 
 CLOUD_SUFFIXES = (".ply", ".pcd", ".xyz", ".txt", ".npy", ".bin", ".las", ".laz", ".e57")
+#: A PCD's coordinate fields.
+XYZ = ("x", "y", "z")
 
 #: z range (metres) above which a cloud counts as 3D.
 FLAT_TOLERANCE = 1e-6
@@ -86,7 +89,7 @@ def load_cloud(path: Path, memory_limit: int | None = None) -> PointMap:
     limit, see :mod:`pcmapq.core.memory`) is refused unread."""
     readers: dict[str, Callable[[Path], np.ndarray]] = {
         ".ply": lambda p: read_open3d(p, memory_limit),
-        ".pcd": lambda p: read_open3d(p, memory_limit), ".xyz": read_text, ".txt": read_text,
+        ".pcd": lambda p: read_pcd(p, memory_limit), ".xyz": read_text, ".txt": read_text,
         ".npy": lambda p: read_npy(p, memory_limit),
         ".bin": lambda p: read_kitti_bin(p, memory_limit),
         ".las": lambda p: read_las(p, memory_limit), ".laz": lambda p: read_las(p, memory_limit),
@@ -150,6 +153,19 @@ def check_points(path: Path, count: int, memory_limit: int | None = None) -> Non
     memory than ``memory_limit`` bytes (None: the default limit)."""
     memory.guard(memory.needed_bytes(0, 0, 0.0, int(count)), memory_limit,
                  f"{path} ({count:,} points declared)")
+
+
+def read_pcd(path: Path, memory_limit: int | None = None) -> np.ndarray:
+    """A PCD's x, y, z (N, 3): a binary one's as stored, read by
+    :func:`pcmapq.io.pcd.read_fields`, any other's by Open3D (:func:`read_open3d`), once its
+    header is checked against the data the file holds and the points it declares against
+    ``memory_limit`` bytes."""
+    header = pcd.check_size(path)
+    check_points(path, header.points, memory_limit)
+    table = pcd.read_fields(path, XYZ, header)
+    if table is None or len(table) < len(XYZ):
+        return read_open3d(path, memory_limit)
+    return np.column_stack([table[axis] for axis in XYZ])
 
 
 def read_open3d(path: Path, memory_limit: int | None = None) -> np.ndarray:

@@ -13,14 +13,16 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
-from kiss_icp.config import KISSConfig
-from kiss_icp.kiss_icp import KissICP
 
 from pcmapq.core.errors import InputError
 from pcmapq.core.voxels import VoxelMap
 from pcmapq.mapping.scans import open_scans
+
+if TYPE_CHECKING:
+    from kiss_icp.config import KISSConfig
 
 __all__ = ["build_map_kiss", "kiss_config"]
 
@@ -36,6 +38,8 @@ def kiss_config(*, max_range: float = 100.0, min_range: float = 0.0, deskew: boo
     threads (0: all cores). Runs agree to about 1e-12 m, not bit for bit, whatever the thread
     count (KISS-ICP's C++ reductions; measured on KITTI 00: 2e-15 m after 20 scans).
     """
+    from kiss_icp.config import KISSConfig  # loaded when KISS-ICP runs (pydantic: 0.1 s)
+
     config = KISSConfig()
     config.data.max_range = float(max_range)
     config.data.min_range = float(min_range)
@@ -59,6 +63,8 @@ def build_map_kiss(source: str | Path, *, max_scans: int | None = None, voxel: f
     scan k -> world), both in the first scan's sensor frame, metres. Repeatable to ~1e-12 m
     (see :func:`kiss_config`).
     """
+    from kiss_icp.kiss_icp import KissICP
+
     scans = open_scans(source, max_scans=max_scans, topic=topic)
     odometry = KissICP(config=config or kiss_config())
     grid = VoxelMap(voxel)

@@ -24,13 +24,13 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import open3d as o3d
 
 from pcmapq.core.errors import InputError
+from pcmapq.io import pcd
 from pcmapq.io.bag_scans import scan_topic
 from pcmapq.io.bag_scans import scans as bag_scans
 from pcmapq.io.bags import is_bag
-from pcmapq.io.clouds import read_kitti_bin, read_npy, with_z
+from pcmapq.io.clouds import XYZ, read_kitti_bin, read_npy, with_z
 from pcmapq.io.writers import one_line
 
 __all__ = ["SCAN_SUFFIXES", "ScanSequence", "open_scans"]
@@ -116,13 +116,26 @@ def read_scan(path: Path) -> Scan:
             return _clean(path, read_kitti_bin(path), np.empty(0))
         if suffix == ".npy":
             return _clean(path, with_z(path, read_npy(path)), np.empty(0))
-        return _read_open3d_scan(path)
+        scan = _read_binary_pcd(path) if suffix == ".pcd" else None
+        return _read_open3d_scan(path) if scan is None else scan
     except OSError as exc:
         raise InputError(f"{path}: cannot read: {one_line(exc)}") from None
 
 
+def _read_binary_pcd(path: Path) -> Scan | None:
+    """A binary PCD's points and per-point times, as Open3D's tensor reader gives them
+    (:func:`pcmapq.io.pcd.read_fields`); None for a PCD it does not read (Open3D does)."""
+    table = pcd.read_fields(path, (*XYZ, *TIME_FIELDS))
+    if table is None or not set(XYZ) <= table.keys():
+        return None
+    stamps = next((table[f] for f in TIME_FIELDS if f in table), np.empty(0))
+    return _clean(path, np.column_stack([table[axis] for axis in XYZ]), stamps)
+
+
 def _read_open3d_scan(path: Path) -> Scan:
     """PLY/PCD with Open3D's tensor reader, keeping a per-point time field if there is one."""
+    import open3d as o3d  # heavy: loaded when a scan is not read without it
+
     with o3d.utility.VerbosityContextManager(o3d.utility.VerbosityLevel.Error):
         cloud = o3d.t.io.read_point_cloud(str(path))
     if cloud.is_empty():

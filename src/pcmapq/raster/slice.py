@@ -9,7 +9,6 @@ from __future__ import annotations
 from collections.abc import Iterator
 
 import numpy as np
-import open3d as o3d
 
 from pcmapq.core.frames import Levelling
 
@@ -129,6 +128,8 @@ def level_rotation(points: np.ndarray) -> np.ndarray:
     inliers by least squares, and the result is the smallest rotation taking it to +z (about the
     axis normal x z). The identity if no such plane is found.
     """
+    import open3d as o3d  # heavy: loaded when a 3D map is levelled
+
     cloud = o3d.geometry.PointCloud(o3d.utility.Vector3dVector(_finite_points(points)))
     voxels = np.asarray(cloud.voxel_down_sample(PLANE_VOXEL).points)
     if len(voxels) > PLANE_POINTS:

@@ -1,0 +1,129 @@
+"""Binary PCD without Open3D: the fields of a record, the values Open3D's readers give, a
+truncated file refused, and the files left to Open3D (ASCII, compressed)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import open3d as o3d
+import pytest
+
+from pcmapq.core.errors import InputError
+from pcmapq.io import load_map, pcd
+from pcmapq.mapping.scans import read_scan
+
+#: Coordinates that float32 stores exactly and some it rounds; a NaN row (dropped).
+XYZ = np.array([[0.0, 1.0, 2.0], [1.5, -2.0, 0.25], [3.1, 4.7, -1.3], [1e5 / 3, -7.77, 0.1],
+                [np.nan, 0.0, 0.0]])
+
+
+def write_pcd(path: Path, fields: list[tuple[str, str, int, int]], records: np.ndarray) -> Path:
+    """A binary PCD whose records have ``fields`` (name, TYPE, SIZE, COUNT) holding
+    ``records`` (as stored)."""
+    def row(i: int) -> str:
+        return " ".join(str(f[i]) for f in fields)
+    head = (f"# .PCD v0.7 - made by a test\nVERSION 0.7\nFIELDS {row(0)}\nSIZE {row(2)}\n"
+            f"TYPE {row(1)}\nCOUNT {row(3)}\nWIDTH {len(records)}\nHEIGHT 1\n"
+            f"VIEWPOINT 0 0 0 1 0 0 0\nPOINTS {len(records)}\nDATA binary\n")
+    path.write_bytes(head.encode() + records.tobytes())
+    return path
+
+
+def tensor_scan(path: Path) -> tuple[np.ndarray, np.ndarray]:
+    """Points and times as Open3D's tensor reader gives them (what scans were read by)."""
+    cloud = o3d.t.io.read_point_cloud(str(path))
+    stamps = cloud.point["t"].numpy().reshape(-1) if "t" in cloud.point else np.empty(0)
+    return cloud.point.positions.numpy(), stamps
+
+
+def records_of(dtype: list[tuple], times: np.ndarray) -> np.ndarray:
+    """Records of :data:`XYZ` with ``times`` in ``t`` and every other field 255."""
+    records = np.zeros(len(XYZ), dtype=dtype)
+    for name in records.dtype.names:
+        records[name] = 255
+    for axis, name in enumerate("xyz"):
+        records[name] = XYZ[:, axis]
+    records["t"] = times
+    return records
+
+
+@pytest.mark.unit
+@pytest.mark.parametrize("size", [4, 8])
+def test_coordinates_and_times_as_open3d_reads_them(tmp_path: Path, size: int) -> None:
+    """Padding of 4 values between the coordinates, a ring and a time field after them; a map
+    of double coordinates reads as stored (Open3D's legacy reader gives zeros)."""
+    fields = [("x", "F", size, 1), ("_", "U", 1, 4), ("y", "F", size, 1), ("z", "F", size, 1),
+              ("ring", "U", 2, 1), ("t", "U", 4, 1)]
+    dtype = [("x", f"<f{size}"), ("_", "u1", (4,)), ("y", f"<f{size}"), ("z", f"<f{size}"),
+             ("ring", "<u2"), ("t", "<u4")]
+    times = np.arange(len(XYZ)) * 1000
+    path = write_pcd(tmp_path / "scan.pcd", fields, records_of(dtype, times))
+    header = pcd.check_size(path)
+    assert header.fields["y"] == pcd.PcdField(f"<f{size}", size + 4)
+    assert header.fields["_"] == pcd.PcdField(None, size)  # 4 values: not read here
+    table = pcd.read_fields(path, ("x", "y", "z", "t", "time"))
+    assert table is not None and list(table) == ["x", "y", "z", "t"]
+    points, stamps = read_scan(path)
+    want_points, want_stamps = tensor_scan(path)
+    keep = np.isfinite(want_points).all(axis=1)
+    np.testing.assert_array_equal(points, want_points[keep])
+    np.testing.assert_array_equal(stamps, want_stamps[keep])
+    np.testing.assert_array_equal(stamps, times[:4])
+    np.testing.assert_array_equal(load_map(path).points, XYZ[:4].astype(f"<f{size}"))
+
+
+@pytest.mark.unit
+def test_repeated_padding_fields(tmp_path: Path) -> None:
+    """Padding fields share the name ``_``: the fields after them are read where they are
+    (Open3D 0.20's tensor reader reads them from the wrong bytes, or crashes)."""
+    fields = [("x", "F", 4, 1), ("y", "F", 4, 1), ("z", "F", 4, 1), ("_", "U", 1, 4),
+              ("_", "U", 1, 2), ("t", "F", 8, 1)]
+    dtype = [("x", "<f4"), ("y", "<f4"), ("z", "<f4"), ("p", "u1", (4,)), ("q", "u1", (2,)),
+             ("t", "<f8")]
+    times = 1.7e9 + np.arange(len(XYZ)) * 0.1
+    path = write_pcd(tmp_path / "scan.pcd", fields, records_of(dtype, times))
+    points, stamps = read_scan(path)
+    np.testing.assert_array_equal(points, XYZ[:4].astype("<f4"))
+    np.testing.assert_array_equal(stamps, times[:4])
+
+
+@pytest.mark.unit
+def test_a_float_map_reads_as_open3d_reads_it(tmp_path: Path) -> None:
+    path = tmp_path / "map.pcd"
+    cloud = o3d.geometry.PointCloud(o3d.utility.Vector3dVector(XYZ[:4]))
+    assert o3d.io.write_point_cloud(str(path), cloud)
+    assert pcd.read_header(path).data == "binary"
+    np.testing.assert_array_equal(load_map(path).points,
+                                  np.asarray(o3d.io.read_point_cloud(str(path)).points))
+
+
+@pytest.mark.unit
+@pytest.mark.parametrize("kind", ["ascii", "compressed"])
+def test_ascii_and_compressed_files_are_left_to_open3d(tmp_path: Path, kind: str) -> None:
+    path = tmp_path / "map.pcd"
+    cloud = o3d.geometry.PointCloud(o3d.utility.Vector3dVector(XYZ[:4]))
+    assert o3d.io.write_point_cloud(str(path), cloud, write_ascii=kind == "ascii",
+                                    compressed=kind == "compressed")
+    assert pcd.read_fields(path, ("x", "y", "z")) is None
+    np.testing.assert_allclose(load_map(path).points, XYZ[:4], atol=1e-6)
+    np.testing.assert_allclose(read_scan(path)[0], XYZ[:4], atol=1e-6)
+
+
+@pytest.mark.unit
+def test_a_field_numpy_does_not_hold_is_left_to_open3d(tmp_path: Path) -> None:
+    """A time field of two values: not read here (Open3D decides what it is)."""
+    records = np.zeros(2, dtype=[("x", "<f4"), ("y", "<f4"), ("z", "<f4"), ("t", "<f4", (2,))])
+    path = write_pcd(tmp_path / "scan.pcd", [("x", "F", 4, 1), ("y", "F", 4, 1),
+                                             ("z", "F", 4, 1), ("t", "F", 4, 2)], records)
+    assert pcd.read_fields(path, ("x", "y", "z", "t")) is None
+    assert pcd.read_fields(path, ("x", "y", "z")) is not None
+
+
+@pytest.mark.unit
+def test_a_truncated_scan_is_refused(tmp_path: Path) -> None:
+    records = np.zeros(10, dtype=[("x", "<f4"), ("y", "<f4"), ("z", "<f4")])
+    path = write_pcd(tmp_path / "scan.pcd", [(a, "F", 4, 1) for a in "xyz"], records)
+    path.write_bytes(path.read_bytes()[:-6])
+    with pytest.raises(InputError, match="declares 10 points, the file holds 9"):
+        read_scan(path)
