@@ -1,0 +1,199 @@
+"""pcmapq's speed and memory as ratios to a floor or a peer measured in the same run, so that a
+busy machine slows both sides alike and cannot hide a regression (``python -m bench``).
+
+Each case runs its commands in fresh processes (wall seconds and peak RSS of the child, by
+``os.wait4``), alternating the two sides and keeping each side's best of ``repeat`` runs:
+
+- ``noref``: ``pcmapq eval`` by default against ``--no-noref`` (the price of the default
+  no-reference block) on the shipped sample, KITTI 00's 20-scan pair and a 10 M-point cloud;
+- ``kitti``: ``pcmapq eval`` of KITTI 00's 20-scan KISS-ICP map against the map from its
+  reference poses, against its floor: a process that imports Open3D, reads both clouds and
+  downsamples them at the registration's 0.3 m voxel;
+- ``clouds``: ``pcmapq eval`` of a 10 M-point cloud against its plan, against Open3D reading
+  it and downsampling it at 0.05 m (:mod:`bench.bench_clouds`);
+- ``campus``: the ``size`` x ``size`` campus grid pair against OpenCV reading both images and
+  one distance transform (:mod:`bench.bench_grids`).
+
+Inputs are built once into a cache folder outside the repository (``--cache``); cases whose
+data (``../shared/data``) is absent are skipped with the reason.
+"""
+
+from __future__ import annotations
+
+import json
+import shutil
+import sys
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from bench import large_grid
+from bench.bench_clouds import FLOOR_CHILD as CLOUD_FLOOR
+from bench.bench_clouds import measured, write_case
+from bench.bench_grids import FLOOR_CHILD as GRID_FLOOR
+from pcmapq.testing.paths import SAMPLE, SHARED_DATA
+
+#: A ratio worse than its stored value by more than this share fails ``--check``.
+TOLERANCE = 0.20
+
+KITTI_FLOOR = r"""
+import json, sys, time
+start = time.perf_counter()
+import open3d as o3d
+for path in sys.argv[1:3]:
+    o3d.io.read_point_cloud(path).voxel_down_sample(float(sys.argv[3]))
+print(json.dumps({"seconds": time.perf_counter() - start}))
+"""
+
+
+@dataclass(frozen=True)
+class Ratio:
+    """One measured ratio: ``name`` (case/figure), ``value`` = ``ours`` / ``theirs`` (lower is
+    better), what each side is, and the issue's target when it sets one."""
+
+    name: str
+    value: float
+    ours: str
+    theirs: str
+    target: float | None = None
+
+    def row(self) -> str:
+        target = "" if self.target is None else f"{self.target:g}"
+        return f"| {self.name} | {self.value:.2f} | {target} | {self.ours} | {self.theirs} |"
+
+
+def best(cmd: list[str], repeat: int) -> tuple[float, float]:
+    """Best wall seconds and best peak GB of ``cmd`` over ``repeat`` fresh processes."""
+    runs = [measured(cmd)[:2] for _ in range(repeat)]
+    return min(r[0] for r in runs), min(r[1] for r in runs)
+
+
+def paired(first: list[str], second: list[str], repeat: int
+           ) -> tuple[tuple[float, float], tuple[float, float]]:
+    """(seconds, GB) of both commands, run alternately, each side's best of ``repeat``."""
+    a, b = [], []
+    for _ in range(repeat):
+        a.append(measured(first)[:2])
+        b.append(measured(second)[:2])
+    return ((min(x[0] for x in a), min(x[1] for x in a)),
+            (min(x[0] for x in b), min(x[1] for x in b)))
+
+
+def eval_cmd(map_path: Path, truth: Path, out: Path, *extra: str) -> list[str]:
+    return [sys.executable, "-m", "pcmapq", "eval", str(map_path), str(truth), "--json",
+            str(out), *extra]
+
+
+def kitti_pair(cache: Path) -> tuple[Path, Path] | None:
+    """KITTI 00's first 20 scans: the KISS-ICP map and the map of the reference poses, as
+    ``pcmapq map`` builds them, written once into ``cache``; None without the data."""
+    folder = SHARED_DATA / "kitti00"
+    if not (folder / "velodyne").is_dir():
+        return None
+    kiss, ref = cache / "kitti20_kiss.ply", cache / "kitti20_ref.ply"
+    if not ref.exists():
+        from bench.validation.kitti import TR
+        from pcmapq.io.writers import write_cloud
+        from pcmapq.mapping import (
+            build_map_from_poses,
+            build_map_kiss,
+            lidar_poses_from_camera,
+            read_kitti_poses,
+        )
+        cache.mkdir(parents=True, exist_ok=True)
+        points, _ = build_map_kiss(folder / "velodyne", max_scans=20)
+        write_cloud(kiss, points)
+        poses = lidar_poses_from_camera(read_kitti_poses(folder / "poses.txt"),
+                                        np.vstack([TR, [0, 0, 0, 1]]))[:20]
+        write_cloud(ref, build_map_from_poses(folder / "velodyne", poses, max_scans=20))
+    return kiss, ref
+
+
+def cloud_case(cache: Path, millions: int = 10) -> tuple[Path, Path]:
+    """:mod:`bench.bench_clouds`' campus cloud of ``millions`` M points and its plan, once."""
+    folder = cache / f"cloud_{millions}M"
+    if not (folder / "truth.yaml").exists():
+        shutil.rmtree(folder, ignore_errors=True)
+        folder.mkdir(parents=True)
+        write_case(folder, millions * 1_000_000)
+    return folder / "cloud.ply", folder / "truth.yaml"
+
+
+def noref(cache: Path, repeat: int) -> list[Ratio]:
+    """The default no-reference block's price: eval by default / eval --no-noref."""
+    pairs = [("sample", SAMPLE / "scan.ply", SAMPLE / "truth.yaml")]
+    kitti = kitti_pair(cache)
+    if kitti is not None:
+        pairs.append(("KITTI 20 scans", *kitti))
+    pairs.append(("10 M points", *cloud_case(cache)))
+    out = []
+    for name, map_path, truth in pairs:
+        on, off = paired(eval_cmd(map_path, truth, cache / "on.json"),
+                         eval_cmd(map_path, truth, cache / "off.json", "--no-noref"), repeat)
+        out += [Ratio(f"noref/{name}/time", on[0] / off[0], f"default {on[0]:.1f} s",
+                      f"--no-noref {off[0]:.1f} s", 1.15),
+                Ratio(f"noref/{name}/memory", on[1] / off[1], f"default {on[1]:.2f} GB",
+                      f"--no-noref {off[1]:.2f} GB", 1.10)]
+    return out
+
+
+def kitti(cache: Path, repeat: int) -> list[Ratio]:
+    """KITTI 00's 20-scan pair by default against Open3D reading and downsampling both."""
+    pair = kitti_pair(cache)
+    if pair is None:
+        print("kitti: skipped, ../shared/data/kitti00 is absent", file=sys.stderr)
+        return []
+    ours, floor = paired(eval_cmd(*pair, cache / "kitti.json"),
+                         [sys.executable, "-c", KITTI_FLOOR, *map(str, pair), "0.3"], repeat)
+    return [Ratio("kitti/time", ours[0] / floor[0], f"pcmapq eval {ours[0]:.1f} s",
+                  f"Open3D read + 0.3 m voxel {floor[0]:.1f} s"),
+            Ratio("kitti/memory", ours[1] / floor[1], f"pcmapq eval {ours[1]:.2f} GB",
+                  f"Open3D read + 0.3 m voxel {floor[1]:.2f} GB")]
+
+
+def clouds(cache: Path, repeat: int) -> list[Ratio]:
+    """A 10 M-point cloud against its plan, against Open3D reading it and voxelising it."""
+    cloud, truth = cloud_case(cache)
+    ours, floor = paired(eval_cmd(cloud, truth, cache / "cloud.json"),
+                         [sys.executable, "-c", CLOUD_FLOOR, str(cloud), "0.05"], repeat)
+    return [Ratio("clouds 10 M/time", ours[0] / floor[0], f"pcmapq eval {ours[0]:.1f} s",
+                  f"Open3D read + 0.05 m voxel {floor[0]:.1f} s (process)"),
+            Ratio("clouds 10 M/memory", ours[1] / floor[1], f"pcmapq eval {ours[1]:.2f} GB",
+                  f"Open3D read + 0.05 m voxel {floor[1]:.2f} GB")]
+
+
+def campus(cache: Path, repeat: int, size: int = 8000) -> list[Ratio]:
+    """The campus grid pair against OpenCV reading both images and one distance transform
+    (timed inside its process, as bench_grids does)."""
+    case = cache / f"grid_{size}"
+    if not (case / "truth.yaml").exists():
+        shutil.rmtree(case, ignore_errors=True)
+        large_grid.write_case(case, size)
+    floors = [json.loads(measured([sys.executable, "-c", GRID_FLOOR, str(case / "truth.png"),
+                                   str(case / "map.png")])[2].strip().splitlines()[-1])
+              ["seconds"] for _ in range(repeat)]
+    seconds, gb = best(eval_cmd(case / "map.yaml", case / "truth.yaml", cache / "grid.json"),
+                       repeat)
+    return [Ratio(f"campus {size}^2/time", seconds / min(floors), f"pcmapq eval {seconds:.1f} s, "
+                  f"{gb:.2f} GB", f"OpenCV read x 2 + distance transform {min(floors):.2f} s",
+                  40.0)]
+
+
+#: name -> case; each returns its ratios.
+CASES: dict[str, Callable[[Path, int], list[Ratio]]] = {
+    "noref": noref, "kitti": kitti, "clouds": clouds, "campus": campus,
+}
+
+
+def compare(found: list[Ratio], stored: dict[str, float]) -> list[str]:
+    """The ratios that worsened by more than TOLERANCE against ``stored``, one line each."""
+    return [f"{r.name}: {r.value:.2f} against {stored[r.name]:.2f} stored (+"
+            f"{100 * (r.value / stored[r.name] - 1):.0f} %)"
+            for r in found if r.name in stored and r.value > stored[r.name] * (1 + TOLERANCE)]
+
+
+def table(found: list[Ratio]) -> str:
+    return "\n".join(["| ratio | value | target | pcmapq | floor or peer |",
+                      "|---|---:|---:|---|---|", *(r.row() for r in found)])
