@@ -28,7 +28,6 @@ from typing import NamedTuple
 import numpy as np
 from scipy.spatial import cKDTree
 
-from pcmapq.align.features3d import global_registration
 from pcmapq.align.refine3d import refine
 from pcmapq.core.errors import EvaluationError, InputError
 from pcmapq.core.transform import affine
@@ -69,6 +68,8 @@ def align_3d(source_xyz: np.ndarray, target_xyz: np.ndarray, *, voxel: float = 0
         raise EvaluationError(f"too few points at voxel {voxel} m to register "
                               f"({len(src_down)} source, {len(tgt_down)} target)")
     if init is None:
+        from pcmapq.align.features3d import global_registration  # Open3D: loaded when it runs
+
         guess = global_registration(src_down, tgt_down, voxel)
     else:
         guess = tgt_shift @ np.asarray(init, dtype=np.float64).reshape(4, 4) @ np.linalg.inv(
