@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import csv
 import json
+import os
 import shlex
 import sys
 from dataclasses import replace
@@ -50,11 +51,18 @@ def local(inputs) -> tuple[Path, dict[str, bytes], list]:
 
 @pytest.fixture(scope="module")
 def cluster():
-    """A dask.distributed LocalCluster of 2 worker processes, closed at the end."""
+    """A dask.distributed LocalCluster of 2 worker processes, closed at the end. Its nannies
+    set their workers' environment (MALLOC_TRIM_THRESHOLD_, OMP_NUM_THREADS ...) in this
+    process's for good: put back, so that later tests' local workers start as a user's do."""
     distributed = pytest.importorskip("dask.distributed")
-    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                                  host="127.0.0.1", dashboard_address=None) as c:
-        yield c
+    environ = dict(os.environ)
+    try:
+        with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                      host="127.0.0.1", dashboard_address=None) as c:
+            yield c
+    finally:
+        os.environ.clear()
+        os.environ.update(environ)
 
 
 def test_noref_columns_are_evals_options(inputs):

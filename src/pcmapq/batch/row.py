@@ -14,6 +14,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 
 from pcmapq import __version__
+from pcmapq.batch.allocator import glibc_thresholds
 from pcmapq.batch.manifest import Row
 from pcmapq.core.errors import EvaluationError, InputError
 from pcmapq.evaluation.pipeline import evaluate
@@ -72,9 +73,11 @@ class Outcome:
 def run_row(task: Task) -> Outcome:
     """The task function, local or on Dask: skip the row when its saved result is valid (and
     not ``task.force``), else evaluate it and write its outputs and record atomically. Never
-    raises: an error becomes a failed Outcome (InputError 2, EvaluationError 1, other 1)."""
+    raises: an error becomes a failed Outcome (InputError 2, EvaluationError 1, other 1). It
+    runs with glibc's own allocator thresholds, even on a Dask worker whose environment fixes
+    them (:func:`~pcmapq.batch.allocator.glibc_thresholds`)."""
     try:
-        with ONE_AT_A_TIME:
+        with ONE_AT_A_TIME, glibc_thresholds():
             return _run(task)
     except (InputError, EvaluationError) as exc:
         return failed(task, exc.exit_code, one_line(exc))
