@@ -3,7 +3,7 @@
     python -m bench [--only noref,kitti,clouds,campus] [--repeat 2] [--check] [--save] [--doc]
                     [--cache DIR]
 
---check: exit 1 when a ratio is worse than its stored one (bench/results/ratios.json) by more
+--check: exit 1 when a ratio is worse than its stored one (bench/ratios.json) by more
 than 20 %. --save: store the ratios measured. --doc: write the table into docs/benchmarks.md.
 """
 
@@ -17,7 +17,7 @@ from pathlib import Path
 from bench.ratios import CASES, compare, table
 
 ROOT = Path(__file__).resolve().parents[1]
-STORED = ROOT / "bench" / "results" / "ratios.json"
+STORED = ROOT / "bench" / "ratios.json"
 DOC = ROOT / "docs" / "benchmarks.md"
 BEGIN, END = "<!-- ratios -->", "<!-- /ratios -->"
 
