@@ -15,7 +15,7 @@ from pcmapq.metrics.noref import LIDAR_RADIUS, MAX_NN, MIN_KNN, mom, scores
 from pcmapq.metrics.orthogonal import MAX_WARD_POINTS, extract_orthogonal_subset
 
 #: A sampled pass extracts MOM's planes from the map reduced at this share of the radius: every
-#: planar region still holds tens of points, at a tenth of the cost of the map's own pass.
+#: planar region still holds tens of points, for a small share of the map's own pass.
 SAMPLED_MOM_VOXEL = 1 / 3
 
 
@@ -42,7 +42,7 @@ def noref_figures(points: np.ndarray, radius: float = LIDAR_RADIUS, min_knn: int
     radius (when neither planes nor a source are given; 0: every point, as map-metrics). Figures
     that are not finite are None.
     """
-    coarse = sample and orth_subset is None and mom_source is None and len(points) > sample
+    coarse = 0 < sample < len(points) and orth_subset is None and mom_source is None
     if coarse:
         mom_source = voxel_centroids(points, radius * SAMPLED_MOM_VOXEL)
     reuse = orth_subset is None and mom_source is None  # the planar points of this pass
