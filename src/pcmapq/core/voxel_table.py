@@ -100,8 +100,8 @@ def streamed_centroids(points: np.ndarray, voxel: float, scale: float = 1.0) -> 
             added, used = _add(chunk[done:], float(scale), float(voxel), keys, sums, counts,
                                used, np.uint64(64 - bits), int(LOAD * len(keys)))
             if added < 0:
-                raise InputError(f"cloud extends beyond +-{OFFSET * voxel:.0f} m of its origin "
-                                 f"at voxel {voxel} m; use a larger voxel")
+                raise InputError(f"map extends beyond +-{OFFSET * voxel:.0f} m of its origin at "
+                                 f"voxel {voxel} m; use a larger voxel")
             done += added
             if done < len(chunk):
                 bits += 1

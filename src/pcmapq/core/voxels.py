@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from pcmapq.core import voxel_table
 from pcmapq.core.bounds import bounds
 from pcmapq.core.errors import InputError
 
@@ -143,6 +144,9 @@ def _dense_groups(index: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
 def voxel_centroids(points: np.ndarray, voxel: float) -> np.ndarray:
     """The centroid of the points (N, d, metres; d = 2 or 3) in each ``voxel``-metre cell,
     (M, d), sorted by voxel index (x, then y, ...). Deterministic."""
+    points = np.asarray(points)
+    if points.ndim == 2 and points.shape[1] == 3 and len(points) > voxel_table.CHUNK:
+        return voxel_table.streamed_centroids(points, voxel)  # the same, without a sort
     points = np.asarray(points, dtype=np.float64)
     grid = VoxelMap(voxel, dims=points.shape[1])
     grid.add(points)

@@ -8,7 +8,7 @@ import pytest
 
 from pcmapq.core import voxel_table
 from pcmapq.core.errors import InputError
-from pcmapq.core.voxels import voxel_centroids
+from pcmapq.core.voxels import VoxelMap, voxel_centroids
 
 
 @pytest.mark.parametrize("dtype", [np.float32, np.float64])
@@ -18,10 +18,24 @@ def test_streamed_centroids_equal_voxel_centroids_bit_for_bit(dtype, monkeypatch
                         rng.uniform(0, 0.5, (40_000, 3))]).astype(dtype)  # many a voxel
     monkeypatch.setattr(voxel_table, "CHUNK", 7_000)  # chunks and many doublings of the table
     got = voxel_table.streamed_centroids(points, 0.1, 2.5)
-    assert np.array_equal(got, voxel_centroids(points.astype(np.float64) * 2.5, 0.1))
+    one_shot = VoxelMap(0.1)  # voxel_centroids' sort, which it hands large clouds to the table
+    one_shot.add(points.astype(np.float64) * 2.5)
+    assert np.array_equal(got, one_shot.points())
+
+
+def test_voxel_centroids_of_a_large_cloud_are_the_tables():
+    points = np.random.default_rng(2).normal(0, 5, (voxel_table.CHUNK + 10, 3))
+    one_shot = VoxelMap(0.2)
+    one_shot.add(points)
+    assert np.array_equal(voxel_centroids(points, 0.2), one_shot.points())
 
 
 def test_a_cloud_beyond_the_keys_range_is_refused_in_one_line():
     points = np.array([[0.0, 0.0, 0.0], [2e6, 0.0, 0.0]])
-    with pytest.raises(InputError, match="beyond"):
+    with pytest.raises(InputError, match="beyond") as table:
         voxel_table.streamed_centroids(points, 0.1)
+    one_shot_map = VoxelMap(0.1)
+    one_shot_map.add(points)
+    with pytest.raises(InputError) as one_shot:
+        one_shot_map.points()
+    assert str(table.value) == str(one_shot.value)
