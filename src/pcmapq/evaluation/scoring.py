@@ -52,8 +52,8 @@ def score(placed: Placed, prepared: PreparedTruth, settings: Settings,
         if placed.features is None:
             progress("drawing the walls' centre lines and detecting features")
             sides = SideBySide(settings.matching.detectors, settings.matching.params)
-            side = placed = replace(placed, features=sides.features(
-                placed.occupied, prepared.grid, threads=FEATURE_THREADS))
+            side = replace(placed, features=sides.features(placed.occupied, prepared.grid,
+                                                           threads=FEATURE_THREADS))
         consistency = None if consistency_job is None else consistency_job.result()
         cloud_distances = None if cloud_job is None else cloud_job.result()
     frames = Frames(alignment.transform, side.level, prepared.level,
@@ -74,9 +74,9 @@ def score(placed: Placed, prepared: PreparedTruth, settings: Settings,
         progress("no-reference figures")
         scale = alignment.transform.scale if settings.alignment.scale else 1.0
         corners = harris_corners(truth, prepared.features, settings)
-        early = early or EarlyFigures({}, settings)
-        noref = {"map": early.get("map") or input_figures(loaded, settings.noref, scale=scale),
-                 "truth": early.get("truth") or input_figures(truth, settings.noref,
+        found = {} if early is None else {name: early.get(name) for name in ("map", "truth")}
+        noref = {"map": found.get("map") or input_figures(loaded, settings.noref, scale=scale),
+                 "truth": found.get("truth") or input_figures(truth, settings.noref,
                                                               corners=corners)}
     return Result(map_path=Path(loaded.path), map_kind=side.source.kind,
                   truth_path=Path(truth.path), truth_kind=truth.kind, grid=grid,

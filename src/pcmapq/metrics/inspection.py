@@ -19,12 +19,8 @@ from pcmapq.metrics.orthogonal import MAX_WARD_POINTS, extract_orthogonal_subset
 SAMPLED_MOM_VOXEL = 1 / 3
 
 
-def _finite(value: float) -> float | None:
-    return value if math.isfinite(value) else None
-
-
-def _finite_or_none(value: float | None) -> float | None:
-    return None if value is None else _finite(value)
+def _finite(value: float | None) -> float | None:
+    return value if value is not None and math.isfinite(value) else None
 
 
 def noref_figures(points: np.ndarray, radius: float = LIDAR_RADIUS, min_knn: int = MIN_KNN,
@@ -61,8 +57,8 @@ def noref_figures(points: np.ndarray, radius: float = LIDAR_RADIUS, min_knn: int
     return {
         "mme": _finite(s.mme), "mpv": _finite(s.mpv), "mom": value, "mom_note": note,
         "points": s.total_points, "mme_points": s.mme_points, "mpv_points": s.mpv_points,
-        "sampled_points": s.sampled_points, "mme_se": _finite_or_none(s.mme_se),
-        "mpv_se": _finite_or_none(s.mpv_se),
+        "sampled_points": s.sampled_points, "mme_se": _finite(s.mme_se),
+        "mpv_se": _finite(s.mpv_se),
         "radius_m": radius, "min_knn": min_knn, "max_nn": max_nn, "orth_subset": source,
         "orth_plane_points": None if planes is None else [len(p) for p in planes],
         "orth_voxel_m": radius * SAMPLED_MOM_VOXEL if coarse else None,
