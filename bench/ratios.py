@@ -27,8 +27,6 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
-import numpy as np
-
 from bench import large_grid
 from bench.bench_clouds import FLOOR_CHILD as CLOUD_FLOOR
 from bench.bench_clouds import measured, write_case
@@ -94,20 +92,12 @@ def kitti_pair(cache: Path) -> tuple[Path, Path] | None:
         return None
     kiss, ref = cache / "kitti20_kiss.ply", cache / "kitti20_ref.ply"
     if not ref.exists():
-        from bench.validation.kitti import TR
+        from bench.validation.kitti import kiss_map, reference_map
         from pcmapq.io.writers import write_cloud
-        from pcmapq.mapping import (
-            build_map_from_poses,
-            build_map_kiss,
-            lidar_poses_from_camera,
-            read_kitti_poses,
-        )
+
         cache.mkdir(parents=True, exist_ok=True)
-        points, _ = build_map_kiss(folder / "velodyne", max_scans=20)
-        write_cloud(kiss, points)
-        poses = lidar_poses_from_camera(read_kitti_poses(folder / "poses.txt"),
-                                        np.vstack([TR, [0, 0, 0, 1]]))[:20]
-        write_cloud(ref, build_map_from_poses(folder / "velodyne", poses, max_scans=20))
+        write_cloud(kiss, kiss_map(folder, 20)[0])
+        write_cloud(ref, reference_map(folder, 20)[0])
     return kiss, ref
 
 

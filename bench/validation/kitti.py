@@ -45,15 +45,27 @@ class Maps:
         return self.run.summary()
 
 
+def kiss_map(folder: Path, scans: int = SCANS) -> tuple[np.ndarray, np.ndarray]:
+    """KISS-ICP's map (N, 3 metres) of the first ``scans`` scans of ``folder/velodyne`` and its
+    poses (K, 4, 4), as ``pcmapq map`` builds them."""
+    return build_map_kiss(folder / "velodyne", max_scans=scans)
+
+
+def reference_map(folder: Path, scans: int = SCANS) -> tuple[np.ndarray, np.ndarray]:
+    """The map (N, 3 metres) of the first ``scans`` scans at KITTI's reference poses, in the
+    first LiDAR frame, and those poses (K, 4, 4), as ``pcmapq map --poses --calib`` builds it."""
+    poses = lidar_poses_from_camera(read_kitti_poses(folder / "poses.txt"),
+                                    np.vstack([TR, [0, 0, 0, 1]]))[:scans]
+    return build_map_from_poses(folder / "velodyne", poses, max_scans=scans), poses
+
+
 def measure(folder: Path, scans: int = SCANS) -> Maps:
     """Build both maps of the first ``scans`` scans, write them as .ply, score one against the
     other."""
     start = time.perf_counter()
-    kiss, kiss_poses = build_map_kiss(folder / "velodyne", max_scans=scans)
+    kiss, kiss_poses = kiss_map(folder, scans)
     middle = time.perf_counter()
-    poses = lidar_poses_from_camera(read_kitti_poses(folder / "poses.txt"),
-                                    np.vstack([TR, [0, 0, 0, 1]]))[:scans]
-    reference = build_map_from_poses(folder / "velodyne", poses, max_scans=scans)
+    reference, poses = reference_map(folder, scans)
     built = (middle - start, time.perf_counter() - middle)
     with tempfile.TemporaryDirectory(prefix="pcmapq_kitti_") as tmp:
         write_cloud(Path(tmp) / "kiss.ply", kiss)
