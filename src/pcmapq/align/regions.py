@@ -130,6 +130,25 @@ def _fit(window: np.ndarray, own: np.ndarray, target: LineTarget, start: Similar
     return local, _fitness(local.apply(own), target, tolerance)
 
 
+def _tile_codes(tiles: np.ndarray) -> tuple[np.ndarray, int]:
+    """One increasing integer per tile (``tiles``: (T, 2) keys, sorted as ``np.unique`` sorts
+    rows) and the stride of its first key, chosen so that a neighbour's code is the tile's plus
+    one less or more, or ``height`` less or more, and so on."""
+    low = tiles.min(axis=0) - 1
+    height = int(tiles[:, 1].max() - low[1]) + 2
+    return (tiles[:, 0] - low[0]) * height + (tiles[:, 1] - low[1]), height
+
+
+def _tile_points(k: int, code: np.ndarray, height: int, order: np.ndarray,
+                 bounds_at: np.ndarray) -> np.ndarray:
+    """Indices, increasing, of the points of tile ``k`` and of its 8 neighbours: ``order``
+    lists the points tile by tile, tile ``j``'s from ``bounds_at[j]`` to ``bounds_at[j + 1]``."""
+    wanted = code[k] + (np.arange(-1, 2)[:, None] * height + np.arange(-1, 2)).ravel()
+    near = np.searchsorted(code, wanted)
+    near = near[(near < len(code)) & (code[np.minimum(near, len(code) - 1)] == wanted)]
+    return np.sort(np.concatenate([order[bounds_at[j]:bounds_at[j + 1]] for j in near]))
+
+
 def regions(map_xy: np.ndarray, transform: Similarity2D, target: LineTarget,
             tolerance: float = 0.2, tile_m: float = 4.0,
             starts: tuple[tuple[Similarity2D, tuple[float, float]], ...] = ()
@@ -155,6 +174,7 @@ def regions(map_xy: np.ndarray, transform: Similarity2D, target: LineTarget,
     inverse = inverse.ravel()
     order = np.argsort(inverse, kind="stable")
     bounds_at = np.concatenate([[0], np.cumsum(counts)])
+    code, height = _tile_codes(tiles)
     # each start as a move of the placed points, truth frame: start o transform^-1
     moves = [pose.compose(transform.inverse()) for pose, _ in starts]
     places = np.array([where for _, where in starts], dtype=np.float64).reshape(-1, 2)
@@ -162,7 +182,10 @@ def regions(map_xy: np.ndarray, transform: Similarity2D, target: LineTarget,
     for k in np.flatnonzero(counts >= MIN_POINTS):
         own = placed[order[bounds_at[k]:bounds_at[k + 1]]]
         lo, hi = (tiles[k] - MARGIN) * tile, (tiles[k] + 1 + MARGIN) * tile
-        window = placed[np.all((placed >= lo) & (placed < hi), axis=1)]
+        # the window lies within the tile and its 8 neighbours (MARGIN < 1): only their
+        # points are compared, in the map's order, so the window is placed[inside] exactly
+        nearby = placed[_tile_points(k, code, height, order, bounds_at)]
+        window = nearby[np.all((nearby >= lo) & (nearby < hi), axis=1)]
         before = _fitness(own, target, tolerance)
         local, after = Similarity2D(), before  # slid out of reach from every start: not moved
         found = False
