@@ -33,7 +33,10 @@ empty cells only, and none reaches farther into them than the margin (the closin
 band's half width), so the window gives the image the whole raster would. A window larger than
 :data:`TILE` working cells a side is drawn tile by tile (each with a halo of :data:`HALO` metres
 that is drawn and dropped), on as many threads as there are cores (at most 4): every step looks
-no farther than the halo, so the tiles join into the same image, in a bounded memory.
+no farther than the halo, so the tiles join into the same image, in a bounded memory. The
+process draws no more tiles at once than that, whichever images they belong to (the truth's,
+the map's and the map's own figures may be drawn at the same time), so that the largest
+temporaries do not pile up with the number of images.
 """
 
 from __future__ import annotations
@@ -41,6 +44,7 @@ from __future__ import annotations
 import os
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
+from threading import BoundedSemaphore
 
 import cv2
 import numpy as np
@@ -62,6 +66,8 @@ MARGIN = 0.5
 THICKEST = 2.0
 #: Threads drawing tiles, at most.
 THREADS = 4
+#: Tiles drawn at once in the process, over all images.
+_DRAWING = BoundedSemaphore(min(THREADS, os.cpu_count() or 1))
 #: The closing's radius, metres (module docstring, 2): readings of a wall up to about twice this
 #: apart join into one line.
 CLOSING = 0.1
@@ -238,7 +244,8 @@ def _tiled(occupied: np.ndarray, grid: MetricGrid, resolution: float, k: int, ti
         corner = grid.pixels_to_xy(np.array([[left - 0.5, rows - lo - 0.5]]))[0]
         sub = MetricGrid(grid.resolution, (float(corner[0]), float(corner[1]), grid.origin[2]),
                          (hi - lo, right - left))
-        got = band(np.ascontiguousarray(below[lo:hi, left:right][::-1]), sub)[::-1]
+        with _DRAWING:
+            got = band(np.ascontiguousarray(below[lo:hi, left:right][::-1]), sub)[::-1]
         top, end = -(-min(to_row, p + step) // k), -(-min(to_col, c + step) // k)
         out[p // k:top, c // k:end] = got[(p - lo) // k:(p - lo) // k + top - p // k,
                                           (c - left) // k:(c - left) // k + end - c // k]
