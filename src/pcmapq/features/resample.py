@@ -45,7 +45,8 @@ def resample(image: np.ndarray, grid: MetricGrid,
                           interpolation=cv2.INTER_NEAREST_EXACT), work
     if down:  # each new cell is a block of old cells; blocks start at the lower-left corner
         rows, cols = work.shape[0] * down, work.shape[1] * down
-        padded = np.pad(image, ((rows - image.shape[0], 0), (0, cols - image.shape[1])))
+        padded = image if (rows, cols) == image.shape else \
+            np.pad(image, ((rows - image.shape[0], 0), (0, cols - image.shape[1])))
         return cv2.resize(padded, work.shape[::-1], interpolation=cv2.INTER_AREA), work
     ax = _overlap_matrix(work.shape[1], resolution, grid.shape[1], grid.resolution)
     # rows count from the top, the origin is at the bottom: average the flipped rows

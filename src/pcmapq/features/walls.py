@@ -119,11 +119,14 @@ def centreline(occupied: np.ndarray, grid: MetricGrid, resolution: float, closin
     size = np.maximum(stats[:, cv2.CC_STAT_WIDTH], stats[:, cv2.CC_STAT_HEIGHT]) * resolution
     is_small = size <= small
     is_small[0] = False
-    objects = fill_holes(is_small[label])
     half = int(0.5 * THICKEST / resolution)  # deep: a square of this half-side all wall
     deep = cv2.erode(wall, cv2.getStructuringElement(cv2.MORPH_RECT, (2 * half + 1,) * 2),
-                     borderType=cv2.BORDER_CONSTANT, borderValue=0).astype(bool)
-    line = prune(skeletonize(wall.astype(bool) & ~objects & ~deep), spur / resolution)
+                     borderType=cv2.BORDER_CONSTANT, borderValue=0)
+    walls = wall > deep  # wall cells that are not deep
+    if not is_small.any():  # no object: nothing to fill or take out (most tiles of a campus)
+        return prune(skeletonize(walls), spur / resolution), np.zeros_like(walls), fine
+    objects = fill_holes(is_small[label])
+    line = prune(skeletonize(walls & ~objects), spur / resolution)
     return line, cores(objects, width / resolution), fine
 
 
