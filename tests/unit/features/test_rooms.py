@@ -1,0 +1,113 @@
+"""Rooms and doors of free space, on plans with known rooms and doors."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from pcmapq.features.rooms import Params, segment, without_furniture
+
+RES = 0.05
+
+
+def cells(metres: float) -> int:
+    return int(round(metres / RES))
+
+
+def plan(rooms: int = 3, room_w: float = 4.0, depth: float = 5.0, door: float = 0.9,
+         doors: tuple[bool, ...] | None = None, walls: tuple[bool, ...] | None = None
+         ) -> np.ndarray:
+    """Free cells (bool) of a row of ``rooms`` rooms ``room_w`` x ``depth`` metres behind walls
+    0.1 m thick; between rooms ``i`` and ``i + 1`` a wall (``walls[i]``) with a door ``door``
+    metres wide in its middle (``doors[i]``)."""
+    doors = (True,) * (rooms - 1) if doors is None else doors
+    walls = (True,) * (rooms - 1) if walls is None else walls
+    wall, margin = cells(0.1), cells(1.0)
+    width, height = rooms * cells(room_w) + (rooms + 1) * wall, cells(depth) + 2 * wall
+    free = np.zeros((height + 2 * margin, width + 2 * margin), dtype=bool)
+    top, left = margin + wall, margin + wall
+    free[top:top + cells(depth), left:left + width - 2 * wall] = True
+    for i in range(rooms - 1):
+        x = left + (i + 1) * cells(room_w) + i * wall
+        if walls[i]:
+            free[top:top + cells(depth), x:x + wall] = False
+            if doors[i]:
+                mid = top + cells(depth) // 2
+                free[mid - cells(door) // 2:mid + cells(door) // 2, x:x + wall] = True
+    return free
+
+
+def test_rooms_and_doors_of_a_row_of_rooms():
+    rooms = segment(plan(), RES)
+    assert len(rooms) == 3
+    np.testing.assert_allclose(rooms.area_m2, 4.0 * 5.0, rtol=0.03)
+    assert sorted(map(tuple, rooms.doors.tolist())) == [(0, 1), (1, 2)]
+    np.testing.assert_allclose(rooms.door_width_m, 0.9, atol=0.1)
+    # centroids left to right, 4.1 m apart; clearance: half the room's shorter side
+    order = np.argsort(rooms.centroid[:, 1])
+    np.testing.assert_allclose(np.diff(rooms.centroid[order, 1]) * RES, 4.1, atol=0.1)
+    np.testing.assert_allclose(rooms.clearance_m, 2.0, atol=0.1)
+
+
+def test_a_wall_removed_merges_two_rooms():
+    rooms = segment(plan(walls=(True, False)), RES)
+    assert len(rooms) == 2
+    np.testing.assert_allclose(np.sort(rooms.area_m2), [20.0, 8.1 * 5.0], rtol=0.03)
+    assert len(rooms.doors) == 1
+
+
+def test_a_door_closed_leaves_the_rooms_without_a_door_between_them():
+    rooms = segment(plan(doors=(True, False)), RES)
+    assert len(rooms) == 3
+    assert len(rooms.doors) == 1
+
+
+def test_a_wide_opening_is_no_door():
+    """An opening nearly as wide as the rooms joins them: one room."""
+    rooms = segment(plan(rooms=2, door=4.0), RES)
+    assert len(rooms) == 1
+
+
+def test_a_long_corridor_is_one_room():
+    rooms = segment(plan(rooms=1, room_w=30.0, depth=2.0), RES)
+    assert len(rooms) == 1
+    assert len(rooms.doors) == 0
+
+
+def test_furniture_does_not_split_a_room():
+    free = plan()
+    rows, cols = np.nonzero(free)
+    # chairs (0.4 m squares) in the middle room and a 0.8 m table
+    r0, c0 = int(rows.mean()), int(cols.mean())
+    for dr, dc, side in ((-20, -20, 0.4), (20, 20, 0.4), (0, 0, 0.8)):
+        free[r0 + dr:r0 + dr + cells(side), c0 + dc:c0 + dc + cells(side)] = False
+    assert without_furniture(free, RES, 1.0)[r0, c0]  # the table made free
+    rooms = segment(free, RES)
+    assert len(rooms) == 3
+    assert len(rooms.doors) == 2
+
+
+def test_a_wall_piece_between_two_doors_is_no_furniture():
+    """A free-standing wall longer than ``furniture_m`` stays an obstacle."""
+    free = np.ones((100, 100), dtype=bool)
+    free[10:12, 20:60] = False  # 2 m of wall
+    free[50:55, 50:55] = False  # a 0.25 m bin
+    kept = without_furniture(free, RES, 1.0)
+    assert not kept[10:12, 20:60].any()
+    assert kept[50:55, 50:55].all()
+
+
+def test_rooms_are_the_same_from_run_to_run_and_tiny_rooms_join_a_neighbour():
+    free = plan()
+    first, second = segment(free, RES), segment(free, RES)
+    np.testing.assert_array_equal(first.labels, second.labels)
+    np.testing.assert_array_equal(first.doors, second.doors)
+    assert (segment(free, RES, Params(min_room_m2=25.0)).area_m2 >= 25.0).all()
+
+
+@pytest.mark.parametrize("rooms", [2, 4])
+def test_labels_cover_the_free_cells_only(rooms):
+    free = plan(rooms=rooms)
+    found = segment(free, RES)
+    assert ((found.labels > 0) == free).all()
+    assert found.labels.max() == len(found) == rooms
