@@ -23,6 +23,7 @@ from . import (
     lidar,
     noref,
     recording,
+    rooms,
     same_place,
     track,
 )
@@ -35,7 +36,7 @@ SECTIONS: dict[str, ModuleType] = {
     "drawings": drawings, "fr79": fr79, "lidar": lidar, "kitti": kitti, "gazebo": gazebo,
     "halmstad": halmstad, "floorplans": floorplans, "carmen": carmen, "noref": noref,
     "same_place": same_place, "corpus": corpus, "consistency": consistency, "track": track,
-    "recording": recording,
+    "recording": recording, "rooms": rooms,
 }
 
 

@@ -20,7 +20,7 @@ from pcmapq.testing.paths import REPO, SHARED_DATA, shared
 pytestmark = pytest.mark.realdata
 #: Sections whose whole run is cheap, and the prefix of their cases' names.
 SECTIONS = {"drawings": "drawings-", "fr79": "fr79-", "lidar": "lidar-",
-            "floorplans": "floorplans-"}
+            "floorplans": "floorplans-", "rooms": "rooms-"}
 
 
 @pytest.mark.parametrize("section", sorted(SECTIONS))

@@ -1,0 +1,173 @@
+"""Rooms: pcmapq's room segmentation against the IPA benchmark's ground-truth rooms (20 plans,
+each plain and furnished), beside the published per-map results of ROSE² and MAORIS."""
+
+from __future__ import annotations
+
+import re
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import cv2
+import numpy as np
+
+from pcmapq.features.rooms import Params, segment
+from pcmapq.match.rooms import match
+
+from .common import Case, Record, Section, header, row
+
+#: The benchmark's plans (rooms/README.md), nominally 0.05 m a pixel.
+MAPS = ("lab_ipa", "lab_a_scan", "lab_b_scan", "lab_c_scan", "lab_d_scan", "lab_f_scan",
+        "lab_intel", "Freiburg52_scan", "Freiburg79_scan", "Freiburg101_scan", "NLB",
+        *(f"office_{c}" for c in "abcdefghi"))
+RESOLUTION = 0.05
+#: The benchmark's evaluation: free is grey > 250 in the ground truth (>= 250 in the maps),
+#: rooms are its 8-connected regions of more than 100 pixels.
+GT_FREE, MAP_FREE, GT_SMALLEST = 250, 250, 100
+MIN_IOU = 0.5
+
+
+def grey(path: Path) -> np.ndarray:
+    """An image as OpenCV's greyscale reading (the benchmark's own)."""
+    image = cv2.imread(str(path), cv2.IMREAD_GRAYSCALE)
+    if image is None:
+        raise FileNotFoundError(path)
+    return image
+
+
+def truth_rooms(path: Path) -> np.ndarray:
+    """The ground-truth rooms of a ``*_gt_segmentation.png`` as labels (0 none)."""
+    free = (grey(path) > GT_FREE).view(np.uint8)
+    n, label, stats, _ = cv2.connectedComponentsWithStats(free, connectivity=8)
+    keep = stats[:, cv2.CC_STAT_AREA] > GT_SMALLEST
+    keep[0] = False
+    number = np.zeros(n, np.int32)
+    number[keep] = np.arange(1, int(keep.sum()) + 1)
+    return number[label]
+
+
+@dataclass(frozen=True)
+class Segmented:
+    """One plan's segmentation against its ground truth."""
+
+    name: str
+    truth: int
+    found: int
+    precision_micro: float
+    recall_micro: float
+    precision_iou: float
+    recall_iou: float
+    seconds: float
+
+    def summary(self) -> dict:
+        return {"truth_rooms": self.truth, "rooms": self.found,
+                "precision_micro": round(self.precision_micro, 6),
+                "recall_micro": round(self.recall_micro, 6),
+                "precision_iou50": round(self.precision_iou, 6),
+                "recall_iou50": round(self.recall_iou, 6)}
+
+
+def measure(data: Path, name: str, furnished: bool) -> Segmented:
+    """Segment ``name`` (its furnished variant with ``furnished``) and score it the
+    benchmark's way (each room's best overlap: micro means over rooms) and by rooms matched
+    one to one at an IoU of at least 0.5."""
+    folder = data / "rooms"
+    image = grey(folder / f"{name}{'_furnitures' if furnished else ''}.png")
+    start = time.perf_counter()
+    found = segment(image >= MAP_FREE, RESOLUTION, Params()).labels
+    seconds = time.perf_counter() - start
+    truth = truth_rooms(folder / f"{name}_gt_segmentation.png")
+    m = match(truth, found, MIN_IOU)
+    t_cells = np.bincount(truth.ravel())[1:]
+    f_cells = np.bincount(found.ravel(), minlength=m.overlap.shape[1] + 1)[1:]
+    best_t = m.overlap.max(axis=1) / t_cells
+    best_f = m.overlap.max(axis=0, initial=0) / np.maximum(f_cells, 1)
+    return Segmented(name + (" (furnished)" if furnished else ""), len(t_cells),
+                     len(f_cells), float(best_f.mean()), float(best_t.mean()),
+                     m.matched / max(len(f_cells), 1), m.matched / len(t_cells), seconds)
+
+
+def published(data: Path) -> dict[str, dict[str, tuple[float, float]]]:
+    """Published per-map (precision, recall) micro, percent: ROSE² without and with furniture,
+    MAORIS without."""
+    folder = data / "rooms" / "third_party_results"
+    out: dict[str, dict[str, tuple[float, float]]] = {}
+    for method, file in (("ROSE²", "ROSE2_bormann_average_evaluation.txt"),
+                         ("ROSE² (furnished)", "ROSE2_bormann_furnitures_average_evaluation.txt")):
+        table = {}
+        for line in (folder / file).read_text().splitlines():
+            cells = [c.strip() for c in line.split("&")]
+            name = cells[0].replace("\\_", "_").removesuffix("_furnitures")
+            if name in MAPS and len(cells) >= 4:
+                table[name] = (float(cells[1]), float(cells[3]))
+        out[method] = table
+    maoris = {}
+    for line in (folder / "maoris_maorisRobotMap.dat").read_text().splitlines():
+        parts = re.split(r"\s+", line.strip())
+        if len(parts) >= 3 and parts[0] in MAPS:
+            maoris[parts[0]] = (float(parts[1]), float(parts[2]))
+    out["MAORIS"] = maoris
+    return out
+
+
+def cases(data: Path) -> list[Case]:
+    return [Case(f"rooms-{name}{'-furnished' if furnished else ''}",
+                 lambda name=name, furnished=furnished: measure(data, name, furnished))
+            for furnished in (False, True) for name in MAPS]
+
+
+def _pct(value: float) -> str:
+    return f"{100 * value:.1f}"
+
+
+def section(data: Path, record: Record) -> Section:
+    """Per plan, and on average beside the published methods on the same plans."""
+    runs = [case.run(record) for case in cases(data)]
+    others = published(data)
+    lines = []
+    for run in runs:
+        lines.append(row([run.name, str(run.truth), str(run.found), _pct(run.precision_micro),
+                          _pct(run.recall_micro), _pct(run.precision_iou),
+                          _pct(run.recall_iou), f"{run.seconds:.2f}"]))
+    compare = []
+    for method, furnished in (("ROSE²", False), ("ROSE² (furnished)", True), ("MAORIS", False)):
+        table = others[method]
+        ours = [r for r in runs if r.name.endswith("(furnished)") == furnished
+                and r.name.split(" ")[0] in table]
+        theirs = np.array([table[r.name.split(" ")[0]] for r in ours])
+        compare.append(row([
+            method, str(len(ours)), f"{theirs[:, 0].mean():.1f}", f"{theirs[:, 1].mean():.1f}",
+            _pct(np.mean([r.precision_micro for r in ours])),
+            _pct(np.mean([r.recall_micro for r in ours]))]))
+    plain = [r for r in runs if not r.name.endswith("(furnished)")]
+    furn = [r for r in runs if r.name.endswith("(furnished)")]
+    averages = [row([label, _pct(np.mean([r.precision_micro for r in rs])),
+                     _pct(np.mean([r.recall_micro for r in rs])),
+                     _pct(np.mean([r.precision_iou for r in rs])),
+                     _pct(np.mean([r.recall_iou for r in rs]))])
+                for label, rs in (("plain", plain), ("furnished", furn))]
+    return Section("\n".join([
+        "## Rooms: the IPA room-segmentation benchmark", "",
+        "`rooms/`: the 20 plans of Bormann et al. (ICRA 2016), each also with furniture, and "
+        "their ground-truth rooms read the benchmark's way (grey above 250, 8-connected "
+        "regions of more than 100 pixels; a furnished plan is scored against its plain "
+        "plan's rooms). pcmapq segments each plan's free cells (grey 250 and above) at the "
+        f"nominal {RESOLUTION} m a pixel with the rooms' default parameters "
+        "(`pcmapq.features.rooms.Params`). **Precision / recall micro** are the benchmark's: "
+        "the mean over found rooms of the share of each lying in its best-overlapping truth "
+        "room, and the mean over truth rooms of the share of each covered by its best "
+        "found room. **IoU 0.5** counts rooms matched one to one (Hungarian on IoU) at an IoU "
+        "of at least 0.5: matched / found rooms and matched / truth rooms.", "",
+        "On average:", "",
+        header(["plans", "precision micro %", "recall micro %", "precision IoU 0.5 %",
+                "recall IoU 0.5 %"]),
+        *averages, "",
+        "Beside the published per-map results (`rooms/third_party_results/`), averaged over "
+        "the plans each method reports:", "",
+        header(["method", "plans", "its precision %", "its recall %", "pcmapq precision %",
+                "pcmapq recall %"]),
+        *compare, "",
+        header(["plan", "truth rooms", "rooms", "precision micro %", "recall micro %",
+                "precision IoU 0.5 %", "recall IoU 0.5 %", "s"]),
+        *lines,
+    ]))
