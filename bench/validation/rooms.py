@@ -1,5 +1,6 @@
 """Rooms: pcmapq's room segmentation against the IPA benchmark's ground-truth rooms (20 plans,
-each plain and furnished), beside the published per-map results of ROSE² and MAORIS."""
+each plain and furnished), beside the published per-map results of ROSE² and MAORIS, and
+against the hand-made room labels of three real robot maps of one office floor in Bonn."""
 
 from __future__ import annotations
 
@@ -11,7 +12,9 @@ from pathlib import Path
 import cv2
 import numpy as np
 
+from pcmapq.core.cells import FREE
 from pcmapq.features.rooms import Params, segment
+from pcmapq.io import load_map
 from pcmapq.match.rooms import match
 
 from .common import Case, Record, Section, header, row
@@ -25,6 +28,11 @@ RESOLUTION = 0.05
 #: rooms are its 8-connected regions of more than 100 pixels.
 GT_FREE, MAP_FREE, GT_SMALLEST = 250, 250, 100
 MIN_IOU = 0.5
+#: The Bonn floor's maps (plans/bonn_youbot_tmcl/): map, its room labels (1-12; 0 walls, 205
+#: unknown, 252-255 unlabelled free cells) and the labels' channel (None: grey).
+BONN = (("FMap (reference)", "Faro/FMap.yaml", "Faro/FMapRoomSeg.png", None),
+        ("GMap (robot, cluttered)", "GMap/GMap.yaml", "GMap/GMapRoomSeg.png", None),
+        ("YouBotMap (robot)", "2021_10_27/YouBotMap.yaml", "2021_10_27/YouBotMapRoomSeg.png", 2))
 
 
 def grey(path: Path) -> np.ndarray:
@@ -87,6 +95,40 @@ def measure(data: Path, name: str, furnished: bool) -> Segmented:
                      m.matched / max(len(f_cells), 1), m.matched / len(t_cells), seconds)
 
 
+@dataclass(frozen=True)
+class Labelled:
+    """One robot map's rooms against its hand-made labels."""
+
+    name: str
+    truth_status: tuple[str, ...]
+    map_status: tuple[str, ...]
+    seconds: float
+
+    def summary(self) -> dict:
+        return {"truth_status": list(self.truth_status), "map_status": list(self.map_status)}
+
+    def count(self, statuses: tuple[str, ...], status: str) -> int:
+        return sum(s == status for s in statuses)
+
+
+def labelled(data: Path, name: str, map_file: str, labels_file: str,
+             channel: int | None) -> Labelled:
+    """Segment a Bonn map's free cells (as pcmapq reads the map with its YAML) and match its
+    rooms to the hand-made labels."""
+    folder = data / "plans" / "bonn_youbot_tmcl"
+    loaded = load_map(folder / map_file)
+    image = cv2.imread(str(folder / labels_file), cv2.IMREAD_UNCHANGED)
+    if image.ndim == 3:
+        image = image[:, :, 0 if channel is None else channel]
+    truth = np.where((image >= 1) & (image <= 12), image, 0).astype(np.int32)
+    start = time.perf_counter()
+    found = segment(loaded.state == FREE, loaded.grid.resolution, Params()).labels
+    seconds = time.perf_counter() - start
+    m = match(truth, found, MIN_IOU)
+    return Labelled(name, tuple(map(str, m.truth_status)), tuple(map(str, m.map_status)),
+                    seconds)
+
+
 def published(data: Path) -> dict[str, dict[str, tuple[float, float]]]:
     """Published per-map (precision, recall) micro, percent: ROSE² without and with furniture,
     MAORIS without."""
@@ -113,7 +155,10 @@ def published(data: Path) -> dict[str, dict[str, tuple[float, float]]]:
 def cases(data: Path) -> list[Case]:
     return [Case(f"rooms-{name}{'-furnished' if furnished else ''}",
                  lambda name=name, furnished=furnished: measure(data, name, furnished))
-            for furnished in (False, True) for name in MAPS]
+            for furnished in (False, True) for name in MAPS] + \
+        [Case(f"rooms-bonn-{file.split('/')[-1].split('.')[0].lower()}",
+              lambda b=(name, file, labels, channel): labelled(data, *b))
+         for name, file, labels, channel in BONN]
 
 
 def _pct(value: float) -> str:
@@ -122,7 +167,14 @@ def _pct(value: float) -> str:
 
 def section(data: Path, record: Record) -> Section:
     """Per plan, and on average beside the published methods on the same plans."""
-    runs = [case.run(record) for case in cases(data)]
+    measured = [case.run(record) for case in cases(data)]
+    runs = [m for m in measured if isinstance(m, Segmented)]
+    bonn = [m for m in measured if isinstance(m, Labelled)]
+    bonn_lines = [row([b.name, str(len(b.truth_status)), str(len(b.map_status)),
+                       *(str(b.count(b.truth_status, s)) for s in
+                         ("matched", "merged", "split", "missing")),
+                       str(b.count(b.map_status, "extra")), f"{b.seconds:.2f}"])
+                  for b in bonn]
     others = published(data)
     lines = []
     for run in runs:
@@ -167,6 +219,16 @@ def section(data: Path, record: Record) -> Section:
         header(["method", "plans", "its precision %", "its recall %", "pcmapq precision %",
                 "pcmapq recall %"]),
         *compare, "",
+        "### Real robot maps against hand-made room labels", "",
+        "`plans/bonn_youbot_tmcl/`: one office floor, 12 rooms with the corridor, labelled "
+        "by hand on each of three maps (a clean reference map and two gmapping maps of the "
+        "robot, one cluttered with furniture). pcmapq reads each map with its YAML and "
+        "segments its free cells; its rooms are matched to the labels one to one at an IoU "
+        "of at least 0.5 (`pcmapq.match.rooms`), and every truth room gets its status.", "",
+        header(["map", "truth rooms", "rooms", "matched", "merged", "split", "missing",
+                "extra rooms", "s"]),
+        *bonn_lines, "",
+        "### Each IPA plan", "",
         header(["plan", "truth rooms", "rooms", "precision micro %", "recall micro %",
                 "precision IoU 0.5 %", "recall IoU 0.5 %", "s"]),
         *lines,
