@@ -21,8 +21,8 @@ from pcmapq.core.grid import MetricGrid
 from pcmapq.features.base import Candidates, Detector, Features
 from pcmapq.features.walls import WallImage, wall_image
 
-__all__ = ["DETECTORS", "Candidates", "Detector", "Features", "SideBySide", "WallImage",
-           "default_params", "detect", "detect_in", "detector", "walls_of"]
+__all__ = ["DEFAULT_DETECTORS", "DETECTORS", "Candidates", "Detector", "Features", "SideBySide",
+           "WallImage", "default_params", "detect", "detect_in", "detector", "walls_of"]
 
 
 def _discover() -> dict[str, Detector]:
@@ -36,8 +36,10 @@ def _discover() -> dict[str, Detector]:
     return found
 
 
-#: The detectors by name: "harris", "hough", "sift".
+#: The detectors by name: "harris", "hough", "rooms", "sift".
 DETECTORS: dict[str, Detector] = _discover()
+#: The detectors an evaluation runs when none are named.
+DEFAULT_DETECTORS: tuple[str, ...] = tuple(n for n, d in DETECTORS.items() if d.by_default)
 
 
 def detector(name: str) -> Detector:
@@ -48,9 +50,10 @@ def detector(name: str) -> Detector:
 
 
 def default_params() -> dict[str, Any]:
-    """Every detector's default parameters by name: frozen dataclasses, lengths in metres;
-    ``dataclasses.asdict`` of each is plain JSON."""
-    return {name: d.params() for name, d in DETECTORS.items()}
+    """The default parameters of the detectors run by default, by name: frozen dataclasses,
+    lengths in metres; ``dataclasses.asdict`` of each is plain JSON. Any other detector run
+    takes its own defaults (``DETECTORS[name].params()``)."""
+    return {name: d.params() for name, d in DETECTORS.items() if d.by_default}
 
 
 def walls_of(occupied: np.ndarray, grid: MetricGrid) -> WallImage:

@@ -36,6 +36,8 @@ class Features:
         never counted on their own.
     descriptors: SIFT descriptors (N, 128) float32, else None.
     segments: Hough segments (N, 4) ``x0, y0, x1, y1`` in metres, else None.
+    labels: rooms: (rows, cols) int32 raster of the rooms' cells on the detector's grid, 0 no
+        room, feature k at k + 1; else None.
     """
 
     xy: np.ndarray
@@ -43,6 +45,7 @@ class Features:
     strong: np.ndarray
     descriptors: np.ndarray | None = None
     segments: np.ndarray | None = None
+    labels: np.ndarray | None = None
 
     def __len__(self) -> int:
         return len(self.xy)
@@ -67,12 +70,14 @@ class Detector:
         (M, 2) in metres, from the truth feature to the map feature.
     params: the detector's parameters, a frozen dataclass whose field defaults are the
         documented ones (``params()``), lengths in metres.
+    by_default: whether an evaluation runs it when no detectors are named.
     """
 
     name: str
     detect: Callable[[WallImage, Any], Features]
     candidates: Callable[[Features, Features, float, Any], Candidates]
     params: type
+    by_default: bool = True
 
     def checked(self, params: Any = None) -> Any:
         """``params``, or the defaults when None; InputError when they are not this

@@ -19,9 +19,20 @@ region of high clearance, a door a narrow passage between two such regions:
 The rooms' graph: a door between two rooms is the widest passage left between them, reported
 by its position and width (twice the clearance there). Every length is in metres; positions
 are cells (row, column) of the raster, which :class:`~pcmapq.core.grid.MetricGrid` takes to
-metres. Anchors: the distance-transform segmentation of Bormann et al. ("Room Segmentation:
-Survey, Implementation, and Analysis", ICRA 2016), with the merge rule of MAORIS (Mielle et
-al., 2018) that compares a passage with the rooms it joins instead of one global threshold.
+metres.
+
+As a detector (:data:`DETECTOR`, ``rooms``), it sees the walls as every detector does (their
+centre lines drawn as a band, :mod:`pcmapq.features.walls`), averaged onto cells of
+``cell_m``: a cell with a share of wall is a wall, every other cell is free, and the rooms that
+reach the raster's edge are the outside, not rooms. So a plan drawn with white outside and a
+robot map with unknown cells beyond its walls give the same rooms, and a map's rooms are its
+walls' rooms whatever it marked free. Its features are the rooms' centroids (strength: area,
+m^2) with their cells; a map room and a truth room may match when their IoU is at least
+``min_iou`` (the metric threshold does not apply), the closer to 1 the better.
+
+Anchors: the distance-transform segmentation of Bormann et al. ("Room Segmentation: Survey,
+Implementation, and Analysis", ICRA 2016), with the merge rule of MAORIS (Mielle et al., 2018)
+that compares a passage with the rooms it joins instead of one global threshold.
 """
 
 from __future__ import annotations
@@ -30,6 +41,10 @@ from dataclasses import dataclass
 
 import cv2
 import numpy as np
+
+from pcmapq.features.base import Candidates, Detector, Features, empty_features
+from pcmapq.features.resample import resample
+from pcmapq.features.walls import WallImage
 
 
 @dataclass(frozen=True)
@@ -42,12 +57,16 @@ class Params:
     min_room_m2: rooms smaller than this join their neighbour.
     furniture_m: obstacles wholly inside free space that fit in a square of this side are
         furniture.
+    cell_m: as a detector, the cell size the rooms are found on.
+    min_iou: as a detector, the least IoU of a truth room and a map room that may match.
     """
 
     door_ratio: float = 0.7
     peak_h_m: float = 0.2
     min_room_m2: float = 1.0
     furniture_m: float = 1.0
+    cell_m: float = 0.1
+    min_iou: float = 0.5
 
 
 @dataclass(frozen=True)
@@ -202,3 +221,69 @@ def segment(free: np.ndarray, resolution: float, params: Params | None = None) -
     door_cell = np.column_stack(np.unravel_index(where[first], labels.shape))
     return Rooms(labels, cells * resolution ** 2, centroid, clear[1:],
                  np.column_stack([ra[first], rb[first]]) - 1, door_cell, 2.0 * v[first])
+
+
+#: A cell holding at least this share of the wall band is a wall (the band is 0.15 m wide, so
+#: a wall closes every cell it crosses).
+WALL_SHARE = 0.05
+
+
+def inside_rooms(walls: WallImage, params: Params) -> tuple[Rooms, np.ndarray]:
+    """The rooms of the walls (see the module docstring) on cells of ``params.cell_m`` and the
+    rooms' labels without those that reach the raster's edge (the outside)."""
+    share, _ = resample(walls.image, walls.grid, params.cell_m)
+    rooms = segment(share < WALL_SHARE, params.cell_m, params)
+    labels = rooms.labels
+    edge = np.zeros(len(rooms) + 1, dtype=bool)
+    for line in (labels[0], labels[-1], labels[:, 0], labels[:, -1]):
+        edge[line] = True
+    edge[0] = True
+    keep = np.flatnonzero(~edge[1:])
+    number = np.zeros(len(rooms) + 1, np.int32)
+    number[keep + 1] = np.arange(1, len(keep) + 1)
+    return rooms, number[labels]
+
+
+def detect(walls: WallImage, params: Params) -> Features:
+    """The rooms of the walls as features: centroids (metres, the walls' frame), area (m^2)
+    as strength, every room strong, their cells as labels (ordered as the features)."""
+    rooms, labels = inside_rooms(walls, params)
+    count = int(labels.max(initial=0))
+    if count == 0:
+        return empty_features()
+    cells = np.bincount(labels.ravel(), minlength=count + 1)[1:]
+    rows, cols = np.indices(labels.shape)
+    centre = np.column_stack([
+        np.bincount(labels.ravel(), weights=cols.ravel(), minlength=count + 1)[1:],
+        np.bincount(labels.ravel(), weights=rows.ravel(), minlength=count + 1)[1:],
+    ]) / cells[:, None]
+    xy = walls.grid.resampled(params.cell_m).pixels_to_xy(centre)
+    area = cells * params.cell_m ** 2
+    order = np.lexsort((area, xy[:, 1], xy[:, 0]))  # the canonical order of every detector
+    number = np.zeros(count + 1, np.int32)
+    number[order + 1] = np.arange(1, count + 1)
+    return Features(xy=xy[order], strength=area[order], strong=np.ones(count, dtype=bool),
+                    labels=number[labels])
+
+
+def candidates(truth: Features, map_: Features, threshold: float,
+               params: Params) -> Candidates:
+    """Pairs of a truth room and a map room whose IoU is at least ``params.min_iou``; cost 0
+    at an IoU of 1 and 1 at ``min_iou``; displacement: from the truth room's centroid to the
+    map room's, metres. ``threshold`` (metres) does not apply to rooms."""
+    from pcmapq.match.rooms import overlap
+
+    none = (np.zeros(0, int), np.zeros(0, int), np.zeros(0), np.zeros((0, 2)))
+    if truth.labels is None or map_.labels is None or truth.labels.shape != map_.labels.shape \
+            or not len(truth) or not len(map_):
+        return none
+    shared = overlap(truth.labels, map_.labels)
+    t_cells = np.bincount(truth.labels.ravel(), minlength=len(truth) + 1)[1:]
+    m_cells = np.bincount(map_.labels.ravel(), minlength=len(map_) + 1)[1:]
+    iou = shared / (t_cells[:, None] + m_cells[None, :] - shared)
+    i, j = np.nonzero(iou >= params.min_iou)
+    cost = np.clip((1.0 - iou[i, j]) / max(1.0 - params.min_iou, 1e-9), 0.0, 1.0)
+    return i, j, cost, map_.xy[j] - truth.xy[i]
+
+
+DETECTOR = Detector("rooms", detect, candidates, Params, by_default=False)

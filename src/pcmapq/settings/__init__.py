@@ -8,7 +8,7 @@ from typing import Any
 
 from pcmapq.align.params import AlignParams
 from pcmapq.core.transform import Similarity2D
-from pcmapq.features import DETECTORS, default_params
+from pcmapq.features import DEFAULT_DETECTORS, DETECTORS, default_params
 from pcmapq.io.extent import Box
 from pcmapq.io.map_yaml import Thresholds
 from pcmapq.metrics.distances import DEFAULT_TAUS
@@ -107,13 +107,13 @@ class FootprintConfig:
 class MatchingConfig:
     """Which features are found and when two match (features and match stages).
 
-    detectors: which detectors to run.
+    detectors: which detectors to run (default: those run by default, not ``rooms``).
     threshold: largest distance between matched features, metres.
     params: each detector's parameters by name (its ``Params``, lengths in metres; see
         :func:`pcmapq.features.default_params`); a detector left out uses its defaults.
     """
 
-    detectors: tuple[str, ...] = DETECTOR_NAMES
+    detectors: tuple[str, ...] = DEFAULT_DETECTORS
     threshold: float = 0.5
     params: dict[str, Any] = field(default_factory=default_params, hash=False)
 

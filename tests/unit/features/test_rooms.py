@@ -111,3 +111,55 @@ def test_labels_cover_the_free_cells_only(rooms):
     found = segment(free, RES)
     assert ((found.labels > 0) == free).all()
     assert found.labels.max() == len(found) == rooms
+
+
+# --- the rooms detector: walls in, rooms matched by IoU -------------------------------------
+
+def walls_of_plan(free: np.ndarray) -> np.ndarray:
+    """The wall cells of a plan made by :func:`plan`: the non-free cells next to a free one."""
+    import cv2
+
+    near = cv2.dilate(free.astype(np.uint8), np.ones((3, 3), np.uint8)).astype(bool)
+    return near & ~free
+
+
+def scored(truth_free: np.ndarray, map_free: np.ndarray):
+    from pcmapq.core.grid import MetricGrid
+    from pcmapq.features import detect
+    from pcmapq.match import match
+
+    grid = MetricGrid(RES, (0.0, 0.0, 0.0), truth_free.shape)
+    t = detect("rooms", walls_of_plan(truth_free), grid)
+    m = detect("rooms", walls_of_plan(map_free), grid)
+    return t, m, match("rooms", t, m)
+
+
+def test_the_detector_finds_the_rooms_of_the_walls_and_matches_them_all():
+    t, m, found = scored(plan(), plan())
+    assert len(t) == len(m) == 3
+    assert found.quality == found.precision == 1.0
+    # 4 x 5 m less the walls' band (0.15 m wide, its cells' share counted as wall): 0.1 m a side
+    np.testing.assert_allclose(t.strength, 3.8 * 4.8, rtol=0.03)
+    assert t.labels.shape == (plan().shape[0] // 2, plan().shape[1] // 2)
+
+
+def test_a_wall_the_map_lacks_merges_two_rooms_and_neither_matches():
+    _, m, found = scored(plan(), plan(walls=(True, False)))
+    assert len(m) == 2
+    assert (found.quality, found.precision) == (pytest.approx(1 / 3), pytest.approx(1 / 2))
+
+
+def test_a_room_the_map_never_entered_is_missing():
+    """The map has the first two rooms only: the third's place is outside its walls."""
+    truth = plan()
+    seen = plan()
+    cut = np.flatnonzero(truth.any(axis=0))[0] + cells(2 * 4.0 + 0.2)
+    seen[:, cut:] = False
+    _, m, found = scored(truth, seen)
+    assert len(m) == 2
+    assert (found.quality, found.precision) == (pytest.approx(2 / 3), 1.0)
+
+
+def test_a_door_the_map_closed_leaves_the_rooms_matched():
+    _, _, found = scored(plan(), plan(doors=(True, False)))
+    assert found.quality == found.precision == 1.0

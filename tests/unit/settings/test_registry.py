@@ -26,7 +26,9 @@ def test_cli_defaults_are_the_settings_defaults():
                                                              s.raster.band_high)
     assert defaults["voxel_3d"] == s.alignment.voxel_3d
     assert defaults["footprint"] == s.footprint.rule
-    assert defaults["detectors"] == ",".join(s.matching.detectors) == ",".join(DETECTOR_NAMES)
+    assert defaults["detectors"] == ",".join(s.matching.detectors) == \
+        ",".join(features.DEFAULT_DETECTORS)
+    assert set(features.DEFAULT_DETECTORS) == set(DETECTOR_NAMES) - {"rooms"}
     assert tuple(float(t) for t in defaults["tau"].split(",")) == s.distances.taus
 
 
@@ -57,8 +59,10 @@ def test_a_detector_is_one_file(tmp_path, monkeypatch):
 
 
 def test_parameters_are_data():
-    """Every detector's defaults are a frozen dataclass of plain numbers; None means them."""
-    defaults = features.default_params()
+    """Every detector's defaults are a frozen dataclass of plain numbers; None means them.
+    default_params holds those of the detectors run by default."""
+    assert set(features.default_params()) == set(features.DEFAULT_DETECTORS)
+    defaults = {name: d.params() for name, d in features.DETECTORS.items()}
     assert set(defaults) == set(DETECTOR_NAMES)
     for name, params in defaults.items():
         assert params == features.DETECTORS[name].params()
