@@ -233,3 +233,20 @@ def test_other_layouts_drawn_otherwise_score_alike(seed, size):
             for m in (match(name, usual[name], other), match(name, other, usual[name])):
                 assert m.quality >= 0.95 and m.precision >= 0.95, (drawing, name, m.quality,
                                                                   m.precision)
+
+
+@pytest.fixture(scope="module")
+def usual_rooms():
+    return detect("rooms", synth.render(PLAN, USUAL, 0.15) == synth.OCCUPIED, USUAL)
+
+
+@pytest.mark.parametrize("resolution", [0.05, 0.025])
+@pytest.mark.parametrize("cells", [1, 3, 6, None], ids=["1", "3", "6", "faces"])
+def test_same_walls_drawn_otherwise_have_the_same_rooms(usual_rooms, resolution, cells):
+    """Rooms, found on the walls' band, are the same whatever the drawing: every room of the
+    usual drawing matches one of the other at an IoU of 0.5 or more, both ways."""
+    occ, grid = drawn(resolution, cells)
+    other = detect("rooms", occ, grid)
+    assert len(usual_rooms) >= 4
+    for m in (match("rooms", usual_rooms, other), match("rooms", other, usual_rooms)):
+        assert m.quality == 1.0 and m.precision == 1.0, (m.quality, m.precision)
