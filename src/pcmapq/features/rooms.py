@@ -14,7 +14,9 @@ region of high clearance, a door a narrow passage between two such regions:
    when the passage's clearance is at least ``door_ratio`` of the smaller basin's peak: a
    corridor cut by its own bumps becomes one room again, a room stays apart from its
    neighbour behind a door;
-4. a room smaller than ``min_room_m2`` joins the neighbour it has the widest passage to.
+4. a room smaller than ``min_room_m2`` joins the neighbour it has the widest passage to; one
+   with no neighbour (a space walled in on its own: between clutter, inside a pillar) is no
+   room when it is smaller than ``min_space_m2``.
 
 The rooms' graph: a door between two rooms is the widest passage left between them, reported
 by its position and width (twice the clearance there). Every length is in metres; positions
@@ -42,6 +44,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
+from pcmapq.core.grid import MetricGrid
 from pcmapq.features.base import Candidates, Detector, Features, empty_features
 from pcmapq.features.resample import resample
 from pcmapq.features.walls import WallImage
@@ -55,15 +58,18 @@ class Params:
         below this share of the smaller basin's peak clearance.
     peak_h_m: a clearance peak must rise this much above its surroundings to seed a basin.
     min_room_m2: rooms smaller than this join their neighbour.
+    min_space_m2: a space walled in on its own smaller than this is no room.
     furniture_m: obstacles wholly inside free space that fit in a square of this side are
         furniture.
-    cell_m: as a detector, the cell size the rooms are found on.
+    cell_m: as a detector, the cell size the rooms are found on (larger on a raster of more
+        than :data:`MAX_CELLS` such cells).
     min_iou: as a detector, the least IoU of a truth room and a map room that may match.
     """
 
     door_ratio: float = 0.7
     peak_h_m: float = 0.2
     min_room_m2: float = 1.0
+    min_space_m2: float = 0.5
     furniture_m: float = 1.0
     cell_m: float = 0.1
     min_iou: float = 0.5
@@ -193,6 +199,7 @@ def segment(free: np.ndarray, resolution: float, params: Params | None = None) -
             break
 
     kept = np.unique(roots[1:])
+    kept = kept[size[kept] >= params.min_space_m2]  # a space walled in alone
     number = np.zeros(count + 1, np.int32)
     number[kept] = np.arange(1, len(kept) + 1)
     final = number[roots]
@@ -226,13 +233,28 @@ def segment(free: np.ndarray, resolution: float, params: Params | None = None) -
 #: A cell holding at least this share of the wall band is a wall (the band is 0.15 m wide, so
 #: a wall closes every cell it crosses).
 WALL_SHARE = 0.05
+#: Cells a raster of rooms holds at most: a larger raster's cells are made larger (whole
+#: multiples of the walls' cell), so that the rooms of a campus cost what a building's do.
+MAX_CELLS = 4_000_000
 
 
-def inside_rooms(walls: WallImage, params: Params) -> tuple[Rooms, np.ndarray]:
-    """The rooms of the walls (see the module docstring) on cells of ``params.cell_m`` and the
-    rooms' labels without those that reach the raster's edge (the outside)."""
-    share, _ = resample(walls.image, walls.grid, params.cell_m)
-    rooms = segment(share < WALL_SHARE, params.cell_m, params)
+def room_cell(grid: MetricGrid, cell_m: float) -> float:
+    """The cell the rooms of ``grid``'s raster are found on: ``cell_m``, or a whole multiple of
+    the grid's cell large enough to keep the raster within :data:`MAX_CELLS`, metres."""
+    rows, cols = grid.shape
+    needed = grid.resolution * np.sqrt(rows * cols / MAX_CELLS)
+    if needed <= cell_m:
+        return cell_m
+    return float(np.ceil(needed / grid.resolution) * grid.resolution)
+
+
+def inside_rooms(walls: WallImage, params: Params) -> tuple[Rooms, np.ndarray, MetricGrid]:
+    """The rooms of the walls (see the module docstring) on cells of ``params.cell_m`` (or
+    larger, :func:`room_cell`), the rooms' labels without those that reach the raster's edge
+    (the outside), and the labels' grid."""
+    cell = room_cell(walls.grid, params.cell_m)
+    share, grid = resample(walls.image, walls.grid, cell)
+    rooms = segment(share < WALL_SHARE, cell, params)
     labels = rooms.labels
     edge = np.zeros(len(rooms) + 1, dtype=bool)
     for line in (labels[0], labels[-1], labels[:, 0], labels[:, -1]):
@@ -241,13 +263,13 @@ def inside_rooms(walls: WallImage, params: Params) -> tuple[Rooms, np.ndarray]:
     keep = np.flatnonzero(~edge[1:])
     number = np.zeros(len(rooms) + 1, np.int32)
     number[keep + 1] = np.arange(1, len(keep) + 1)
-    return rooms, number[labels]
+    return rooms, number[labels], grid
 
 
 def detect(walls: WallImage, params: Params) -> Features:
     """The rooms of the walls as features: centroids (metres, the walls' frame), area (m^2)
     as strength, every room strong, their cells as labels (ordered as the features)."""
-    rooms, labels = inside_rooms(walls, params)
+    _, labels, grid = inside_rooms(walls, params)
     count = int(labels.max(initial=0))
     if count == 0:
         return empty_features()
@@ -257,8 +279,8 @@ def detect(walls: WallImage, params: Params) -> Features:
         np.bincount(labels.ravel(), weights=cols.ravel(), minlength=count + 1)[1:],
         np.bincount(labels.ravel(), weights=rows.ravel(), minlength=count + 1)[1:],
     ]) / cells[:, None]
-    xy = walls.grid.resampled(params.cell_m).pixels_to_xy(centre)
-    area = cells * params.cell_m ** 2
+    xy = grid.pixels_to_xy(centre)
+    area = cells * grid.resolution ** 2
     order = np.lexsort((area, xy[:, 1], xy[:, 0]))  # the canonical order of every detector
     number = np.zeros(count + 1, np.int32)
     number[order + 1] = np.arange(1, count + 1)
