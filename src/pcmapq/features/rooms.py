@@ -288,13 +288,20 @@ def detect(walls: WallImage, params: Params) -> Features:
                     labels=number[labels])
 
 
+def overlap(truth: np.ndarray, map_: np.ndarray) -> np.ndarray:
+    """(T, M) cells shared by each truth room and each map room: two int label rasters of one
+    shape, 0 no room, room k at k + 1."""
+    t, m = int(truth.max(initial=0)), int(map_.max(initial=0))
+    both = (truth > 0) & (map_ > 0)
+    pairs = (truth[both].astype(np.int64) - 1) * m + (map_[both] - 1)
+    return np.bincount(pairs, minlength=t * m).reshape(t, m)
+
+
 def candidates(truth: Features, map_: Features, threshold: float,
                params: Params) -> Candidates:
     """Pairs of a truth room and a map room whose IoU is at least ``params.min_iou``; cost 0
     at an IoU of 1 and 1 at ``min_iou``; displacement: from the truth room's centroid to the
     map room's, metres. ``threshold`` (metres) does not apply to rooms."""
-    from pcmapq.match.rooms import overlap
-
     none = (np.zeros(0, int), np.zeros(0, int), np.zeros(0), np.zeros((0, 2)))
     if truth.labels is None or map_.labels is None or truth.labels.shape != map_.labels.shape \
             or not len(truth) or not len(map_):

@@ -23,6 +23,10 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 
+from pcmapq.features.rooms import overlap
+
+__all__ = ["EXTRA", "MATCHED", "MERGED", "MISSING", "SPLIT", "RoomMatch", "match", "overlap"]
+
 #: Statuses of a truth room and of a map room.
 MATCHED, MERGED, SPLIT, MISSING, EXTRA = "matched", "merged", "split", "missing", "extra"
 
@@ -46,15 +50,6 @@ class RoomMatch:
     def matched(self) -> int:
         """Matched pairs."""
         return int((self.truth_of_map >= 0).sum())
-
-
-def overlap(truth: np.ndarray, map_: np.ndarray) -> np.ndarray:
-    """(T, M) cells shared by each truth room and each map room: two int label rasters of one
-    shape, 0 no room, room k at k + 1."""
-    t, m = int(truth.max(initial=0)), int(map_.max(initial=0))
-    both = (truth > 0) & (map_ > 0)
-    pairs = (truth[both].astype(np.int64) - 1) * m + (map_[both] - 1)
-    return np.bincount(pairs, minlength=t * m).reshape(t, m)
 
 
 def match(truth: np.ndarray, map_: np.ndarray, min_iou: float = 0.5,

@@ -12,7 +12,7 @@ from pcmapq.core.errors import InputError
 from pcmapq.io.writers import OutputSet, one_line, write_atomic
 from pcmapq.results.figures import HEADERS, SCORES, TAIL, columns
 from pcmapq.results.result import DECIMALS
-from pcmapq.settings import DETECTOR_NAMES
+from pcmapq.settings import DEFAULT_DETECTORS, DETECTOR_NAMES
 
 #: Decimals of the markdown table: scale 4, degrees 2, everything else 3 (as the terminal).
 MD_DECIMALS = {"scale": 4, "yaw_deg": 2}
@@ -51,9 +51,16 @@ def table_md(rows: Sequence[dict[str, object]]) -> str:
     return "\n".join(lines) + "\n"
 
 
-#: The columns of the terminal's table and their short headers: the comparison at a glance
-#: (the files hold every column).
-TERMINAL = {**{f"{d}_quality": d for d in DETECTOR_NAMES}, "coverage": "coverage",
+def shown_detectors(rows: Sequence[dict[str, object]]) -> list[str]:
+    """The detectors a summary shows: those run by default, and any other some row has."""
+    return [d for d in DETECTOR_NAMES if d in DEFAULT_DETECTORS
+            or any(row.get(f"{d}_quality") is not None for row in rows)]
+
+
+def terminal_columns(rows: Sequence[dict[str, object]]) -> dict[str, str]:
+    """The columns of the terminal's table and their short headers: the comparison at a
+    glance (the files hold every column)."""
+    return {**{f"{d}_quality": d for d in shown_detectors(rows)}, "coverage": "coverage",
             "accuracy_mean_m": "accuracy\n(m)", "completeness_mean_m": "completeness\n(m)"}
 
 
@@ -69,13 +76,14 @@ def print_summary(rows: Sequence[dict[str, object]], console) -> None:
                   title="feature quality per detector; accuracy, completeness: mean wall "
                   "distances", title_justify="left")
     table.add_column("name", no_wrap=True)
-    for header in TERMINAL.values():
+    columns = terminal_columns(rows)
+    for header in columns.values():
         table.add_column(header, justify="right", no_wrap=True)
     table.add_column("status", no_wrap=True)
     for row in rows:
         failed = bool(row.get("exit_code"))
         table.add_row(Text(str(row.get("name"))),
-                      *(_md_cell(c, row.get(c), failed) for c in TERMINAL),
+                      *(_md_cell(c, row.get(c), failed) for c in columns),
                       f"exit {row['exit_code']}" if failed else "ok")
     console.print(table, highlight=False)
     for row in rows:
@@ -97,7 +105,7 @@ def summary_figure(rows: Sequence[dict[str, object]]):
     'failed (exit N)' over a failed map's group. A matplotlib Figure (Agg)."""
     from pcmapq.report.plot import plt  # matplotlib on the Agg backend
 
-    n, k = len(rows), len(DETECTOR_NAMES)
+    n, k = len(rows), len(shown_detectors(rows))
     width = 0.8 / k
     fig, axes = plt.subplots(len(PANELS), 1, sharex=True, layout="constrained",
                              figsize=(min(max(4.0, 1.2 + 0.9 * n), 20.0), 2.6 * len(PANELS)))
@@ -114,8 +122,9 @@ def summary_figure(rows: Sequence[dict[str, object]]):
 
 def _score_panel(ax, rows: Sequence[dict[str, object]], score: str, width: float) -> None:
     """One panel of :func:`summary_figure`: ``score`` of every detector, per map."""
-    k = len(DETECTOR_NAMES)
-    for j, det in enumerate(DETECTOR_NAMES):
+    names = shown_detectors(rows)
+    k = len(names)
+    for j, det in enumerate(names):
         xs = [i + (j - (k - 1) / 2) * width for i in range(len(rows))]
         values = [row.get(f"{det}_{score}") for row in rows]
         shown = [(x, v) for x, v, row in zip(xs, values, rows, strict=True)
