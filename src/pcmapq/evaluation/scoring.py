@@ -20,6 +20,7 @@ from pcmapq.evaluation.truth import FEATURE_THREADS, PreparedTruth
 from pcmapq.features import Features, SideBySide, default_params
 from pcmapq.io import OccupancyMap, PointMap
 from pcmapq.match import match
+from pcmapq.match.rooms import room_table
 from pcmapq.metrics.distances import distances, distances_3d
 from pcmapq.results.result import OTHER, DetectorResult, Result
 from pcmapq.settings import Settings
@@ -69,6 +70,8 @@ def score(placed: Placed, prepared: PreparedTruth, settings: Settings,
         detectors[name] = DetectorResult(truth_f, map_f,
                                          match(name, truth_f, map_f, threshold,
                                                settings.matching.params.get(name)))
+    rooms = None if "rooms" not in detectors else \
+        room_table(detectors["rooms"].truth, detectors["rooms"].map)
     noref = None
     if settings.noref.enabled:
         progress("no-reference figures")
@@ -88,7 +91,7 @@ def score(placed: Placed, prepared: PreparedTruth, settings: Settings,
                   threshold=threshold, full=full, detectors=detectors,
                   footprint_rule=rule, frames=frames, settings=settings.to_dict(),
                   truth_occupied=prepared.occupied, map_occupied=side.occupied, noref=noref,
-                  consistency=consistency)
+                  consistency=consistency, rooms=rooms)
 
 
 def inside(features: Features, area: np.ndarray, grid: MetricGrid) -> np.ndarray:

@@ -297,11 +297,30 @@ def overlap(truth: np.ndarray, map_: np.ndarray) -> np.ndarray:
     return np.bincount(pairs, minlength=t * m).reshape(t, m)
 
 
+def room_ious(shared: np.ndarray, t_cells: np.ndarray, m_cells: np.ndarray, most: float = 0.5
+              ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The IoU (T, M) of every truth room and map room from their shared cells (T, M) and
+    their cells (T,), (M,); and which rooms merge or split (:mod:`pcmapq.match.rooms`): truth
+    rooms merged (T,), truth rooms split (T,), map rooms merging (M,), map rooms that are
+    pieces of a split room (M,). ``most``: the share of a room that counts as most of it."""
+    union = t_cells[:, None] + m_cells[None, :] - shared
+    iou = np.divide(shared, union, out=np.zeros(shared.shape), where=union > 0)
+    of_truth = shared / np.maximum(t_cells, 1)[:, None]  # share of each truth room
+    of_map = shared / np.maximum(m_cells, 1)[None, :]  # share of each map room
+    merging = (of_truth >= most).sum(axis=0) >= 2  # holds most of two or more truth rooms
+    merged = (of_truth[:, merging] >= most).any(axis=1)
+    piece = of_map >= most  # the map room lies mostly in the truth room
+    split = (piece.sum(axis=1) >= 2) & ~merged
+    pieces = piece[split].any(axis=0) & ~merging
+    return iou, merged, split, merging, pieces
+
+
 def candidates(truth: Features, map_: Features, threshold: float,
                params: Params) -> Candidates:
-    """Pairs of a truth room and a map room whose IoU is at least ``params.min_iou``; cost 0
-    at an IoU of 1 and 1 at ``min_iou``; displacement: from the truth room's centroid to the
-    map room's, metres. ``threshold`` (metres) does not apply to rooms."""
+    """Pairs of a truth room and a map room whose IoU is at least ``params.min_iou``, neither
+    merged nor split (:func:`room_ious`); cost 0 at an IoU of 1 and 1 at ``min_iou``;
+    displacement: from the truth room's centroid to the map room's, metres. ``threshold``
+    (metres) does not apply to rooms."""
     none = (np.zeros(0, int), np.zeros(0, int), np.zeros(0), np.zeros((0, 2)))
     if truth.labels is None or map_.labels is None or truth.labels.shape != map_.labels.shape \
             or not len(truth) or not len(map_):
@@ -309,7 +328,10 @@ def candidates(truth: Features, map_: Features, threshold: float,
     shared = overlap(truth.labels, map_.labels)
     t_cells = np.bincount(truth.labels.ravel(), minlength=len(truth) + 1)[1:]
     m_cells = np.bincount(map_.labels.ravel(), minlength=len(map_) + 1)[1:]
-    iou = shared / (t_cells[:, None] + m_cells[None, :] - shared)
+    iou, merged, split, merging, pieces = room_ious(shared, t_cells, m_cells)
+    # a merger, a split room and its pieces are what they are, not a match to one of them
+    iou[merged | split] = 0.0
+    iou[:, merging | pieces] = 0.0
     i, j = np.nonzero(iou >= params.min_iou)
     cost = np.clip((1.0 - iou[i, j]) / max(1.0 - params.min_iou, 1e-9), 0.0, 1.0)
     return i, j, cost, map_.xy[j] - truth.xy[i]

@@ -23,9 +23,11 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 
-from pcmapq.features.rooms import overlap
+from pcmapq.features.base import Features
+from pcmapq.features.rooms import overlap, room_ious
 
-__all__ = ["EXTRA", "MATCHED", "MERGED", "MISSING", "SPLIT", "RoomMatch", "match", "overlap"]
+__all__ = ["EXTRA", "MATCHED", "MERGED", "MISSING", "SPLIT", "UNSEEN", "RoomMatch", "match",
+           "overlap", "room_table"]
 
 #: Statuses of a truth room and of a map room.
 MATCHED, MERGED, SPLIT, MISSING, EXTRA = "matched", "merged", "split", "missing", "extra"
@@ -59,16 +61,7 @@ def match(truth: np.ndarray, map_: np.ndarray, min_iou: float = 0.5,
     shared = overlap(truth, map_)
     t_cells = np.bincount(truth.ravel(), minlength=shared.shape[0] + 1)[1:]
     m_cells = np.bincount(map_.ravel(), minlength=shared.shape[1] + 1)[1:]
-    union = t_cells[:, None] + m_cells[None, :] - shared
-    iou = np.divide(shared, union, out=np.zeros(shared.shape), where=union > 0)
-    of_truth = shared / np.maximum(t_cells, 1)[:, None]  # share of each truth room
-    of_map = shared / np.maximum(m_cells, 1)[None, :]  # share of each map room
-    merging = (of_truth >= most).sum(axis=0) >= 2  # (M,) holds most of 2+ truth rooms
-    merged = (of_truth[:, merging] >= most).any(axis=1)
-    piece = of_map >= most  # (T, M) the map room lies mostly in the truth room
-    split = (piece.sum(axis=1) >= 2) & ~merged
-    pieces = piece[split].any(axis=0) & ~merging
-    # a merger, a split room and its pieces are what they are, not a match to one of them
+    iou, merged, split, merging, pieces = room_ious(shared, t_cells, m_cells, most)
     usable = np.where(merged[:, None] | split[:, None] | merging[None, :] | pieces[None, :],
                       0.0, iou)
     i, j = linear_sum_assignment(-usable)
@@ -86,3 +79,40 @@ def match(truth: np.ndarray, map_: np.ndarray, min_iou: float = 0.5,
     map_status[j[keep]] = MATCHED
     return RoomMatch(shared, iou, truth_of_map, truth_status.astype(str),
                      map_status.astype(str))
+
+
+#: The status of a truth room outside the map's footprint that no map room matches.
+UNSEEN = "unseen"
+
+
+def room_table(truth: Features, map_: Features) -> dict:
+    """The rooms of the rooms detector's two sides as JSON (lists of plain numbers, metres,
+    square metres, truth frame): per truth room its centroid, area, status (``unseen``: not
+    counted, outside the map's footprint, and unmatched), and for a matched one its IoU, the
+    map room's area less its own and the centroids' offset; per map room its centroid, area,
+    status and matched truth room (index, or None); and the count of each status."""
+    if truth.labels is None or map_.labels is None or truth.labels.shape != map_.labels.shape:
+        return {"truth": [], "map": [], "counts": {}}
+    found = match(truth.labels, map_.labels)
+    t_status = np.where((found.truth_status != MATCHED) & ~truth.strong, UNSEEN,
+                        found.truth_status)
+    map_of_truth = np.full(len(truth), -1)
+    paired = np.flatnonzero(found.truth_of_map >= 0)
+    map_of_truth[found.truth_of_map[paired]] = paired
+    rows = []
+    for k in range(len(truth)):
+        row = {"x_m": float(truth.xy[k, 0]), "y_m": float(truth.xy[k, 1]),
+               "area_m2": float(truth.strength[k]), "status": str(t_status[k])}
+        j = map_of_truth[k]
+        if j >= 0:
+            row.update(iou=float(found.iou[k, j]),
+                       area_error_m2=float(map_.strength[j] - truth.strength[k]),
+                       offset_m=float(np.hypot(*(map_.xy[j] - truth.xy[k]))))
+        rows.append(row)
+    maps = [{"x_m": float(map_.xy[j, 0]), "y_m": float(map_.xy[j, 1]),
+             "area_m2": float(map_.strength[j]), "status": str(found.map_status[j]),
+             "truth": None if found.truth_of_map[j] < 0 else int(found.truth_of_map[j])}
+            for j in range(len(map_))]
+    statuses = [*(f"truth {s}" for s in t_status), *(f"map {s}" for s in found.map_status)]
+    return {"truth": rows, "map": maps,
+            "counts": {s: statuses.count(s) for s in sorted(set(statuses))}}

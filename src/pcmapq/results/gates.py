@@ -27,10 +27,11 @@ UNDER, OVER = "under", "over"
 OPTIONS = {UNDER: "--fail-under", OVER: "--fail-over"}
 #: Other names of figures that gates have always read.
 ALIASES = {"chamfer.mean": "chamfer", "chamfer_3d.mean": "chamfer_3d"}
-#: The top-level keys of the result's JSON (``alignment_3d``, ``distances_3d``: two 3D clouds).
+#: The top-level keys of the result's JSON (``alignment_3d``, ``distances_3d``: two 3D clouds;
+#: ``rooms``: the rooms detector ran).
 TOP_LEVEL = ("pcmapq", "settings", "map", "truth", "alignment", "consistency", "frames",
              "coverage", "footprint", "scored_against", "distances", "noref", "detectors",
-             "matches", "missing", "extra", "alignment_3d", "distances_3d")
+             "matches", "missing", "extra", "alignment_3d", "distances_3d", "rooms")
 _F_SCORE = re.compile(r"^(f_score(?:_3d)?)(?:@(.*))?$")
 
 

@@ -97,7 +97,9 @@ class Result:
     no-reference figures, ``{"map": ..., "truth": ...}``
     (:func:`pcmapq.evaluation.noref_figures.input_figures`), None when not asked for.
     truth_sha256: the truth file's SHA-256 (hex; None for a result made without its file), so
-    that results of one truth are known as such however its path was written.
+    that results of one truth are known as such however its path was written. rooms: the
+    rooms detector's rooms, each with its status (:func:`pcmapq.match.rooms.room_table`), None
+    when it did not run.
     truth_occupied, map_occupied (and the overlap's footprint): the rasters on ``grid``; None
     in a result read back by :meth:`from_json`, which holds everything the JSON holds and no
     more.
@@ -125,6 +127,7 @@ class Result:
     noref: dict | None = None
     consistency: Consistency | None = None
     truth_sha256: str | None = None
+    rooms: dict | None = None
 
     @property
     def transform(self) -> Similarity2D:
@@ -208,6 +211,8 @@ class Result:
                                for t in det.truth.xy[m.missing].tolist()]
             doc["extra"] += [{"detector": name, "map_xy_m": p}
                              for p in det.map.xy[m.extra].tolist()]
+        if self.rooms is not None:
+            doc["rooms"] = self.rooms
         doc = rounded(doc)
         doc["noref"] = significant(self.noref)  # MPV, MOM: areas of 1e-3 m^2 and less
         return doc

@@ -54,3 +54,30 @@ def test_a_room_not_entered_is_missing_and_a_room_outside_the_truth_is_extra():
     found = match(truth, map_)
     assert list(found.truth_status) == [MATCHED, MISSING]
     assert list(found.map_status) == [MATCHED, EXTRA]
+
+
+def features_of(labels: np.ndarray, strong: np.ndarray | None = None):
+    """Rooms as the detector gives them: centroids (cells as metres), areas, labels."""
+    from pcmapq.features.base import Features
+
+    n = int(labels.max())
+    rows, cols = np.indices(labels.shape)
+    cells = np.bincount(labels.ravel(), minlength=n + 1)[1:]
+    xy = np.column_stack([np.bincount(labels.ravel(), cols.ravel(), n + 1)[1:],
+                          np.bincount(labels.ravel(), rows.ravel(), n + 1)[1:]]) / cells[:, None]
+    return Features(xy=xy, strength=cells.astype(float),
+                    strong=np.ones(n, bool) if strong is None else strong, labels=labels)
+
+
+def test_the_room_table_says_what_became_of_every_room():
+    from pcmapq.match.rooms import UNSEEN, room_table
+
+    truth = features_of(strips(5, 5, 8, 4), strong=np.array([True, True, True, False]))
+    table = room_table(truth, features_of(strips(10, 8, -4)))
+    assert [r["status"] for r in table["truth"]] == [MERGED, MERGED, MATCHED, UNSEEN]
+    assert [r["status"] for r in table["map"]] == [MERGED, MATCHED]
+    assert table["map"][1]["truth"] == 2 and table["map"][0]["truth"] is None
+    assert table["truth"][2]["iou"] == 1.0 and table["truth"][2]["offset_m"] == 0.0
+    assert "iou" not in table["truth"][0]
+    assert table["counts"] == {"map matched": 1, "map merged": 1, "truth matched": 1,
+                               "truth merged": 2, "truth unseen": 1}
