@@ -106,6 +106,8 @@ def _panel(ax: Axes, result: Result, factor: int, image: np.ndarray,
         ax.contour(footprint, levels=[0.5], colors=FOOTPRINT, linewidths=0.8,
                    extent=extent(result, factor), origin="upper")
     m = det.matching
+    if det.truth.labels is not None and result.rooms is not None:  # rooms: shaded by status
+        _rooms_overlay(ax, result, det)
     if det.truth.segments is not None:  # Hough: draw the segments themselves
         for idx, feats, colour in ((m.truth_idx, det.truth, MATCHED),
                                    (m.missing, det.truth, MISSING), (m.extra, det.map, EXTRA)):
@@ -121,6 +123,34 @@ def _panel(ax: Axes, result: Result, factor: int, image: np.ndarray,
         ax.quiver(*det.truth_xy[matched].T, *m.displacement[matched].T, angles="xy",
                   scale_units="xy", scale=1.0 / gain, color="black", width=0.003, zorder=4)
     _scale_bar(ax, result)
+
+
+#: Colours of the rooms' statuses (RGB; drawn translucent over the map).
+ROOM_COLOURS = {"matched": MATCHED, "merged": "#e6ab02", "split": "#7570b3",
+                "missing": MISSING, "unseen": "#bbbbbb", "extra": EXTRA}
+
+
+def _rooms_overlay(ax: Axes, result: Result, det: DetectorResult) -> None:
+    """The truth's rooms shaded by status, and the map's extra rooms, on their cells: the
+    rooms' grid shares the truth grid's lower-left corner (cells from the labels' areas)."""
+    from matplotlib.colors import to_rgba
+
+    truth, map_ = det.truth, det.map
+    cells = np.bincount(truth.labels.ravel(), minlength=len(truth) + 1)[1:]
+    if not len(truth) or cells[0] == 0:
+        return
+    cell = float(np.sqrt(truth.strength[0] / cells[0]))
+    rows, cols = truth.labels.shape
+    x0, y0 = result.grid.origin[0], result.grid.origin[1]
+    colours = np.zeros((len(truth) + 1, 4))
+    for k, row in enumerate(result.rooms["truth"]):
+        colours[k + 1] = to_rgba(ROOM_COLOURS.get(row["status"], "#bbbbbb"), 0.28)
+    overlay = colours[truth.labels]
+    extra = [j + 1 for j, row in enumerate(result.rooms["map"]) if row["status"] == "extra"]
+    if extra and map_.labels is not None and map_.labels.shape == truth.labels.shape:
+        overlay[np.isin(map_.labels, extra)] = to_rgba(ROOM_COLOURS["extra"], 0.45)
+    ax.imshow(overlay, extent=(x0, x0 + cols * cell, y0, y0 + rows * cell), origin="upper",
+              interpolation="nearest", zorder=2)
 
 
 def regions_gain(result: Result, arrow_scale: float) -> float:
@@ -162,6 +192,10 @@ def _legend_handles(result: Result, gain: float, as_density: bool) -> list[Line2
     if _has_regions(result):
         handles.append(Line2D([], [], color=MISSING, marker="o", mfc="none", ls="",
                               label="regions: largest offset (grey: not held)"))
+    if result.rooms is not None:
+        shown = {row["status"] for side in ("truth", "map") for row in result.rooms[side]}
+        handles += [Line2D([], [], color=colour, lw=6, alpha=0.45, label=f"room {status}")
+                    for status, colour in ROOM_COLOURS.items() if status in shown]
     return handles
 
 

@@ -1,0 +1,51 @@
+"""The rooms detector through the whole evaluation: a plan against a map of it that lacks
+one wall reports those two rooms merged, every other room matched, and draws them."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from pcmapq.evaluation.pipeline import evaluate
+from pcmapq.results.result import Result
+from pcmapq.settings import MatchingConfig, Settings
+from pcmapq.testing import synth
+from pcmapq.testing.files import write_image_map
+
+PLAN = synth.building_plan(0)
+#: The wall between the two rooms of the lower row at x = 8.03 m.
+WALL = 5
+
+
+@pytest.fixture(scope="module")
+def result(tmp_path_factory) -> Result:
+    folder = tmp_path_factory.mktemp("rooms")
+    truth = write_image_map(PLAN, folder / "truth.png")
+    seen = write_image_map(np.delete(PLAN, WALL, axis=0), folder / "map.png")
+    return evaluate(seen, truth, Settings(matching=MatchingConfig(detectors=("rooms",))))
+
+
+def test_a_wall_the_map_lacks_merges_its_two_rooms_and_nothing_else(result):
+    rooms = result.rooms
+    merged = [r for r in rooms["truth"] if r["status"] == "merged"]
+    assert len(merged) == 2
+    assert sorted(round(r["x_m"]) for r in merged) == [6, 11]  # either side of x = 8.03 m
+    assert all(r["status"] == "matched" for r in rooms["truth"] if r not in merged)
+    assert [r["status"] for r in rooms["map"]].count("merged") == 1
+    assert rooms["counts"]["truth merged"] == 2
+    m = result.detectors["rooms"].matching
+    assert m.truth_features - m.matched == 2 and m.precision == pytest.approx(
+        (m.map_features - 1) / m.map_features)
+    matched = [r for r in rooms["truth"] if r["status"] == "matched"]
+    assert all(r["iou"] > 0.9 and r["offset_m"] < 0.1 for r in matched)
+
+
+def test_the_json_keeps_the_rooms_and_the_picture_shows_them(result, tmp_path):
+    from pcmapq.report.plot import vectorial_figure
+
+    back = Result.from_json(result.to_json())
+    assert back.rooms == result.to_dict()["rooms"]
+    fig = vectorial_figure(result)
+    labels = [t.get_text() for legend in fig.legends for t in legend.get_texts()] + \
+        [t.get_text() for ax in fig.axes if ax.get_legend() for t in ax.get_legend().get_texts()]
+    assert "room merged" in labels and "room matched" in labels
