@@ -49,3 +49,34 @@ def test_the_json_keeps_the_rooms_and_the_picture_shows_them(result, tmp_path):
     labels = [t.get_text() for legend in fig.legends for t in legend.get_texts()] + \
         [t.get_text() for ax in fig.axes if ax.get_legend() for t in ax.get_legend().get_texts()]
     assert "room merged" in labels and "room matched" in labels
+
+
+@pytest.fixture(scope="module")
+def doors(tmp_path_factory) -> Result:
+    """The map closes the lower-left room's door (x 1.24-2.14 m at y = 6.72 m) and opens a
+    door of its own in the wall at x = 4.91 m (y 2-3 m)."""
+    folder = tmp_path_factory.mktemp("doors")
+    truth = write_image_map(PLAN, folder / "truth.png")
+    walls = np.vstack([np.delete(PLAN, 4, axis=0),
+                       [[1.24, 6.72, 2.14, 6.72], [4.91, 0.0, 4.91, 2.0],
+                        [4.91, 3.0, 4.91, 6.72]]])
+    seen = write_image_map(walls, folder / "map.png")
+    return evaluate(seen, truth, Settings(matching=MatchingConfig(detectors=("rooms",))))
+
+
+def test_a_door_closed_is_missing_and_a_door_the_plan_lacks_is_wrong(doors):
+    rooms = doors.rooms
+    assert all(r["status"] == "matched" for r in rooms["truth"])
+    missing = [d for d in rooms["doors"]["truth"] if d["status"] == "missing"]
+    assert len(missing) == 1 and abs(missing[0]["x_m"] - 1.7) < 0.3 \
+        and abs(missing[0]["y_m"] - 6.72) < 0.3
+    wrong = [d for d in rooms["doors"]["map"] if d["status"] == "wrong"]
+    assert len(wrong) == 1 and abs(wrong[0]["x_m"] - 4.91) < 0.3 \
+        and 2.0 <= wrong[0]["y_m"] <= 3.0
+    assert rooms["counts"]["truth door found"] == len(rooms["doors"]["truth"]) - 1
+    assert "truth door not judged" not in rooms["counts"]
+
+
+def test_doors_of_merged_rooms_are_not_judged(result):
+    judged = {d["status"] for d in result.rooms["doors"]["truth"]}
+    assert "not judged" in judged and "missing" not in judged

@@ -38,6 +38,8 @@ class Features:
     segments: Hough segments (N, 4) ``x0, y0, x1, y1`` in metres, else None.
     labels: rooms: (rows, cols) int32 raster of the rooms' cells on the detector's grid, 0 no
         room, feature k at k + 1; else None.
+    doors: rooms: (D, 5) the doors between them: the two rooms (feature indices, the smaller
+        first), the door's x, y (metres) and width (metres); else None.
     """
 
     xy: np.ndarray
@@ -46,6 +48,7 @@ class Features:
     descriptors: np.ndarray | None = None
     segments: np.ndarray | None = None
     labels: np.ndarray | None = None
+    doors: np.ndarray | None = None
 
     def __len__(self) -> int:
         return len(self.xy)

@@ -250,8 +250,8 @@ def room_cell(grid: MetricGrid, cell_m: float) -> float:
 
 def inside_rooms(walls: WallImage, params: Params) -> tuple[Rooms, np.ndarray, MetricGrid]:
     """The rooms of the walls (see the module docstring) on cells of ``params.cell_m`` (or
-    larger, :func:`room_cell`), the rooms' labels without those that reach the raster's edge
-    (the outside), and the labels' grid."""
+    larger, :func:`room_cell`), the new number of each room (0: it reaches the raster's edge,
+    the outside; else 1, 2, ...), and the rooms' grid."""
     cell = room_cell(walls.grid, params.cell_m)
     share, grid = resample(walls.image, walls.grid, cell)
     rooms = segment(share < WALL_SHARE, cell, params)
@@ -263,13 +263,15 @@ def inside_rooms(walls: WallImage, params: Params) -> tuple[Rooms, np.ndarray, M
     keep = np.flatnonzero(~edge[1:])
     number = np.zeros(len(rooms) + 1, np.int32)
     number[keep + 1] = np.arange(1, len(keep) + 1)
-    return rooms, number[labels], grid
+    return rooms, number, grid
 
 
 def detect(walls: WallImage, params: Params) -> Features:
     """The rooms of the walls as features: centroids (metres, the walls' frame), area (m^2)
-    as strength, every room strong, their cells as labels (ordered as the features)."""
-    _, labels, grid = inside_rooms(walls, params)
+    as strength, every room strong, their cells as labels and the doors between them
+    (ordered as the features)."""
+    rooms, inside, grid = inside_rooms(walls, params)
+    labels = inside[rooms.labels]
     count = int(labels.max(initial=0))
     if count == 0:
         return empty_features()
@@ -284,8 +286,15 @@ def detect(walls: WallImage, params: Params) -> Features:
     order = np.lexsort((area, xy[:, 1], xy[:, 0]))  # the canonical order of every detector
     number = np.zeros(count + 1, np.int32)
     number[order + 1] = np.arange(1, count + 1)
+    # doors between two rooms inside: their rooms as feature indices, smaller first
+    ends = number[inside[rooms.doors + 1]] - 1
+    inner = (ends >= 0).all(axis=1)
+    ends = np.sort(ends[inner], axis=1)
+    at = grid.pixels_to_xy(rooms.door_cell[inner][:, ::-1].astype(np.float64))
+    doors = np.column_stack([ends, at, rooms.door_width_m[inner]]).reshape(-1, 5)
+    doors = doors[np.lexsort((doors[:, 1], doors[:, 0]))]
     return Features(xy=xy[order], strength=area[order], strong=np.ones(count, dtype=bool),
-                    labels=number[labels])
+                    labels=number[labels], doors=doors)
 
 
 def overlap(truth: np.ndarray, map_: np.ndarray) -> np.ndarray:

@@ -26,8 +26,8 @@ from scipy.optimize import linear_sum_assignment
 from pcmapq.features.base import Features
 from pcmapq.features.rooms import overlap, room_ious
 
-__all__ = ["EXTRA", "MATCHED", "MERGED", "MISSING", "SPLIT", "UNSEEN", "RoomMatch", "match",
-           "overlap", "room_table"]
+__all__ = ["EXTRA", "FOUND", "MATCHED", "MERGED", "MISSING", "SPLIT", "UNJUDGED", "UNSEEN",
+           "WRONG", "RoomMatch", "door_table", "match", "overlap", "room_table"]
 
 #: Statuses of a truth room and of a map room.
 MATCHED, MERGED, SPLIT, MISSING, EXTRA = "matched", "merged", "split", "missing", "extra"
@@ -90,9 +90,10 @@ def room_table(truth: Features, map_: Features) -> dict:
     square metres, truth frame): per truth room its centroid, area, status (``unseen``: not
     counted, outside the map's footprint, and unmatched), and for a matched one its IoU, the
     map room's area less its own and the centroids' offset; per map room its centroid, area,
-    status and matched truth room (index, or None); and the count of each status."""
+    status and matched truth room (index, or None); each side's doors (:func:`door_table`);
+    and the count of each status."""
     if truth.labels is None or map_.labels is None or truth.labels.shape != map_.labels.shape:
-        return {"truth": [], "map": [], "counts": {}}
+        return {"truth": [], "map": [], "doors": {"truth": [], "map": []}, "counts": {}}
     found = match(truth.labels, map_.labels)
     t_status = np.where((found.truth_status != MATCHED) & ~truth.strong, UNSEEN,
                         found.truth_status)
@@ -113,6 +114,44 @@ def room_table(truth: Features, map_: Features) -> dict:
              "area_m2": float(map_.strength[j]), "status": str(found.map_status[j]),
              "truth": None if found.truth_of_map[j] < 0 else int(found.truth_of_map[j])}
             for j in range(len(map_))]
-    statuses = [*(f"truth {s}" for s in t_status), *(f"map {s}" for s in found.map_status)]
-    return {"truth": rows, "map": maps,
+    truth_doors, map_doors = door_table(truth, map_, found.truth_of_map)
+    statuses = [*(f"truth {s}" for s in t_status), *(f"map {s}" for s in found.map_status),
+                *(f"truth door {d['status']}" for d in truth_doors),
+                *(f"map door {d['status']}" for d in map_doors)]
+    return {"truth": rows, "map": maps, "doors": {"truth": truth_doors, "map": map_doors},
             "counts": {s: statuses.count(s) for s in sorted(set(statuses))}}
+
+
+#: A door's status: found in both, missing from the map, connecting other rooms than any
+#: truth door, or between rooms that are not both matched (nothing to compare).
+FOUND, WRONG, UNJUDGED = "found", "wrong", "not judged"
+
+
+def door_table(truth: Features, map_: Features, truth_of_map: np.ndarray
+               ) -> tuple[list[dict], list[dict]]:
+    """Each side's doors as JSON rows (``rooms``: the two rooms' indices, ``x_m``, ``y_m``,
+    ``width_m``, ``status``). A truth door between two matched rooms is ``found`` when a map
+    door joins their map rooms, else ``missing``; a map door between two matched rooms is
+    ``found`` when a truth door joins their truth rooms, else ``wrong`` (the map connects
+    rooms the truth does not); a door with a room not matched on its side is ``not judged``."""
+    def rows(doors: np.ndarray | None) -> list[dict]:
+        if doors is None:
+            return []
+        return [{"rooms": [int(a), int(b)], "x_m": float(x), "y_m": float(y),
+                 "width_m": float(w)} for a, b, x, y, w in doors]
+
+    t_rows, m_rows = rows(truth.doors), rows(map_.doors)
+    map_of_truth = np.full(len(truth), -1)
+    paired = np.flatnonzero(truth_of_map >= 0)
+    map_of_truth[truth_of_map[paired]] = paired
+    truth_pairs = {tuple(r["rooms"]) for r in t_rows}
+    map_pairs = {tuple(r["rooms"]) for r in m_rows}
+    for r in t_rows:
+        a, b = (int(map_of_truth[k]) for k in r["rooms"])
+        r["status"] = UNJUDGED if min(a, b) < 0 else \
+            FOUND if (min(a, b), max(a, b)) in map_pairs else MISSING
+    for r in m_rows:
+        a, b = (int(truth_of_map[k]) for k in r["rooms"])
+        r["status"] = UNJUDGED if min(a, b) < 0 else \
+            FOUND if (min(a, b), max(a, b)) in truth_pairs else WRONG
+    return t_rows, m_rows
