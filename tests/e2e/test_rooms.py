@@ -80,3 +80,12 @@ def test_a_door_closed_is_missing_and_a_door_the_plan_lacks_is_wrong(doors):
 def test_doors_of_merged_rooms_are_not_judged(result):
     judged = {d["status"] for d in result.rooms["doors"]["truth"]}
     assert "not judged" in judged and "missing" not in judged
+
+
+def test_the_reports_map_tells_each_rooms_fit_on_hover(result):
+    from pcmapq.report.viewer import viewer_html
+
+    page = viewer_html(result, 10.0)
+    # every truth room (matched or missing), and the map room over two of them (extra)
+    assert page.count("data-room=") == len(result.rooms["truth"]) + 1
+    assert "matched; IoU" in page and "merged" in page

@@ -104,6 +104,21 @@ def _groups(result: Result, name: str, det: DetectorResult, gain: float) -> dict
                for (px, py), (dx, dy), d in zip(det.map_xy.tolist(), disp.tolist(),
                                                  det.distances.tolist(), strict=True)]
     missing, extra = det.truth.xy[m.missing], det.map.xy[m.extra]
+    rooms = result.rooms if name == "rooms" else None
+
+    def room(side: str, k: int) -> dict[str, str]:
+        """A room's line of the tooltip: its number, area, status and, matched, its fit."""
+        if rooms is None:
+            return {}
+        r = rooms[side][k]
+        text = f"{side} room {k}: {r['area_m2']:.2f} m2, {r['status']}"
+        if "iou" in r:
+            text += (f"; IoU {r['iou']:.3f}, area error {r['area_error_m2']:+.2f} m2, "
+                     f"offset {r['offset_m']:.3f} m")
+        return {"room": html.escape(text)}
+
+    matched = [{**row, **room("truth", int(k))} for row, k in zip(matched, m.truth_idx,
+                                                                 strict=True)]
 
     def near(d: float) -> dict[str, str]:
         return {"nearest": "" if np.isnan(d) else _mm(d)}
@@ -114,10 +129,12 @@ def _groups(result: Result, name: str, det: DetectorResult, gain: float) -> dict
         + _circles(result, name, "matched", det.truth_xy, matched),
         "missing": _segments(result, det.truth.segments, m.missing)
         + _circles(result, name, "missing", missing,
-                   [near(d) for d in nearest_distances(missing, det.map.xy)]),
+                   [{**near(d), **room("truth", int(k))} for d, k in
+                    zip(nearest_distances(missing, det.map.xy), m.missing, strict=True)]),
         "extra": _segments(result, det.map.segments, m.extra)
         + _circles(result, name, "extra", extra,
-                   [near(d) for d in nearest_distances(extra, det.truth.xy)]),
+                   [{**near(d), **room("map", int(k))} for d, k in
+                    zip(nearest_distances(extra, det.truth.xy), m.extra, strict=True)]),
     }
 
 

@@ -113,6 +113,7 @@ SCRIPT = """
                  (d.status === 'missing' ? 'map' : 'truth') + ' feature: ' +
                  (d.nearest ? m(d.nearest) : 'none'));
     }
+    if (d.room) lines.push(d.room);
     return lines.join('\\n');
   }
   let pinned = null;
