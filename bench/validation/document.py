@@ -24,6 +24,7 @@ from . import (
     noref,
     recording,
     rooms,
+    rooms_drift,
     same_place,
     track,
 )
@@ -36,7 +37,7 @@ SECTIONS: dict[str, ModuleType] = {
     "drawings": drawings, "fr79": fr79, "lidar": lidar, "kitti": kitti, "gazebo": gazebo,
     "halmstad": halmstad, "floorplans": floorplans, "carmen": carmen, "noref": noref,
     "same_place": same_place, "corpus": corpus, "consistency": consistency, "track": track,
-    "recording": recording, "rooms": rooms,
+    "recording": recording, "rooms": rooms, "rooms_drift": rooms_drift,
 }
 
 
