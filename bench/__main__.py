@@ -4,7 +4,8 @@
                     [--cache DIR]
 
 --check: exit 1 when a ratio is worse than its stored one (bench/ratios.json) by more
-than 20 %. --save: store the ratios measured. --doc: write the table into docs/benchmarks.md.
+than 20 %. --save: store the ratios measured. --doc: write them into docs/benchmarks.md's
+table (the rows of the ratios not measured now stay).
 """
 
 from __future__ import annotations
@@ -47,7 +48,8 @@ def main() -> int:
     if args.doc:
         text = DOC.read_text()
         head, rest = text.split(BEGIN, 1)
-        DOC.write_text(head + BEGIN + "\n" + table(found) + "\n" + END + rest.split(END, 1)[1])
+        shown, tail = rest.split(END, 1)
+        DOC.write_text(head + BEGIN + "\n" + table(found, shown) + "\n" + END + tail)
     if args.check:
         worse = compare(found, stored)
         print("\n".join(worse) if worse else f"{len(found)} ratios within 20 % of those stored")

@@ -184,6 +184,13 @@ def compare(found: list[Ratio], stored: dict[str, float]) -> list[str]:
             for r in found if r.name in stored and r.value > stored[r.name] * (1 + TOLERANCE)]
 
 
-def table(found: list[Ratio]) -> str:
+def table(found: list[Ratio], shown: str = "") -> str:
+    """The ratios' markdown table: the rows of ``shown`` (a table this function wrote) with
+    those measured now replaced, in their places, and the new ones after them."""
+    rows = {r.name: r.row() for r in found}
+    kept = [line for line in shown.splitlines() if line.startswith("| ") and
+            not line.startswith("| ratio |")]
+    names = [line.split("|")[1].strip() for line in kept]
+    body = [rows.pop(name, line) for name, line in zip(names, kept, strict=True)]
     return "\n".join(["| ratio | value | target | pcmapq | floor or peer |",
-                      "|---|---:|---:|---|---|", *(r.row() for r in found)])
+                      "|---|---:|---:|---|---|", *body, *rows.values()])
