@@ -39,7 +39,7 @@ that compares a passage with the rooms it joins instead of one global threshold.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import cv2
 import numpy as np
@@ -273,8 +273,9 @@ def detect(walls: WallImage, params: Params) -> Features:
     rooms, inside, grid = inside_rooms(walls, params)
     labels = inside[rooms.labels]
     count = int(labels.max(initial=0))
-    if count == 0:
-        return empty_features()
+    if count == 0:  # no room: its cells (none) are still there to say so
+        return replace(empty_features(), labels=labels.astype(np.int32),
+                       doors=np.zeros((0, 5)))
     cells = np.bincount(labels.ravel(), minlength=count + 1)[1:]
     rows, cols = np.indices(labels.shape)
     centre = np.column_stack([

@@ -163,3 +163,18 @@ def test_a_room_the_map_never_entered_is_missing():
 def test_a_door_the_map_closed_leaves_the_rooms_matched():
     _, _, found = scored(plan(), plan(doors=(True, False)))
     assert found.quality == found.precision == 1.0
+
+
+def test_a_map_without_rooms_leaves_every_truth_room_missing():
+    from pcmapq.core.grid import MetricGrid
+    from pcmapq.features import detect
+    from pcmapq.match import match
+    from pcmapq.match.rooms import room_table
+
+    free = plan()
+    grid = MetricGrid(RES, (0.0, 0.0, 0.0), free.shape)
+    truth = detect("rooms", walls_of_plan(free), grid)
+    none = detect("rooms", np.zeros_like(free), grid)
+    assert len(none) == 0 and none.labels.shape == truth.labels.shape
+    assert match("rooms", truth, none).quality == 0.0
+    assert room_table(truth, none)["counts"]["truth missing"] == 3
