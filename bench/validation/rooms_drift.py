@@ -23,7 +23,7 @@ RHO = -0.9
 
 
 def cases(data: Path) -> list[Case]:
-    return [Case(f"rooms-drift-{log}-{100 * level:g}",
+    return [Case(f"drift-rooms-{log}-{100 * level:g}",
                  lambda log=log, level=level: drift.rung(
                      data / "carmen" / f"{log}-corrected.log.gz", level, SEED,
                      settings=SETTINGS))
