@@ -217,7 +217,7 @@ def segment(free: np.ndarray, resolution: float, params: Params | None = None) -
 
     # doors: the widest passage left between two rooms
     room_pairs = final[pairs]
-    apart = room_pairs[:, 0] != room_pairs[:, 1]
+    apart = (room_pairs[:, 0] != room_pairs[:, 1]) & (room_pairs > 0).all(axis=1)
     ra = np.minimum(room_pairs[apart, 0], room_pairs[apart, 1])
     rb = np.maximum(room_pairs[apart, 0], room_pairs[apart, 1])
     v, where = value[apart], at[apart]

@@ -178,3 +178,15 @@ def test_a_map_without_rooms_leaves_every_truth_room_missing():
     assert len(none) == 0 and none.labels.shape == truth.labels.shape
     assert match("rooms", truth, none).quality == 0.0
     assert room_table(truth, none)["counts"]["truth missing"] == 3
+
+
+def test_a_closet_smaller_than_a_room_joins_the_room_behind_its_gap():
+    """A 0.3 x 0.3 m closet behind a gap in the wall is part of the room: no door to it."""
+    free = plan(rooms=1)
+    rows, cols = np.nonzero(free)
+    top, right = rows.min(), cols.max()
+    free[top + 10:top + 16, right + 3:right + 9] = True  # the closet, behind the wall
+    free[top + 12:top + 14, right + 1:right + 3] = True  # its gap through the wall
+    rooms = segment(free, RES)
+    assert len(rooms) == 1
+    assert rooms.doors.shape == (0, 2) and (rooms.doors >= 0).all()
