@@ -89,3 +89,18 @@ def test_the_reports_map_tells_each_rooms_fit_on_hover(result):
     # every truth room (matched or missing), and the map room over two of them (extra)
     assert page.count("data-room=") == len(result.rooms["truth"]) + 1
     assert "matched; IoU" in page and "merged" in page
+
+
+def test_the_picture_draws_the_rooms_graph_with_its_wrong_and_missing_doors(doors):
+    from matplotlib.collections import LineCollection
+
+    from pcmapq.report.plot import DOOR_COLOURS, vectorial_figure
+
+    fig = vectorial_figure(doors)
+    ax = fig.axes[0]
+    dashed = [c for c in ax.collections if isinstance(c, LineCollection)
+              and c.get_linestyle()[0][1] is not None]
+    assert len(dashed) == 2 and sum(len(c.get_segments()) for c in dashed) == 2
+    labels = [t.get_text() for legend in fig.legends for t in legend.get_texts()]
+    assert {"door missing", "door wrong"} <= set(labels)
+    assert DOOR_COLOURS["missing"] != DOOR_COLOURS["wrong"]

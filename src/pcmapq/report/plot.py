@@ -151,6 +151,28 @@ def _rooms_overlay(ax: Axes, result: Result, det: DetectorResult) -> None:
         overlay[np.isin(map_.labels, extra)] = to_rgba(ROOM_COLOURS["extra"], 0.45)
     ax.imshow(overlay, extent=(x0, x0 + cols * cell, y0, y0 + rows * cell), origin="upper",
               interpolation="nearest", zorder=2)
+    _room_graph(ax, result)
+
+
+#: Colours of the doors' statuses in the rooms' graph.
+DOOR_COLOURS = {"found": "0.35", "not judged": "0.7", "missing": MISSING, "wrong": EXTRA}
+
+
+def _room_graph(ax: Axes, result: Result) -> None:
+    """The rooms' graph over the rooms: each door an edge from one room's centroid through the
+    door to the other's, grey when found (light: not judged), red when the map misses it;
+    the map's wrong doors (joining rooms the truth does not) orange, through the map's rooms."""
+    for side, statuses in (("truth", ("found", "not judged", "missing")), ("map", ("wrong",))):
+        rooms, doors = result.rooms[side], result.rooms["doors"][side]
+        for status in statuses:
+            paths = [[(rooms[a]["x_m"], rooms[a]["y_m"]), (d["x_m"], d["y_m"]),
+                      (rooms[b]["x_m"], rooms[b]["y_m"])]
+                     for d in doors if d["status"] == status for a, b in [d["rooms"]]]
+            if paths:
+                ax.add_collection(LineCollection(
+                    paths, colors=DOOR_COLOURS[status], zorder=2.5,
+                    linewidths=0.8 if status in ("found", "not judged") else 1.4,
+                    linestyles="solid" if status in ("found", "not judged") else "dashed"))
 
 
 def regions_gain(result: Result, arrow_scale: float) -> float:
@@ -196,6 +218,15 @@ def _legend_handles(result: Result, gain: float, as_density: bool) -> list[Line2
         shown = {row["status"] for side in ("truth", "map") for row in result.rooms[side]}
         handles += [Line2D([], [], color=colour, lw=6, alpha=0.45, label=f"room {status}")
                     for status, colour in ROOM_COLOURS.items() if status in shown]
+        doors = result.rooms.get("doors", {})
+        drawn = {d["status"] for side in ("truth", "map") for d in doors.get(side, [])} - \
+            {"found"}
+        handles += [Line2D([], [], color=DOOR_COLOURS[status], lw=1.4, ls="--",
+                           label=f"door {status}") for status in ("missing", "wrong")
+                    if status in drawn]
+        if doors.get("truth"):
+            handles.append(Line2D([], [], color=DOOR_COLOURS["found"], lw=0.8,
+                                  label="rooms joined by a door (truth)"))
     return handles
 
 
