@@ -25,6 +25,7 @@ from . import (
     recording,
     rooms,
     rooms_drift,
+    rooms_halmstad,
     same_place,
     track,
 )
@@ -38,6 +39,7 @@ SECTIONS: dict[str, ModuleType] = {
     "halmstad": halmstad, "floorplans": floorplans, "carmen": carmen, "noref": noref,
     "same_place": same_place, "corpus": corpus, "consistency": consistency, "track": track,
     "recording": recording, "rooms": rooms, "rooms_drift": rooms_drift,
+    "rooms_halmstad": rooms_halmstad,
 }
 
 
