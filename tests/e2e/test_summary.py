@@ -171,3 +171,15 @@ def test_one_name_per_figure_reaches_the_same_value_everywhere(summary_docs):
     assert [values[f"f_score@{t:g}"] for t in taus] == [f["f"] for f in doc["distances"]["f_score"]]
     assert values["harris.quality"] == doc["detectors"]["harris"]["quality"]
     assert values["accuracy.mean"] == doc["distances"]["accuracy_m"]["mean"]
+
+
+def test_a_detector_run_by_choice_is_shown_where_a_row_has_it(table_rows):
+    """rooms, not run by default, gets a bar and a terminal column once a row has it."""
+    assert summary.shown_detectors(table_rows) == list(DEFAULT_DETECTORS)
+    with_rooms = [dict(table_rows[0], rooms_quality=0.5, rooms_precision=1.0, rooms_f1=0.667),
+                  *table_rows[1:]]
+    assert summary.shown_detectors(with_rooms) == \
+        [d for d in DETECTOR_NAMES if d in (*DEFAULT_DETECTORS, "rooms")]
+    assert "rooms_quality" in summary.terminal_columns(with_rooms)
+    bars = {c.get_label() for c in summary_figure(with_rooms).axes[0].containers}
+    assert "rooms" in bars
