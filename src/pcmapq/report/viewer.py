@@ -104,7 +104,9 @@ def _groups(result: Result, name: str, det: DetectorResult, gain: float) -> dict
                for (px, py), (dx, dy), d in zip(det.map_xy.tolist(), disp.tolist(),
                                                  det.distances.tolist(), strict=True)]
     missing, extra = det.truth.xy[m.missing], det.map.xy[m.extra]
-    rooms = result.rooms if name == "rooms" else None
+    # the rooms' table is in the features' order in a result scored here (not one read back
+    # from JSON, whose features are rebuilt from its lists)
+    rooms = result.rooms if name == "rooms" and det.truth.labels is not None else None
 
     def room(side: str, k: int) -> dict[str, str]:
         """A room's line of the tooltip: its number, area, status and, matched, its fit."""
