@@ -40,6 +40,7 @@ that compares a passage with the rooms it joins instead of one global threshold.
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from typing import NamedTuple
 
 import cv2
 import numpy as np
@@ -307,12 +308,30 @@ def overlap(truth: np.ndarray, map_: np.ndarray) -> np.ndarray:
     return np.bincount(pairs, minlength=t * m).reshape(t, m)
 
 
-def room_ious(shared: np.ndarray, t_cells: np.ndarray, m_cells: np.ndarray, most: float = 0.5
-              ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """The IoU (T, M) of every truth room and map room from their shared cells (T, M) and
-    their cells (T,), (M,); and which rooms merge or split (:mod:`pcmapq.match.rooms`): truth
-    rooms merged (T,), truth rooms split (T,), map rooms merging (M,), map rooms that are
-    pieces of a split room (M,). ``most``: the share of a room that counts as most of it."""
+class RoomOverlap(NamedTuple):
+    """How the rooms of two label rasters overlap (T truth rooms, M map rooms).
+
+    shared: (T, M) cells each pair shares. iou: (T, M) their IoU. usable: (T, M) the IoU of
+    the pairs that may match, 0 for the others: a truth room merged (a map room holds most of
+    it and of another truth room) or split (two or more map rooms lie mostly within it), and
+    the map rooms that merge or are its pieces. merged, split: (T,) those truth rooms;
+    merging, pieces: (M,) those map rooms."""
+
+    shared: np.ndarray
+    iou: np.ndarray
+    usable: np.ndarray
+    merged: np.ndarray
+    split: np.ndarray
+    merging: np.ndarray
+    pieces: np.ndarray
+
+
+def room_overlap(truth: np.ndarray, map_: np.ndarray, most: float = 0.5) -> RoomOverlap:
+    """The overlap of the rooms of two label rasters of one shape (0 no room, room k at
+    k + 1); ``most``: the share of a room that counts as most of it."""
+    shared = overlap(truth, map_)
+    t_cells = np.bincount(truth.ravel(), minlength=shared.shape[0] + 1)[1:]
+    m_cells = np.bincount(map_.ravel(), minlength=shared.shape[1] + 1)[1:]
     union = t_cells[:, None] + m_cells[None, :] - shared
     iou = np.divide(shared, union, out=np.zeros(shared.shape), where=union > 0)
     of_truth = shared / np.maximum(t_cells, 1)[:, None]  # share of each truth room
@@ -322,28 +341,25 @@ def room_ious(shared: np.ndarray, t_cells: np.ndarray, m_cells: np.ndarray, most
     piece = of_map >= most  # the map room lies mostly in the truth room
     split = (piece.sum(axis=1) >= 2) & ~merged
     pieces = piece[split].any(axis=0) & ~merging
-    return iou, merged, split, merging, pieces
+    # a merger, a split room and its pieces are what they are, not a match to one of them
+    usable = np.where(merged[:, None] | split[:, None] | merging[None, :] | pieces[None, :],
+                      0.0, iou)
+    return RoomOverlap(shared, iou, usable, merged, split, merging, pieces)
 
 
 def candidates(truth: Features, map_: Features, threshold: float,
                params: Params) -> Candidates:
     """Pairs of a truth room and a map room whose IoU is at least ``params.min_iou``, neither
-    merged nor split (:func:`room_ious`); cost 0 at an IoU of 1 and 1 at ``min_iou``;
+    merged nor split (:func:`room_overlap`); cost 0 at an IoU of 1 and 1 at ``min_iou``;
     displacement: from the truth room's centroid to the map room's, metres. ``threshold``
     (metres) does not apply to rooms."""
     none = (np.zeros(0, int), np.zeros(0, int), np.zeros(0), np.zeros((0, 2)))
     if truth.labels is None or map_.labels is None or truth.labels.shape != map_.labels.shape \
             or not len(truth) or not len(map_):
         return none
-    shared = overlap(truth.labels, map_.labels)
-    t_cells = np.bincount(truth.labels.ravel(), minlength=len(truth) + 1)[1:]
-    m_cells = np.bincount(map_.labels.ravel(), minlength=len(map_) + 1)[1:]
-    iou, merged, split, merging, pieces = room_ious(shared, t_cells, m_cells)
-    # a merger, a split room and its pieces are what they are, not a match to one of them
-    iou[merged | split] = 0.0
-    iou[:, merging | pieces] = 0.0
-    i, j = np.nonzero(iou >= params.min_iou)
-    cost = np.clip((1.0 - iou[i, j]) / max(1.0 - params.min_iou, 1e-9), 0.0, 1.0)
+    usable = room_overlap(truth.labels, map_.labels).usable
+    i, j = np.nonzero(usable >= params.min_iou)
+    cost = np.clip((1.0 - usable[i, j]) / max(1.0 - params.min_iou, 1e-9), 0.0, 1.0)
     return i, j, cost, map_.xy[j] - truth.xy[i]
 
 

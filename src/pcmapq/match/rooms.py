@@ -24,7 +24,7 @@ import numpy as np
 from scipy.optimize import linear_sum_assignment
 
 from pcmapq.features.base import Features
-from pcmapq.features.rooms import overlap, room_ious
+from pcmapq.features.rooms import overlap, room_overlap
 
 __all__ = ["EXTRA", "FOUND", "MATCHED", "MERGED", "MISSING", "SPLIT", "UNJUDGED", "UNSEEN",
            "WRONG", "RoomMatch", "door_table", "match", "overlap", "room_table"]
@@ -58,26 +58,21 @@ def match(truth: np.ndarray, map_: np.ndarray, min_iou: float = 0.5,
           most: float = 0.5) -> RoomMatch:
     """The rooms of ``map_`` matched to those of ``truth`` (label rasters, see
     :func:`overlap`), and the status of every room (module docstring)."""
-    shared = overlap(truth, map_)
-    t_cells = np.bincount(truth.ravel(), minlength=shared.shape[0] + 1)[1:]
-    m_cells = np.bincount(map_.ravel(), minlength=shared.shape[1] + 1)[1:]
-    iou, merged, split, merging, pieces = room_ious(shared, t_cells, m_cells, most)
-    usable = np.where(merged[:, None] | split[:, None] | merging[None, :] | pieces[None, :],
-                      0.0, iou)
-    i, j = linear_sum_assignment(-usable)
-    keep = usable[i, j] >= min_iou
-    truth_of_map = np.full(shared.shape[1], -1)
+    o = room_overlap(truth, map_, most)
+    i, j = linear_sum_assignment(-o.usable)
+    keep = o.usable[i, j] >= min_iou
+    truth_of_map = np.full(o.shared.shape[1], -1)
     truth_of_map[j[keep]] = i[keep]
 
-    truth_status = np.full(shared.shape[0], MISSING, dtype=object)
-    map_status = np.full(shared.shape[1], EXTRA, dtype=object)
-    truth_status[split] = SPLIT
-    truth_status[merged] = MERGED
-    map_status[merging] = MERGED
-    map_status[pieces] = SPLIT
+    truth_status = np.full(o.shared.shape[0], MISSING, dtype=object)
+    map_status = np.full(o.shared.shape[1], EXTRA, dtype=object)
+    truth_status[o.split] = SPLIT
+    truth_status[o.merged] = MERGED
+    map_status[o.merging] = MERGED
+    map_status[o.pieces] = SPLIT
     truth_status[i[keep]] = MATCHED
     map_status[j[keep]] = MATCHED
-    return RoomMatch(shared, iou, truth_of_map, truth_status.astype(str),
+    return RoomMatch(o.shared, o.iou, truth_of_map, truth_status.astype(str),
                      map_status.astype(str))
 
 
