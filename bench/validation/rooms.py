@@ -13,7 +13,7 @@ import cv2
 import numpy as np
 
 from pcmapq.core.cells import FREE
-from pcmapq.features.rooms import Params, segment
+from pcmapq.features.room_segmentation import Params, segment
 from pcmapq.io import load_map
 from pcmapq.match.rooms import match
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from pcmapq.features.rooms import Params, segment, without_furniture
+from pcmapq.features.room_segmentation import Params, segment, without_furniture
 
 RES = 0.05
 
