@@ -30,8 +30,9 @@ def cases(data: Path) -> list[Case]:
             for log in LOGS for level in LEVELS]
 
 
-def _rho(levels: list[float], values: list[float | None]) -> float:
-    """Spearman's rho of the values against the levels, an undefined value counted as 0."""
+def rho(levels: list[float], values: list[float | None]) -> float:
+    """Spearman's rho of the values against the levels, an undefined value counted as 0 (no
+    room matched where none was found)."""
     return float(spearmanr(levels, [0.0 if v is None else v for v in values])[0])
 
 
@@ -45,7 +46,7 @@ def section(data: Path, record: Record) -> Section:
         levels = [r.level for r in rungs]
         quality = [r.quality["rooms"] for r in rungs]
         f1 = [r.f1["rooms"] for r in rungs]
-        rho_q, rho_f = _rho(levels, quality), _rho(levels, f1)
+        rho_q, rho_f = rho(levels, quality), rho(levels, f1)
         truth_rooms = rungs[0].figures["detectors"]["rooms"]["truth_features"]
         lines.append(row([
             log, str(truth_rooms), " ".join(score(q, 2) for q in quality),

@@ -8,8 +8,6 @@ import tempfile
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-from scipy.stats import spearmanr
-
 from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.report.text import score
 from pcmapq.testing.realdata.halmstad import (
@@ -21,6 +19,7 @@ from pcmapq.testing.realdata.halmstad import (
 )
 
 from .common import Case, Record, Section, header, row
+from .rooms_drift import rho
 
 BUILDINGS = ("E5", "F5", "HIH", "KPT4A")
 DETECTORS = ("harris", "hough", "sift", "rooms")
@@ -70,10 +69,6 @@ def cases(data: Path) -> list[Case]:
             for building in BUILDINGS for name in names(data, building)]
 
 
-def _rho(x: list[float], y: list[float | None]) -> str:
-    return f"{spearmanr(x, [0.0 if v is None else v for v in y])[0]:.2f}"
-
-
 def section(data: Path, record: Record) -> Section:
     """Per building: each map's residual and qualities, and the rank correlation of each
     detector's quality with the residual."""
@@ -83,7 +78,8 @@ def section(data: Path, record: Record) -> Section:
         maps = [g for g in got if g.name.rsplit("_", 1)[0] == building]
         residual = [m.residual_px for m in maps]
         rhos.append(row([building, str(len(maps)),
-                         *(_rho(residual, [m.quality[d] for m in maps]) for d in DETECTORS)]))
+                         *(f"{rho(residual, [m.quality[d] for m in maps]):.2f}"
+                           for d in DETECTORS)]))
         lines += [row([m.name, f"{m.residual_px:.1f}",
                        *(score(m.quality[d], 2) for d in DETECTORS),
                        ", ".join(f"{n} {k.replace('truth ', '')}" for k, n in m.rooms.items()
