@@ -14,6 +14,7 @@ import pytest
 from typer.testing import CliRunner
 
 from pcmapq.cli import app
+from pcmapq.settings import MatchingConfig
 from pcmapq.testing.paths import REPO, SHARED_DATA
 
 README = (REPO / "README.md").read_text()
@@ -116,6 +117,7 @@ def test_the_api_page_runs_as_written(repo, capsys):
         pytest.skip("../shared/data/carmen is absent (real data lives in ../shared/data)")
     exec(compile(body, "docs/api.md", "exec"), {})
     out = capsys.readouterr().out.splitlines()
-    assert out[0].startswith("harris: quality ") and "occupied cells" in out[4]
-    scans = [int(line.split()[0]) for line in out[5:]]
+    n = len(MatchingConfig().detectors)  # a line per detector, then the yaw
+    assert out[0].startswith("harris: quality ") and "occupied cells" in out[n + 1]
+    scans = [int(line.split()[0]) for line in out[n + 2:]]
     assert scans[-1] == 488 and scans == sorted(scans)

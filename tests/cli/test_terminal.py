@@ -29,7 +29,7 @@ def test_help_shows_defaults_choices_and_no_bool_placeholder():
     assert "<bool>" not in text
     flat = re.sub(r"\s+", " ", text)
     assert "occupied (default: 2 for a 3D cloud, 1 for a 2D one)" in flat
-    assert "[default: 0.5; x>=1e-06]" in flat and "[default: harris,hough,sift]" in flat
+    assert "[default: 0.5; x>=1e-06]" in flat and "[default: harris,hough,sift,rooms]" in flat
     assert "--scale <fixed|auto>" in text and "--footprint <auto|known|walls|all>" in text
     assert "-q, --quiet" in text
 

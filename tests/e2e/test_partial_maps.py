@@ -59,6 +59,12 @@ def true_share(plan: np.ndarray, cut) -> float:
     return float(np.mean((xy[:, 0] >= x0) & (xy[:, 0] <= x1) & (xy[:, 1] >= y0) & (xy[:, 1] <= y1)))
 
 
+def unjudged_rooms(name: str, det) -> bool:
+    """Rooms with no truth room wholly inside the footprint: nothing to count (a room the
+    part saw only in part cannot be judged), so no quality."""
+    return name == "rooms" and det.matching.truth_features == 0 and det.matching.quality is None
+
+
 def write_partial_image(plan, box, tf: Similarity2D, path):
     """The plan seen in the map frame, with everything outside ``box`` (truth frame) unknown."""
     segments = in_map_frame(plan, tf)
@@ -90,7 +96,8 @@ def test_partial_image_map(plan, truth_png, tmp_path, box, tf):
     assert np.hypot(got.tx - tf.tx, got.ty - tf.ty) < 0.1
     assert abs(result.overlap.coverage - share) < 0.1, (result.overlap.coverage, share)
     for name, det in result.detectors.items():
-        assert det.matching.quality >= 0.85, (name, det.matching.quality)
+        assert unjudged_rooms(name, det) or det.matching.quality >= 0.85, \
+            (name, det.matching.quality)
 
 
 @pytest.mark.parametrize(("box", "tf"), CUTS)
@@ -102,7 +109,8 @@ def test_partial_cloud_map(plan, truth_png, tmp_path, box, tf):
     result = evaluate(write_cloud_map(tf.inverse().apply(pts), tmp_path / "part.npy"), truth_png)
     assert abs(result.overlap.coverage - share) < 0.1, (result.overlap.coverage, share)
     for name, det in result.detectors.items():
-        assert det.matching.quality >= 0.85, (name, det.matching.quality)
+        assert unjudged_rooms(name, det) or det.matching.quality >= 0.85, \
+            (name, det.matching.quality)
 
 
 def test_full_map_covers_the_truth(plan, truth_png, tmp_path):
@@ -134,7 +142,8 @@ def test_binary_partial_image_map(plan, truth_png, tmp_path, box, tf):
     assert np.hypot(got.tx - tf.tx, got.ty - tf.ty) < 0.1
     assert abs(result.overlap.coverage - share) < 0.1, (result.overlap.coverage, share)
     for name, det in result.detectors.items():
-        assert det.matching.quality >= 0.85, (name, det.matching.quality)
+        assert unjudged_rooms(name, det) or det.matching.quality >= 0.85, \
+            (name, det.matching.quality)
 
 
 @pytest.mark.parametrize(("seed", "cut", "tf"), OPEN_CUTS)
@@ -152,7 +161,8 @@ def test_binary_cut_open_coverage_is_the_share_it_kept(seed, cut, tf, tmp_path):
     assert np.hypot(got.tx - tf.tx, got.ty - tf.ty) < 0.1
     assert abs(result.overlap.coverage - share) < 0.05, (result.overlap.coverage, share)
     for name, det in result.detectors.items():
-        assert det.matching.quality >= 0.9, (name, det.matching.quality)
+        assert unjudged_rooms(name, det) or det.matching.quality >= 0.9, \
+            (name, det.matching.quality)
 
 
 def test_known_footprint_of_a_binary_map_counts_its_whole_rectangle(plan, truth_png, tmp_path):

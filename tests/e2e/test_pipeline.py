@@ -121,6 +121,8 @@ def test_moved_wall_shows_its_displacement(plan, truth_png, tmp_path):
                                                 alignment=AlignmentConfig(force=True)))
     near_count = 0
     for name, det in result.detectors.items():
+        if name == "rooms":  # a room's centroid moves by a share of it: tests/e2e/test_rooms.py
+            continue
         gap = _distance_to_segments(det.truth_xy, wall)
         d, near, far = det.distances, gap < 0.4, gap > 2.0
         expected = np.full(len(d), 0.5)

@@ -115,7 +115,8 @@ def sample_rigid(tmp_path_factory: pytest.TempPathFactory) -> Rigid:
 def degraded_rigid(tmp_path_factory: pytest.TempPathFactory) -> Rigid:
     """A 2D laser-like cloud of the plan with a wall moved 0.3 m, a fifth of the inner walls
     missing, eight boxes and 3 cm noise, against the plan: qualities well below 1 (about 0.73
-    to 0.82), so a change in the pose shows in them.
+    to 0.82; rooms lower, where missing walls merge them), so a change in the pose shows in
+    them.
 
     Not here (a finding of this file, not fixed here): the same map bent by 0.15 degrees a
     metre (``synth.bend_segments``), whose best pose is flat: rigid transforms of it move the
@@ -131,7 +132,9 @@ def degraded_rigid(tmp_path_factory: pytest.TempPathFactory) -> Rigid:
                          8, seed=3)
     points = synth.wall_points(seen, 0.05, noise=0.03, seed=4)
     rigid = Rigid(points, truth, work)
-    assert all(0.6 < q < 0.95 for q in _qualities(rigid.base).values()), rigid.base
+    qualities = _qualities(rigid.base)
+    assert all(0.6 < q < 0.95 for n, q in qualities.items() if n != "rooms"), qualities
+    assert 0.0 < qualities["rooms"] < 1.0, qualities  # rooms merged where walls are missing
     return rigid
 
 

@@ -8,7 +8,7 @@ import pytest
 
 from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.results.result import Result
-from pcmapq.settings import MatchingConfig, Settings
+from pcmapq.settings import AlignmentConfig, MatchingConfig, Settings
 from pcmapq.testing import synth
 from pcmapq.testing.files import write_image_map
 
@@ -49,6 +49,23 @@ def test_the_json_keeps_the_rooms_and_the_picture_shows_them(result, tmp_path):
     labels = [t.get_text() for legend in fig.legends for t in legend.get_texts()] + \
         [t.get_text() for ax in fig.axes if ax.get_legend() for t in ax.get_legend().get_texts()]
     assert "room merged" in labels and "room matched" in labels
+
+
+def test_a_moved_wall_changes_the_two_rooms_beside_it_by_the_area_it_swept(tmp_path):
+    """The wall at x = 8.03 m moved 0.5 m east: the room west of it grows by 0.5 m times the
+    wall's length, the room east of it shrinks by as much, every room stays matched and the
+    others keep their area within 0.5 m^2 (the alignment may shift the map by a 0.05 m
+    cell)."""
+    truth = write_image_map(PLAN, tmp_path / "truth.png")
+    seen = write_image_map(synth.move_wall(PLAN, WALL, (0.5, 0.0)), tmp_path / "map.png")
+    rooms = evaluate(seen, truth, Settings(matching=MatchingConfig(detectors=("rooms",)),
+                                           alignment=AlignmentConfig(force=True))).rooms
+    swept = 0.5 * float(np.hypot(*(PLAN[WALL, 2:] - PLAN[WALL, :2])))
+    assert all(r["status"] == "matched" for r in rooms["truth"])
+    error = {round(r["x_m"]): r["area_error_m2"] for r in rooms["truth"]}
+    assert error.pop(6) == pytest.approx(swept, abs=0.3)  # west of x = 8.03 m
+    assert error.pop(11) == pytest.approx(-swept, abs=0.3)  # east of it
+    assert all(abs(e) < 0.5 for e in error.values()), (error, swept)
 
 
 @pytest.fixture(scope="module")

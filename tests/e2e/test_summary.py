@@ -46,7 +46,7 @@ def test_a_row_holds_the_documents_figures(summary_docs):
     row = table_row("sample", doc)
     assert list(row)[:len(HEAD)] == list(HEAD)
     assert row["map"] == doc["map"]["path"] and row["truth"] == doc["truth"]["path"]
-    for det in DETECTOR_NAMES:  # a detector not run (rooms, by default) is null
+    for det in DETECTOR_NAMES:  # a detector not run is null
         for score in ("quality", "precision", "f1"):
             assert row[f"{det}_{score}"] == doc["detectors"].get(det, {}).get(score)
     a, d = doc["alignment"], doc["distances"]
@@ -112,14 +112,15 @@ def test_figure_draws_a_bar_per_defined_score_and_marks_the_gaps(table_rows, pan
     ax = fig.axes[panel]
     assert ax.get_ylabel().startswith(score)
     bars = {c.get_label(): c for c in ax.containers}
-    assert list(bars) == list(DEFAULT_DETECTORS)  # rooms, run by none of the rows: no bars
+    assert list(bars) == list(DEFAULT_DETECTORS)
     for det, container in bars.items():
         expected = [r[f"{det}_{score}"] for r in table_rows
                     if r[f"{det}_{score}"] is not None and not r["exit_code"]]
         assert [p.get_height() for p in container.patches] == pytest.approx(expected)
     assert len(bars["hough"].patches) == 1  # the degraded map's and the failed one's: gaps
     texts = [t.get_text() for t in ax.texts]
-    assert texts.count("n/a") == 1 and texts.count("failed (exit 2)") == 1
+    # the degraded map ran neither hough nor rooms
+    assert texts.count("n/a") == 2 and texts.count("failed (exit 2)") == 1
     labels = [t.get_text() for t in fig.axes[-1].get_xticklabels()]
     assert labels == ["sample", "degraded", "broken"]
 
@@ -173,11 +174,16 @@ def test_one_name_per_figure_reaches_the_same_value_everywhere(summary_docs):
     assert values["accuracy.mean"] == doc["distances"]["accuracy_m"]["mean"]
 
 
-def test_a_detector_run_by_choice_is_shown_where_a_row_has_it(table_rows):
-    """rooms, not run by default, gets a bar and a terminal column once a row has it."""
+def test_a_detector_run_by_choice_is_shown_where_a_row_has_it(table_rows, monkeypatch):
+    """A detector not run by default (rooms, as if it were not) gets a bar and a terminal
+    column once a row has it, and none while no row has."""
     assert summary.shown_detectors(table_rows) == list(DEFAULT_DETECTORS)
-    with_rooms = [dict(table_rows[0], rooms_quality=0.5, rooms_precision=1.0, rooms_f1=0.667),
-                  *table_rows[1:]]
+    monkeypatch.setattr(summary, "DEFAULT_DETECTORS", ("harris", "hough", "sift"))
+    without = [{k: v for k, v in row.items() if not k.startswith("rooms_")}
+               for row in table_rows]
+    assert "rooms" not in summary.shown_detectors(without)
+    with_rooms = [dict(without[0], rooms_quality=0.5, rooms_precision=1.0, rooms_f1=0.667),
+                  *without[1:]]
     assert summary.shown_detectors(with_rooms) == \
         [d for d in DETECTOR_NAMES if d in (*DEFAULT_DETECTORS, "rooms")]
     assert "rooms_quality" in summary.terminal_columns(with_rooms)

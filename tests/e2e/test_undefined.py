@@ -73,7 +73,9 @@ def test_round_room_json_table_report_plot(round_result):
     print_table(round_result, Console(file=buf, width=200))
     table = buf.getvalue()
     rows: dict[str, str] = {}  # the score table's rows, the first of each detector's
-    for line in table.splitlines():
+    lines = table.splitlines()
+    start = next(i for i, line in enumerate(lines) if line.split()[:2] == ["detector", "quality"])
+    for line in lines[start:]:
         if line.split()[:1] in (["harris"], ["hough"], ["sift"]):
             rows.setdefault(line.split()[0], line)
     assert rows["harris"].count("n/a") == 3 and rows["sift"].count("n/a") == 3

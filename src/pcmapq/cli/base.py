@@ -14,7 +14,7 @@ from pcmapq.cli.terminal import HELP_WIDTH, OneLineUsageErrors
 
 #: Each command's help, by name, in the order ``pcmapq --help`` lists them.
 HELP = {
-    "eval": "Align MAP to TRUTH, then score it with Harris, Hough and SIFT features.",
+    "eval": "Align MAP to TRUTH, then score it with Harris, Hough, SIFT and room features.",
     "map": "Build a map from LiDAR scans with KISS-ICP (or with given poses) and save it.",
     "inspect": "How good is a map without a ground truth: MME, MPV and MOM of a 3D cloud, "
                "occupancy figures of a 2D map (docs/metrics.md).",

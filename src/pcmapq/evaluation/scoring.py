@@ -18,6 +18,8 @@ from pcmapq.evaluation.noref_figures import EarlyFigures, input_figures
 from pcmapq.evaluation.placing import Placed, Progress
 from pcmapq.evaluation.truth import FEATURE_THREADS, PreparedTruth
 from pcmapq.features import Features, SideBySide, default_params
+from pcmapq.features.rooms import Params as RoomParams
+from pcmapq.features.rooms import share_inside
 from pcmapq.io import OccupancyMap, PointMap
 from pcmapq.match import match
 from pcmapq.match.rooms import room_table
@@ -64,9 +66,10 @@ def score(placed: Placed, prepared: PreparedTruth, settings: Settings,
     for name in settings.matching.detectors:
         truth_f, map_f = prepared.features[name], side.features[name]
         if not full:  # truth features the map never saw are not missing
-            truth_f = truth_f.counted_where(inside(truth_f, footprint, grid))
+            params = settings.matching.params.get(name)
+            truth_f = truth_f.counted_where(inside(truth_f, footprint, grid, params))
             if rule == "seen":  # nor are the features of walls its scans only dotted extra
-                map_f = map_f.counted_where(inside(map_f, footprint, grid))
+                map_f = map_f.counted_where(inside(map_f, footprint, grid, params))
         detectors[name] = DetectorResult(truth_f, map_f,
                                          match(name, truth_f, map_f, threshold,
                                                settings.matching.params.get(name)))
@@ -94,8 +97,14 @@ def score(placed: Placed, prepared: PreparedTruth, settings: Settings,
                   consistency=consistency, rooms=rooms)
 
 
-def inside(features: Features, area: np.ndarray, grid: MetricGrid) -> np.ndarray:
-    """(N,) bool: which features lie in the cells where ``area`` is true."""
+def inside(features: Features, area: np.ndarray, grid: MetricGrid,
+           params: object = None) -> np.ndarray:
+    """(N,) bool: which features lie in the cells where ``area`` is true; rooms (features
+    with cells), those with at least ``min_seen`` of their cells there (their ``params``, or
+    the rooms' defaults)."""
+    if features.labels is not None:
+        seen = params.min_seen if isinstance(params, RoomParams) else RoomParams().min_seen
+        return share_inside(features, area, grid) >= seen
     uv = np.floor(grid.xy_to_pixels(features.xy) + 0.5).astype(int)
     rows, cols = area.shape
     ok = (uv[:, 0] >= 0) & (uv[:, 0] < cols) & (uv[:, 1] >= 0) & (uv[:, 1] < rows)

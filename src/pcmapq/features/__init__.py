@@ -26,17 +26,18 @@ __all__ = ["DEFAULT_DETECTORS", "DETECTORS", "Candidates", "Detector", "Features
 
 
 def _discover() -> dict[str, Detector]:
-    """Every ``DETECTOR`` defined by a module of this package, by name."""
-    found = {}
-    for info in sorted(pkgutil.iter_modules(__path__), key=lambda m: m.name):
+    """Every ``DETECTOR`` defined by a module of this package, by name: the paper's first,
+    each group in alphabetical order."""
+    found = []
+    for info in pkgutil.iter_modules(__path__):
         module = importlib.import_module(f"{__name__}.{info.name}")
         detector = getattr(module, "DETECTOR", None)
         if isinstance(detector, Detector):
-            found[detector.name] = detector
-    return found
+            found.append(detector)
+    return {d.name: d for d in sorted(found, key=lambda d: (not d.from_paper, d.name))}
 
 
-#: The detectors by name: "harris", "hough", "rooms", "sift".
+#: The detectors by name: "harris", "hough", "sift" (the paper's), then "rooms".
 DETECTORS: dict[str, Detector] = _discover()
 #: The detectors an evaluation runs when none are named.
 DEFAULT_DETECTORS: tuple[str, ...] = tuple(n for n, d in DETECTORS.items() if d.by_default)

@@ -74,6 +74,7 @@ class Detector:
     params: the detector's parameters, a frozen dataclass whose field defaults are the
         documented ones (``params()``), lengths in metres.
     by_default: whether an evaluation runs it when no detectors are named.
+    from_paper: one of the paper's detectors (Harris, Hough, SIFT), listed before the others.
     """
 
     name: str
@@ -81,6 +82,7 @@ class Detector:
     candidates: Callable[[Features, Features, float, Any], Candidates]
     params: type
     by_default: bool = True
+    from_paper: bool = True
 
     def checked(self, params: Any = None) -> Any:
         """``params``, or the defaults when None; InputError when they are not this

@@ -52,6 +52,8 @@ class Params:
     cell_m: as a detector, the cell size the rooms are found on (larger on a raster of more
         than :data:`MAX_CELLS` such cells).
     min_iou: as a detector, the least IoU of a truth room and a map room that may match.
+    min_seen: as a detector, the least share of a truth room inside the map's footprint for
+        it to count (a room the map saw only in part cannot be judged as a room).
     """
 
     door_ratio: float = 0.7
@@ -61,6 +63,7 @@ class Params:
     furniture_m: float = 1.0
     cell_m: float = 0.1
     min_iou: float = 0.5
+    min_seen: float = 0.98
 
 
 @dataclass(frozen=True)
@@ -98,6 +101,75 @@ def without_furniture(free: np.ndarray, resolution: float, largest_m: float) -> 
     small[label[0, 0]] = False  # the piece around the edge
     small[0] = False  # free cells
     return free | small[label[1:-1, 1:-1]]
+
+
+#: As a detector: a straight piece of wall at least this long (metres) is a wall, never
+#: furniture against it.
+WALL_LINE_M = 1.5
+#: As a detector: an obstacle holding a square of this side (metres) is solid, not a wall (the
+#: walls every detector sees are a band 0.15 m wide).
+SOLID_M = 0.4
+#: Directions (degrees) of the straight pieces of wall.
+LINE_ANGLES = tuple(range(0, 180, 15))
+
+
+def _line(length: int, degrees: float) -> np.ndarray:
+    """A straight line of ``length`` cells through the centre of a square kernel (uint8)."""
+    half = (length - 1) / 2
+    t = np.deg2rad(degrees)
+    dx, dy = half * np.cos(t), -half * np.sin(t)
+    side = 2 * int(np.ceil(max(abs(dx), abs(dy)))) + 1
+    kernel = np.zeros((side, side), np.uint8)
+    c = side // 2
+    cv2.line(kernel, (round(c - dx), round(c - dy)), (round(c + dx), round(c + dy)), 1)
+    return kernel
+
+
+def without_wall_furniture(free: np.ndarray, resolution: float, params: Params) -> np.ndarray:
+    """``free`` (bool, thin walls) with the furniture that stands against its walls made free.
+
+    For walls drawn as thin lines (the band every detector sees): the obstacle cells that lie
+    on no straight piece of wall :data:`WALL_LINE_M` long, in any of :data:`LINE_ANGLES`, are
+    what hangs off the walls. A piece of them (8-connected) that fits in a square of
+    ``furniture_m``, does not reach the raster's edge, and is solid (holds a square of
+    :data:`SOLID_M`) or closes a pocket (a walled-in free space under ``min_space_m2``) with
+    the wall, is furniture: it and its pockets are made free. The wall behind it stays, since
+    it lies on a straight piece of wall; a short wall between two doors is no such piece but
+    neither solid nor closing a pocket, so it stays too."""
+    wall = np.ascontiguousarray(~free).view(np.uint8)
+    length = max(int(round(WALL_LINE_M / resolution)), 3)
+    lines = np.zeros(free.shape, dtype=bool)
+    for degrees in LINE_ANGLES:
+        lines |= cv2.morphologyEx(wall, cv2.MORPH_OPEN, _line(length, degrees)).view(bool)
+    rest = wall.view(bool) & ~lines
+    if not rest.any():
+        return free
+    padded = np.pad(free, 1, constant_values=True).view(np.uint8)
+    _, label, stats, _ = cv2.connectedComponentsWithStats(padded, connectivity=4)
+    small = stats[:, cv2.CC_STAT_AREA] * resolution ** 2 < params.min_space_m2
+    small[label[0, 0]] = small[0] = False  # the free space around the edge; the walls
+    pocket = small[label[1:-1, 1:-1]]
+    count, piece, stats, _ = cv2.connectedComponentsWithStats(rest.view(np.uint8),
+                                                               connectivity=8)
+    side = np.maximum(stats[:, cv2.CC_STAT_WIDTH], stats[:, cv2.CC_STAT_HEIGHT]) * resolution
+    by_pocket = np.zeros(count, dtype=bool)
+    by_pocket[piece[cv2.dilate(pocket.view(np.uint8), np.ones((3, 3), np.uint8)).view(bool)]] \
+        = True
+    k = max(int(round(SOLID_M / resolution)), 2)
+    solid = np.zeros(count, dtype=bool)
+    solid[piece[cv2.morphologyEx(rest.view(np.uint8), cv2.MORPH_OPEN,
+                                 np.ones((k, k), np.uint8)).view(bool)]] = True
+    edge = np.zeros(count, dtype=bool)
+    for line in (piece[0], piece[-1], piece[:, 0], piece[:, -1]):
+        edge[line] = True
+    furniture = (side <= params.furniture_m) & (by_pocket | solid) & ~edge
+    furniture[0] = False
+    made_free = furniture[piece]
+    # the pockets those pieces closed
+    _, holes = cv2.connectedComponents(pocket.view(np.uint8), connectivity=4)
+    grown = cv2.dilate(made_free.view(np.uint8), np.ones((3, 3), np.uint8)).view(bool)
+    near = np.unique(holes[grown & pocket])
+    return free | made_free | np.isin(holes, near[near > 0])
 
 
 def _passages(basin: np.ndarray, clearance: np.ndarray

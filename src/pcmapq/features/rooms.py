@@ -21,11 +21,11 @@ import numpy as np
 from pcmapq.core.grid import MetricGrid
 from pcmapq.features.base import Candidates, Detector, Features, empty_features
 from pcmapq.features.resample import resample
-from pcmapq.features.room_segmentation import Params, Rooms, segment
+from pcmapq.features.room_segmentation import Params, Rooms, segment, without_wall_furniture
 from pcmapq.features.walls import WallImage
 
 __all__ = ["DETECTOR", "Params", "RoomOverlap", "candidates", "detect", "inside_rooms",
-           "overlap", "room_cell", "room_overlap"]
+           "label_cell", "overlap", "room_cell", "room_overlap", "share_inside"]
 
 
 #: A cell holding at least this share of the wall band is a wall (the band is 0.15 m wide, so
@@ -52,7 +52,7 @@ def inside_rooms(walls: WallImage, params: Params) -> tuple[Rooms, np.ndarray, M
     the outside; else 1, 2, ...), and the rooms' grid."""
     cell = room_cell(walls.grid, params.cell_m)
     share, grid = resample(walls.image, walls.grid, cell)
-    rooms = segment(share < WALL_SHARE, cell, params)
+    rooms = segment(without_wall_furniture(share < WALL_SHARE, cell, params), cell, params)
     labels = rooms.labels
     edge = np.zeros(len(rooms) + 1, dtype=bool)
     for line in (labels[0], labels[-1], labels[:, 0], labels[:, -1]):
@@ -94,6 +94,36 @@ def detect(walls: WallImage, params: Params) -> Features:
     doors = doors[np.lexsort((doors[:, 1], doors[:, 0]))]
     return Features(xy=xy[order], strength=area[order], strong=np.ones(count, dtype=bool),
                     labels=number[labels], doors=doors)
+
+
+def label_cell(features: Features) -> float:
+    """The cell size of the rooms' labels (metres; their grid shares the input grid's origin
+    and yaw), from a room's area and its cells; 0 without rooms."""
+    if features.labels is None or not len(features):
+        return 0.0
+    cells = np.bincount(features.labels.ravel(), minlength=len(features) + 1)[1:]
+    k = int(np.argmax(cells))
+    return float(np.sqrt(features.strength[k] / cells[k])) if cells[k] else 0.0
+
+
+def share_inside(features: Features, area: np.ndarray, grid: MetricGrid) -> np.ndarray:
+    """(K,) the share of each room's cells whose centre lies in a cell where ``area`` (bool on
+    ``grid``) is true."""
+    cell = label_cell(features)
+    if not cell:
+        return np.zeros(len(features))
+    rows, cols = np.nonzero(features.labels)
+    lab_rows = features.labels.shape[0]
+    # a label cell's centre in the input grid's pixels (both grids share the lower-left corner)
+    u = (cols + 0.5) * cell / grid.resolution - 0.5
+    v = grid.shape[0] - (lab_rows - rows - 0.5) * cell / grid.resolution - 0.5
+    u, v = np.floor(u + 0.5).astype(np.int64), np.floor(v + 0.5).astype(np.int64)
+    ok = (u >= 0) & (u < grid.shape[1]) & (v >= 0) & (v < grid.shape[0])
+    hit = np.zeros(len(u), dtype=bool)
+    hit[ok] = area[v[ok], u[ok]]
+    room = features.labels[rows, cols] - 1
+    total = np.bincount(room, minlength=len(features))
+    return np.bincount(room, weights=hit, minlength=len(features)) / np.maximum(total, 1)
 
 
 def overlap(truth: np.ndarray, map_: np.ndarray) -> np.ndarray:
@@ -160,4 +190,4 @@ def candidates(truth: Features, map_: Features, threshold: float,
     return i, j, cost, map_.xy[j] - truth.xy[i]
 
 
-DETECTOR = Detector("rooms", detect, candidates, Params, by_default=False)
+DETECTOR = Detector("rooms", detect, candidates, Params, from_paper=False)

@@ -36,6 +36,7 @@ from matplotlib.legend import Legend  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
 from mpl_toolkits.axes_grid1.anchored_artists import AnchoredSizeBar  # noqa: E402
 
+from pcmapq.features.rooms import label_cell  # noqa: E402
 from pcmapq.raster.pool import max_pool  # noqa: E402
 from pcmapq.report.canvas import (  # noqa: E402
     density,
@@ -132,14 +133,13 @@ ROOM_COLOURS = {"matched": MATCHED, "merged": "#e6ab02", "split": "#7570b3",
 
 def _rooms_overlay(ax: Axes, result: Result, det: DetectorResult) -> None:
     """The truth's rooms shaded by status, and the map's extra rooms, on their cells: the
-    rooms' grid shares the truth grid's lower-left corner (cells from the labels' areas)."""
+    rooms' grid shares the truth grid's lower-left corner."""
     from matplotlib.colors import to_rgba
 
     truth, map_ = det.truth, det.map
-    cells = np.bincount(truth.labels.ravel(), minlength=len(truth) + 1)[1:]
-    if not len(truth) or cells[0] == 0:
+    cell = label_cell(truth)
+    if not cell:
         return
-    cell = float(np.sqrt(truth.strength[0] / cells[0]))
     rows, cols = truth.labels.shape
     x0, y0 = result.grid.origin[0], result.grid.origin[1]
     colours = np.zeros((len(truth) + 1, 4))

@@ -5,7 +5,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from pcmapq.features.room_segmentation import Params, segment, without_furniture
+from pcmapq.features.room_segmentation import (
+    Params,
+    segment,
+    without_furniture,
+    without_wall_furniture,
+)
 
 RES = 0.05
 
@@ -190,3 +195,49 @@ def test_a_closet_smaller_than_a_room_joins_the_room_behind_its_gap():
     rooms = segment(free, RES)
     assert len(rooms) == 1
     assert rooms.doors.shape == (0, 2) and (rooms.doors >= 0).all()
+
+
+def corridor(cell: float = 0.1) -> tuple[np.ndarray, tuple[int, int]]:
+    """Free cells of a corridor 10 m x 2 m between thin walls (0.2 m, the band every detector
+    sees), and the rows of its lower and upper wall."""
+    n = int(round(1.0 / cell))
+    free = np.ones((4 * n, 14 * n), dtype=bool)
+    low, high = n, 3 * n  # wall rows: the corridor is the rows between
+    free[[low, low + 1, high, high + 1], 2 * n:12 * n + 2] = False
+    free[low:high + 2, [2 * n, 2 * n + 1, 12 * n, 12 * n + 1]] = False
+    return free, (low, high)
+
+
+def test_a_box_against_a_wall_is_furniture_and_the_wall_behind_it_stays():
+    """A 0.6 m box seen from three sides (an outline closing a pocket with the wall) and a solid
+    0.5 m block against the walls of a corridor: both taken out, the walls behind them kept,
+    and the corridor is one room; a 1.5 m cabinet stays."""
+    cell = 0.1
+    free, (low, high) = corridor(cell)
+    box = np.s_[low + 2:low + 8, 40:46]  # 0.6 m square on the lower wall
+    free[box] = False
+    free[low + 3:low + 7, 41:45] = True  # its inside: a pocket
+    free[high - 5:high, 80:85] = False  # a solid 0.5 m block under the upper wall
+    free[high - 4:high, 100:115] = False  # a 1.5 m cabinet
+    kept = without_wall_furniture(free, cell, Params())
+    assert kept[box].all() and kept[high - 5:high, 80:85].all()
+    assert not kept[low:low + 2, 20:120].any() and not kept[high:high + 2, 20:120].any()
+    assert not kept[high - 4:high, 100:115].any()
+
+    def corridor_rooms(cells: np.ndarray) -> int:
+        inside = segment(cells, cell).labels[low + 2:high, 22:120]
+        return len(np.unique(inside[inside > 0]))
+
+    assert corridor_rooms(free) > 1 and corridor_rooms(kept) == 1
+
+
+def test_a_short_wall_between_two_doors_is_no_wall_furniture():
+    """A wall across the corridor with two doors leaves a 0.8 m piece between them: thin and
+    closing no pocket, it stays, and so do the two rooms it parts."""
+    cell = 0.1
+    free, (low, high) = corridor(cell)
+    free[low + 2:high, 70:72] = False  # a wall across the corridor at x = 7 m
+    free[low + 2:low + 8, 70:72] = True  # a 0.6 m door
+    free[high - 6:high, 70:72] = True  # another: 0.6 m of wall between them
+    kept = without_wall_furniture(free, cell, Params())
+    np.testing.assert_array_equal(kept, free)

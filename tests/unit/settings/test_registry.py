@@ -28,7 +28,7 @@ def test_cli_defaults_are_the_settings_defaults():
     assert defaults["footprint"] == s.footprint.rule
     assert defaults["detectors"] == ",".join(s.matching.detectors) == \
         ",".join(features.DEFAULT_DETECTORS)
-    assert set(features.DEFAULT_DETECTORS) == set(DETECTOR_NAMES) - {"rooms"}
+    assert set(features.DEFAULT_DETECTORS) == set(DETECTOR_NAMES)
     assert tuple(float(t) for t in defaults["tau"].split(",")) == s.distances.taus
 
 
