@@ -13,6 +13,9 @@ import cv2
 import numpy as np
 
 from pcmapq.core.cells import FREE
+from pcmapq.core.grid import MetricGrid
+from pcmapq.features import walls_of
+from pcmapq.features.rooms import detect
 from pcmapq.features.room_segmentation import Params, segment
 from pcmapq.io import load_map
 from pcmapq.match.rooms import match
@@ -129,6 +132,28 @@ def labelled(data: Path, name: str, map_file: str, labels_file: str,
                     seconds)
 
 
+@dataclass(frozen=True)
+class Furnished(Labelled):
+    """One IPA plan's furnished variant scored against its plain plan by the rooms detector."""
+
+
+def furnished(data: Path, name: str) -> Furnished:
+    """The rooms detector on a plan and on its furnished variant (each plan's obstacle cells,
+    grey under 250, as the walls every detector sees), the furnished plan's rooms matched to
+    the plain plan's one to one: the furniture is all that differs."""
+    folder = data / "rooms"
+    start = time.perf_counter()
+    labels = []
+    for suffix in ("", "_furnitures"):
+        image = grey(folder / f"{name}{suffix}.png")
+        grid = MetricGrid(RESOLUTION, (0.0, 0.0, 0.0), image.shape)
+        labels.append(detect(walls_of(image < MAP_FREE, grid), Params()).labels)
+    seconds = time.perf_counter() - start
+    m = match(labels[0], labels[1], MIN_IOU)
+    return Furnished(name, tuple(map(str, m.truth_status)), tuple(map(str, m.map_status)),
+                     seconds)
+
+
 def published(data: Path) -> dict[str, dict[str, tuple[float, float]]]:
     """Published per-map (precision, recall) micro, percent: ROSE² without and with furniture,
     MAORIS without."""
@@ -158,7 +183,9 @@ def cases(data: Path) -> list[Case]:
             for furnished in (False, True) for name in MAPS] + \
         [Case(f"rooms-bonn-{file.split('/')[-1].split('.')[0].lower()}",
               lambda b=(name, file, labels, channel): labelled(data, *b))
-         for name, file, labels, channel in BONN]
+         for name, file, labels, channel in BONN] + \
+        [Case(f"rooms-furniture-{name}", lambda name=name: furnished(data, name))
+         for name in MAPS]
 
 
 def _pct(value: float) -> str:
@@ -169,7 +196,19 @@ def section(data: Path, record: Record) -> Section:
     """Per plan, and on average beside the published methods on the same plans."""
     measured = [case.run(record) for case in cases(data)]
     runs = [m for m in measured if isinstance(m, Segmented)]
-    bonn = [m for m in measured if isinstance(m, Labelled)]
+    bonn = [m for m in measured if type(m) is Labelled]
+    furn = [m for m in measured if isinstance(m, Furnished)]
+    statuses = ("matched", "merged", "split", "missing")
+    furn_lines = [row([f.name, str(len(f.truth_status)),
+                       *(str(f.count(f.truth_status, s)) for s in statuses),
+                       str(f.count(f.map_status, "extra")),
+                       f"{f.count(f.truth_status, 'matched') / len(f.truth_status):.3f}",
+                       f"{f.seconds:.2f}"]) for f in furn]
+    totals = [sum(f.count(f.truth_status, s) for f in furn) for s in statuses]
+    truth_total = sum(len(f.truth_status) for f in furn)
+    furn_lines.append(row(["**all**", str(truth_total), *map(str, totals),
+                           str(sum(f.count(f.map_status, "extra") for f in furn)),
+                           f"{totals[0] / truth_total:.3f}", ""]))
     bonn_lines = [row([b.name, str(len(b.truth_status)), str(len(b.map_status)),
                        *(str(b.count(b.truth_status, s)) for s in
                          ("matched", "merged", "split", "missing")),
@@ -228,6 +267,16 @@ def section(data: Path, record: Record) -> Section:
         header(["map", "truth rooms", "rooms", "matched", "merged", "split", "missing",
                 "extra rooms", "s"]),
         *bonn_lines, "",
+        "### Furniture a plan lacks", "",
+        "Each IPA plan's furnished variant scored against the plain plan by the rooms "
+        "detector, as `pcmapq eval` scores a map: both plans' obstacle cells (grey under 250) "
+        "drawn as the walls every detector sees, their rooms found and matched one to one "
+        "(`pcmapq.features.rooms`, `pcmapq.match.rooms`). Only the furniture differs, so every "
+        "room not matched is one the furniture cut (split), hid or walled in; **quality** is "
+        "the rooms detector's, matched / truth rooms.", "",
+        header(["plan", "truth rooms", "matched", "merged", "split", "missing", "extra rooms",
+                "quality", "s"]),
+        *furn_lines, "",
         "### Each IPA plan", "",
         header(["plan", "truth rooms", "rooms", "precision micro %", "recall micro %",
                 "precision IoU 0.5 %", "recall IoU 0.5 %", "s"]),

@@ -3,6 +3,8 @@ one wall reports those two rooms merged, every other room matched, and draws the
 
 from __future__ import annotations
 
+import shutil
+
 import numpy as np
 import pytest
 
@@ -106,6 +108,27 @@ def test_the_reports_map_tells_each_rooms_fit_on_hover(result):
     # every truth room (matched or missing), and the map room over two of them (extra)
     assert page.count("data-room=") == len(result.rooms["truth"]) + 1
     assert "matched; IoU" in page and "merged" in page
+
+
+@pytest.mark.skipif(shutil.which("chromium") is None, reason="Debian's chromium is not installed")
+def test_hovering_a_room_in_chromium_tells_its_fit(result, tmp_path):
+    """The whole report in headless Chromium: hovering a matched room's marker shows its
+    number, area, status, IoU, area error and offset as the rooms' table has them; unticking
+    the matched rooms hides them and nothing else."""
+    from pcmapq.report.html import report_html
+    from pcmapq.testing.viewer import probed, selector
+
+    det = result.detectors["rooms"]
+    k = int(det.matching.truth_idx[0])
+    row = result.rooms["truth"][k]
+    (x, y) = det.truth_xy[k]
+    out = probed(report_html(result), selector("rooms", "matched", x, y),
+                 ("rooms", "matched"), tmp_path)
+    assert out["hit"] and out["hoverShown"] == "block"
+    assert f"truth room {k}: {row['area_m2']:.2f} m2, matched; IoU {row['iou']:.3f}" \
+        in out["hover"], out["hover"]
+    assert f"offset {row['offset_m']:.3f} m" in out["hover"], out["hover"]
+    assert not any(out["toggledAfter"]) and all(out["othersAfter"])
 
 
 def test_the_picture_draws_the_rooms_graph_with_its_wrong_and_missing_doors(doors):
