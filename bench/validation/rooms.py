@@ -15,8 +15,8 @@ import numpy as np
 from pcmapq.core.cells import FREE
 from pcmapq.core.grid import MetricGrid
 from pcmapq.features import walls_of
-from pcmapq.features.rooms import detect
 from pcmapq.features.room_segmentation import Params, segment
+from pcmapq.features.rooms import detect
 from pcmapq.io import load_map
 from pcmapq.match.rooms import match
 
