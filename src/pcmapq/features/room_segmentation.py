@@ -106,8 +106,8 @@ def without_furniture(free: np.ndarray, resolution: float, largest_m: float) -> 
 #: As a detector: a straight piece of wall at least this long (metres) is a wall, never
 #: furniture against it.
 WALL_LINE_M = 1.5
-#: As a detector: an obstacle holding a square of this side (metres) is solid, not a wall (the
-#: walls every detector sees are a band 0.15 m wide).
+#: As a detector: an obstacle holding a square of this side (metres, and at least 3 cells) is
+#: solid, not a wall (the walls every detector sees are a band 0.15 m wide).
 SOLID_M = 0.4
 #: Directions (degrees) of the straight pieces of wall.
 LINE_ANGLES = tuple(range(0, 180, 15))
@@ -155,7 +155,7 @@ def without_wall_furniture(free: np.ndarray, resolution: float, params: Params) 
     by_pocket = np.zeros(count, dtype=bool)
     by_pocket[piece[cv2.dilate(pocket.view(np.uint8), np.ones((3, 3), np.uint8)).view(bool)]] \
         = True
-    k = max(int(round(SOLID_M / resolution)), 2)
+    k = max(int(round(SOLID_M / resolution)), 3)  # on coarse cells a wall fills two
     solid = np.zeros(count, dtype=bool)
     solid[piece[cv2.morphologyEx(rest.view(np.uint8), cv2.MORPH_OPEN,
                                  np.ones((k, k), np.uint8)).view(bool)]] = True
