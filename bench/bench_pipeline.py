@@ -25,7 +25,7 @@ from pcmapq.testing import synth
 from pcmapq.core.transform import Similarity2D
 from pcmapq.evaluation.pipeline import evaluate
 sys.path.insert(0, sys.argv[1])
-from tests.conftest import in_map_frame, write_cloud_map, write_image_map
+from pcmapq.testing.files import in_map_frame, write_cloud_map, write_image_map
 
 case, out = sys.argv[2], Path(sys.argv[3])
 if case == "sample":
@@ -62,10 +62,12 @@ def main() -> None:
             proc = subprocess.run([sys.executable, "-c", CHILD, str(ROOT), case, tmp],
                                   capture_output=True, text=True, check=True)
         rows.append(json.loads(proc.stdout.strip().splitlines()[-1]))
-    steps = ["loading", "aligning", "rasterising", "drawing", "detecting", "total"]
-    names = {"drawing": "wall centre lines"}  # the step "drawing the walls' centre lines"
+    steps = ["loading", "aligning", "rasterising", "drawing", "total"]
+    # "drawing the walls' centre lines and detecting features"; "aligning" holds the regions'
+    names = {"drawing": "wall centre lines and features"}
+    detectors = "/".join(rows[0]["quality"])
     print("| case | grid (rows x cols) | " + " | ".join(f"{names.get(s, s)} s" for s in steps)
-          + " | peak RSS MB | quality harris/hough/sift |")
+          + f" | peak RSS MB | quality {detectors} |")
     print("|---" * (len(steps) + 4) + "|")
     for r in rows:
         q = "/".join(score(v, 2) for v in r["quality"].values())
