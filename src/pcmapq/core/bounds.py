@@ -1,5 +1,5 @@
 """Bounding boxes: of many points, column by column, and of the nonzero cells of an image;
-the radius of points about their centroid.
+the radius of points about their centroid; the labels that reach a raster's edge.
 
 NumPy reduces an (N, d) array over axis 0 with a strided inner loop, which the columns one at
 a time avoid (the box is the same, for a fraction of the time).
@@ -34,3 +34,12 @@ def nonzero_window(image: np.ndarray, margin: int = 0) -> tuple[int, int, int, i
 def radius(xy: np.ndarray) -> float:
     """Largest distance of points (N, 2) from their centroid, in their unit."""
     return float(np.sqrt(((xy - xy.mean(axis=0)) ** 2).sum(axis=1).max()))
+
+
+def on_edge(labels: np.ndarray, count: int) -> np.ndarray:
+    """(count,) bool: which of the labels 0 .. count - 1 of the raster ``labels`` (int, rows x
+    cols) have a cell in its first or last row or column."""
+    edge = np.zeros(count, dtype=bool)
+    for line in (labels[0], labels[-1], labels[:, 0], labels[:, -1]):
+        edge[line] = True
+    return edge

@@ -65,14 +65,13 @@ def score(placed: Placed, prepared: PreparedTruth, settings: Settings,
     full, threshold = settings.footprint.full, settings.matching.threshold
     for name in settings.matching.detectors:
         truth_f, map_f = prepared.features[name], side.features[name]
+        params = settings.matching.params.get(name)
         if not full:  # truth features the map never saw are not missing
-            params = settings.matching.params.get(name)
             truth_f = truth_f.counted_where(inside(truth_f, footprint, grid, params))
             if rule == "seen":  # nor are the features of walls its scans only dotted extra
                 map_f = map_f.counted_where(inside(map_f, footprint, grid, params))
         detectors[name] = DetectorResult(truth_f, map_f,
-                                         match(name, truth_f, map_f, threshold,
-                                               settings.matching.params.get(name)))
+                                         match(name, truth_f, map_f, threshold, params))
     rooms = None if "rooms" not in detectors else \
         room_table(detectors["rooms"].truth, detectors["rooms"].map)
     noref = None

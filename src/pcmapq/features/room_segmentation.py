@@ -37,6 +37,8 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
+from pcmapq.core.bounds import on_edge
+
 
 @dataclass(frozen=True)
 class Params:
@@ -159,10 +161,7 @@ def without_wall_furniture(free: np.ndarray, resolution: float, params: Params) 
     solid = np.zeros(count, dtype=bool)
     solid[piece[cv2.morphologyEx(rest.view(np.uint8), cv2.MORPH_OPEN,
                                  np.ones((k, k), np.uint8)).view(bool)]] = True
-    edge = np.zeros(count, dtype=bool)
-    for line in (piece[0], piece[-1], piece[:, 0], piece[:, -1]):
-        edge[line] = True
-    furniture = (side <= params.furniture_m) & (by_pocket | solid) & ~edge
+    furniture = (side <= params.furniture_m) & (by_pocket | solid) & ~on_edge(piece, count)
     furniture[0] = False
     made_free = furniture[piece]
     # the pockets those pieces closed

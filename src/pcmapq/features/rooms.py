@@ -18,6 +18,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from pcmapq.core.bounds import on_edge
 from pcmapq.core.grid import MetricGrid
 from pcmapq.features.base import Candidates, Detector, Features, empty_features
 from pcmapq.features.resample import resample
@@ -54,9 +55,7 @@ def inside_rooms(walls: WallImage, params: Params) -> tuple[Rooms, np.ndarray, M
     share, grid = resample(walls.image, walls.grid, cell)
     rooms = segment(without_wall_furniture(share < WALL_SHARE, cell, params), cell, params)
     labels = rooms.labels
-    edge = np.zeros(len(rooms) + 1, dtype=bool)
-    for line in (labels[0], labels[-1], labels[:, 0], labels[:, -1]):
-        edge[line] = True
+    edge = on_edge(labels, len(rooms) + 1)
     edge[0] = True
     keep = np.flatnonzero(~edge[1:])
     number = np.zeros(len(rooms) + 1, np.int32)

@@ -92,9 +92,7 @@ def room_table(truth: Features, map_: Features) -> dict:
     found = match(truth.labels, map_.labels)
     t_status = np.where((found.truth_status != MATCHED) & ~truth.strong, UNSEEN,
                         found.truth_status)
-    map_of_truth = np.full(len(truth), -1)
-    paired = np.flatnonzero(found.truth_of_map >= 0)
-    map_of_truth[found.truth_of_map[paired]] = paired
+    map_of_truth = _inverse(found.truth_of_map, len(truth))
     rows = []
     for k in range(len(truth)):
         row = {"x_m": float(truth.xy[k, 0]), "y_m": float(truth.xy[k, 1]),
@@ -136,9 +134,7 @@ def door_table(truth: Features, map_: Features, truth_of_map: np.ndarray
                  "width_m": float(w)} for a, b, x, y, w in doors]
 
     t_rows, m_rows = rows(truth.doors), rows(map_.doors)
-    map_of_truth = np.full(len(truth), -1)
-    paired = np.flatnonzero(truth_of_map >= 0)
-    map_of_truth[truth_of_map[paired]] = paired
+    map_of_truth = _inverse(truth_of_map, len(truth))
     truth_pairs = {tuple(r["rooms"]) for r in t_rows}
     map_pairs = {tuple(r["rooms"]) for r in m_rows}
     for r in t_rows:
@@ -150,3 +146,12 @@ def door_table(truth: Features, map_: Features, truth_of_map: np.ndarray
         r["status"] = UNJUDGED if min(a, b) < 0 else \
             FOUND if (min(a, b), max(a, b)) in truth_pairs else WRONG
     return t_rows, m_rows
+
+
+def _inverse(truth_of_map: np.ndarray, truths: int) -> np.ndarray:
+    """(truths,) the map room matched to each truth room, -1 for none: the inverse of
+    ``truth_of_map`` (each map room's truth room, -1 for none)."""
+    map_of_truth = np.full(truths, -1)
+    paired = np.flatnonzero(truth_of_map >= 0)
+    map_of_truth[truth_of_map[paired]] = paired
+    return map_of_truth

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
+from pcmapq.core.bounds import on_edge
 from pcmapq.core.cells import FREE, OCCUPIED, UNKNOWN
 from pcmapq.core.grid import MetricGrid
 from pcmapq.features import detect
@@ -59,10 +60,8 @@ def enclosed_areas(state: np.ndarray, resolution: float,
     unknown cell and not touching the map's edge, of at least ``min_area_m2``."""
     open_ = (state != OCCUPIED).astype(np.uint8)
     count, labels = cv2.connectedComponents(open_, connectivity=4)
-    leaks = np.zeros(count, dtype=bool)
+    leaks = on_edge(labels, count)
     leaks[labels[state == UNKNOWN]] = True  # marked by indexing: no sort of the labels
-    for edge in (labels[0], labels[-1], labels[:, 0], labels[:, -1]):
-        leaks[edge] = True
     leaks[0] = True  # label 0: the occupied cells
     cells = np.bincount(labels.ravel(), minlength=count)
     areas = cells[~leaks] * resolution * resolution
