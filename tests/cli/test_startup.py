@@ -7,6 +7,7 @@ fresh process, never from its time."""
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
 
@@ -135,3 +136,35 @@ def test_the_library_names_load_on_first_use():
                          timeout=120)
     assert got.returncode == 0, got.stderr
     assert got.stdout.split("\n")[:2] == ["[]", "True True"], got.stdout
+
+
+#: Asks the OpenBLAS that NumPy loaded how many threads it runs, in a process that ran a command.
+BLAS_THREADS = """
+import ctypes, os, re, sys
+from pcmapq.cli import main
+sys.argv = ['pcmapq', 'info', sys.argv[1]]
+try:
+    main()
+except SystemExit as exit:
+    assert not exit.code, exit.code
+import numpy
+found = re.findall(r'(/\\S*scipy_openblas64_\\S*\\.so)', open('/proc/self/maps').read())
+print('threads', ctypes.CDLL(found[0]).scipy_openblas_get_num_threads64_() if found else 'none')
+"""
+
+
+@pytest.mark.parametrize(("preset", "expected"), [(None, "1"), ("2", "2")],
+                         ids=["default", "user's value"])
+def test_a_command_holds_openblas_to_one_thread_unless_told(preset, expected):
+    """OpenBLAS threads only spin beside the pipeline's on its small systems; a user's
+    OPENBLAS_NUM_THREADS is kept."""
+    env = {k: v for k, v in os.environ.items() if k != "OPENBLAS_NUM_THREADS"}
+    if preset is not None:
+        env["OPENBLAS_NUM_THREADS"] = preset
+    got = subprocess.run([sys.executable, "-c", BLAS_THREADS, str(SAMPLE / "truth.yaml")],
+                         capture_output=True, text=True, timeout=300, env=env)
+    assert got.returncode == 0, got.stderr
+    threads = got.stdout.strip().splitlines()[-1].split()[-1]
+    if threads == "none":
+        pytest.skip("NumPy does not use the scipy-openblas64 build here")
+    assert threads == expected

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import gc
 import importlib
+import os
 import sys
 from typing import Any
 
@@ -20,6 +21,10 @@ __all__ = ["MODULES", "app", "main"]
 
 #: Arguments answered by :func:`~pcmapq.cli.base.listing_app` alone.
 LISTING = ([], ["--help"], ["-h"], ["--version"])
+#: Threads of NumPy's and SciPy's OpenBLAS: pcmapq's linear algebra is on small systems (3 x 3
+#: normal equations, batched 2 x 2 and 3 x 3 fits), where more threads only spin beside the
+#: pipeline's own threads (docs/benchmarks.md). Set before NumPy loads; the user's value wins.
+BLAS_THREADS = "1"
 #: Each command's module in pcmapq.cli, in the order ``pcmapq --help`` lists them
 #: (:data:`~pcmapq.cli.base.HELP`).
 MODULES = {"eval": "evaluate", "map": "map_scans", "inspect": "inspect", "compare": "compare",
@@ -43,6 +48,7 @@ def main() -> None:
     alone, which parses, helps and fails as the whole one does (a command's start-up is then
     its own imports only); anything else: the whole application."""
     args = sys.argv[1:]
+    os.environ.setdefault("OPENBLAS_NUM_THREADS", BLAS_THREADS)
     try:
         if args in LISTING:
             from pcmapq.cli.base import listing_app
