@@ -40,6 +40,11 @@ import numpy as np
 from pcmapq.core.bounds import on_edge
 
 
+#: The door test's slack: clearances are float32 metres, so a passage of exactly ``door_ratio``
+#: of a peak in whole cells (0.7 m of 1.0 m) would fall either side of it by rounding alone.
+TIE = 1.0 - 1e-6
+
+
 @dataclass(frozen=True)
 class Params:
     """Room segmentation parameters, lengths in metres, areas in square metres.
@@ -232,7 +237,7 @@ def segment(free: np.ndarray, resolution: float, params: Params | None = None) -
     peak, size = top.astype(np.float64), area.astype(np.float64)
     for k in np.lexsort((pairs[:, 1], pairs[:, 0], -value)):  # widest passage first
         ra, rb = _root(parent, pairs[k, 0]), _root(parent, pairs[k, 1])
-        if ra != rb and value[k] >= params.door_ratio * min(peak[ra], peak[rb]):
+        if ra != rb and value[k] >= params.door_ratio * min(peak[ra], peak[rb]) * TIE:
             parent[rb] = ra
             peak[ra], size[ra] = max(peak[ra], peak[rb]), size[ra] + size[rb]
     roots = np.array([_root(parent, k) for k in range(count + 1)])

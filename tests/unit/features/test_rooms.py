@@ -73,6 +73,26 @@ def test_a_wide_opening_is_no_door():
     assert len(rooms) == 1
 
 
+
+def two_squares(gap: int) -> np.ndarray:
+    """Free cells of two 19 x 19-cell rooms side by side, peak clearance 10 cells, with an
+    opening of ``gap`` cells in the middle of the one-cell wall between them: its clearance is
+    (gap + 1) / 2 cells."""
+    free = np.zeros((21, 41), dtype=bool)
+    free[1:20, 1:20] = free[1:20, 21:40] = True
+    free[10 - gap // 2:10 + gap // 2 + 1, 20] = True
+    return free
+
+
+@pytest.mark.parametrize("resolution", [0.05, 0.1, 0.2])
+@pytest.mark.parametrize(("gap", "count"), [(11, 2), (13, 1), (15, 1)],
+                         ids=["0.6 of the peak", "exactly door_ratio", "0.8 of the peak"])
+def test_an_opening_of_exactly_door_ratio_joins_two_rooms(gap, count, resolution):
+    """A passage whose clearance is door_ratio (0.7) of the rooms' peak, in whole cells, joins
+    them as one narrower than that does not, on every cell size (float32 rounding aside)."""
+    bare = Params(furniture_m=0.0, min_room_m2=0.0, min_space_m2=0.0)
+    assert len(segment(two_squares(gap), resolution, bare)) == count
+
 def test_a_long_corridor_is_one_room():
     rooms = segment(plan(rooms=1, room_w=30.0, depth=2.0), RES)
     assert len(rooms) == 1
