@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -11,6 +12,15 @@ from pcmapq.core.transform import Similarity2D
 from pcmapq.testing import synth
 from pcmapq.testing.files import write_image_map
 from pcmapq.testing.paths import SAMPLE
+
+
+@pytest.fixture(autouse=True)
+def _figures_closed():
+    """Figures a test opened and kept (to look at their artists) are closed after it, so that
+    they do not pile up in the test process."""
+    yield
+    if "matplotlib.pyplot" in sys.modules:
+        sys.modules["matplotlib.pyplot"].close("all")
 
 
 @pytest.fixture(scope="session")
