@@ -39,7 +39,6 @@ import numpy as np
 
 from pcmapq.core.bounds import on_edge
 
-
 #: The door test's slack: clearances are float32 metres, so a passage of exactly ``door_ratio``
 #: of a peak in whole cells (0.7 m of 1.0 m) would fall either side of it by rounding alone.
 TIE = 1.0 - 1e-6
