@@ -13,9 +13,8 @@ from typing import Any
 
 import numpy as np
 
-from pcmapq.core.voxel_table import CHUNK as STREAMED
 from pcmapq.core.voxel_table import streamed_centroids
-from pcmapq.core.voxels import voxel_centroids
+from pcmapq.core.voxels import STREAM_FROM, voxel_centroids
 from pcmapq.evaluation.inputs import truth_raster
 from pcmapq.io import OccupancyMap, PointMap
 from pcmapq.metrics.inspection import noref_figures
@@ -47,7 +46,7 @@ def reduced(points: np.ndarray, voxel: float, scale: float = 1.0) -> np.ndarray:
     file is never converted whole."""
     if voxel <= 0:
         return np.asarray(points, dtype=np.float64) * scale
-    if len(points) <= STREAMED:  # the same centroids, without loading the compiled table
+    if len(points) <= STREAM_FROM:  # the same centroids, without loading the compiled table
         return voxel_centroids(np.asarray(points, dtype=np.float64) * scale, voxel)
     return streamed_centroids(points, voxel, scale)
 

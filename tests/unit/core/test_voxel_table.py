@@ -8,7 +8,7 @@ import pytest
 
 from pcmapq.core import voxel_table
 from pcmapq.core.errors import InputError
-from pcmapq.core.voxels import VoxelMap, voxel_centroids
+from pcmapq.core.voxels import STREAM_FROM, VoxelMap, voxel_centroids
 
 
 @pytest.mark.parametrize("dtype", [np.float32, np.float64])
@@ -23,11 +23,18 @@ def test_streamed_centroids_equal_voxel_centroids_bit_for_bit(dtype, monkeypatch
     assert np.array_equal(got, one_shot.points())
 
 
-def test_voxel_centroids_of_a_large_cloud_are_the_tables():
-    points = np.random.default_rng(2).normal(0, 5, (voxel_table.CHUNK + 10, 3))
+def test_voxel_centroids_of_a_large_cloud_are_the_tables(monkeypatch):
+    """A 3D cloud over STREAM_FROM points goes to the table, and gets the sort's centroids."""
+    points = np.random.default_rng(2).normal(0, 5, (STREAM_FROM + 10, 3))
+    calls = []
+    table = voxel_table.streamed_centroids
+    monkeypatch.setattr(voxel_table, "streamed_centroids",
+                        lambda p, v: calls.append(len(p)) or table(p, v))
     one_shot = VoxelMap(0.2)
     one_shot.add(points)
     assert np.array_equal(voxel_centroids(points, 0.2), one_shot.points())
+    voxel_centroids(points[:STREAM_FROM], 0.2)
+    assert calls == [STREAM_FROM + 10]
 
 
 def test_a_cloud_beyond_the_keys_range_is_refused_in_one_line():
