@@ -73,7 +73,6 @@ def test_a_wide_opening_is_no_door():
     assert len(rooms) == 1
 
 
-
 def two_squares(gap: int) -> np.ndarray:
     """Free cells of two 19 x 19-cell rooms side by side, peak clearance 10 cells, with an
     opening of ``gap`` cells in the middle of the one-cell wall between them: its clearance is
@@ -92,6 +91,7 @@ def test_an_opening_of_exactly_door_ratio_joins_two_rooms(gap, count, resolution
     them as one narrower than that does not, on every cell size (float32 rounding aside)."""
     bare = Params(furniture_m=0.0, min_room_m2=0.0, min_space_m2=0.0)
     assert len(segment(two_squares(gap), resolution, bare)) == count
+
 
 def test_a_long_corridor_is_one_room():
     rooms = segment(plan(rooms=1, room_w=30.0, depth=2.0), RES)
