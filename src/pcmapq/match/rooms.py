@@ -76,22 +76,22 @@ def match(truth: np.ndarray, map_: np.ndarray, min_iou: float = 0.5,
                      map_status.astype(str))
 
 
-#: The status of a truth room outside the map's footprint that no map room matches.
+#: The status of a truth room the quality does not count (less than ``min_seen`` of it inside
+#: the map's footprint), whether or not a map room overlaps it.
 UNSEEN = "unseen"
 
 
 def room_table(truth: Features, map_: Features) -> dict:
     """The rooms of the rooms detector's two sides as JSON (lists of plain numbers, metres,
     square metres, truth frame): per truth room its centroid, area, status (``unseen``: not
-    counted, outside the map's footprint, and unmatched), and for a matched one its IoU, the
+    counted, the map saw too little of it), and for one paired with a map room its IoU, the
     map room's area less its own and the centroids' offset; per map room its centroid, area,
     status and matched truth room (index, or None); each side's doors (:func:`door_table`);
     and the count of each status."""
     if truth.labels is None or map_.labels is None or truth.labels.shape != map_.labels.shape:
         return {"truth": [], "map": [], "doors": {"truth": [], "map": []}, "counts": {}}
     found = match(truth.labels, map_.labels)
-    t_status = np.where((found.truth_status != MATCHED) & ~truth.strong, UNSEEN,
-                        found.truth_status)
+    t_status = np.where(~truth.strong, UNSEEN, found.truth_status)
     map_of_truth = _inverse(found.truth_of_map, len(truth))
     rows = []
     for k in range(len(truth)):

@@ -81,3 +81,16 @@ def test_the_room_table_says_what_became_of_every_room():
     assert "iou" not in table["truth"][0]
     assert table["counts"] == {"map matched": 1, "map merged": 1, "truth matched": 1,
                                "truth merged": 2, "truth unseen": 1}
+
+
+def test_a_room_the_map_saw_too_little_of_is_unseen_even_when_a_map_room_overlaps_it():
+    """Its status agrees with the quality, which leaves it out; its fit is still given, and the
+    map room that overlaps it is matched (the precision counts it so)."""
+    from pcmapq.match.rooms import UNSEEN, room_table
+
+    truth = features_of(strips(8, 8), strong=np.array([True, False]))
+    table = room_table(truth, features_of(strips(8, 8)))
+    assert [r["status"] for r in table["truth"]] == [MATCHED, UNSEEN]
+    assert table["truth"][1]["iou"] == 1.0
+    assert [r["status"] for r in table["map"]] == [MATCHED, MATCHED]
+    assert table["counts"] == {"map matched": 2, "truth matched": 1, "truth unseen": 1}
