@@ -146,13 +146,16 @@ def _dense_groups(index: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
     return keys, slots[linear]
 
 
-def voxel_centroids(points: np.ndarray, voxel: float) -> np.ndarray:
-    """The centroid of the points (N, d, metres; d = 2 or 3) in each ``voxel``-metre cell,
-    (M, d), sorted by voxel index (x, then y, ...). Deterministic."""
+def voxel_centroids(points: np.ndarray, voxel: float, scale: float = 1.0) -> np.ndarray:
+    """The centroid of the points (N, d; d = 2 or 3) times ``scale``, metres, in each
+    ``voxel``-metre cell, (M, d), sorted by voxel index (x, then y, ...). Deterministic. A large
+    3D cloud (a file mapped into memory, say) is read in chunks, never converted whole."""
     points = np.asarray(points)
     if points.ndim == 2 and points.shape[1] == 3 and len(points) > STREAM_FROM:
-        return voxel_table.streamed_centroids(points, voxel)  # the same, without a sort
+        return voxel_table.streamed_centroids(points, voxel, scale)  # the same, without a sort
     points = np.asarray(points, dtype=np.float64)
+    if scale != 1.0:
+        points = points * scale
     grid = VoxelMap(voxel, dims=points.shape[1])
     grid.add(points)
     return grid.points()

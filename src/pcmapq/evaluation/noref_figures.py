@@ -13,8 +13,7 @@ from typing import Any
 
 import numpy as np
 
-from pcmapq.core.voxel_table import streamed_centroids
-from pcmapq.core.voxels import STREAM_FROM, voxel_centroids
+from pcmapq.core.voxels import voxel_centroids
 from pcmapq.evaluation.inputs import truth_raster
 from pcmapq.io import OccupancyMap, PointMap
 from pcmapq.metrics.inspection import noref_figures
@@ -42,13 +41,11 @@ def input_figures(source: OccupancyMap | PointMap, config: NoRefConfig = NoRefCo
 
 def reduced(points: np.ndarray, voxel: float, scale: float = 1.0) -> np.ndarray:
     """(M, 3) float64: ``points`` times ``scale``, metres, reduced to their centroid in each
-    voxel of ``voxel`` metres (0: all of them), read in chunks so that a cloud mapped onto its
-    file is never converted whole."""
+    voxel of ``voxel`` metres (0: all of them); a large cloud mapped onto its file is read in
+    chunks, never converted whole (:func:`~pcmapq.core.voxels.voxel_centroids`)."""
     if voxel <= 0:
         return np.asarray(points, dtype=np.float64) * scale
-    if len(points) <= STREAM_FROM:  # the same centroids, without loading the compiled table
-        return voxel_centroids(np.asarray(points, dtype=np.float64) * scale, voxel)
-    return streamed_centroids(points, voxel, scale)
+    return voxel_centroids(points, voxel, scale)
 
 
 def occupancy_figures(source: OccupancyMap | PointMap, scale: float = 1.0,
