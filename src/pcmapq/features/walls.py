@@ -141,8 +141,9 @@ def skeleton(mask: np.ndarray) -> np.ndarray:
 
     rows, cols = _touched(mask.any(axis=1)), _touched(mask.any(axis=0))
     out = np.zeros_like(mask)
-    if len(rows):
-        out[np.ix_(rows, cols)] = skeletonize(mask[np.ix_(rows, cols)])
+    if len(rows):  # gathered by takes, put back cell by cell: both far cheaper than np.ix_
+        r, c = np.nonzero(skeletonize(mask.take(rows, axis=0).take(cols, axis=1)))
+        out[rows[r], cols[c]] = True
     return out
 
 
