@@ -25,6 +25,11 @@ LISTING = ([], ["--help"], ["-h"], ["--version"])
 #: normal equations, batched 2 x 2 and 3 x 3 fits), where more threads only spin beside the
 #: pipeline's own threads (docs/benchmarks.md). Set before NumPy loads; the user's value wins.
 BLAS_THREADS = "1"
+#: Modules the command never uses that a library it loads would import when installed, marked
+#: absent for the command's process: Open3D loads Dash, whose notebook support loads IPython
+#: (0.2-0.4 s of every run that aligns; Dash carries on without it). The library, imported in
+#: the user's own process, is left alone.
+UNUSED = ("IPython",)
 #: Each command's module in pcmapq.cli, in the order ``pcmapq --help`` lists them
 #: (:data:`~pcmapq.cli.base.HELP`).
 MODULES = {"eval": "evaluate", "map": "map_scans", "inspect": "inspect", "compare": "compare",
@@ -49,6 +54,8 @@ def main() -> None:
     its own imports only); anything else: the whole application."""
     args = sys.argv[1:]
     os.environ.setdefault("OPENBLAS_NUM_THREADS", BLAS_THREADS)
+    for name in UNUSED:
+        sys.modules.setdefault(name, None)  # type: ignore[arg-type]  # import raises ImportError
     try:
         if args in LISTING:
             from pcmapq.cli.base import listing_app
