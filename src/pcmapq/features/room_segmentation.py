@@ -38,6 +38,7 @@ import cv2
 import numpy as np
 
 from pcmapq.core.bounds import on_edge
+from pcmapq.features.peaks import h_maxima
 
 #: The door test's slack: clearances are float32 metres, so a passage of exactly ``door_ratio``
 #: of a peak in whole cells (0.7 m of 1.0 m) would fall either side of it by rounding alone.
@@ -216,8 +217,7 @@ def _root(parent: np.ndarray, k: int) -> int:
 def segment(free: np.ndarray, resolution: float, params: Params | None = None) -> Rooms:
     """The rooms of the free cells ``free`` (bool raster of ``resolution`` metres a cell); see
     the module docstring."""
-    from skimage.morphology import h_maxima  # loaded when rooms are segmented
-    from skimage.segmentation import watershed
+    from skimage.segmentation import watershed  # loaded when rooms are segmented
 
     params = Params() if params is None else params
     free = without_furniture(np.asarray(free, dtype=bool), resolution, params.furniture_m)
