@@ -20,10 +20,10 @@ import numpy as np
 from pcmapq.align import AlignParams, align
 from pcmapq.align.similarity_icp import fit_similarity
 from pcmapq.core.transform import Similarity2D
-from pcmapq.testing.realdata.halmstad import keypoint_pairs
+from pcmapq.testing.realdata.halmstad import BROKEN_ANNOTATIONS, keypoint_pairs
 
 DATA = Path(__file__).resolve().parents[2] / "shared" / "data" / "halmstad"
-SKIP = {"E5_08"}
+SKIP = BROKEN_ANNOTATIONS
 TARGET_PX = 20.0
 #: Share of the maps that should be under TARGET_PX.
 TARGET_SHARE = 0.8

@@ -27,6 +27,9 @@ SETTINGS = Settings(alignment=AlignmentConfig(scale=True),
                     truth=SourceConfig(resolution=PLAN_RESOLUTION))
 #: A layout's wall cores: pixels darker than this grey.
 DARK = 50
+#: Maps whose keypoint association is broken (../shared/README.md): no residual of theirs means
+#: anything.
+BROKEN_ANNOTATIONS = frozenset({"E5_08"})
 #: map_server's default thresholds (a map without YAML or options).
 ROS = MapMeta(resolution=None)
 
@@ -71,6 +74,17 @@ def keypoint_pairs(data: Path, name: str, building: str) -> tuple[np.ndarray, np
     map_keys = np.load(notes / f"keypoints_{name}.npy", allow_pickle=True).astype(np.float64)
     layout_keys = np.load(notes / f"keypoints_{building}_layout.npy", allow_pickle=True)
     return map_keys[pairs[:, 0]], layout_keys.astype(np.float64)[pairs[:, 1]]
+
+
+def fit_residual(map_keys: np.ndarray, layout_keys: np.ndarray) -> float:
+    """Median distance, layout pixels, between the annotated map keypoints carried by their own
+    least-squares similarity fit onto their layout partners (Umeyama's) and those partners: how
+    far the map is from a scaled, turned and shifted copy of the layout (its distortion, and the
+    annotations' noise), whatever pcmapq's alignment. Keypoints: (K, 2) pixels."""
+    from pcmapq.align.similarity_icp import fit_similarity
+
+    fit = fit_similarity(map_keys, layout_keys)
+    return float(np.median(np.linalg.norm(fit.apply(map_keys) - layout_keys, axis=1)))
 
 
 def keypoint_residual(result: Result, map_path: Path, map_keys: np.ndarray,
