@@ -275,7 +275,7 @@ def segment(free: np.ndarray, resolution: float, params: Params | None = None) -
         np.bincount(labels.ravel(), weights=rows.ravel(), minlength=k_rooms + 1)[1:],
         np.bincount(labels.ravel(), weights=cols.ravel(), minlength=k_rooms + 1)[1:],
     ]) / np.maximum(cells, 1)[:, None]
-    clear = np.zeros(k_rooms + 1)
+    clear = np.zeros(k_rooms + 1, np.float32)  # the clearance's own type: no cast per cell
     np.maximum.at(clear, labels.ravel(), clearance.ravel())
 
     # doors: the widest passage left between two rooms
@@ -289,5 +289,5 @@ def segment(free: np.ndarray, resolution: float, params: Params | None = None) -
     first = np.ones(len(ra), dtype=bool)
     first[1:] = (ra[1:] != ra[:-1]) | (rb[1:] != rb[:-1])
     door_cell = np.column_stack(np.unravel_index(where[first], labels.shape))
-    return Rooms(labels, cells * resolution ** 2, centroid, clear[1:],
+    return Rooms(labels, cells * resolution ** 2, centroid, clear[1:].astype(np.float64),
                  np.column_stack([ra[first], rb[first]]) - 1, door_cell, 2.0 * v[first])
