@@ -20,7 +20,7 @@ BASE = 450e6
 #: Bytes per input image cell, per truth grid cell, per working cell and per cloud point. A
 #: working cell's cost is the largest seen when the detectors' biggest temporaries coincide
 #: (the 8000^2 campus pair: 83 B, when one side's SIFT scale space was alive while the other's
-#: walls, Harris and Hough were found), with a margin.
+#: Harris and Hough were found), with a margin.
 PER_IMAGE_CELL, PER_GRID_CELL, PER_WORKING_CELL, PER_POINT = 10, 17, 100, 100
 #: The detectors' working cell, metres (:func:`pcmapq.features.walls.wall_image`).
 WORKING_CELL = 0.05
