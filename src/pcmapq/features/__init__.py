@@ -8,10 +8,11 @@ lengths in metres): adding a detector is adding a file.
 from __future__ import annotations
 
 import importlib
+import os
 import pkgutil
 from collections.abc import Mapping, Sequence
 from concurrent.futures import ThreadPoolExecutor
-from threading import Event, Lock
+from threading import BoundedSemaphore, Event, Lock
 from typing import Any
 
 import numpy as np
@@ -57,6 +58,12 @@ def default_params() -> dict[str, Any]:
     return {name: d.params() for name, d in DETECTORS.items() if d.by_default}
 
 
+#: Detectors running at once in the process, over both sides and every map: as many as there
+#: are cores (at least 2). More only stack their largest temporaries (an 8000^2 SIFT scale
+#: space beside another side's Harris and Hough) on a machine that cannot run them faster.
+_DETECTING = BoundedSemaphore(max(2, os.cpu_count() or 1))
+
+
 def walls_of(occupied: np.ndarray, grid: MetricGrid) -> WallImage:
     """The walls of a binary map as every detector sees them (see :mod:`pcmapq.features.walls`).
 
@@ -71,9 +78,11 @@ def walls_of(occupied: np.ndarray, grid: MetricGrid) -> WallImage:
 def detect_in(name: str, walls: WallImage, params: Any = None) -> Features:
     """Features of detector ``name`` (a key of :data:`DETECTORS`) in ``walls``, in the metric
     frame of its grid; ``params`` are the detector's own (its ``Params``, lengths in metres),
-    its defaults when None."""
+    its defaults when None. Waits while as many detectors as the process allows run
+    (``_DETECTING``)."""
     found = detector(name)
-    return found.detect(walls, found.checked(params))
+    with _DETECTING:
+        return found.detect(walls, found.checked(params))
 
 
 class SideBySide:
@@ -84,8 +93,10 @@ class SideBySide:
     the other side is not running (waiting only when all that are left are busy): the two
     sides' largest temporaries (SIFT's scale space) never coincide, neither side idles while
     there is work the other does not hold, and one side's Python-bound steps (Hough's merging)
-    overlap the other's OpenCV and NumPy work, which runs without the interpreter lock. Each
-    result depends on its own input only, whichever thread computes it and in whatever order.
+    overlap the other's OpenCV and NumPy work, which runs without the interpreter lock. No more
+    detectors run at once in the process than it has cores (at least 2; :func:`detect_in`),
+    whichever side or caller runs them. Each result depends on its own input only, whichever
+    thread computes it and in whatever order.
     :meth:`cancel` stops a side at its next detector (a refused map needs no truth features)."""
 
     def __init__(self, names: Sequence[str], params: Mapping[str, Any]) -> None:

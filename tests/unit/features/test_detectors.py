@@ -162,3 +162,43 @@ def test_empty_map(grid):
     for name in NAMES:
         f = detect(name, empty, grid)
         assert len(f) == 0 and f.xy.shape == (0, 2), name
+
+
+def test_no_more_detectors_run_at_once_than_the_process_allows(monkeypatch):
+    """Both sides' threads and a third caller (the no-reference figures' Harris) share one
+    bound on the detectors running at once, so their largest temporaries do not all stack:
+    with the bound at 1, detectors that each take a while never overlap."""
+    import threading
+    import time
+    from dataclasses import replace
+
+    import pcmapq.features as features
+
+    monkeypatch.setattr(features, "_DETECTING", threading.BoundedSemaphore(1))
+    running, most, count = 0, 0, threading.Lock()
+    real = {name: features.detector(name) for name in ("harris", "hough")}
+
+    def slow(name):
+        def detect(walls, params):
+            nonlocal running, most
+            with count:
+                running += 1
+                most = max(most, running)
+            time.sleep(0.05)
+            with count:
+                running -= 1
+            return real[name].detect(walls, params)
+        return replace(real[name], detect=detect)
+
+    monkeypatch.setattr(features, "detector", lambda name: slow(name))
+    occupied = np.zeros((40, 40), bool)
+    occupied[10, 5:35] = occupied[5:35, 10] = True
+    grid = MetricGrid(0.05, (0.0, 0.0, 0.0), occupied.shape)
+    sides = features.SideBySide(["harris", "hough"], {})
+    jobs = [threading.Thread(target=sides.features, args=(occupied, grid, 2)) for _ in range(2)]
+    jobs.append(threading.Thread(target=features.detect, args=("harris", occupied, grid)))
+    for job in jobs:
+        job.start()
+    for job in jobs:
+        job.join()
+    assert most == 1
