@@ -23,15 +23,16 @@ def h_maxima(image: np.ndarray, h: float) -> np.ndarray:
         return np.zeros(image.shape, dtype=np.uint8)
     h = image.dtype.type(h)
     resolution = 2 * np.finfo(image.dtype).resolution * np.abs(image)
-    seed = image - h - resolution
-    return ((image - reconstruction(seed, image)) >= h).astype(np.uint8)
+    rebuilt = image - h - resolution  # the seed, a new array: reconstructed in place
+    _reconstruct(rebuilt, np.ascontiguousarray(image))
+    return ((image - rebuilt) >= h).astype(np.uint8)
 
 
 def reconstruction(seed: np.ndarray, mask: np.ndarray) -> np.ndarray:
     """The grayscale reconstruction by dilation of ``seed`` under ``mask`` (both (rows, cols),
     one float type, seed <= mask everywhere), 8-connected: ``skimage.morphology.reconstruction(
     seed, mask)``."""
-    out = np.ascontiguousarray(seed).copy()
+    out = np.array(seed, order="C")  # one copy: the caller's seed is left as it was
     _reconstruct(out, np.ascontiguousarray(mask, dtype=out.dtype))
     return out
 
