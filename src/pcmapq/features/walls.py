@@ -139,7 +139,7 @@ def skeleton(mask: np.ndarray) -> np.ndarray:
     any two lines of cells that were apart)."""
     from skimage.morphology import skeletonize  # loaded when walls are traced (0.04 s)
 
-    rows, cols = _touched(mask.any(axis=1)), _touched(mask.any(axis=0))
+    rows, cols = _lines_near(mask)
     out = np.zeros_like(mask)
     if len(rows):  # gathered by takes, put back cell by cell: both far cheaper than np.ix_
         r, c = np.nonzero(skeletonize(mask.take(rows, axis=0).take(cols, axis=1)))
@@ -166,7 +166,7 @@ def cores(objects: np.ndarray, width_px: float) -> np.ndarray:
     dropping the rest changes no cell's depth and joins no two objects."""
     if not objects.any():
         return objects
-    rows, cols = _touched(objects.any(axis=1)), _touched(objects.any(axis=0))
+    rows, cols = _lines_near(objects)
     crop = objects[np.ix_(rows, cols)]
     _, label = cv2.connectedComponents(crop.astype(np.uint8), connectivity=8)
     depth = distance_to(np.pad(~crop, 1, constant_values=True))[1:-1, 1:-1]
@@ -175,6 +175,12 @@ def cores(objects: np.ndarray, width_px: float) -> np.ndarray:
     core = np.zeros_like(objects)
     core[np.ix_(rows, cols)] = crop & (depth >= deepest[label] - 0.5 * width_px)
     return core
+
+
+def _lines_near(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The rows and the columns of ``mask`` (bool) that hold a true cell or lie next to one
+    (:func:`_touched`): the crop on which :func:`cores` and :func:`skeleton` work."""
+    return _touched(mask.any(axis=1)), _touched(mask.any(axis=0))
 
 
 def _touched(held: np.ndarray) -> np.ndarray:
