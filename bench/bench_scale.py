@@ -23,7 +23,6 @@ from pcmapq.core.transform import Similarity2D
 from pcmapq.testing.realdata.halmstad import BROKEN_ANNOTATIONS, keypoint_pairs
 
 DATA = Path(__file__).resolve().parents[2] / "shared" / "data" / "halmstad"
-SKIP = BROKEN_ANNOTATIONS
 TARGET_PX = 20.0
 #: Share of the maps that should be under TARGET_PX.
 TARGET_SHARE = 0.8
@@ -44,7 +43,7 @@ def run(data: Path) -> list[tuple[str, Similarity2D, Similarity2D, float, float]
     rows = []
     for path in sorted(data.glob("maps/*/pseudo_occupancy/*.png")):
         name, building = path.stem, path.parents[1].name
-        if name in SKIP:
+        if name in BROKEN_ANNOTATIONS:
             continue
         layout = cv2.imread(str(data / "maps" / building / "layout" / f"{building}_layout.png"),
                             cv2.IMREAD_UNCHANGED)

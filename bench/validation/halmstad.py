@@ -15,6 +15,7 @@ from pcmapq.io.occupancy import classify
 from pcmapq.raster.draw import OCCUPIED
 from pcmapq.report.text import number
 from pcmapq.testing.realdata.halmstad import (
+    BROKEN_ANNOTATIONS,
     DARK,
     MAPS,
     PLAN_RESOLUTION,
@@ -57,7 +58,7 @@ def alignment_text(rows: list) -> str:
     return (
         f"Alignment only (`bench/bench_scale.py`, both images in pixels, "
         f"{bench_scale.PIXELS.voxel:g} px voxels, {bench_scale.PIXELS.tolerance:g} px tolerance; "
-        f"{', '.join(sorted(bench_scale.SKIP))} skipped, its annotation is broken): "
+        f"{', '.join(sorted(BROKEN_ANNOTATIONS))} skipped, its annotation is broken): "
         f"**{good} of {len(rows)} maps ({good / len(rows):.0%}) have a median keypoint "
         f"residual under {bench_scale.TARGET_PX:.0f} px** (target: "
         f"{100 * bench_scale.TARGET_SHARE:.0f} %). Residual median "
