@@ -18,7 +18,7 @@ import numpy as np
 
 from pcmapq.align.point_to_line import LineTarget, refine_point_to_line
 from pcmapq.core.transform import Similarity2D
-from pcmapq.core.voxels import voxel_centroids
+from pcmapq.core.voxel_table import streamed_centroids
 
 #: Map points are taken at this voxel, metres, before they are cut into regions.
 VOXEL = 0.15
@@ -164,7 +164,8 @@ def regions(map_xy: np.ndarray, transform: Similarity2D, target: LineTarget,
     is nearest, and that fit replaces the one from the map's own pose when it puts BETTER more
     of the region's points on truth walls: a part that broke off further than ICP reaches from
     the map's pose is fitted from its own."""
-    placed = voxel_centroids(transform.apply(map_xy), VOXEL)
+    # moved and grouped a chunk of points at a time: a large map is never copied whole
+    placed = streamed_centroids(map_xy, VOXEL, move=transform.apply)
     if len(placed) == 0 or len(target.points) < 3:
         return Consistency.empty(tile_m, tolerance)
     span = float(np.ptp(placed, axis=0).max())

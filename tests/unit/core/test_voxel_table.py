@@ -1,5 +1,5 @@
 """Voxel centroids of a large cloud in one streamed pass: the same as the one-shot reduction,
-bit for bit, whatever the chunks and the table's growth."""
+bit for bit, in 2D and 3D, whatever the chunks and the table's growth."""
 
 from __future__ import annotations
 
@@ -8,7 +8,8 @@ import pytest
 
 from pcmapq.core import voxel_table
 from pcmapq.core.errors import InputError
-from pcmapq.core.voxels import STREAM_FROM, VoxelMap, voxel_centroids
+from pcmapq.core.transform import Similarity2D
+from pcmapq.core.voxels import STREAM_FROM, VoxelMap, voxel_centroids, voxel_count
 
 
 @pytest.mark.parametrize("dtype", [np.float32, np.float64])
@@ -23,25 +24,57 @@ def test_streamed_centroids_equal_voxel_centroids_bit_for_bit(dtype, monkeypatch
     assert np.array_equal(got, one_shot.points())
 
 
-def test_voxel_centroids_of_a_large_cloud_are_the_tables(monkeypatch):
-    """A 3D cloud over STREAM_FROM points goes to the table, and gets the sort's centroids."""
-    points = np.random.default_rng(2).normal(0, 5, (STREAM_FROM + 10, 3))
+@pytest.mark.parametrize("dense", [True, False])
+def test_streamed_plan_points_equal_voxel_centroids_bit_for_bit(dense, monkeypatch):
+    """2D points: the same as the one-shot reduction both ways it groups them (counting on a
+    small box, sorting the keys of a large one)."""
+    rng = np.random.default_rng(4)
+    spread = 3.0 if dense else 3000.0
+    points = np.vstack([rng.normal(0, spread, (40_000, 2)), rng.uniform(0, 0.5, (40_000, 2))])
+    monkeypatch.setattr(voxel_table, "CHUNK", 7_000)
+    got = voxel_table.streamed_centroids(points, 0.1)
+    one_shot = VoxelMap(0.1, dims=2)
+    one_shot.add(points)
+    assert np.array_equal(got, one_shot.points())
+
+
+def test_points_moved_chunk_by_chunk_give_the_centroids_of_the_moved_cloud(monkeypatch):
+    """``move`` applied a chunk at a time (a map -> truth transform): the centroids of the
+    whole cloud moved at once, bit for bit."""
+    rng = np.random.default_rng(5)
+    points = rng.normal(0, 20, (50_000, 2))
+    move = Similarity2D(3.0, -7.0, np.radians(33.0), 1.0).apply
+    monkeypatch.setattr(voxel_table, "CHUNK", 4_096)
+    got = voxel_table.streamed_centroids(points, 0.15, move=move)
+    assert np.array_equal(got, voxel_centroids(move(points), 0.15))
+
+
+@pytest.mark.parametrize("dims", [2, 3])
+def test_voxel_centroids_of_a_large_cloud_are_the_tables(dims, monkeypatch):
+    """A cloud over STREAM_FROM points goes to the table, and gets the sort's centroids; its
+    voxels are counted there too."""
+    points = np.random.default_rng(2).normal(0, 5, (STREAM_FROM + 10, dims))
     calls = []
     table = voxel_table.streamed_centroids
     monkeypatch.setattr(voxel_table, "streamed_centroids",
                         lambda p, *rest: calls.append(len(p)) or table(p, *rest))
-    one_shot = VoxelMap(0.2)
+    one_shot = VoxelMap(0.2, dims=dims)
     one_shot.add(points)
     assert np.array_equal(voxel_centroids(points, 0.2), one_shot.points())
     voxel_centroids(points[:STREAM_FROM], 0.2)
     assert calls == [STREAM_FROM + 10]
+    assert voxel_count(points, 0.2) == len(one_shot.points())
+    assert voxel_count(points[:STREAM_FROM], 0.2) == len(voxel_centroids(points[:STREAM_FROM],
+                                                                         0.2))
+    assert calls == [STREAM_FROM + 10] * 2
 
 
-def test_a_cloud_beyond_the_keys_range_is_refused_in_one_line():
-    points = np.array([[0.0, 0.0, 0.0], [2e6, 0.0, 0.0]])
+@pytest.mark.parametrize("far", [[0.0, 0.0, 0.0, 2e6, 0.0, 0.0], [0.0, 0.0, 0.0, -2e9]])
+def test_a_cloud_beyond_the_keys_range_is_refused_in_one_line(far):
+    points = np.array(far).reshape(2, -1)
     with pytest.raises(InputError, match="beyond") as table:
         voxel_table.streamed_centroids(points, 0.1)
-    one_shot_map = VoxelMap(0.1)
+    one_shot_map = VoxelMap(0.1, dims=points.shape[1])
     one_shot_map.add(points)
     with pytest.raises(InputError) as one_shot:
         one_shot_map.points()
