@@ -134,7 +134,8 @@ def map_raster(source: OccupancyMap | PointMap, map_xy: np.ndarray, transform: S
             np.array([[-0.5, -0.5], [cols - 0.5, -0.5], [cols - 0.5, rows - 0.5],
                       [-0.5, rows - 0.5]]))
     else:
-        occupied = points_to_grid(transform.apply(map_xy), grid, min_hits(source, settings))
+        occupied = points_to_grid(map_xy, grid, min_hits(source, settings),
+                                  move=transform.apply)
         known = None
         if rule == "seen" and source.seen is not None:
             seen = seen_on(source.seen, transform, grid)

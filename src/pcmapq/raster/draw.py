@@ -3,6 +3,7 @@ images by warping."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import TYPE_CHECKING
 
 import cv2
@@ -14,15 +15,28 @@ from pcmapq.core.grid import MetricGrid
 if TYPE_CHECKING:
     from pcmapq.core.transform import Similarity2D
 
+#: Points counted at once by :func:`hit_counts` (its temporaries: about 40 bytes a point).
+CHUNK = 1 << 22
 
 
-def hit_counts(xy: np.ndarray, grid: MetricGrid) -> np.ndarray:
-    """Number of points (N, 2, metres, grid frame) in each cell: (rows, cols) int32."""
-    uv = np.floor(grid.xy_to_pixels(xy) + 0.5).astype(np.int64)
+def hit_counts(xy: np.ndarray, grid: MetricGrid,
+               move: Callable[[np.ndarray], np.ndarray] | None = None) -> np.ndarray:
+    """Number of points (N, 2, metres, grid frame) in each cell: (rows, cols) int32. ``move``:
+    applied to the points first (e.g. map frame -> grid frame), a chunk at a time, so that a
+    large cloud is never copied whole."""
     rows, cols = grid.shape
-    inside = (uv[:, 0] >= 0) & (uv[:, 0] < cols) & (uv[:, 1] >= 0) & (uv[:, 1] < rows)
-    flat = uv[inside, 1] * cols + uv[inside, 0]
-    return np.bincount(flat, minlength=rows * cols).reshape(rows, cols).astype(np.int32)
+    counts = np.zeros(rows * cols, dtype=np.int64)
+    for start in range(0, len(xy), CHUNK):
+        part = xy[start:start + CHUNK]
+        uv = np.floor(grid.xy_to_pixels(part if move is None else move(part)) + 0.5)
+        uv = uv.astype(np.int64)
+        inside = (uv[:, 0] >= 0) & (uv[:, 0] < cols) & (uv[:, 1] >= 0) & (uv[:, 1] < rows)
+        flat = uv[inside, 1] * cols + uv[inside, 0]
+        if len(flat):  # a chunk's points lie close together: count over their range only
+            low = int(flat.min())
+            hits = np.bincount(flat - low)
+            counts[low:low + len(hits)] += hits
+    return counts.reshape(rows, cols).astype(np.int32)
 
 
 def polygon_cells(polygons: np.ndarray, grid: MetricGrid) -> np.ndarray:
@@ -40,9 +54,11 @@ def polygon_cells(polygons: np.ndarray, grid: MetricGrid) -> np.ndarray:
     return area.astype(bool)
 
 
-def points_to_grid(xy: np.ndarray, grid: MetricGrid, min_hits: int = 1) -> np.ndarray:
-    """Occupied cells: those holding at least ``min_hits`` of the points (N, 2, metres). Bool."""
-    return hit_counts(xy, grid) >= min_hits
+def points_to_grid(xy: np.ndarray, grid: MetricGrid, min_hits: int = 1,
+                   move: Callable[[np.ndarray], np.ndarray] | None = None) -> np.ndarray:
+    """Occupied cells: those holding at least ``min_hits`` of the points (N, 2, metres, grid
+    frame, or moved into it by ``move`` as :func:`hit_counts` does). Bool."""
+    return hit_counts(xy, grid, move) >= min_hits
 
 
 def warp_state(state: np.ndarray, src: MetricGrid, tf: Similarity2D, dst: MetricGrid) -> np.ndarray:

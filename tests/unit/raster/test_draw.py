@@ -7,6 +7,7 @@ import pytest
 
 from pcmapq.core.grid import MetricGrid
 from pcmapq.core.transform import Similarity2D
+from pcmapq.raster import draw
 from pcmapq.raster.draw import FREE, OCCUPIED, UNKNOWN, hit_counts, points_to_grid, warp_state
 from pcmapq.raster.footprint import footprint_rule
 from pcmapq.testing import synth
@@ -29,6 +30,21 @@ def test_hit_counts_and_min_hits():
     counts = hit_counts(xy, grid)
     assert counts.sum() == 3 and counts[9, 0] == 2 and counts[0, 5] == 1
     assert points_to_grid(xy, grid, min_hits=2).sum() == 1
+
+
+def test_hit_counts_in_chunks_of_moved_points_are_the_counts_of_the_whole(monkeypatch):
+    """Points moved and counted a chunk at a time (walls here and there, some off the grid)
+    give the counts of all of them moved at once."""
+    rng = np.random.default_rng(3)
+    grid = MetricGrid(0.05, (-2.0, -1.0, 0.0), (300, 400))
+    xy = np.vstack([rng.uniform(-5, 25, (3000, 2)), rng.normal(4, 0.3, (3000, 2)),
+                    rng.normal(12, 0.2, (3000, 2))])
+    move = Similarity2D(1.5, -0.5, np.radians(20.0), 1.2).apply
+    whole = hit_counts(move(xy), grid)
+    monkeypatch.setattr(draw, "CHUNK", 1000)
+    assert np.array_equal(hit_counts(xy, grid, move), whole)
+    assert 0 < whole.sum() < len(xy)  # points on and off the grid
+    assert np.array_equal(points_to_grid(xy, grid, 2, move=move), whole >= 2)
 
 
 def test_warp_identity_is_exact(plan):
