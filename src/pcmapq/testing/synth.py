@@ -109,6 +109,28 @@ def bend(xy: np.ndarray, degrees_per_metre: float, pivot: tuple[float, float] = 
     return np.column_stack([c * rel[:, 0] - s * rel[:, 1], s * rel[:, 0] + c * rel[:, 1]]) + pivot
 
 
+def bend_image(image: np.ndarray, corner_shift: float, fill: int) -> np.ndarray:
+    """A raster map bent as :func:`bend` bends points: each pixel turned about the lower-left
+    corner of the box of the pixels that are not ``fill`` (x to the right, y up), by an angle
+    that grows with its x distance from that corner, so that the box's far corner moves by
+    ``corner_shift`` times the box's diagonal. (H, W) in, (H, W) out: each pixel the nearest
+    of the bent map, ``fill`` where it comes from outside the image."""
+    import cv2
+
+    known = np.argwhere(image != fill)
+    (top, left), (bottom, right) = known.min(axis=0), known.max(axis=0)
+    width = max(int(right - left), 1)
+    rate = 2.0 * np.arcsin(corner_shift / 2.0) / width  # radians per pixel: the chord's angle
+    rows, cols = np.indices(image.shape, dtype=np.float64)
+    q = np.stack([cols - left, bottom - rows])  # each output pixel, box frame
+    p = q.copy()
+    for _ in range(8):  # the source pixel p that bends onto q: q turned back by p's angle
+        c, s = np.cos(rate * p[0]), np.sin(rate * p[0])
+        p = np.stack([c * q[0] + s * q[1], -s * q[0] + c * q[1]])
+    return cv2.remap(image, (left + p[0]).astype(np.float32), (bottom - p[1]).astype(np.float32),
+                     cv2.INTER_NEAREST, borderMode=cv2.BORDER_CONSTANT, borderValue=int(fill))
+
+
 def bend_segments(segments: np.ndarray, degrees_per_metre: float, step: float = 0.1):
     """Densify then bend: the plan as a drifted map would draw it."""
     fine = densify(segments, step)
