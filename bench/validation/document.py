@@ -24,6 +24,7 @@ from . import (
     noref,
     recording,
     rooms,
+    rooms_bent,
     rooms_drift,
     rooms_halmstad,
     same_place,
@@ -39,7 +40,7 @@ SECTIONS: dict[str, ModuleType] = {
     "halmstad": halmstad, "floorplans": floorplans, "carmen": carmen, "noref": noref,
     "same_place": same_place, "corpus": corpus, "consistency": consistency, "track": track,
     "recording": recording, "rooms": rooms, "rooms_drift": rooms_drift,
-    "rooms_halmstad": rooms_halmstad,
+    "rooms_halmstad": rooms_halmstad, "rooms_bent": rooms_bent,
 }
 
 
