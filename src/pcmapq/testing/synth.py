@@ -117,8 +117,8 @@ def bend_image(image: np.ndarray, corner_shift: float, fill: int) -> np.ndarray:
     of the bent map, ``fill`` where it comes from outside the image."""
     import cv2
 
-    known = np.argwhere(image != fill)
-    (top, left), (bottom, right) = known.min(axis=0), known.max(axis=0)
+    known = np.argwhere(image != fill)  # row, col
+    bottom, (left, right) = known[:, 0].max(), (known[:, 1].min(), known[:, 1].max())
     width = max(int(right - left), 1)
     rate = 2.0 * np.arcsin(corner_shift / 2.0) / width  # radians per pixel: the chord's angle
     rows, cols = np.indices(image.shape, dtype=np.float64)
