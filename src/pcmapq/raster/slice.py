@@ -72,8 +72,10 @@ def _band_by_chunks(points: np.ndarray, rotation: np.ndarray, low: float,
     """:func:`wall_band`'s floor (metres) and band (M, 2) of a cloud (N, 3) larger than CHUNK,
     levelled by ``rotation``, in two passes over it: the height histogram (the floor's bin, as
     :func:`floor_height` finds it), then the heights in the floor's three bins (their median is
-    the floor) and the points that may lie in the band whatever the floor within those bins.
-    Levelled coordinates are sums of products (one thread, no BLAS), the same in both passes."""
+    the floor) and the points that may lie in the band whatever the floor within those bins,
+    kept as the cloud holds them (float32 rows: half the memory of their levelled coordinates).
+    Levelled coordinates are sums of products (one thread, no BLAS), the same in both passes
+    and for the kept points again: each is computed from its own row alone."""
     bins, counts = _merged([_histogram(_bins(_turned(rows, rotation[2])))
                             for rows in _finite_chunks(points)])
     if len(bins) == 0:
@@ -81,22 +83,27 @@ def _band_by_chunks(points: np.ndarray, rotation: np.ndarray, low: float,
     peak = _floor_bin(bins, counts)
     # The floor lies in bins peak - 1 .. peak + 1; one bin more each side covers rounding.
     lo, hi = (peak - 2) * FLOOR_BIN + low, (peak + 3) * FLOOR_BIN + high
-    near, heights, plans = [], [], []  # per chunk: the floor bins' z; the candidates' z, x y
+    # rows go back to the cloud's own float type exactly (they were read from it)
+    held = points.dtype if points.dtype in (np.float16, np.float32) else np.float64
+    near, candidates = [], []  # per chunk: the floor bins' z; the candidates' rows
     for rows in _finite_chunks(points):
         z = _turned(rows, rotation[2])
         near.append(z[np.abs(_bins(z) - peak) <= 1])
-        keep = (z >= lo) & (z <= hi)
-        kept = rows[keep]
-        heights.append(z[keep])
-        plans.append(np.column_stack([_turned(kept, rotation[0]), _turned(kept, rotation[1])]))
+        candidates.append(rows[(z >= lo) & (z <= hi)].astype(held))
     floor = float(np.median(np.concatenate(near)))
-    inside = [(z - floor >= low) & (z - floor <= high) for z in heights]
-    band = np.empty((sum(int(np.count_nonzero(keep)) for keep in inside), 2))
+
+    def inside(kept: np.ndarray) -> np.ndarray:
+        z = _turned(kept.astype(np.float64), rotation[2]) - floor
+        return (z >= low) & (z <= high)
+
+    band = np.empty((sum(int(np.count_nonzero(inside(kept))) for kept in candidates), 2))
     start = 0
-    for keep in inside:
-        xy = plans.pop(0)[keep]  # each chunk's candidates freed once copied
-        band[start:start + len(xy)] = xy
-        start += len(xy)
+    for i, kept in enumerate(candidates):
+        rows = kept.astype(np.float64)[inside(kept)]
+        candidates[i] = None  # each chunk's candidates freed once copied
+        band[start:start + len(rows), 0] = _turned(rows, rotation[0])
+        band[start:start + len(rows), 1] = _turned(rows, rotation[1])
+        start += len(rows)
     return floor, band
 
 

@@ -127,6 +127,22 @@ def test_chunked_floor_and_band_equal_the_one_shot_ones(tilted: np.ndarray,
     np.testing.assert_allclose(got_band, band, atol=1e-12)
 
 
+def test_chunked_band_of_a_float32_cloud_is_exact(tilted: np.ndarray, small_chunks: int) -> None:
+    """A float32 cloud's candidates are held as float32 rows and levelled again: the band is
+    bit for bit the one levelled once from the rows read as float64."""
+    cloud = tilted.astype(np.float32)
+    rotation = level_rotation(cloud)
+    rows = cloud.astype(np.float64)
+    def turned(axis: np.ndarray) -> np.ndarray:
+        return rows[:, 0] * axis[0] + rows[:, 1] * axis[1] + rows[:, 2] * axis[2]
+
+    floor, band = slice_module._band_by_chunks(cloud, rotation, 0.3, 2.0)
+    z = turned(rotation[2]) - floor
+    keep = (z >= 0.3) & (z <= 2.0)
+    expected = np.column_stack([turned(rotation[0])[keep], turned(rotation[1])[keep]])
+    assert np.array_equal(band, expected)
+
+
 def test_chunked_wall_band_is_the_one_shot_band(tilted: np.ndarray, cloud: np.ndarray,
                                                 small_chunks: int) -> None:
     """Levelled on every 9th point, in float32 with rows to skip, the band is the same walls:
