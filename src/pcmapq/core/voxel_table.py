@@ -110,5 +110,15 @@ def streamed_centroids(points: np.ndarray, voxel: float, scale: float = 1.0,
                 bits += 1
                 keys, sums, counts = _moved(keys, sums, counts, 1 << bits, np.uint64(64 - bits))
     held = np.flatnonzero(keys != EMPTY)
-    held = held[np.argsort(keys[held], kind="stable")]
-    return sums[held] / counts[held, None]
+    return _centroids(sums, counts, held[np.argsort(keys[held], kind="stable")])
+
+
+@numba.njit(cache=True, nogil=True)
+def _centroids(sums: np.ndarray, counts: np.ndarray, slots: np.ndarray) -> np.ndarray:
+    """(len(slots), d): each slot's sums over its count, in the order of ``slots``, written
+    straight into the result (no gathered copy of the sums beside the table)."""
+    out = np.empty((len(slots), sums.shape[1]))
+    for i in range(len(slots)):
+        for axis in range(sums.shape[1]):
+            out[i, axis] = sums[slots[i], axis] / counts[slots[i]]
+    return out
