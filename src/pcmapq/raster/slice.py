@@ -89,7 +89,7 @@ def _band_by_chunks(points: np.ndarray, rotation: np.ndarray, low: float,
     for rows in _finite_chunks(points):
         z = _turned(rows, rotation[2])
         near.append(z[np.abs(_bins(z) - peak) <= 1])
-        candidates.append(rows[(z >= lo) & (z <= hi)].astype(held))
+        candidates.append(rows[(z >= lo) & (z <= hi)].astype(held, copy=False))
     floor = float(np.median(np.concatenate(near)))
 
     def inside(kept: np.ndarray) -> np.ndarray:
