@@ -29,7 +29,7 @@ from pcmapq.testing import synth
 
 from .common import Case, Record, Section, header, row
 
-NAMES = ("harris", "hough", "sift")
+NAMES = ("harris", "hough", "sift", "rooms")
 #: The usual drawing: walls 0.15 m thick on 0.05 m cells; the variants' cells and thicknesses.
 USUAL_RESOLUTION, USUAL_THICKNESS = 0.05, 0.15
 RESOLUTIONS, CELLS = (0.05, 0.025), (1, 2, 3, 6)
@@ -203,7 +203,7 @@ def section(data: Path, record: Record) -> Section:
     got = [case.run(record) for case in cases(data)]
     n = len(SEEDS)
     plans, (fr79, e5), truths = got[:n], got[n:n + 2], got[n + 2:]
-    cols = ["drawing", "Harris", "Hough", "SIFT"]
+    cols = ["drawing", "Harris", "Hough", "SIFT", "rooms"]
     res = " and ".join(f"{r} m" for r in RESOLUTIONS)
     thick = ", ".join(str(c) for c in CELLS[:-1]) + f" and {CELLS[-1]}"
     wide = f"outlines {WIDE_OUTLINES} m apart at {USUAL_RESOLUTION} m"
@@ -248,7 +248,7 @@ def section(data: Path, record: Record) -> Section:
         "clutter.", "",
         "Strong features of every real truth (images at the resolution given, CARMEN "
         f"references rasterised at {Settings().raster.cloud_resolution} m):", "",
-        header(["truth", "cells", "Harris", "Hough", "SIFT"]),
+        header(["truth", "cells", "Harris", "Hough", "SIFT", "rooms"]),
         *(row([t, f"{c.shape[1]} x {c.shape[0]} at {c.resolution * 1000:.3g} mm",
                *(str(c.counts[n]) for n in NAMES)]) for (t, _, _), c in zip(TRUTHS, truths,
                                                                           strict=True)),
