@@ -186,8 +186,15 @@ def thinned(xy: np.ndarray, voxel: float, max_points: int) -> tuple[np.ndarray, 
     """Voxel centroids of ``xy`` (N, 2, metres) at ``voxel`` metres; when more than
     ``max_points``, at the voxel grown by the ratio (about ``max_points`` remain on walls).
     Returns them and the voxel used, metres. Beyond ``max_points`` points the voxels are counted
-    first, so a cloud to be thinned is grouped once, at the grown voxel."""
-    if len(xy) > max_points and (count := voxel_count(xy, voxel)) > max_points:
-        grown = voxel * count / max_points
-        return voxel_centroids(xy, grown), grown
+    first: a few points by sorting their keys, so a cloud to be thinned is grouped once, at the
+    grown voxel; more than STREAM_FROM by the compiled table, which counts them by grouping
+    them, so that grouping is kept when it is the answer."""
+    if len(xy) > max_points:
+        fine = voxel_centroids(xy, voxel) if len(xy) > STREAM_FROM else None
+        count = voxel_count(xy, voxel) if fine is None else len(fine)
+        if count > max_points:
+            grown = voxel * count / max_points
+            return voxel_centroids(xy, grown), grown
+        if fine is not None:
+            return fine, voxel
     return voxel_centroids(xy, voxel), voxel

@@ -96,10 +96,11 @@ def _band_by_chunks(points: np.ndarray, rotation: np.ndarray, low: float,
         z = _turned(kept.astype(np.float64), rotation[2]) - floor
         return (z >= low) & (z <= high)
 
-    band = np.empty((sum(int(np.count_nonzero(inside(kept))) for kept in candidates), 2))
+    keep = [inside(kept) for kept in candidates]  # a byte a candidate
+    band = np.empty((sum(int(np.count_nonzero(k)) for k in keep), 2))
     start = 0
     for i, kept in enumerate(candidates):
-        rows = kept.astype(np.float64)[inside(kept)]
+        rows = kept[keep[i]].astype(np.float64)
         candidates[i] = None  # each chunk's candidates freed once copied
         band[start:start + len(rows), 0] = _turned(rows, rotation[0])
         band[start:start + len(rows), 1] = _turned(rows, rotation[1])
