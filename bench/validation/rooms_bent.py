@@ -18,8 +18,8 @@ from pcmapq.testing.realdata.halmstad import halmstad_truth, paths
 
 from .common import Case, Record, Section, header, row
 from .noref import rho
-from .rooms_drift import RHO
-from .rooms_halmstad import DETECTORS, ROOMS_SETTINGS
+from .rooms_drift import RHO, rho_cell
+from .rooms_halmstad import DETECTORS, ROOMS_SETTINGS, truth_rooms
 
 #: Each building's map with the most truth rooms matched in the Halmstad rooms section (the
 #: first by name among equals): a map with rooms to lose.
@@ -72,12 +72,6 @@ def cases(data: Path) -> list[Case]:
             for name in MAPS for level in LEVELS]
 
 
-def _rho(value: float | None) -> str:
-    if value is None:
-        return "n/a"
-    return f"{value:.2f}" if value <= RHO else f"**{value:.2f}**"
-
-
 def section(data: Path, record: Record) -> Section:
     """Per map: each detector's quality at each bend, and its rank correlation with the bend."""
     got = [case.run(record) for case in cases(data)]
@@ -86,12 +80,9 @@ def section(data: Path, record: Record) -> Section:
         ladder = got[i * len(LEVELS):(i + 1) * len(LEVELS)]
         lines += [row([name if k == 0 else "", f"{100 * b.level:g}", f"{b.scale:.3f}",
                        b.verdict if b.verdict == SAME else f"**{b.verdict}**",
-                       *(score(b.quality[d], 2) for d in DETECTORS),
-                       ", ".join(f"{n} {key.replace('truth ', '')}"
-                                 for key, n in b.rooms.items()
-                                 if key.startswith("truth ") and "door" not in key)])
+                       *(score(b.quality[d], 2) for d in DETECTORS), truth_rooms(b.rooms)])
                   for k, b in enumerate(ladder)]
-        falls = [_rho(rho(list(LEVELS), [b.quality[d] for b in ladder])) for d in DETECTORS]
+        falls = [rho_cell(rho(list(LEVELS), [b.quality[d] for b in ladder])) for d in DETECTORS]
         lines.append(row(["", "rho", "", "", *falls, ""]))
     return Section("\n".join([
         "## Rooms of bent real maps: Halmstad maps bent more and more", "",

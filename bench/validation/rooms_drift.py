@@ -40,7 +40,10 @@ def rho(levels: list[float], values: list[float | None]) -> float:
     return float(spearmanr(levels, [0.0 if v is None else v for v in values])[0])
 
 
-def _rho(value: float) -> str:
+def rho_cell(value: float | None) -> str:
+    """A rank correlation for a table: bold where above RHO, "n/a" where undefined."""
+    if value is None:
+        return "n/a"
     return f"{value:.2f}" if value <= RHO else f"**{value:.2f}**"
 
 
@@ -67,8 +70,8 @@ def section(data: Path, record: Record) -> Section:
         truth_rooms = ladders[0][0].figures["detectors"]["rooms"]["truth_features"]
         lines.append(row([
             log, str(truth_rooms), " ".join(score(float(q), 2) for q in mean_q),
-            _rho(rho(levels, list(mean_q))), f"{rho(levels, list(mean_f)):.2f}",
-            " ".join(_rho(r) for r in each), f"{sum(r <= RHO for r in each)} of {len(each)}"]))
+            rho_cell(rho(levels, list(mean_q))), f"{rho(levels, list(mean_f)):.2f}",
+            " ".join(rho_cell(r) for r in each), f"{sum(r <= RHO for r in each)} of {len(each)}"]))
     return Section("\n".join([
         "## Rooms under drift: the CARMEN ladders scored by rooms", "",
         "The drift ladder of the CARMEN section (the same reference and drifted maps, levels "

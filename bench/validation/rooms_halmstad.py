@@ -89,8 +89,7 @@ def section(data: Path, record: Record) -> Section:
                                         [m.quality[d] for m in known])) for d in DETECTORS)]))
         lines += [row([m.name, _fmt(m.residual_px, 1), _fmt(m.fit_px, 1),
                        *(score(m.quality[d], 2) for d in DETECTORS),
-                       ", ".join(f"{n} {k.replace('truth ', '')}" for k, n in m.rooms.items()
-                                 if k.startswith("truth ") and "door" not in k)])
+                       truth_rooms(m.rooms)])
                   for m in maps]
     return Section("\n".join([
         "## Rooms of real robot maps: Halmstad against the layouts", "",
@@ -112,6 +111,12 @@ def section(data: Path, record: Record) -> Section:
                 "truth rooms"]),
         *lines,
     ]))
+
+
+def truth_rooms(counts: dict[str, int]) -> str:
+    """The truth rooms' statuses of a result's room counts, e.g. "7 matched, 1 split"."""
+    return ", ".join(f"{n} {k.replace('truth ', '')}" for k, n in counts.items()
+                     if k.startswith("truth ") and "door" not in k)
 
 
 def _rounded(value: float | None) -> float | None:
