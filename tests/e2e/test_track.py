@@ -270,6 +270,23 @@ def test_drift_at_a_known_scan_is_dated_by_the_worst_drop(runs: Runs) -> None:
     assert values(corrected.steps, "precision")[-1] >= 0.95
 
 
+def test_precision_leaves_the_rooms_out(runs: Runs) -> None:
+    """A step's ``precision``, the figure the worst drop follows, is the mean precision of
+    Harris, Hough and SIFT; the rooms' precision, which falls as a growing map's rooms are
+    drawn in part, is a column of its own and moves no drop."""
+    steps = [s for s in runs.track_run("corrected").steps if s.scored]
+    rooms_apart = 0
+    for step in steps:
+        f = step.figures
+        parts = [f[f"{d}_precision"] for d in ("harris", "hough", "sift")
+                 if f[f"{d}_precision"] is not None]
+        assert f["precision"] == pytest.approx(float(np.mean(parts)), abs=1e-6)  # 6 digits
+        if f["rooms_precision"] is not None:
+            rooms_apart += abs(float(np.mean([*parts, f["rooms_precision"]]))
+                               - f["precision"]) > 1e-5
+    assert rooms_apart > 0  # the rooms were found, and the mean would differ with them
+
+
 def test_the_newest_part_of_a_drifting_map_lies_off_the_truth(runs: Runs) -> None:
     """``local_offset_m``: the readings since the step before, aligned alone, move less than
     1 cm at the corrected poses and before the drift; from the first drifted step on they lie
