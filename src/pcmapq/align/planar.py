@@ -49,6 +49,14 @@ THINNED_TRUTH_VOXEL = 0.4
 CLOSE_FINALISTS = 0.9
 #: ... when it is another pose than every finalist's: farther than these, metres and degrees.
 SAME_POSE_M, SAME_POSE_DEG = 1.0, 5.0
+#: With the scale free, finalists whose fitness is within this of the best one's are told apart
+#: by the share of the truth's walls they cover: a map's fitness barely changes when it is
+#: shrunk into a part of the truth that looks like it, the walls it covers do (a bent map of a
+#: small building fits as well at half its scale in one half of it, covering a third of the
+#: truth's walls against four fifths; ``tests/e2e/test_bent_scale.py``).
+TIE_FITNESS = 0.02
+#: ... when it covers at least this share of the truth more than the fittest finalist does.
+TIE_COVERAGE = 0.05
 
 #: One refinement: a map -> truth transform in, the refined one out.
 Refine = Callable[[Similarity2D], Similarity2D]
@@ -239,16 +247,25 @@ def align_similarity(map_xy: np.ndarray, truth_xy: np.ndarray,
         return refine_point_to_line(_map_at_scale(map_xy, tf, voxel), lines, tf, tolerance,
                                     with_scale=True)
 
+    def covered(tf: Similarity2D) -> float:
+        """Share of the truth's points within ``tolerance`` of the map's, at ``tf``."""
+        near = cKDTree(tf.apply(_map_at_scale(map_xy, tf, voxel)))
+        return float(np.mean(np.isfinite(
+            near.query(truth_ds, distance_upper_bound=tolerance)[0])))
+
     best = refine_best(_starts(search, start), lambda tf: refine_similarity(map_xy, rough, tf),
-                       finish, scored, params.finalists_for(scale=True))
+                       finish, scored, params.finalists_for(scale=True), covered=covered)
     return _labelled(scored(best), search, "similarity+icp")
 
 
 def refine_best(starts: Sequence[Similarity2D], rough: Refine, fine: Refine,
-                scored: Callable[[Similarity2D], Alignment], finalists: int) -> Similarity2D:
+                scored: Callable[[Similarity2D], Alignment], finalists: int, *,
+                covered: Callable[[Similarity2D], float] | None = None) -> Similarity2D:
     """Every start refined by ``rough``; the ``finalists`` best of those (highest fitness, then
     lowest RMSE, by ``scored``), and any other pose within CLOSE_FINALISTS of the best
-    fitness, refined by ``fine``; the best of these. A single start (an
+    fitness, refined by ``fine``; the best of these. Given ``covered`` (the share of the
+    truth a pose covers), the one covering most among those within TIE_FITNESS of the best
+    fitness wins instead when it covers TIE_COVERAGE more than the best. A single start (an
     ``init``, every step of ``pcmapq track``) is refined without scoring: there is no choice
     to make."""
     if len(starts) == 1:
@@ -259,7 +276,15 @@ def refine_best(starts: Sequence[Similarity2D], rough: Refine, fine: Refine,
         if r.fitness >= CLOSE_FINALISTS * firsts[0].fitness and \
                 not any(_same_pose(r.transform, c.transform) for c in chosen):
             chosen.append(r)
-    return min((scored(fine(r.transform)) for r in chosen), key=_rank).transform
+    finals = sorted((scored(fine(r.transform)) for r in chosen), key=_rank)
+    if covered is None:
+        return finals[0].transform
+    tied = [f.transform for f in finals if f.fitness >= finals[0].fitness - TIE_FITNESS]
+    if len(tied) == 1:
+        return tied[0]
+    shares = [covered(tf) for tf in tied]
+    most = int(np.argmax(shares))
+    return tied[most] if shares[most] >= shares[0] + TIE_COVERAGE else tied[0]
 
 
 def _same_pose(a: Similarity2D, b: Similarity2D) -> bool:

@@ -7,7 +7,7 @@ import pytest
 
 from pcmapq.align import Alignment, AlignParams, align, score
 from pcmapq.align.coarse import coarse_search
-from pcmapq.align.planar import refine_best
+from pcmapq.align.planar import TIE_COVERAGE, TIE_FITNESS, refine_best
 from pcmapq.core.transform import Similarity2D
 from pcmapq.core.voxels import voxel_centroids
 from pcmapq.testing import synth
@@ -264,3 +264,21 @@ def test_thinned_map_runs_light_icp_and_lands(campus):
     dxy, dyaw = pose_error(t_true, result.transform)
     assert dxy < 0.05 and dyaw < 0.05, (dxy, dyaw)
     assert result.fitness > 0.99
+
+
+def test_refine_best_breaks_a_fitness_tie_by_the_truth_covered():
+    """Given ``covered``, a finalist within TIE_FITNESS of the best fitness that covers
+    TIE_COVERAGE more of the truth wins; a smaller gain in coverage, or a clear lead in
+    fitness, keeps the fittest."""
+    def run(fitness: dict[float, float], cover: dict[float, float]) -> float:
+        def scored(tf: Similarity2D) -> Alignment:
+            return Alignment(tf, fitness=fitness[tf.tx], rmse_m=0.0, tolerance_m=0.2, method="")
+
+        starts = [Similarity2D(x, 0.0, 0.0) for x in fitness]
+        return refine_best(starts, lambda tf: tf, lambda tf: tf, scored, len(starts),
+                           covered=lambda tf: cover[tf.tx]).tx
+
+    tie = TIE_FITNESS / 2
+    assert run({0.0: 0.43, 10.0: 0.43 - tie}, {0.0: 0.2, 10.0: 0.6}) == 10.0
+    assert run({0.0: 0.43, 10.0: 0.43 - tie}, {0.0: 0.2, 10.0: 0.2 + TIE_COVERAGE / 2}) == 0.0
+    assert run({0.0: 0.43, 10.0: 0.43 - 2 * TIE_FITNESS}, {0.0: 0.2, 10.0: 0.9}) == 0.0
