@@ -1,6 +1,7 @@
 """Rooms of bent real maps: a Halmstad map per building bent more and more (the slow turn that
-odometry drift gives a map, :func:`pcmapq.testing.synth.bend_image`) and scored against its
-building's layout: does the rooms' quality fall with the bend, as on the CARMEN ladders?"""
+odometry drift gives a map, :func:`pcmapq.testing.synth.bend_image`), each way and from each
+side, and scored against its building's layout: does the rooms' quality fall with the bend, as
+on the CARMEN ladders?"""
 
 from __future__ import annotations
 
@@ -9,6 +10,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 
 import cv2
+import numpy as np
 
 from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.report.text import score
@@ -17,8 +19,7 @@ from pcmapq.testing import synth
 from pcmapq.testing.realdata.halmstad import halmstad_truth, paths
 
 from .common import Case, Record, Section, header, row
-from .noref import rho
-from .rooms_drift import RHO, rho_cell
+from .rooms_drift import RHO, rho, rho_cell
 from .rooms_halmstad import DETECTORS, ROOMS_SETTINGS, truth_rooms
 
 #: Each building's map with the most truth rooms matched in the Halmstad rooms section (the
@@ -27,6 +28,10 @@ MAPS = ("E5_07", "F5_12", "HIH_01", "KPT4A_01")
 #: How far the bend moves the far corner of the map's known pixels, a share of their box's
 #: diagonal (on these maps 1 % is about 0.4-0.6 m).
 LEVELS = (0.0, 0.01, 0.02, 0.04, 0.08)
+#: The draws of every bend above 0: the map turned by k quarter turns, bent one way (+1) or the
+#: other (-1), and turned back, so that the bend grows along each side of the map in turn. The
+#: first is the bend alone.
+DRAWS = tuple((turns, way) for turns in range(4) for way in (1, -1))
 #: The maps' unknown grey.
 UNKNOWN = 127
 #: The Halmstad rooms settings, forced: a bent map the verdict refuses is scored all the same,
@@ -41,6 +46,7 @@ class Bent:
 
     name: str
     level: float
+    draw: int
     scale: float
     verdict: str
     quality: dict[str, float | None]
@@ -53,51 +59,75 @@ class Bent:
                 "rooms": self.rooms}
 
 
-def bent(name: str, level: float, data: Path) -> Bent:
-    """The map bent by ``level`` and scored against its layout with the four detectors."""
+def bent_image(image: np.ndarray, level: float, draw: int) -> np.ndarray:
+    """``image`` bent by ``level`` as draw ``draw`` of DRAWS bends it."""
+    turns, way = DRAWS[draw]
+    turned = np.ascontiguousarray(np.rot90(image, turns))
+    return np.ascontiguousarray(np.rot90(synth.bend_image(turned, way * level, UNKNOWN), -turns))
+
+
+def bent(name: str, level: float, draw: int, data: Path) -> Bent:
+    """The map bent by ``level`` (draw ``draw``) and scored against its layout with the four
+    detectors."""
     map_path, layout = paths(data, name)
     image = cv2.imread(str(map_path), cv2.IMREAD_UNCHANGED)
     with tempfile.TemporaryDirectory(prefix="pcmapq_halmstad_bent_") as tmp:
         drawn = Path(tmp) / f"{name}.png"
-        cv2.imwrite(str(drawn), synth.bend_image(image, level, UNKNOWN))
+        cv2.imwrite(str(drawn), bent_image(image, level, draw))
         result = evaluate(drawn, halmstad_truth(layout, Path(tmp)), SETTINGS)
-    return Bent(name, level, result.alignment.transform.scale, result.overlap.verdict,
+    return Bent(name, level, draw, result.alignment.transform.scale, result.overlap.verdict,
                 {k: d.matching.quality for k, d in result.detectors.items()},
                 result.rooms["counts"] if result.rooms else {})
 
 
+def draws(level: float) -> range:
+    """The draws of a level: one for the map unbent."""
+    return range(1 if level == 0 else len(DRAWS))
+
+
 def cases(data: Path) -> list[Case]:
-    return [Case(f"halmstad-rooms-bent-{name}-{100 * level:g}",
-                 lambda name=name, level=level: bent(name, level, data))
-            for name in MAPS for level in LEVELS]
+    return [Case(f"halmstad-rooms-bent-{name}-{100 * level:g}" + (f"-draw{k}" if k else ""),
+                 lambda name=name, level=level, k=k: bent(name, level, k, data))
+            for name in MAPS for level in LEVELS for k in draws(level)]
 
 
 def section(data: Path, record: Record) -> Section:
-    """Per map: each detector's quality at each bend, and its rank correlation with the bend."""
+    """Per map and bend: each detector's quality averaged over the draws, and its rank
+    correlation with the bend."""
     got = [case.run(record) for case in cases(data)]
     lines = []
-    for i, name in enumerate(MAPS):
-        ladder = got[i * len(LEVELS):(i + 1) * len(LEVELS)]
-        lines += [row([name if k == 0 else "", f"{100 * b.level:g}", f"{b.scale:.3f}",
-                       b.verdict if b.verdict == SAME else f"**{b.verdict}**",
-                       *(score(b.quality[d], 2) for d in DETECTORS), truth_rooms(b.rooms)])
-                  for k, b in enumerate(ladder)]
-        falls = [rho_cell(rho(list(LEVELS), [b.quality[d] for b in ladder])) for d in DETECTORS]
-        lines.append(row(["", "rho", "", "", *falls, ""]))
+    for name in MAPS:
+        means = []
+        for level in LEVELS:
+            runs = [b for b in got if b.name == name and b.level == level]
+            mean = {d: float(np.mean([b.quality[d] or 0.0 for b in runs])) for d in DETECTORS}
+            means.append(mean)
+            same = sum(b.verdict == SAME for b in runs)
+            scales = [b.scale for b in runs]
+            lines.append(row([
+                name if level == 0 else "", f"{100 * level:g}", str(len(runs)),
+                f"{min(scales):.3f}" + ("" if len(runs) == 1 else f"-{max(scales):.3f}"),
+                f"{same}" if same == len(runs) else f"**{same}**",
+                *(score(mean[d], 2) for d in DETECTORS), truth_rooms(runs[0].rooms)]))
+        falls = [rho_cell(rho(list(LEVELS), [m[d] for m in means])) for d in DETECTORS]
+        lines.append(row(["", "rho", "", "", "", *falls, ""]))
     return Section("\n".join([
         "## Rooms of bent real maps: Halmstad maps bent more and more", "",
         "The Halmstad maps do not span a range of drift (their keypoints' own fit residuals, "
         "above, are the annotations' noise), so drift is put into them: each building's map "
-        "with the most truth rooms matched above, bent about the lower-left corner of its "
-        "known pixels by an angle growing along x (`synth.bend_image`, the turn that odometry "
-        "drift gives a map, as `synth.bend` bends the synthetic plans) so that the far corner "
-        "moves by the given share of the known box's diagonal, then scored against its "
-        "layout as above (scale unknown), with `force`: scale is the scale the alignment "
-        "found; verdict in bold where it is not the same place. rho: Spearman's rank "
-        "correlation of the quality with the bend, "
-        f"over the {len(LEVELS)} levels (n/a: no quality, or all equal); bold where above "
-        f"{RHO}.", "",
-        header(["map", "bend % of diagonal", "scale", "verdict", *(f"q {d}" for d in DETECTORS),
-                "truth rooms"]),
+        "with the most truth rooms matched above, bent about a corner of its known pixels by "
+        "an angle growing along one side (`synth.bend_image`, the turn that odometry drift "
+        "gives a map, as `synth.bend` bends the synthetic plans) so that the far corner moves "
+        "by the given share of the known box's diagonal, then scored against its layout as "
+        f"above (scale unknown), with `force`. Each bend above 0 is drawn {len(DRAWS)} times: "
+        "bent one way and the other along each of the map's four sides in turn (the map "
+        "turned by quarter turns before the bend and back after). q: each detector's quality "
+        "averaged over the draws (an undefined quality counts as 0); scale: the scales the "
+        "alignment found; same place: the draws the verdict takes for the same place, bold "
+        "where not all; truth rooms: the statuses of the first draw's. rho: Spearman's rank "
+        "correlation of the mean quality with the bend, "
+        f"over the {len(LEVELS)} levels; bold where above {RHO}.", "",
+        header(["map", "bend % of diagonal", "draws", "scale", "same place",
+                *(f"q {d}" for d in DETECTORS), "truth rooms (first draw)"]),
         *lines,
     ]))
