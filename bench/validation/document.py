@@ -104,7 +104,7 @@ def write_one(name: str, section: Section, path: Path = DOC) -> None:
     if len(present) != len(blocks):
         raise ValueError(f"{path}: {len(blocks)} sections, expected {len(present)}")
     placed = dict(zip(present, blocks, strict=True))
-    placed[name] = section.text
+    placed[name] = section.text.rstrip("\n")
     opening_text, _, again = head.partition("\n\n" + AGAIN)
     notes = [n for n in again.rstrip(".").split("; ") if n and not n.startswith(f"`{name}` ")]
     notes.append(f"`{name}` on {datetime.date.today().isoformat()} ({commit()})")

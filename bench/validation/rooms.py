@@ -188,6 +188,11 @@ def cases(data: Path) -> list[Case]:
          for name in MAPS]
 
 
+def _f1(pairs: np.ndarray) -> np.ndarray:
+    """Each plan's f1, the harmonic mean of its (precision, recall) row."""
+    return 2 * pairs[:, 0] * pairs[:, 1] / (pairs[:, 0] + pairs[:, 1])
+
+
 def _pct(value: float) -> str:
     return f"{100 * value:.1f}"
 
@@ -226,10 +231,11 @@ def section(data: Path, record: Record) -> Section:
         ours = [r for r in runs if r.name.endswith("(furnished)") == furnished
                 and r.name.split(" ")[0] in table]
         theirs = np.array([table[r.name.split(" ")[0]] for r in ours])
+        mine = 100 * np.array([(r.precision_micro, r.recall_micro) for r in ours])
         compare.append(row([
             method, str(len(ours)), f"{theirs[:, 0].mean():.1f}", f"{theirs[:, 1].mean():.1f}",
-            _pct(np.mean([r.precision_micro for r in ours])),
-            _pct(np.mean([r.recall_micro for r in ours]))]))
+            f"{_f1(theirs).mean():.1f}", f"{mine[:, 0].mean():.1f}", f"{mine[:, 1].mean():.1f}",
+            f"{_f1(mine).mean():.1f}"]))
     plain = [r for r in runs if not r.name.endswith("(furnished)")]
     furn = [r for r in runs if r.name.endswith("(furnished)")]
     averages = [row([label, _pct(np.mean([r.precision_micro for r in rs])),
@@ -254,9 +260,10 @@ def section(data: Path, record: Record) -> Section:
                 "recall IoU 0.5 %"]),
         *averages, "",
         "Beside the published per-map results (`rooms/third_party_results/`), averaged over "
-        "the plans each method reports:", "",
-        header(["method", "plans", "its precision %", "its recall %", "pcmapq precision %",
-                "pcmapq recall %"]),
+        "the plans each method reports (f1: each plan's harmonic mean of its precision and "
+        "recall micro, averaged):", "",
+        header(["method", "plans", "its precision %", "its recall %", "its f1 %",
+                "pcmapq precision %", "pcmapq recall %", "pcmapq f1 %"]),
         *compare, "",
         "### Real robot maps against hand-made room labels", "",
         "`plans/bonn_youbot_tmcl/`: one office floor, 12 rooms with the corridor, labelled "
