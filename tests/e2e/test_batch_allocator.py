@@ -33,7 +33,7 @@ print(changed, outside, within, faults())
 """
 
 
-@pytest.mark.skipif(allocator._glibc() is None, reason="glibc's allocator only")
+@pytest.mark.skipif(allocator.glibc() is None, reason="glibc's allocator only")
 def test_rows_reuse_pages_in_dasks_environment():
     env = {k: v for k, v in os.environ.items() if not k.startswith("MALLOC_")}
     got = subprocess.run([sys.executable, "-c", CHILD], capture_output=True, text=True,

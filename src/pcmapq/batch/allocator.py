@@ -17,9 +17,10 @@ from __future__ import annotations
 
 import contextlib
 import ctypes
-import functools
 import os
 from collections.abc import Iterator, Mapping
+
+from pcmapq.core.heap import glibc
 
 #: mallopt's parameters (malloc.h).
 M_TRIM_THRESHOLD, M_MMAP_THRESHOLD = -1, -3
@@ -27,22 +28,6 @@ M_TRIM_THRESHOLD, M_MMAP_THRESHOLD = -1, -3
 #: (DEFAULT_MMAP_THRESHOLD_MAX: 32 MiB on 64-bit); the trim threshold follows at twice it.
 MMAP_START = 128 * 1024
 MMAP_MAX = 4 * 1024 * 1024 * ctypes.sizeof(ctypes.c_long)
-
-
-@functools.cache
-def _glibc() -> ctypes.CDLL | None:
-    """The process's C library when it is glibc (mallopt and malloc_trim), else None."""
-    try:
-        if not os.confstr("CS_GNU_LIBC_VERSION"):
-            return None
-        libc = ctypes.CDLL(None)
-    except (ValueError, OSError, AttributeError):  # not glibc, or no os.confstr
-        return None
-    if not (hasattr(libc, "mallopt") and hasattr(libc, "malloc_trim")):
-        return None
-    libc.mallopt.argtypes, libc.mallopt.restype = [ctypes.c_int, ctypes.c_int], ctypes.c_int
-    libc.malloc_trim.argtypes, libc.malloc_trim.restype = [ctypes.c_size_t], ctypes.c_int
-    return libc
 
 
 def start_environment() -> Mapping[str, str]:
@@ -66,7 +51,7 @@ def fixed_trim_threshold(environ: Mapping[str, str] | None = None) -> int | None
     left alone); else None."""
     environ = start_environment() if environ is None else environ
     trim = environ.get("MALLOC_TRIM_THRESHOLD_")
-    if trim is None or "MALLOC_MMAP_THRESHOLD_" in environ or _glibc() is None:
+    if trim is None or "MALLOC_MMAP_THRESHOLD_" in environ or glibc() is None:
         return None
     try:
         return int(trim.strip(), 0)
@@ -82,7 +67,7 @@ def glibc_thresholds() -> Iterator[bool]:
     memory returned to the system. Nothing where it started with none, or on another C library.
     Yields whether it changed them. One caller at a time: the thresholds are the process's."""
     trim = fixed_trim_threshold()
-    libc = None if trim is None else _glibc()
+    libc = None if trim is None else glibc()
     if libc is None:
         yield False
         return

@@ -148,13 +148,17 @@ def _dense_groups(index: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
     return keys, slots[linear]
 
 
-def voxel_centroids(points: np.ndarray, voxel: float, scale: float = 1.0) -> np.ndarray:
+def voxel_centroids(points: np.ndarray, voxel: float, scale: float = 1.0,
+                    stripe_points: int | None = None) -> np.ndarray:
     """The centroid of the points (N, d; d = 2 or 3) times ``scale``, metres, in each
     ``voxel``-metre cell, (M, d), sorted by voxel index (x, then y, ...). Deterministic. A large
-    cloud (a file mapped into memory, say) is read in chunks, never converted whole."""
+    cloud (a file mapped into memory, say) is read in chunks, never converted whole; with more
+    than ``stripe_points`` points, in stripes of x, a pass each, holding one stripe's voxels at
+    a time (:func:`~pcmapq.core.voxel_table.streamed_centroids`)."""
     points = np.asarray(points)
     if points.ndim == 2 and points.shape[1] in (2, 3) and len(points) > STREAM_FROM:
-        return voxel_table.streamed_centroids(points, voxel, scale)  # the same, without a sort
+        return voxel_table.streamed_centroids(points, voxel, scale,  # the same, without a sort
+                                              stripe_points=stripe_points)
     points = np.asarray(points, dtype=np.float64)
     if scale != 1.0:
         points = points * scale

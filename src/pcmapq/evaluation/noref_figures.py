@@ -13,6 +13,7 @@ from typing import Any
 
 import numpy as np
 
+from pcmapq.core.heap import release_free_memory
 from pcmapq.core.voxels import voxel_centroids
 from pcmapq.evaluation.inputs import truth_raster
 from pcmapq.io import OccupancyMap, PointMap
@@ -39,13 +40,19 @@ def input_figures(source: OccupancyMap | PointMap, config: NoRefConfig = NoRefCo
     return {"cloud": None, "grid": occupancy_figures(source, scale, corners)}
 
 
+#: A cloud of more than this many points is reduced in stripes of x, one pass over its points
+#: each, so that the voxel table holds one stripe's voxels at a time: the 97 M-point cloud's
+#: table of 9.7 M voxels took about 1 GB beside the evaluation (docs/benchmarks.md).
+STRIPE_POINTS = 25_000_000
+
+
 def reduced(points: np.ndarray, voxel: float, scale: float = 1.0) -> np.ndarray:
     """(M, 3) float64: ``points`` times ``scale``, metres, reduced to their centroid in each
     voxel of ``voxel`` metres (0: all of them); a large cloud mapped onto its file is read in
     chunks, never converted whole (:func:`~pcmapq.core.voxels.voxel_centroids`)."""
     if voxel <= 0:
         return np.asarray(points, dtype=np.float64) * scale
-    return voxel_centroids(points, voxel, scale)
+    return voxel_centroids(points, voxel, scale, stripe_points=STRIPE_POINTS)
 
 
 def occupancy_figures(source: OccupancyMap | PointMap, scale: float = 1.0,
@@ -73,13 +80,25 @@ def occupancy_figures(source: OccupancyMap | PointMap, scale: float = 1.0,
 BACKGROUND_NICE = 10
 
 
+#: A map cloud of more than this many points, reduced in one pass (at most STRIPE_POINTS), has
+#: its figures wait for its plan points (:meth:`EarlyFigures.walls_found`): its wall band is
+#: shorter than the reduction beside it, and the band's end is the evaluation's first peak in
+#: memory (a 10 M-point cloud: the figures' voxel table beside it raised the peak 9-13 %; after
+#: it, 0-1 %). A cloud reduced in stripes starts at once: its wall band is long enough for the
+#: reduction to end within it (11 s at 97 M points), and after it the table would stand beside
+#: the plan's global search, that run's peak (16-22 % measured; docs/benchmarks.md).
+DEFER_FROM = 2_000_000
+
+
 class EarlyFigures:
     """The no-reference figures of an evaluation's 3D clouds and of an image map, found on a
     thread of their own while the map is placed (they need neither the alignment nor the
     truth's features). The thread is a daemon's, so a map refused before its figures are
     wanted does not wait for them. A map whose scale is estimated, a 2D cloud, and an image
     truth (whose corners the truth's own Harris features give) are left to
-    :func:`input_figures` after the alignment."""
+    :func:`input_figures` after the alignment. With a map cloud of DEFER_FROM to
+    STRIPE_POINTS points the thread starts its work once :meth:`walls_found` is called (or
+    the figures are wanted)."""
 
     def __init__(self, sides: dict[str, OccupancyMap | PointMap], settings: Settings) -> None:
         config = settings.noref
@@ -90,19 +109,36 @@ class EarlyFigures:
                  or (side == "map" and isinstance(source, OccupancyMap)))}
         self._figures: dict[str, dict[str, Any]] = {}
         self._error: BaseException | None = None
+        self._go, self._cancelled = threading.Event(), False
+        cloud = sides.get("map")
+        if not (isinstance(cloud, PointMap) and DEFER_FROM < len(cloud.points) <= STRIPE_POINTS):
+            self._go.set()
         self._thread = threading.Thread(target=self._run, args=(config,), daemon=True,
                                         name="pcmapq-noref")
         if self._sources:
             self._thread.start()
+
+    def walls_found(self) -> None:
+        """The map's plan points are found: a deferred thread may start."""
+        self._go.set()
+
+    def cancel(self) -> None:
+        """The evaluation stopped: a thread still waiting to start does no work."""
+        self._cancelled = True
+        self._go.set()
 
     def _run(self, config: NoRefConfig) -> None:
         try:
             os.setpriority(os.PRIO_PROCESS, threading.get_native_id(), BACKGROUND_NICE)
         except (AttributeError, OSError):  # not Linux: the thread keeps the process's priority
             pass
+        self._go.wait()
+        if self._cancelled:
+            return
         try:
             for side, source in self._sources.items():
                 self._figures[side] = input_figures(source, config)
+            release_free_memory()  # the reduction's table and chunks, freed into the heap
         except BaseException as exc:  # handed to the caller by get()
             self._error = exc
 
@@ -111,6 +147,7 @@ class EarlyFigures:
         when this side was left to the caller."""
         if side not in self._sources:
             return None
+        self._go.set()
         self._thread.join()
         if self._error is not None:
             raise self._error

@@ -34,9 +34,10 @@ def evaluate(map_path: str | Path | PointMap, truth_path: str | Path,
                              background=True)
     early = EarlyFigures({"map": source, "truth": truth}, settings)
     try:
-        result = score(place(source, prepared, settings, progress), prepared, settings,
-                       progress, early)
+        result = score(place(source, prepared, settings, progress, early.walls_found),
+                       prepared, settings, progress, early)
     except BaseException:
         prepared.cancel()
+        early.cancel()
         raise
     return replace(result, truth_sha256=truth_sha256 or sha256_file(truth_path))

@@ -60,10 +60,12 @@ class Placed:
 
 
 def place(source: OccupancyMap | PointMap, prepared: PreparedTruth, settings: Settings,
-          progress: Progress = lambda step: None) -> Placed:
+          progress: Progress = lambda step: None,
+          walls_found: Callable[[], None] = lambda: None) -> Placed:
     """Align ``source`` to the prepared truth, draw it on the truth's grid and measure the
     overlap. A map that does not seem to show the truth's place is refused (EvaluationError)
-    unless ``settings.alignment.force``."""
+    unless ``settings.alignment.force``. ``walls_found`` is called once the map's plan points
+    are found (a cloud's wall band, the first large step)."""
     check_span(source, MAP_CROP)
     rule = map_footprint_rule(source, settings)
     progress("aligning")
@@ -71,6 +73,7 @@ def place(source: OccupancyMap | PointMap, prepared: PreparedTruth, settings: Se
     given = source
     source, registration = align_clouds_3d(source, truth, settings)
     map_xy, map_level = plan_points(source, settings)
+    walls_found()
     target = prepared.aligner
     if target is None or not target.fits(option.params):
         target = RigidTarget(prepared.xy, option.params)

@@ -15,7 +15,7 @@ from pcmapq.batch import allocator
 @pytest.fixture
 def glibc(monkeypatch):
     """A C library with mallopt, whatever this machine's: nothing here calls it."""
-    monkeypatch.setattr(allocator, "_glibc", lambda: object())
+    monkeypatch.setattr(allocator, "glibc", lambda: object())
 
 
 @pytest.mark.parametrize("environ, fixed", [
@@ -46,7 +46,7 @@ def test_the_environment_the_process_started_with(glibc, monkeypatch):
 
 def test_other_c_library(monkeypatch):
     """Another C library than glibc (musl, macOS): nothing fixed, nothing changed."""
-    monkeypatch.setattr(allocator, "_glibc", lambda: None)
+    monkeypatch.setattr(allocator, "glibc", lambda: None)
     monkeypatch.setattr(allocator, "start_environment",
                         lambda: {"MALLOC_TRIM_THRESHOLD_": "65536"})
     assert allocator.fixed_trim_threshold() is None

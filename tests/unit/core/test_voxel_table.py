@@ -57,7 +57,7 @@ def test_voxel_centroids_of_a_large_cloud_are_the_tables(dims, monkeypatch):
     calls = []
     table = voxel_table.streamed_centroids
     monkeypatch.setattr(voxel_table, "streamed_centroids",
-                        lambda p, *rest: calls.append(len(p)) or table(p, *rest))
+                        lambda p, *rest, **kw: calls.append(len(p)) or table(p, *rest, **kw))
     one_shot = VoxelMap(0.2, dims=dims)
     one_shot.add(points)
     assert np.array_equal(voxel_centroids(points, 0.2), one_shot.points())
@@ -79,3 +79,31 @@ def test_a_cloud_beyond_the_keys_range_is_refused_in_one_line(far):
     with pytest.raises(InputError) as one_shot:
         one_shot_map.points()
     assert str(table.value) == str(one_shot.value)
+
+
+@pytest.mark.parametrize("dims", [2, 3])
+@pytest.mark.parametrize("stripe_points", [9_000, 30_000, 79_999])
+def test_a_cloud_reduced_in_stripes_of_x_gives_the_same_centroids(dims, stripe_points,
+                                                                 monkeypatch):
+    """Stripes of x, one pass each (moved chunk by chunk, on a float32 cloud, the table growing
+    in each): the centroids of one pass, bit for bit and in their order."""
+    rng = np.random.default_rng(6)
+    points = np.vstack([rng.normal(0, 25, (40_000, dims)),
+                        rng.uniform(0, 0.5, (40_000, dims))]).astype(np.float32)
+    monkeypatch.setattr(voxel_table, "CHUNK", 7_000)
+    whole = voxel_table.streamed_centroids(points, 0.1, 2.5)
+    striped = voxel_table.streamed_centroids(points, 0.1, 2.5, stripe_points=stripe_points)
+    assert np.array_equal(striped, whole)
+    if dims == 2:
+        move = Similarity2D(3.0, -7.0, np.radians(33.0), 1.0).apply
+        assert np.array_equal(
+            voxel_table.streamed_centroids(points, 0.15, move=move, stripe_points=stripe_points),
+            voxel_table.streamed_centroids(points, 0.15, move=move))
+
+
+def test_stripes_see_every_point_beyond_the_keys_range():
+    """A point beyond the keys' range is refused whichever stripe it would fall in."""
+    points = np.zeros((30_000, 3))
+    points[-1, 1] = 1e9
+    with pytest.raises(InputError, match="beyond"):
+        voxel_table.streamed_centroids(points, 0.1, stripe_points=5_000)

@@ -4,8 +4,11 @@ of the whole cloud's, and MOM's planes come from the cloud at a third of the rad
 
 from __future__ import annotations
 
+import time
+
 import numpy as np
 
+from pcmapq.evaluation import noref_figures as early_figures
 from pcmapq.evaluation.noref_figures import EarlyFigures, input_figures, reduced
 from pcmapq.io import PointMap
 from pcmapq.metrics import noref
@@ -82,3 +85,27 @@ def test_figures_found_while_the_map_is_placed_equal_those_found_after(tmp_path)
     early = EarlyFigures({"map": cloud, "truth": flat}, settings)
     assert early.get("truth") is None  # a 2D cloud's figures are left to the caller
     assert early.get("map") == input_figures(cloud, settings.noref)
+
+
+def test_a_large_cloud_s_figures_wait_for_its_walls(tmp_path, monkeypatch):
+    """Above DEFER_FROM points the map's figures start once its plan points are found (its wall
+    band is over), and are those found at once; a cancelled evaluation's thread does no work."""
+    monkeypatch.setattr(early_figures, "DEFER_FROM", 10_000)
+    cloud = PointMap(tmp_path / "room.ply", _box_room(8), True)
+    settings = Settings()
+    early = EarlyFigures({"map": cloud}, settings)
+    time.sleep(0.2)
+    assert early._thread.is_alive() and not early._figures  # waiting, nothing done
+    early.walls_found()
+    assert early.get("map") == input_figures(cloud, settings.noref)
+    stopped = EarlyFigures({"map": cloud}, settings)
+    stopped.cancel()
+    stopped._thread.join(timeout=60)
+    assert not stopped._thread.is_alive() and not stopped._figures
+
+
+def test_a_small_cloud_s_figures_start_at_once(tmp_path):
+    cloud = PointMap(tmp_path / "room.ply", _box_room(8), True)
+    early = EarlyFigures({"map": cloud}, Settings())
+    early._thread.join(timeout=60)
+    assert set(early._figures) == {"map"}
