@@ -84,9 +84,9 @@ BACKGROUND_NICE = 10
 #: its figures wait for its plan points (:meth:`EarlyFigures.walls_found`): its wall band is
 #: shorter than the reduction beside it, and the band's end is the evaluation's first peak in
 #: memory (a 10 M-point cloud: the figures' voxel table beside it raised the peak 9-13 %; after
-#: it, 0-1 %). A cloud reduced in stripes starts at once: its wall band is long enough for the
+#: it, 1-3 %). A cloud reduced in stripes starts at once: its wall band is long enough for the
 #: reduction to end within it (11 s at 97 M points), and after it the table would stand beside
-#: the plan's global search, that run's peak (16-22 % measured; docs/benchmarks.md).
+#: the plan's global search, that run's peak (16-24 % measured; docs/benchmarks.md).
 DEFER_FROM = 2_000_000
 
 
