@@ -14,7 +14,7 @@ import numpy as np
 
 from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.report.text import score
-from pcmapq.results.result import SAME
+from pcmapq.results.result import INCONSISTENT, OTHER
 from pcmapq.testing import synth
 from pcmapq.testing.realdata.halmstad import halmstad_truth, paths
 
@@ -102,12 +102,14 @@ def section(data: Path, record: Record) -> Section:
             runs = [b for b in got if b.name == name and b.level == level]
             mean = {d: float(np.mean([b.quality[d] or 0.0 for b in runs])) for d in DETECTORS}
             means.append(mean)
-            same = sum(b.verdict == SAME for b in runs)
+            scored = sum(b.verdict != OTHER for b in runs)
+            inconsistent = sum(b.verdict == INCONSISTENT for b in runs)
             scales = [b.scale for b in runs]
             lines.append(row([
                 name if level == 0 else "", f"{100 * level:g}", str(len(runs)),
                 f"{min(scales):.3f}" + ("" if len(runs) == 1 else f"-{max(scales):.3f}"),
-                f"{same}" if same == len(runs) else f"**{same}**",
+                (f"{scored}" if scored == len(runs) else f"**{scored}**")
+                + (f" ({inconsistent} inconsistent)" if inconsistent else ""),
                 *(score(mean[d], 2) for d in DETECTORS), truth_rooms(runs[0].rooms)]))
         falls = [rho_cell(rho(list(LEVELS), [m[d] for m in means])) for d in DETECTORS]
         lines.append(row(["", "rho", "", "", "", *falls, ""]))
@@ -123,11 +125,13 @@ def section(data: Path, record: Record) -> Section:
         "bent one way and the other along each of the map's four sides in turn (the map "
         "turned by quarter turns before the bend and back after). q: each detector's quality "
         "averaged over the draws (an undefined quality counts as 0); scale: the scales the "
-        "alignment found; same place: the draws the verdict takes for the same place, bold "
-        "where not all; truth rooms: the statuses of the first draw's. rho: Spearman's rank "
+        "alignment found; scored: the draws the verdict scores (the same place, or the same "
+        "place with an inconsistent map: at least 3 of its 8 parts, placed on their own, "
+        "agree with its pose), bold where not all, and how many of them it finds "
+        "inconsistent; truth rooms: the statuses of the first draw's. rho: Spearman's rank "
         "correlation of the mean quality with the bend, "
         f"over the {len(LEVELS)} levels; bold where above {RHO}.", "",
-        header(["map", "bend % of diagonal", "draws", "scale", "same place",
+        header(["map", "bend % of diagonal", "draws", "scale", "scored",
                 *(f"q {d}" for d in DETECTORS), "truth rooms (first draw)"]),
         *lines,
     ]))
