@@ -31,7 +31,7 @@ LOGS = ("fhw-corrected.log.gz", "aces-corrected.log.gz")
 EVERY = 20
 LEVEL = 0.02
 START_SHARE = 0.5
-#: The figures compared: the detectors' mean precision (the worst drop's), each detector's
+#: The figures compared: the mean precision (the worst drop's), each detector's
 #: quality, the share of the map's walls within 0.1 m of the truth's, and how far the newest
 #: part of the map lies off the truth.
 FIGURES = ("precision", "harris_quality", "hough_quality", "sift_quality",
@@ -159,8 +159,9 @@ def section(data: Path, record: Record) -> Section:
             "its map so far against the map of all its corrected poses, inside the area its "
             "scans saw) twice: at its corrected poses, and at poses integrated again with a "
             f"{100 * LEVEL:g} % gain error on every rotation and translation increment after "
-            "its middle scan k. The worst drop is the largest fall of the detectors' mean "
-            "precision from its highest value so far (docs/metrics.md).", ""]
+            "its middle scan k. The worst drop is the largest fall of the mean precision of "
+            "Harris, Hough and SIFT (the rooms' precision, which falls as a growing map's rooms "
+            "are drawn in part, aside) from its highest value so far (docs/metrics.md).", ""]
     files = {}
     for c in measured:
         stem = c.log.split("-")[0]
