@@ -44,16 +44,27 @@ class _Grid:
     columns in sorted order (empty where there are no points)."""
 
     def __init__(self, pts: np.ndarray, radius: float) -> None:
+        # Built an axis at a time, with no temporary of all the points beside those kept (a
+        # 9.7 M-point map: about 40 bytes a point less at the peak).
         self.axes = np.argsort(np.ptp(pts, axis=0), kind="stable")  # longest axis last
         self.low = pts.min(axis=0)[self.axes[:2]]
-        ij = np.floor((pts[:, self.axes[:2]] - self.low) / radius).astype(np.int64) + 1
-        dim1 = int(ij[:, 1].max()) + 2
-        if (int(ij[:, 0].max()) + 2) * dim1 >= 2**62:
+        i, j = (np.floor((pts[:, a] - low) / radius).astype(np.int64) + 1
+                for a, low in zip(self.axes[:2], self.low, strict=True))
+        dim1 = int(j.max()) + 2
+        if (int(i.max()) + 2) * dim1 >= 2**62:
             raise ValueError(f"radius {radius} m is too small for the map's extent")
-        col = ij[:, 0] * dim1 + ij[:, 1]
+        col = i * dim1 + j
+        del i, j
         self.order = np.lexsort((pts[:, self.axes[2]], col))
-        self.xyz = np.ascontiguousarray(pts[self.order].T)
-        cols, starts, counts = np.unique(col[self.order], return_index=True, return_counts=True)
+        self.xyz = np.empty((3, len(pts)))
+        for axis in range(3):
+            self.xyz[axis] = pts[self.order, axis]
+        col = col[self.order]
+        # the columns' runs in sorted order: np.unique(col, return_index, return_counts)
+        starts = np.flatnonzero(np.concatenate(([True], col[1:] != col[:-1])))
+        cols = col[starts]
+        counts = np.diff(np.append(starts, len(col)))
+        del col
         self.rank = np.repeat(np.arange(len(cols)), counts)
         self.cell = np.column_stack([cols // dim1, cols % dim1])
         ends = starts + counts
@@ -148,8 +159,8 @@ def ball_sums(points: np.ndarray, radius: float, chunk_points: int = CHUNK_POINT
               workers: int | None = None,
               queries: np.ndarray | None = None) -> Iterator[tuple[np.ndarray, np.ndarray]]:
     """Yield (indices into ``points``, (k, 10) moment sums) over the neighbourhood (points with
-    |p - q| < ``radius`` metres) of every point, or of the points ``queries`` (indices into
-    ``points``) only: count, sums of x, y, z, xx, xy, xz, yy, yz, zz of the neighbours' offsets
+    |p - q| < ``radius`` metres) of every point, or of the points ``queries`` (distinct indices
+    into ``points``) only: count, sums of x, y, z, xx, xy, xz, yy, yz, zz of the neighbours' offsets
     from the point itself. Chunks of about ``chunk_points`` points, in an order and with figures
     independent of ``workers`` (threads; default Numba's, at most its ``NUMBA_NUM_THREADS``);
     a point's sums are the same whether it is one of ``queries`` or not. Memory: the sorted map
@@ -160,10 +171,10 @@ def ball_sums(points: np.ndarray, radius: float, chunk_points: int = CHUNK_POINT
     grid = _Grid(pts, radius)
     if queries is None:
         rows = np.arange(len(pts), dtype=np.int64)
-    else:
-        sorted_at = np.empty(len(pts), dtype=np.int64)
-        sorted_at[grid.order] = np.arange(len(pts))
-        rows = np.sort(sorted_at[np.asarray(queries, dtype=np.int64)])
+    else:  # the sorted positions of the queries, in order (a byte a point, not an index)
+        asked = np.zeros(len(pts), dtype=bool)
+        asked[np.asarray(queries, dtype=np.int64)] = True
+        rows = np.flatnonzero(asked[grid.order])
     threads = min(workers or numba.get_num_threads(), numba.config.NUMBA_NUM_THREADS)
     step = max(1, chunk_points)
     for p0 in range(0, len(rows), step):
