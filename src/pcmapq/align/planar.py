@@ -2,14 +2,14 @@
 (:mod:`~pcmapq.align.coarse`), then ICP from its best candidates. ``Alignment.transform`` takes
 map-frame points to the truth frame, ``p_truth = s * R(yaw) * p_map + t``.
 
-Rigid and similarity alignment run the same refinement (:func:`refine_best`): a rough ICP stage
-from every candidate of the search (or from ``init``), the best ``finalists`` of those by
-fitness through the fine stages, and the best of these by fitness, then RMSE. Point-to-line
-finishes it: each finalist's fine stages with the scale free, the winner alone when rigid."""
+Rigid and similarity alignment run the same refinement
+(:func:`~pcmapq.align.finalists.refine_best`): a rough ICP stage from every candidate of the
+search (or from ``init``), the best ``finalists`` of those by fitness through the fine stages,
+and the best of these by fitness, then RMSE. Point-to-line finishes it: each finalist's fine
+stages with the scale free, the winner alone when rigid."""
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -23,12 +23,13 @@ from pcmapq.align.coarse import (
     similarity_resolution,
     similarity_search,
 )
+from pcmapq.align.finalists import refine_best
 from pcmapq.align.params import AlignParams
 from pcmapq.align.point_to_line import LineTarget, refine_point_to_line
 from pcmapq.align.point_to_point import DEFAULT_SCHEDULE, IcpTarget, refine_point_to_point
 from pcmapq.align.pyramid import descend
 from pcmapq.align.similarity_icp import SimilarityTarget, refine_similarity, similarity_schedule
-from pcmapq.core.transform import Similarity2D, wrapped
+from pcmapq.core.transform import Similarity2D
 from pcmapq.core.voxels import evenly, thinned, voxel_centroids
 
 #: The truth keeps this many times the map's ``max_points``: a sparse target would put map points
@@ -41,26 +42,6 @@ TRUTH_POINTS = 10
 #: RMSE still use every thinned map point and truth point.
 ICP_POINTS = 5_000
 THINNED_TRUTH_VOXEL = 0.4
-
-#: A rough-stage result whose fitness is at least this share of the best one's goes through the
-#: fine stages too, beyond the ``finalists``: clutter can drag the rough stage of the right
-#: start below a wrong pose's, which the fine stages then overtake
-#: (``tests/e2e/test_placement.py``, a plan under 800 boxes).
-CLOSE_FINALISTS = 0.9
-#: ... when it is another pose than every finalist's: farther than these, metres and degrees.
-SAME_POSE_M, SAME_POSE_DEG = 1.0, 5.0
-#: With the scale free, finalists whose fitness is within this of the best one's are told apart
-#: by the share of the truth's walls they cover: a map's fitness barely changes when it is
-#: shrunk into a part of the truth that looks like it, the walls it covers do (a bent map of a
-#: small building fits as well at half its scale in one half of it, covering 18 % of the truth's
-#: walls against 57 %; ``tests/realdata/test_scale_halmstad.py``).
-TIE_FITNESS = 0.02
-#: ... when it covers at least this share of the truth more than the fittest finalist does.
-TIE_COVERAGE = 0.05
-
-#: One refinement: a map -> truth transform in, the refined one out.
-Refine = Callable[[Similarity2D], Similarity2D]
-
 
 @dataclass(frozen=True)
 class Alignment:
@@ -258,42 +239,6 @@ def align_similarity(map_xy: np.ndarray, truth_xy: np.ndarray,
     return _labelled(scored(best), search, "similarity+icp")
 
 
-def refine_best(starts: Sequence[Similarity2D], rough: Refine, fine: Refine,
-                scored: Callable[[Similarity2D], Alignment], finalists: int, *,
-                covered: Callable[[Similarity2D], float] | None = None) -> Similarity2D:
-    """Every start refined by ``rough``; the ``finalists`` best of those (highest fitness, then
-    lowest RMSE, by ``scored``), and any other pose within CLOSE_FINALISTS of the best
-    fitness, refined by ``fine``; the best of these. Given ``covered`` (the share of the
-    truth a pose covers), the one covering most among those within TIE_FITNESS of the best
-    fitness wins instead when it covers TIE_COVERAGE more than the best. A single start (an
-    ``init``, every step of ``pcmapq track``) is refined without scoring: there is no choice
-    to make."""
-    if len(starts) == 1:
-        return fine(rough(starts[0]))
-    firsts = sorted((scored(rough(s)) for s in starts), key=_rank)
-    chosen = firsts[:finalists]
-    for r in firsts[finalists:]:
-        if r.fitness >= CLOSE_FINALISTS * firsts[0].fitness and \
-                not any(_same_pose(r.transform, c.transform) for c in chosen):
-            chosen.append(r)
-    finals = sorted((scored(fine(r.transform)) for r in chosen), key=_rank)
-    if covered is None:
-        return finals[0].transform
-    tied = [f.transform for f in finals if f.fitness >= finals[0].fitness - TIE_FITNESS]
-    if len(tied) == 1:
-        return tied[0]
-    shares = [covered(tf) for tf in tied]
-    most = int(np.argmax(shares))
-    return tied[most] if shares[most] >= shares[0] + TIE_COVERAGE else tied[0]
-
-
-def _same_pose(a: Similarity2D, b: Similarity2D) -> bool:
-    """Whether two poses are one for the choice of finalists: within SAME_POSE_M of
-    translation and SAME_POSE_DEG of yaw."""
-    turn = abs(np.degrees(wrapped(a.yaw - b.yaw)))
-    return bool(np.hypot(a.tx - b.tx, a.ty - b.ty) < SAME_POSE_M and turn < SAME_POSE_DEG)
-
-
 def _starts(search: Search | None, init: Similarity2D) -> list[Similarity2D]:
     """The search's candidate poses, best first; ``init`` alone when there was no search."""
     return [init] if search is None else [c.transform for c in search.candidates]
@@ -304,11 +249,6 @@ def _labelled(best: Alignment, search: Search | None, method: str) -> Alignment:
     if search is None:
         return replace(best, method="init+icp")
     return replace(best, method=method, distinctiveness=distinctiveness(search, best.transform))
-
-
-def _rank(a: Alignment) -> tuple[float, float]:
-    """Sort key: higher fitness first, then lower RMSE."""
-    return -a.fitness, a.rmse_m
 
 
 def _scored(map_xy: np.ndarray, tree: cKDTree, tf: Similarity2D, tolerance: float) -> Alignment:

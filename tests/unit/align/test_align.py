@@ -7,7 +7,7 @@ import pytest
 
 from pcmapq.align import Alignment, AlignParams, align, score
 from pcmapq.align.coarse import coarse_search
-from pcmapq.align.planar import TIE_COVERAGE, TIE_FITNESS, refine_best
+from pcmapq.align.finalists import TIE_COVERAGE, TIE_FITNESS, refine_best
 from pcmapq.core.transform import Similarity2D
 from pcmapq.core.voxels import voxel_centroids
 from pcmapq.testing import synth
