@@ -12,18 +12,19 @@ thin one has none). So the detectors never see the cells as drawn. They see the 
    wall when any part of it is (so a one-cell wall of a much finer image survives);
 2. a closing with a disc of ``closing`` metres joins the two faces of a wall drawn as outlines
    (faces up to about twice that apart) and bridges one-cell breaks;
-3. the result is thinned to its skeleton (scikit-image ``skeletonize``), the medial axis: one
+3. the result is thinned to its skeleton (Zhang and Suen's thinning as scikit-image's
+   ``skeletonize`` does it, :mod:`pcmapq.features.thinning`), the medial axis: one
    line per wall, whatever its thickness up to :data:`THICKEST` metres. A thicker area is no
    wall but a filled region: its cells deeper than half that (the centres of a square of
    that half-side all wall; a diagonal wall that thick holds none) are left out first, so it is
-   thinned as a band ``THICKEST / 2`` wide along its outline (and the thinning, whose cost
-   grows with the cube of a solid area's side, stays fast);
+   thinned as a band ``THICKEST / 2`` wide along its outline;
 4. spurs are pruned: a branch that ends free and meets the rest of the skeleton at a junction
    is dropped when it is shorter than ``spur`` metres. These are the branches the medial axis
    grows into the outer corner of a thick wall's bend and into the two corners of a thick
    wall's square end; the centre line then ends where the wall's geometry does;
-5. the centre lines are drawn back as an anti-aliased band ``width`` metres wide (from their
-   Euclidean distance transform) and area-averaged onto the working grid.
+5. the centre lines are drawn back as an anti-aliased band ``width`` metres wide (shaded by
+   the Euclidean distance to them, :mod:`pcmapq.features.band`) and area-averaged onto the
+   working grid.
 
 What the detectors see then depends on where the walls are, not on how many cells paint them.
 
@@ -52,9 +53,11 @@ import numpy as np
 from pcmapq.core.bounds import nonzero_window
 from pcmapq.core.grid import MetricGrid
 from pcmapq.core.morphology import disc, distance_to
+from pcmapq.features.band import draw_band
 from pcmapq.features.pixels import flat_index, neighbour_pairs
 from pcmapq.features.pixels import pieces as connected
 from pcmapq.features.resample import resample
+from pcmapq.features.thinning import skeletonize
 
 #: Working cells a side of a tile of a large raster, and the halo drawn around each, metres:
 #: more than any step looks (a small object's 1 m, a spur's 0.25 m, the closing's 0.1 m).
@@ -122,29 +125,10 @@ def centreline(occupied: np.ndarray, grid: MetricGrid, resolution: float, closin
                      borderType=cv2.BORDER_CONSTANT, borderValue=0)
     walls = wall > deep  # wall cells that are not deep
     if not is_small.any():  # no object: nothing to fill or take out (most tiles of a campus)
-        return prune(skeleton(walls), spur / resolution), np.zeros_like(walls), fine
+        return prune(skeletonize(walls), spur / resolution), np.zeros_like(walls), fine
     objects = fill_holes(is_small[label])
-    line = prune(skeleton(walls & ~objects), spur / resolution)
+    line = prune(skeletonize(walls & ~objects), spur / resolution)
     return line, cores(objects, width / resolution), fine
-
-
-def skeleton(mask: np.ndarray) -> np.ndarray:
-    """scikit-image's ``skeletonize`` of ``mask`` (bool), thinned on the rows and columns that
-    hold its cells or touch one (as :func:`cores` crops): the same skeleton, for a share of the
-    cost on sparse walls (the thinning passes over every cell of its image, each pass).
-
-    The same because each cell's thinning looks at its 8 neighbours only: a dropped row or
-    column holds no cell and touches none, so every cell keeps the same 3 x 3 neighbourhood,
-    and no two cells become neighbours that were not (a kept empty line still lies between
-    any two lines of cells that were apart)."""
-    from skimage.morphology import skeletonize  # loaded when walls are traced (0.04 s)
-
-    rows, cols = _lines_near(mask)
-    out = np.zeros_like(mask)
-    if len(rows):  # gathered by takes, put back cell by cell: both far cheaper than np.ix_
-        r, c = np.nonzero(skeletonize(mask.take(rows, axis=0).take(cols, axis=1)))
-        out[rows[r], cols[c]] = True
-    return out
 
 
 def fill_holes(mask: np.ndarray) -> np.ndarray:
@@ -179,7 +163,7 @@ def cores(objects: np.ndarray, width_px: float) -> np.ndarray:
 
 def _lines_near(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The rows and the columns of ``mask`` (bool) that hold a true cell or lie next to one
-    (:func:`_touched`): the crop on which :func:`cores` and :func:`skeleton` work."""
+    (:func:`_touched`): the crop on which :func:`cores` works."""
     return _touched(mask.any(axis=1)), _touched(mask.any(axis=0))
 
 
@@ -289,10 +273,5 @@ def _band(occupied: np.ndarray, grid: MetricGrid, resolution: float, closing: fl
     ``grid.resampled(resolution)``."""
     fine_res = 0.5 * resolution
     line, core, fine = centreline(occupied, grid, fine_res, closing, spur, small, width)
-    band = core.astype(np.float32)
-    if line.any():
-        shade = distance_to(line)  # in place: 0.5 + (half width - distance), clipped to [0, 1]
-        np.subtract(0.5 * width / fine_res, shade, out=shade)
-        np.add(0.5, shade, out=shade)
-        np.maximum(band, np.clip(shade, 0.0, 1.0, out=shade), out=band)
+    band = draw_band(line, 0.5 * width / fine_res, core.astype(np.float32))
     return resample(band, fine, resolution)[0]

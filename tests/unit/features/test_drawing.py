@@ -6,8 +6,6 @@ from __future__ import annotations
 import cv2
 import numpy as np
 import pytest
-from hypothesis import given, settings
-from hypothesis import strategies as st
 
 from pcmapq.core.grid import MetricGrid
 from pcmapq.features import detect
@@ -172,41 +170,6 @@ def test_cores_on_the_rows_and_columns_of_objects_equal_the_whole_image():
     for width in (3.0, 6.0):
         want = objects & (depth >= deepest[label] - 0.5 * width)
         assert np.array_equal(cores(objects, width), want)
-
-
-@given(st.lists(st.tuples(st.integers(0, 119), st.integers(0, 119), st.integers(0, 119),
-                          st.integers(0, 119), st.integers(1, 6)), min_size=1, max_size=8))
-@settings(max_examples=60, deadline=None)
-def test_skeleton_on_the_rows_and_columns_of_walls_is_scikit_images(walls):
-    """skeleton() thins only the rows and columns that hold or touch walls: the skeleton is
-    scikit-image's of the whole image, whatever the walls' thickness, gaps and place (edges
-    included)."""
-    from skimage.morphology import skeletonize
-
-    from pcmapq.features.walls import skeleton
-
-    image = np.zeros((120, 120), np.uint8)
-    for x0, y0, x1, y1, thickness in walls:
-        cv2.line(image, (x0, y0), (x1, y1), 1, thickness)
-    mask = image.astype(bool)
-    assert np.array_equal(skeleton(mask), skeletonize(mask))
-
-
-def test_skeleton_of_walls_one_empty_line_apart_is_scikit_images():
-    """Two walls one empty row (or column) apart stay apart; a crop that closed the gap would
-    join them into one band and thin it to one line."""
-    from skimage.morphology import skeletonize
-
-    from pcmapq.features.walls import skeleton
-
-    mask = np.zeros((60, 70), bool)
-    mask[10:14, 5:60] = True  # 4 rows thick
-    mask[15:19, 5:60] = True  # one empty row between
-    mask[30:50, 20:23] = True
-    mask[30:50, 24:27] = True  # one empty column between
-    assert np.array_equal(skeleton(mask), skeletonize(mask))
-    assert np.count_nonzero(skeleton(mask)[10:19].any(axis=1)) >= 2
-    assert not skeleton(np.zeros((5, 5), bool)).any()
 
 
 def test_a_filled_area_is_drawn_along_its_outline():
