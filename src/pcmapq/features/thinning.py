@@ -56,10 +56,10 @@ def _thin(image: np.ndarray, cells: np.ndarray, lut: np.ndarray) -> None:
     count = int(np.count_nonzero(flat))
     # the cells each kind of sub-pass is to look at, each listed once at a time
     todo = np.empty((2, count), np.int64)
-    listed = np.zeros((2, flat.size), np.bool_)
+    listed = np.zeros(flat.size, np.uint8)  # bit 1 << kind: on that kind's list
     for k in range(len(cells)):
         todo[0, k] = todo[1, k] = cells[k]
-        listed[0, cells[k]] = listed[1, cells[k]] = True
+        listed[cells[k]] = 3
     length = np.array([len(cells), len(cells)])
     removed = np.empty(count, np.int64)
     step = np.array([-cols - 1, -cols, -cols + 1, 1, cols + 1, cols, cols - 1, -1])
@@ -69,7 +69,7 @@ def _thin(image: np.ndarray, cells: np.ndarray, lut: np.ndarray) -> None:
             n_removed = 0
             for k in range(length[kind]):
                 i = todo[kind, k]
-                listed[kind, i] = False
+                listed[i] &= ~np.uint8(1 << kind)
                 if flat[i] == 0:
                     continue
                 code = 0
@@ -85,12 +85,12 @@ def _thin(image: np.ndarray, cells: np.ndarray, lut: np.ndarray) -> None:
             for k in range(n_removed):
                 for b in range(8):
                     j = removed[k] + step[b]
-                    if flat[j]:
+                    if flat[j] and listed[j] != 3:
                         for other in range(2):
-                            if not listed[other, j]:
-                                listed[other, j] = True
+                            if not listed[j] & (1 << other):
                                 todo[other, length[other]] = j
                                 length[other] += 1
+                        listed[j] = 3
             changed |= n_removed > 0
         if not changed:
             return
