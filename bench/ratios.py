@@ -84,30 +84,40 @@ def eval_cmd(map_path: Path, truth: Path, out: Path, *extra: str) -> list[str]:
             str(out), *extra]
 
 
+def written(folder: Path, write: Callable[[Path], object]) -> Path:
+    """``folder``, written by ``write(folder)`` the first time: into a sibling folder renamed
+    once whole, so that an interrupted run leaves no half-written case to be read later."""
+    if not folder.is_dir():
+        part = folder.with_name(folder.name + ".part")
+        shutil.rmtree(part, ignore_errors=True)
+        part.mkdir(parents=True)
+        write(part)
+        part.rename(folder)
+    return folder
+
+
 def kitti_pair(cache: Path) -> tuple[Path, Path] | None:
     """KITTI 00's first 20 scans: the KISS-ICP map and the map of the reference poses, as
     ``pcmapq map`` builds them, written once into ``cache``; None without the data."""
-    folder = SHARED_DATA / "kitti00"
-    if not (folder / "velodyne").is_dir():
+    data = SHARED_DATA / "kitti00"
+    if not (data / "velodyne").is_dir():
         return None
-    kiss, ref = cache / "kitti20_kiss.ply", cache / "kitti20_ref.ply"
-    if not ref.exists():
+
+    def write(folder: Path) -> None:
         from bench.validation.kitti import kiss_map, reference_map
         from pcmapq.io.writers import write_cloud
 
-        cache.mkdir(parents=True, exist_ok=True)
-        write_cloud(kiss, kiss_map(folder, 20)[0])
-        write_cloud(ref, reference_map(folder, 20)[0])
-    return kiss, ref
+        write_cloud(folder / "kiss.ply", kiss_map(data, 20)[0])
+        write_cloud(folder / "ref.ply", reference_map(data, 20)[0])
+
+    folder = written(cache / "kitti20", write)
+    return folder / "kiss.ply", folder / "ref.ply"
 
 
 def cloud_case(cache: Path, millions: int = 10) -> tuple[Path, Path]:
     """:mod:`bench.bench_clouds`' campus cloud of ``millions`` M points and its plan, once."""
-    folder = cache / f"cloud_{millions}M"
-    if not (folder / "truth.yaml").exists():
-        shutil.rmtree(folder, ignore_errors=True)
-        folder.mkdir(parents=True)
-        write_case(folder, millions * 1_000_000)
+    folder = written(cache / f"cloud_{millions}M",
+                     lambda part: write_case(part, millions * 1_000_000))
     return folder / "cloud.ply", folder / "truth.yaml"
 
 
@@ -157,10 +167,7 @@ def clouds(cache: Path, repeat: int) -> list[Ratio]:
 def campus(cache: Path, repeat: int, size: int = 8000) -> list[Ratio]:
     """The campus grid pair against OpenCV reading both images and one distance transform
     (timed inside its process, as bench_grids does)."""
-    case = cache / f"grid_{size}"
-    if not (case / "truth.yaml").exists():
-        shutil.rmtree(case, ignore_errors=True)
-        large_grid.write_case(case, size)
+    case = written(cache / f"grid_{size}", lambda part: large_grid.write_case(part, size))
     floors = [json.loads(measured([sys.executable, "-c", GRID_FLOOR, str(case / "truth.png"),
                                    str(case / "map.png")])[2].strip().splitlines()[-1])
               ["seconds"] for _ in range(repeat)]
