@@ -38,7 +38,11 @@ def draw_band(line: np.ndarray, half_width: float, out: np.ndarray) -> np.ndarra
     return out
 
 
-@numba.njit(cache=True, nogil=True)
+# compiled (or read from the cache) at import, in the importing thread: compiled lazily, on a
+# drawing thread of an evaluation that outlived its command, the next command run in the
+# process found its output streams closed (tests/cli without a terminal, from a cold cache)
+@numba.njit(numba.void(numba.float32[:, :], numba.int64[::1], numba.int64[::1], numba.int64[::1],
+                       numba.int64[::1], numba.float32[::1]), cache=True, nogil=True)
 def _raise(out: np.ndarray, rows: np.ndarray, cols: np.ndarray, dy: np.ndarray, dx: np.ndarray,
            shade: np.ndarray) -> None:
     """out[r + dy, c + dx] = max(itself, shade) for every line cell (r, c) and offset."""

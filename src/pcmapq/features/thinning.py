@@ -46,7 +46,11 @@ def skeletonize(mask: np.ndarray) -> np.ndarray:
     return np.ascontiguousarray(image[1:-1, 1:-1]).view(bool)
 
 
-@numba.njit(cache=True, nogil=True)
+# compiled (or read from the cache) at import, in the importing thread: compiled lazily, on a
+# drawing thread of an evaluation that outlived its command, the next command run in the
+# process found its output streams closed (tests/cli without a terminal, from a cold cache)
+@numba.njit(numba.void(numba.uint8[:, ::1], numba.int64[::1], numba.uint8[::1]), cache=True,
+            nogil=True)
 def _thin(image: np.ndarray, cells: np.ndarray, lut: np.ndarray) -> None:
     """Thin ``image`` (uint8 0/1, its border cells 0) in place: sub-passes of the first and the
     second kind in turn, until a first and a second remove nothing (module docstring). cells:
