@@ -16,12 +16,12 @@ come from SciPy kd-trees.
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.sparse as sp
 from scipy.spatial import cKDTree
 
 from pcmapq.core.bounds import bounds
@@ -35,6 +35,8 @@ MAX_NN = 30
 #: MOM keeps an orthogonal-subset point whose neighbourhood holds more than this many map
 #: points (hard-coded in map-metrics, independent of ``min_knn``).
 MOM_MIN_NEIGHBOURS = 3
+#: Pairs of query and map point that MOM's sums hold at once (:func:`_ball_sums`).
+CHUNK_PAIRS = 100_000
 #: The seed of a sampled pass's draw (:func:`sample_of`).
 SAMPLE_SEED = 0
 #: ln(2 pi e): MME's constant per dimension.
@@ -97,10 +99,26 @@ def covariances(sums: np.ndarray) -> np.ndarray:
     return cov
 
 
-def _cross(tree: cKDTree, other: cKDTree, r: float) -> sp.coo_matrix:
-    """Adjacency rows = ``tree``'s points, columns = ``other``'s, for pairs within r."""
-    d = tree.sparse_distance_matrix(other, r, output_type="ndarray")
-    return sp.coo_matrix((np.ones(len(d)), (d["i"], d["j"])), shape=(tree.n, other.n))
+def _ball_sums(tree: cKDTree, queries: np.ndarray, r: float,
+               chunk_pairs: int = CHUNK_PAIRS) -> np.ndarray:
+    """(Q, 10) moment sums (see :func:`~pcmapq.metrics.ballsums.moments`) of ``tree``'s points
+    within r (inclusive) of each query, added in the order of the points' indices; queries are
+    taken a few at a time so that no more than about ``chunk_pairs`` pairs are held at once
+    (the figures do not depend on it)."""
+    counts = tree.query_ball_point(queries, r, return_length=True)
+    sums = np.zeros((len(queries), 10))
+    bounds_ = np.searchsorted(np.cumsum(counts), np.arange(chunk_pairs, int(counts.sum()),
+                                                             chunk_pairs), side="right")
+    for lo, hi in itertools.pairwise([0, *np.unique(bounds_).tolist(), len(queries)]):
+        if lo == hi or not counts[lo:hi].any():
+            continue
+        d = cKDTree(queries[lo:hi]).sparse_distance_matrix(tree, r, output_type="ndarray")
+        order = np.lexsort((d["j"], d["i"]))
+        rows, cols = d["i"][order], d["j"][order]
+        del d, order
+        starts = np.flatnonzero(np.r_[True, rows[1:] != rows[:-1]])
+        sums[lo + rows[starts]] = np.add.reduceat(moments(tree.data[cols]), starts, axis=0)
+    return sums
 
 
 def neighbourhood_sums(points: np.ndarray, radius: float, chunk_points: int = CHUNK_POINTS,
@@ -221,10 +239,11 @@ def query_covariances(points: np.ndarray, queries: np.ndarray,
     lo, hi = bounds(q)
     lo, hi = lo - radius, hi + radius
     near = pts[np.all((pts >= lo) & (pts <= hi), axis=1)]
-    origin = q.mean(axis=0)
     if len(near) == 0:
         return np.zeros(len(q), dtype=np.int64), np.full((len(q), 3, 3), np.nan)
-    sums = _cross(cKDTree(q - origin), cKDTree(near - origin), r) @ moments(near - origin)
+    origin = q.mean(axis=0)
+    near -= origin
+    sums = _ball_sums(cKDTree(near), q - origin, r)
     return sums[:, 0].astype(np.int64), covariances(sums)
 
 
