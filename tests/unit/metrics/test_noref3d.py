@@ -245,3 +245,45 @@ def test_planes_found_through_a_sample_of_the_planar_points():
         assert np.abs(plane[:, axis]).max() < 0.01  # every point on its wall
     assert sum(map(len, sampled)) >= 0.98 * sum(map(len, whole))
     assert sum(map(len, whole)) > 500
+
+
+def _brute_best_triple(means: np.ndarray, sizes: np.ndarray, eps: float):
+    """Every i < j < k in lexicographic order, the first of the largest total kept."""
+    adj = np.abs(means @ means.T) < eps
+    best, total = None, -1
+    n = len(means)
+    for i in range(n):
+        for j in range(i + 1, n):
+            for k in range(j + 1, n):
+                if adj[i, j] and adj[i, k] and adj[j, k] and sizes[i] + sizes[j] + sizes[k] > total:
+                    best, total = (i, j, k), sizes[i] + sizes[j] + sizes[k]
+    return best
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_best_triple_is_the_largest_orthogonal_triple_first_among_equals(seed):
+    """Normals near the three axes (several clusters each) and random ones, sizes with ties:
+    the triple found is the brute-force search's."""
+    rng = np.random.default_rng(seed)
+    axes = np.eye(3)[rng.integers(0, 3, 24)] + rng.normal(0, 0.03, (24, 3))
+    means = np.vstack([axes, rng.normal(size=(10, 3))])
+    means /= np.linalg.norm(means, axis=1, keepdims=True)
+    sizes = rng.integers(6, 12, len(means))  # few values: many equal totals
+    want = _brute_best_triple(means, sizes, orthogonal.ORTHOGONAL_COS)
+    assert want is not None
+    assert orthogonal._best_triple(means, sizes, orthogonal.ORTHOGONAL_COS) == want
+
+
+def test_ward_tree_cut_as_scipys():
+    """The clusters of 3,000 noisy normals (fastcluster's tree from the vectors) are SciPy's
+    Ward clusters, label for label."""
+    from scipy.cluster.hierarchy import fcluster, ward
+
+    rng = np.random.default_rng(2)
+    normals = np.eye(3)[rng.integers(0, 3, 3000)] + rng.normal(0, 0.05, (3000, 3))
+    normals /= np.linalg.norm(normals, axis=1, keepdims=True)
+    tree = ward(normals)
+    want = fcluster(tree, int(np.count_nonzero(tree[:, 2] >= orthogonal.WARD_CUT)) + 1,
+                    criterion="maxclust")
+    labels, _, _ = orthogonal._clusters(normals, 0, len(normals))
+    np.testing.assert_array_equal(labels, want)
