@@ -25,8 +25,9 @@ import numpy as np
 #: beside some installs is too old, and Numba warns when it tries it first).
 numba.config.THREADING_LAYER_PRIORITY = ["omp", "workqueue", "tbb"]
 
-#: Points whose sums one yield holds (80 bytes each).
-CHUNK_POINTS = 1_000_000
+#: Points whose sums one yield holds (80 bytes each; the covariances, determinants and
+#: eigenvalues found from them hold about four times that beside them).
+CHUNK_POINTS = 100_000
 #: The 3 x 3 columns around a column: offsets across the two shorter axes.
 OFFSETS = np.array([(d0, d1) for d0 in (-1, 0, 1) for d1 in (-1, 0, 1)], dtype=np.int64)
 
