@@ -6,6 +6,9 @@ Each case runs its commands in fresh processes (wall seconds and peak RSS of the
 
 - ``noref``: ``pcmapq eval`` by default against ``--no-noref`` (the price of the default
   no-reference block) on the shipped sample, KITTI 00's 20-scan pair and a 10 M-point cloud;
+- ``rooms``: ``pcmapq eval`` by default against ``--detectors harris,hough,sift`` (the price of
+  the rooms detector; under a fifth of the evaluation's time is a ratio under 1.25) on the
+  shipped sample, a Halmstad map against its building's layout and the campus grid pair;
 - ``kitti``: ``pcmapq eval`` of KITTI 00's 20-scan KISS-ICP map against the map from its
   reference poses, against its floor: a process that imports Open3D, reads both clouds and
   downsamples them at the registration's 0.3 m voxel;
@@ -31,7 +34,10 @@ from bench import large_grid
 from bench.bench_clouds import FLOOR_CHILD as CLOUD_FLOOR
 from bench.bench_clouds import measured, write_case
 from bench.bench_grids import FLOOR_CHILD as GRID_FLOOR
+from pcmapq.features import DEFAULT_DETECTORS
 from pcmapq.testing.paths import SAMPLE, SHARED_DATA
+from pcmapq.testing.realdata.halmstad import PLAN_RESOLUTION, halmstad_truth
+from pcmapq.testing.realdata.halmstad import paths as halmstad_paths
 
 #: A ratio worse than its stored value by more than this share fails ``--check``.
 TOLERANCE = 0.20
@@ -139,6 +145,40 @@ def noref(cache: Path, repeat: int) -> list[Ratio]:
     return out
 
 
+#: The detectors but the rooms.
+WITHOUT_ROOMS = ",".join(d for d in DEFAULT_DETECTORS if d != "rooms")
+#: The Halmstad map of the rooms case (the one with the most truth rooms matched, docs/
+#: validation.md), read as the Halmstad validation reads it: scale unknown.
+HALMSTAD_MAP = "E5_07"
+
+
+def rooms(cache: Path, repeat: int) -> list[Ratio]:
+    """The rooms detector's price: eval by default / eval without the rooms detector."""
+    cases = [("sample", [str(SAMPLE / "scan.ply"), str(SAMPLE / "truth.yaml")])]
+    if (SHARED_DATA / "halmstad").is_dir():
+        map_path, layout = halmstad_paths(SHARED_DATA, HALMSTAD_MAP)
+        folder = cache / "halmstad"
+        folder.mkdir(exist_ok=True)
+        truth = halmstad_truth(layout, folder)
+        cases.append((f"Halmstad {HALMSTAD_MAP}",
+                      [str(map_path), str(truth), "--scale", "auto", "--truth-resolution",
+                       str(PLAN_RESOLUTION)]))
+    else:
+        print(f"rooms: Halmstad skipped, {SHARED_DATA / 'halmstad'} is absent", file=sys.stderr)
+    grid = written(cache / "grid_8000", lambda part: large_grid.write_case(part, 8000))
+    cases.append(("campus 8000^2", [str(grid / "map.yaml"), str(grid / "truth.yaml")]))
+    out = []
+    for name, args in cases:
+        with_rooms, without = paired(
+            [sys.executable, "-m", "pcmapq", "eval", *args, "--json", str(cache / "on.json")],
+            [sys.executable, "-m", "pcmapq", "eval", *args, "--json", str(cache / "off.json"),
+             "--detectors", WITHOUT_ROOMS], repeat)
+        out.append(Ratio(f"rooms/{name}/time", with_rooms[0] / without[0],
+                         f"default {with_rooms[0]:.1f} s",
+                         f"--detectors {WITHOUT_ROOMS} {without[0]:.1f} s", 1.25))
+    return out
+
+
 def kitti(cache: Path, repeat: int) -> list[Ratio]:
     """KITTI 00's 20-scan pair by default against Open3D reading and downsampling both."""
     pair = kitti_pair(cache)
@@ -180,7 +220,7 @@ def campus(cache: Path, repeat: int, size: int = 8000) -> list[Ratio]:
 
 #: name -> case; each returns its ratios.
 CASES: dict[str, Callable[[Path, int], list[Ratio]]] = {
-    "noref": noref, "kitti": kitti, "clouds": clouds, "campus": campus,
+    "noref": noref, "rooms": rooms, "kitti": kitti, "clouds": clouds, "campus": campus,
 }
 
 
