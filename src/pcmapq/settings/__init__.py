@@ -159,7 +159,7 @@ EVAL_NOREF_VOXEL = 0.1
 #: (docs/metrics.md gives the measured errors), at a small share of an evaluation.
 EVAL_NOREF_SAMPLE = 20_000
 #: ``eval``'s Ward tree for MOM's planes: 2,000 normals, a small share of the run (the tree's
-#: memory and time grow with the square of the normals).
+#: time grows with the square of the normals).
 EVAL_MAX_WARD = 2_000
 
 
