@@ -11,6 +11,9 @@ import subprocess
 import numpy as np
 
 from pcmapq.core.grid import MetricGrid
+from pcmapq.features import Features
+from pcmapq.match import Matching
+from pcmapq.results.result import DetectorResult, Result
 
 CIRCLE = re.compile(r"<circle ([^>]*)/>")
 ATTR = re.compile(r'([\w-]+)="([^"]*)"')
@@ -120,3 +123,41 @@ def check_view(out: dict, grid: MetricGrid) -> None:
 def selector(name: str, status: str, x: float, y: float) -> str:
     return f'circle[data-detector="{name}"][data-status="{status}"][data-x="{x + 0.0:.3f}"]' \
            f'[data-y="{y + 0.0:.3f}"]'
+
+
+def detector_result(truth_xy, map_xy, pairs, displacement, missing, extra,
+                    segments=None) -> DetectorResult:
+    """A hand-made detector result: truth and map features (metres), the matched pairs
+    (truth indices, map indices) with their displacements, the missing truth and extra map
+    features (indices); Hough's ``segments`` when given. Only what the viewer reads is set."""
+    n, k = len(truth_xy), len(map_xy)
+    m = Matching(np.array(pairs[0], dtype=np.intp), np.array(pairs[1], dtype=np.intp),
+                 np.array(displacement, dtype=float).reshape(-1, 2), np.zeros(len(pairs[0])),
+                 None, None, None, n, k, len(pairs[0]), len(pairs[0]),
+                 np.array(missing, dtype=np.intp), np.array(extra, dtype=np.intp))
+    return DetectorResult(
+        Features(np.array(truth_xy, float).reshape(-1, 2), np.ones(n), np.ones(n, bool),
+                 segments=segments),
+        Features(np.array(map_xy, float).reshape(-1, 2), np.ones(k), np.ones(k, bool)), m)
+
+
+def small_result(grid: MetricGrid) -> Result:
+    """A hand-made result on ``grid``: harris with 1 matched (0.3, -0.4 m: 0.5 m), 2 missing,
+    1 extra; hough with one matched segment; sift with no feature. Only what the viewer reads
+    is set."""
+    harris = detector_result([[2.0, 3.0], [4.0, 5.0], [6.0, 2.5]], [[2.3, 2.6], [5.0, 3.0]],
+                       ([0], [0]), [[0.3, -0.4]], [1, 2], [1])
+    hough = detector_result([[3.0, 4.0]], [[3.0, 4.1]], ([0], [0]), [[0.0, 0.1]], [], [],
+                      segments=np.array([[2.0, 4.0, 4.0, 4.0]]))
+    sift = detector_result(np.zeros((0, 2)), np.zeros((0, 2)), ([], []), [], [], [])
+    walls = np.zeros(grid.shape, bool)
+    walls[5, :] = True
+    return Result(map_path=None, map_kind="", truth_path=None, truth_kind="", grid=grid,
+                  alignment=None, overlap=None, distances=None, registration_3d=None,
+                  distances_3d=None, threshold=0.5, full=True,
+                  detectors={"harris": harris, "hough": hough, "sift": sift},
+                  truth_occupied=walls, map_occupied=np.roll(walls, 2, axis=0), frames=None)
+
+
+#: A grid turned by 30 degrees, off the origin: the features must follow the grid.
+TURNED = MetricGrid(0.1, (1.0, 2.0, float(np.radians(30.0))), (60, 80))
