@@ -44,6 +44,10 @@ def input_figures(source: OccupancyMap | PointMap, config: NoRefConfig = NoRefCo
 #: each, so that the voxel table holds one stripe's voxels at a time: the 97 M-point cloud's
 #: table of 9.7 M voxels took about 1 GB beside the evaluation (docs/benchmarks.md).
 STRIPE_POINTS = 25_000_000
+#: Such a cloud's stripes hold about this many points each: the table of one stripe's voxels and
+#: the centroids of the stripes before it stand beside the plan's global search (97 M points:
+#: 13 stripes peaked at 4.65-4.75 GB, 4 at 4.70-4.83 GB, three runs each).
+STRIPE_WIDTH_POINTS = 8_000_000
 
 
 def reduced(points: np.ndarray, voxel: float, scale: float = 1.0) -> np.ndarray:
@@ -52,7 +56,8 @@ def reduced(points: np.ndarray, voxel: float, scale: float = 1.0) -> np.ndarray:
     chunks, never converted whole (:func:`~pcmapq.core.voxels.voxel_centroids`)."""
     if voxel <= 0:
         return np.asarray(points, dtype=np.float64) * scale
-    return voxel_centroids(points, voxel, scale, stripe_points=STRIPE_POINTS)
+    return voxel_centroids(points, voxel, scale, stripe_points=None
+                           if len(points) <= STRIPE_POINTS else STRIPE_WIDTH_POINTS)
 
 
 def occupancy_figures(source: OccupancyMap | PointMap, scale: float = 1.0,
