@@ -59,11 +59,12 @@ def dense_result() -> Result:
     shift = np.array([0.1, 0.0])
     n, k = len(matched), len(missing)
     points = detector_result(np.vstack([matched, missing]), np.vstack([matched + shift, extra]),
-                       (np.arange(n), np.arange(n)), np.tile(shift, (n, 1)),
-                       np.arange(n, n + k), np.arange(n, n + len(extra)))
+                             (np.arange(n), np.arange(n)), np.tile(shift, (n, 1)),
+                             np.arange(n, n + k), np.arange(n, n + len(extra)))
     middles = (plan[:, :2] + plan[:, 2:]) / 2
-    hough = detector_result(middles, middles + shift, (np.arange(len(plan)), np.arange(len(plan))),
-                      np.tile(shift, (len(plan), 1)), [], [], segments=plan)
+    pairs = (np.arange(len(plan)), np.arange(len(plan)))
+    hough = detector_result(middles, middles + shift, pairs, np.tile(shift, (len(plan), 1)), [],
+                            [], segments=plan)
     walls = synth.render(plan, grid) == synth.OCCUPIED
     moved = synth.render(plan + np.tile(shift, 2), grid) == synth.OCCUPIED
     return Result(map_path=None, map_kind="", truth_path=None, truth_kind="", grid=grid,

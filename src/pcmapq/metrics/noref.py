@@ -107,9 +107,9 @@ def _ball_sums(tree: cKDTree, queries: np.ndarray, r: float,
     (the figures do not depend on it)."""
     counts = tree.query_ball_point(queries, r, return_length=True)
     sums = np.zeros((len(queries), 10))
-    bounds_ = np.searchsorted(np.cumsum(counts), np.arange(chunk_pairs, int(counts.sum()),
-                                                             chunk_pairs), side="right")
-    for lo, hi in itertools.pairwise([0, *np.unique(bounds_).tolist(), len(queries)]):
+    cuts = np.searchsorted(np.cumsum(counts), np.arange(chunk_pairs, int(counts.sum()),
+                                                          chunk_pairs), side="right")
+    for lo, hi in itertools.pairwise([0, *np.unique(cuts).tolist(), len(queries)]):
         if lo == hi or not counts[lo:hi].any():
             continue
         d = cKDTree(queries[lo:hi]).sparse_distance_matrix(tree, r, output_type="ndarray")

@@ -146,9 +146,9 @@ def small_result(grid: MetricGrid) -> Result:
     1 extra; hough with one matched segment; sift with no feature. Only what the viewer reads
     is set."""
     harris = detector_result([[2.0, 3.0], [4.0, 5.0], [6.0, 2.5]], [[2.3, 2.6], [5.0, 3.0]],
-                       ([0], [0]), [[0.3, -0.4]], [1, 2], [1])
+                             ([0], [0]), [[0.3, -0.4]], [1, 2], [1])
     hough = detector_result([[3.0, 4.0]], [[3.0, 4.1]], ([0], [0]), [[0.0, 0.1]], [], [],
-                      segments=np.array([[2.0, 4.0, 4.0, 4.0]]))
+                            segments=np.array([[2.0, 4.0, 4.0, 4.0]]))
     sift = detector_result(np.zeros((0, 2)), np.zeros((0, 2)), ([], []), [], [], [])
     walls = np.zeros(grid.shape, bool)
     walls[5, :] = True
