@@ -291,9 +291,10 @@ def section(data: Path, record: Record) -> Section:
         *averages, "",
         "Beside the published per-map results (`rooms/third_party_results/`), averaged over "
         "the plans each method reports (f1: each plan's harmonic mean of its precision and "
-        "recall micro, averaged). ROSE²'s figures are the benchmark's evaluation; MAORIS's "
-        "come from its own (`compare_images` in its `Evaluation.cpp`), which counts only the "
-        "cells both segmentations label and rounds each room's share down to a whole percent, "
+        "recall micro, averaged). ROSE²'s tables give the benchmark's figures by name "
+        "(precision and recall, micro and macro); MAORIS's come from its own "
+        "(`compare_images` in its `Evaluation.cpp`), which counts only the cells both "
+        "segmentations label and rounds each room's share down to a whole percent, "
         "so pcmapq is scored both ways beside it. MAORIS's file lists each plan's recall "
         "before its precision: the first figure is the mean over the truth's rooms.", "",
         header(["method", "plans", "its precision %", "its recall %", "its f1 %",
