@@ -127,6 +127,11 @@ def cloud_case(cache: Path, millions: int = 10) -> tuple[Path, Path]:
     return folder / "cloud.ply", folder / "truth.yaml"
 
 
+def grid_case(cache: Path, size: int) -> Path:
+    """:mod:`bench.large_grid`'s ``size`` x ``size`` campus grid pair, written once."""
+    return written(cache / f"grid_{size}", lambda part: large_grid.write_case(part, size))
+
+
 def noref(cache: Path, repeat: int) -> list[Ratio]:
     """The default no-reference block's price: eval by default / eval --no-noref."""
     pairs = [("sample", SAMPLE / "scan.ply", SAMPLE / "truth.yaml")]
@@ -154,25 +159,23 @@ HALMSTAD_MAP = "E5_07"
 
 def rooms(cache: Path, repeat: int) -> list[Ratio]:
     """The rooms detector's price: eval by default / eval without the rooms detector."""
-    cases = [("sample", [str(SAMPLE / "scan.ply"), str(SAMPLE / "truth.yaml")])]
+    cases = [("sample", SAMPLE / "scan.ply", SAMPLE / "truth.yaml", ())]
     if (SHARED_DATA / "halmstad").is_dir():
         map_path, layout = halmstad_paths(SHARED_DATA, HALMSTAD_MAP)
         folder = cache / "halmstad"
         folder.mkdir(exist_ok=True)
-        truth = halmstad_truth(layout, folder)
-        cases.append((f"Halmstad {HALMSTAD_MAP}",
-                      [str(map_path), str(truth), "--scale", "auto", "--truth-resolution",
-                       str(PLAN_RESOLUTION)]))
+        cases.append((f"Halmstad {HALMSTAD_MAP}", map_path, halmstad_truth(layout, folder),
+                      ("--scale", "auto", "--truth-resolution", str(PLAN_RESOLUTION))))
     else:
         print(f"rooms: Halmstad skipped, {SHARED_DATA / 'halmstad'} is absent", file=sys.stderr)
-    grid = written(cache / "grid_8000", lambda part: large_grid.write_case(part, 8000))
-    cases.append(("campus 8000^2", [str(grid / "map.yaml"), str(grid / "truth.yaml")]))
+    grid = grid_case(cache, 8000)
+    cases.append(("campus 8000^2", grid / "map.yaml", grid / "truth.yaml", ()))
     out = []
-    for name, args in cases:
+    for name, map_path, truth, extra in cases:
         with_rooms, without = paired(
-            [sys.executable, "-m", "pcmapq", "eval", *args, "--json", str(cache / "on.json")],
-            [sys.executable, "-m", "pcmapq", "eval", *args, "--json", str(cache / "off.json"),
-             "--detectors", WITHOUT_ROOMS], repeat)
+            eval_cmd(map_path, truth, cache / "on.json", *extra),
+            eval_cmd(map_path, truth, cache / "off.json", *extra, "--detectors", WITHOUT_ROOMS),
+            repeat)
         out.append(Ratio(f"rooms/{name}/time", with_rooms[0] / without[0],
                          f"default {with_rooms[0]:.1f} s",
                          f"--detectors {WITHOUT_ROOMS} {without[0]:.1f} s", 1.25))
@@ -207,7 +210,7 @@ def clouds(cache: Path, repeat: int) -> list[Ratio]:
 def campus(cache: Path, repeat: int, size: int = 8000) -> list[Ratio]:
     """The campus grid pair against OpenCV reading both images and one distance transform
     (timed inside its process, as bench_grids does)."""
-    case = written(cache / f"grid_{size}", lambda part: large_grid.write_case(part, size))
+    case = grid_case(cache, size)
     floors = [json.loads(measured([sys.executable, "-c", GRID_FLOOR, str(case / "truth.png"),
                                    str(case / "map.png")])[2].strip().splitlines()[-1])
               ["seconds"] for _ in range(repeat)]
