@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import re
 import shutil
-import subprocess
 from dataclasses import replace
 
 import cv2
@@ -23,6 +22,7 @@ from pcmapq.report.text import number
 from pcmapq.settings import MatchingConfig, Settings
 from pcmapq.testing import synth
 from pcmapq.testing.files import write_image_map
+from pcmapq.testing.viewer import chromium
 
 #: The colour of the truth's walls where no map wall is under them.
 TRUTH_ON_WHITE = tuple(overlay(np.ones((1, 1)), np.zeros((1, 1)))[0, 0])
@@ -101,12 +101,7 @@ def test_report_renders_in_chromium(moved_result, tmp_path):
     page = tmp_path / "report.html"
     page.write_text(report_html(moved_result))
     shot = tmp_path / "shot.png"
-    subprocess.run(["chromium", "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic",
-                    "--no-first-run", "--disable-background-networking",
-                    "--disable-component-update", "--disable-sync",
-                    f"--user-data-dir={tmp_path / 'profile'}", "--window-size=1400,2400",
-                    f"--screenshot={shot}", page.as_uri()],
-                   capture_output=True, timeout=120, check=True)
+    chromium(page, tmp_path, 1400, 2400, f"--screenshot={shot}")
     img = cv2.imread(str(shot))
     assert img is not None and img.shape[:2] == (2400, 1400)
     # the embedded figures rendered: many non-white, coloured pixels

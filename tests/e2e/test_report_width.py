@@ -3,17 +3,14 @@ than the window, every column of the steps table reachable, figures scaled to th
 
 from __future__ import annotations
 
-import html
-import json
-import re
 import shutil
-import subprocess
 from dataclasses import asdict
 
 import pytest
 
 from pcmapq.report.plot import png_bytes
 from pcmapq.report.timeline import TABLE, timeline_figure, timeline_html
+from pcmapq.testing.viewer import chromium, probe_of
 from pcmapq.track.drop import worst_drop
 from pcmapq.track.outputs import step_rows
 from pcmapq.track.timeline import Step
@@ -68,15 +65,7 @@ def probed(page: str, width: int, tmp_path) -> dict:
     """What PROBE found in ``page`` (HTML) in headless Chromium, ``width`` x 1000 px."""
     path = tmp_path / f"track-{width}.html"
     path.write_text(page.replace("</body>", PROBE + "</body>"))
-    run = subprocess.run(["chromium", "--headless", "--no-sandbox", "--disable-gpu",
-                          "--disable-quic", "--no-first-run", "--disable-background-networking",
-                          "--disable-component-update", "--disable-sync",
-                          f"--user-data-dir={tmp_path / 'profile'}", f"--window-size={width},1000",
-                          "--dump-dom", path.as_uri()],
-                         capture_output=True, timeout=120, check=True, text=True)
-    probe = re.search(r'<pre id="probe">(.*?)</pre>', run.stdout, re.S)
-    assert probe, run.stderr[-2000:]
-    return json.loads(html.unescape(probe.group(1)))
+    return probe_of(chromium(path, tmp_path, width, 1000, "--dump-dom"))
 
 
 @pytest.mark.skipif(shutil.which("chromium") is None, reason="Debian's chromium is not installed")

@@ -3,11 +3,8 @@ toggles on a hand-made result, and walls that show through crowded features."""
 
 from __future__ import annotations
 
-import html
 import json
-import re
 import shutil
-import subprocess
 
 import cv2
 import numpy as np
@@ -20,7 +17,9 @@ from pcmapq.testing import synth
 from pcmapq.testing.viewer import (
     TURNED,
     check_view,
+    chromium,
     detector_result,
+    probe_of,
     probed,
     selector,
     small_result,
@@ -121,16 +120,10 @@ def rendered(page: str, tmp_path, name: str, walls: bool, features: bool,
         script = script.replace(key, json.dumps(value))
     path.write_text(page.replace("</body>", script + "</body>"))
     shot = tmp_path / f"{name}.png"
-    run = subprocess.run(["chromium", "--headless", "--no-sandbox", "--disable-gpu",
-                          "--disable-quic", "--no-first-run", "--disable-background-networking",
-                          "--disable-component-update", "--disable-sync", "--hide-scrollbars",
-                          f"--user-data-dir={tmp_path / 'profile'}", "--window-size=1400,1000",
-                          "--dump-dom" if probe else f"--screenshot={shot}", path.as_uri()],
-                         capture_output=True, timeout=120, check=True, text=True)
+    run = chromium(path, tmp_path, 1400, 1000, "--hide-scrollbars",
+                   "--dump-dom" if probe else f"--screenshot={shot}")
     if probe:
-        found = re.search(r'<pre id="probe">(.*?)</pre>', run.stdout, re.S)
-        assert found, run.stderr[-2000:]
-        return json.loads(html.unescape(found.group(1)))
+        return probe_of(run)
     img = cv2.imread(str(shot))
     assert img is not None and img.shape == (1000, 1400, 3)
     return img.astype(int)

@@ -7,6 +7,7 @@ import html
 import json
 import re
 import subprocess
+from pathlib import Path
 
 import numpy as np
 
@@ -87,21 +88,33 @@ PROBE = """
 """
 
 
-def probed(page: str, feature: str, toggle: tuple[str, str], tmp_path) -> dict:
+def chromium(path: Path, tmp_path: Path, width: int = 1400, height: int = 1000,
+             *flags: str) -> subprocess.CompletedProcess:
+    """Headless Chromium run on the page at ``path`` in a ``width`` x ``height`` px window,
+    with a profile of its own under ``tmp_path`` and nothing beside the page (no network, no
+    sync); ``flags``: what it is to do (``--dump-dom``, ``--screenshot=FILE``, ...)."""
+    return subprocess.run(["chromium", "--headless", "--no-sandbox", "--disable-gpu",
+                           "--disable-quic", "--no-first-run", "--disable-background-networking",
+                           "--disable-component-update", "--disable-sync",
+                           f"--user-data-dir={tmp_path / 'profile'}",
+                           f"--window-size={width},{height}", *flags, path.as_uri()],
+                          capture_output=True, timeout=120, check=True, text=True)
+
+
+def probe_of(run: subprocess.CompletedProcess) -> dict:
+    """The JSON a page's script wrote into ``<pre id="probe">``, from Chromium's dumped DOM."""
+    probe = re.search(r'<pre id="probe">(.*?)</pre>', run.stdout, re.S)
+    assert probe, run.stderr[-2000:]
+    return json.loads(html.unescape(probe.group(1)))
+
+
+def probed(page: str, feature: str, toggle: tuple[str, str], tmp_path: Path) -> dict:
     """What PROBE found in ``page`` (HTML) in headless Chromium, hovering and clicking the
     circle ``feature`` (a CSS selector) and unticking the ``toggle`` (detector, status)."""
     path = tmp_path / "page.html"
     path.write_text(page.replace("</body>", PROBE.replace("FEATURE", json.dumps(feature))
                                  .replace("TOGGLE", json.dumps(toggle)) + "</body>"))
-    run = subprocess.run(["chromium", "--headless", "--no-sandbox", "--disable-gpu",
-                          "--disable-quic", "--no-first-run", "--disable-background-networking",
-                          "--disable-component-update", "--disable-sync",
-                          f"--user-data-dir={tmp_path / 'profile'}", "--window-size=1400,1000",
-                          "--dump-dom", path.as_uri()],
-                         capture_output=True, timeout=120, check=True, text=True)
-    probe = re.search(r'<pre id="probe">(.*?)</pre>', run.stdout, re.S)
-    assert probe, run.stderr[-2000:]
-    return json.loads(html.unescape(probe.group(1)))
+    return probe_of(chromium(path, tmp_path, 1400, 1000, "--dump-dom"))
 
 
 def check_view(out: dict, grid: MetricGrid) -> None:
