@@ -51,12 +51,13 @@ class Bent:
     verdict: str
     quality: dict[str, float | None]
     rooms: dict[str, int]
+    iou: float | None
 
     def summary(self) -> dict:
         return {"scale": round(self.scale, 6), "verdict": self.verdict,
                 "quality": {k: None if v is None else round(v, 6)
                             for k, v in self.quality.items()},
-                "rooms": self.rooms}
+                "rooms": self.rooms, "iou": None if self.iou is None else round(self.iou, 6)}
 
 
 def bent_image(image: np.ndarray, level: float, draw: int) -> np.ndarray:
@@ -75,9 +76,12 @@ def bent(name: str, level: float, draw: int, data: Path) -> Bent:
         drawn = Path(tmp) / f"{name}.png"
         cv2.imwrite(str(drawn), bent_image(image, level, draw))
         result = evaluate(drawn, halmstad_truth(layout, Path(tmp)), SETTINGS)
+    matched = [r["iou"] for r in (result.rooms or {}).get("truth", [])
+               if r["status"] == "matched"]
     return Bent(name, level, draw, result.alignment.transform.scale, result.overlap.verdict,
                 {k: d.matching.quality for k, d in result.detectors.items()},
-                result.rooms["counts"] if result.rooms else {})
+                result.rooms["counts"] if result.rooms else {},
+                float(np.mean(matched)) if matched else None)
 
 
 def draws(level: float) -> range:
@@ -101,6 +105,8 @@ def section(data: Path, record: Record) -> Section:
         for level in LEVELS:
             runs = [b for b in got if b.name == name and b.level == level]
             mean = {d: float(np.mean([b.quality[d] or 0.0 for b in runs])) for d in DETECTORS}
+            fits = [b.iou for b in runs if b.iou is not None]
+            mean["iou"] = float(np.mean(fits)) if fits else float("nan")
             means.append(mean)
             scored = sum(b.verdict != OTHER for b in runs)
             inconsistent = sum(b.verdict == INCONSISTENT for b in runs)
@@ -110,8 +116,11 @@ def section(data: Path, record: Record) -> Section:
                 f"{min(scales):.3f}" + ("" if len(runs) == 1 else f"-{max(scales):.3f}"),
                 (f"{scored}" if scored == len(runs) else f"**{scored}**")
                 + (f" ({inconsistent} inconsistent)" if inconsistent else ""),
-                *(score(mean[d], 2) for d in DETECTORS), truth_rooms(runs[0].rooms)]))
-        falls = [rho_cell(rho(list(LEVELS), [m[d] for m in means])) for d in DETECTORS]
+                *(score(mean[d], 2) for d in DETECTORS),
+                "n/a" if np.isnan(mean["iou"]) else f"{mean['iou']:.3f}",
+                truth_rooms(runs[0].rooms)]))
+        falls = [rho_cell(rho(list(LEVELS), [m[d] for m in means]))
+                 for d in (*DETECTORS, "iou")]
         lines.append(row(["", "rho", "", "", "", *falls, ""]))
     return Section("\n".join([
         "## Rooms of bent real maps: Halmstad maps bent more and more", "",
@@ -128,10 +137,12 @@ def section(data: Path, record: Record) -> Section:
         "alignment found; scored: the draws the verdict scores (the same place, or the same "
         "place with an inconsistent map: at least 3 of its 8 parts, placed on their own, "
         "agree with its pose), bold where not all, and how many of them it finds "
-        "inconsistent; truth rooms: the statuses of the first draw's. rho: Spearman's rank "
-        "correlation of the mean quality with the bend, "
-        f"over the {len(LEVELS)} levels; bold where above {RHO}.", "",
+        "inconsistent; rooms IoU: the mean IoU of the matched truth rooms over the draws (how "
+        "well the rooms the map still has right fit); truth rooms: the statuses of the first "
+        "draw's. rho: Spearman's rank correlation of the mean quality (or IoU) with the bend, "
+        f"over the {len(LEVELS)} levels; bold where above {RHO}, and n/a where the figure is "
+        "the same at every level.", "",
         header(["map", "bend % of diagonal", "draws", "scale", "scored",
-                *(f"q {d}" for d in DETECTORS), "truth rooms (first draw)"]),
+                *(f"q {d}" for d in DETECTORS), "rooms IoU", "truth rooms (first draw)"]),
         *lines,
     ]))

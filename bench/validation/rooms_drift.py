@@ -41,9 +41,12 @@ def rho(levels: list[float], values: list[float | None]) -> float:
 
 
 def rho_cell(value: float | None) -> str:
-    """A rank correlation for a table: bold where above RHO, "n/a" where undefined."""
+    """A rank correlation for a table: bold where above RHO, "n/a" where undefined (bold where
+    the figure is the same at every level: it does not fall)."""
     if value is None:
         return "n/a"
+    if np.isnan(value):
+        return "**n/a**"
     return f"{value:.2f}" if value <= RHO else f"**{value:.2f}**"
 
 

@@ -139,9 +139,9 @@ class RoomOverlap(NamedTuple):
 
     shared: (T, M) cells each pair shares. iou: (T, M) their IoU. usable: (T, M) the IoU of
     the pairs that may match, 0 for the others: a truth room merged (a map room holds most of
-    it and of another truth room) or split (two or more map rooms lie mostly within it), and
-    the map rooms that merge or are its pieces. merged, split: (T,) those truth rooms;
-    merging, pieces: (M,) those map rooms."""
+    it and of another truth room) or split (two or more map rooms lie mostly within it, each
+    holding a piece of it), and the map rooms that merge or are its pieces. merged, split:
+    (T,) those truth rooms; merging, pieces: (M,) those map rooms."""
 
     shared: np.ndarray
     iou: np.ndarray
@@ -152,9 +152,17 @@ class RoomOverlap(NamedTuple):
     pieces: np.ndarray
 
 
-def room_overlap(truth: np.ndarray, map_: np.ndarray, most: float = 0.5) -> RoomOverlap:
+#: A map room is a piece of a split truth room only when it holds at least this share of it: a
+#: pocket the map closed off inside a room (a cupboard's outline, a corner behind a bin) is an
+#: extra room, not a wall that splits it.
+PIECE = 0.1
+
+
+def room_overlap(truth: np.ndarray, map_: np.ndarray, most: float = 0.5,
+                 piece: float = PIECE) -> RoomOverlap:
     """The overlap of the rooms of two label rasters of one shape (0 no room, room k at
-    k + 1); ``most``: the share of a room that counts as most of it."""
+    k + 1); ``most``: the share of a room that counts as most of it; ``piece``: the least share
+    of a truth room a map room holds to be one of its pieces."""
     shared = overlap(truth, map_)
     t_cells = np.bincount(truth.ravel(), minlength=shared.shape[0] + 1)[1:]
     m_cells = np.bincount(map_.ravel(), minlength=shared.shape[1] + 1)[1:]
@@ -164,9 +172,10 @@ def room_overlap(truth: np.ndarray, map_: np.ndarray, most: float = 0.5) -> Room
     of_map = shared / np.maximum(m_cells, 1)[None, :]  # share of each map room
     merging = (of_truth >= most).sum(axis=0) >= 2  # holds most of two or more truth rooms
     merged = (of_truth[:, merging] >= most).any(axis=1)
-    piece = of_map >= most  # the map room lies mostly in the truth room
-    split = (piece.sum(axis=1) >= 2) & ~merged
-    pieces = piece[split].any(axis=0) & ~merging
+    # the map room lies mostly in the truth room and holds a piece of it
+    part = (of_map >= most) & (of_truth >= piece)
+    split = (part.sum(axis=1) >= 2) & ~merged
+    pieces = part[split].any(axis=0) & ~merging
     # a merger, a split room and its pieces are what they are, not a match to one of them
     usable = np.where(merged[:, None] | split[:, None] | merging[None, :] | pieces[None, :],
                       0.0, iou)

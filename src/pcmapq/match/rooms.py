@@ -8,8 +8,9 @@ at least ``min_iou``. A room left over is:
 - **merged**: a map room holds at least ``most`` of each of two or more truth rooms (a wall
   or door the map lacks joined them): those truth rooms and that map room;
 - **split**: at least two map rooms lie each for at least ``most`` of their own cells within
-  one truth room (the map put a wall or a door where the truth has none): that truth room and
-  those map rooms;
+  one truth room and hold each at least ``PIECE`` (a tenth) of it (the map put a wall or a
+  door where the truth has none): that truth room and those map rooms; a smaller pocket the
+  map closed off inside it is an extra room;
 - **missing** (a truth room) or **extra** (a map room) otherwise.
 
 Merged and split rooms are left out of the assignment: a map room over two truth rooms is not

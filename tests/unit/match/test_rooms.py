@@ -49,6 +49,23 @@ def test_an_extra_wall_splits_a_truth_room():
     assert list(found.map_status) == [SPLIT, SPLIT, MATCHED]
 
 
+def test_a_pocket_closed_off_inside_a_room_is_extra_and_the_room_matched():
+    """A map room of 4 cells inside a truth room of 100 (a cupboard's outline): no split; at 12
+    cells (more than a tenth of the room) it is a piece, and the room split."""
+    truth = strips(10, 8)
+    for size, split in ((4, False), (12, True)):
+        map_ = truth.copy()
+        map_[map_ == 2] = 3
+        map_[:size // 2, :2] = 2  # the pocket, in the first room's corner
+        found = match(truth, map_)
+        if split:
+            assert list(found.truth_status) == [SPLIT, MATCHED]
+            assert list(found.map_status) == [SPLIT, SPLIT, MATCHED]
+        else:
+            assert list(found.truth_status) == [MATCHED, MATCHED]
+            assert list(found.map_status) == [MATCHED, EXTRA, MATCHED]
+
+
 def test_a_room_not_entered_is_missing_and_a_room_outside_the_truth_is_extra():
     truth, map_ = strips(5, 5, -5), strips(5, -5, 5)
     found = match(truth, map_)
