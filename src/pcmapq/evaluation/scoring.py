@@ -19,7 +19,7 @@ from pcmapq.evaluation.placing import Placed, Progress
 from pcmapq.evaluation.truth import FEATURE_THREADS, PreparedTruth
 from pcmapq.features import Features, SideBySide, default_params
 from pcmapq.features.rooms import Params as RoomParams
-from pcmapq.features.rooms import share_inside
+from pcmapq.features.rooms import drawn, share_inside
 from pcmapq.io import OccupancyMap, PointMap
 from pcmapq.match import match
 from pcmapq.match.rooms import room_table
@@ -67,7 +67,7 @@ def score(placed: Placed, prepared: PreparedTruth, settings: Settings,
         truth_f, map_f = prepared.features[name], side.features[name]
         params = settings.matching.params.get(name)
         if not full:  # truth features the map never saw are not missing
-            truth_f = truth_f.counted_where(inside(truth_f, footprint, grid, params))
+            truth_f = truth_f.counted_where(inside(truth_f, footprint, grid, params, map_f))
             if rule == "seen":  # nor are the features of walls its scans only dotted extra
                 map_f = map_f.counted_where(inside(map_f, footprint, grid, params))
         detectors[name] = DetectorResult(truth_f, map_f,
@@ -97,13 +97,18 @@ def score(placed: Placed, prepared: PreparedTruth, settings: Settings,
 
 
 def inside(features: Features, area: np.ndarray, grid: MetricGrid,
-           params: object = None) -> np.ndarray:
+           params: object = None, other: Features | None = None) -> np.ndarray:
     """(N,) bool: which features lie in the cells where ``area`` is true; rooms (features
-    with cells), those with at least ``min_seen`` of their cells there (their ``params``, or
-    the rooms' defaults)."""
+    with cells), those with at least ``min_seen`` of their cells there, or at least
+    ``min_drawn`` where ``other`` (the other side's rooms) drew a room over them (their
+    ``params``, or the rooms' defaults; see :class:`~pcmapq.features.rooms.Params`)."""
     if features.labels is not None:
-        seen = params.min_seen if isinstance(params, RoomParams) else RoomParams().min_seen
-        return share_inside(features, area, grid) >= seen
+        p = params if isinstance(params, RoomParams) else RoomParams()
+        share = share_inside(features, area, grid)
+        seen = share >= p.min_seen
+        if other is not None:
+            seen |= (share >= p.min_drawn) & drawn(features, other)
+        return seen
     uv = np.floor(grid.xy_to_pixels(features.xy) + 0.5).astype(int)
     rows, cols = area.shape
     ok = (uv[:, 0] >= 0) & (uv[:, 0] < cols) & (uv[:, 1] >= 0) & (uv[:, 1] < rows)

@@ -25,8 +25,8 @@ from pcmapq.features.resample import resample
 from pcmapq.features.room_segmentation import Params, Rooms, segment, without_wall_furniture
 from pcmapq.features.walls import WallImage
 
-__all__ = ["DETECTOR", "Params", "RoomOverlap", "candidates", "detect", "inside_rooms",
-           "label_cell", "overlap", "room_cell", "room_overlap", "share_inside"]
+__all__ = ["DETECTOR", "PIECE", "Params", "RoomOverlap", "candidates", "detect", "drawn",
+           "inside_rooms", "label_cell", "overlap", "room_cell", "room_overlap", "share_inside"]
 
 
 #: A cell holding at least this share of the wall band is a wall (the band is 0.15 m wide, so
@@ -35,6 +35,12 @@ WALL_SHARE = 0.05
 #: Cells a raster of rooms holds at most: a larger raster's cells are made larger (whole
 #: multiples of the walls' cell), so that the rooms of a campus cost what a building's do.
 MAX_CELLS = 4_000_000
+
+
+#: A map room is a piece of a split truth room only when it holds at least this share of it: a
+#: pocket the map closed off inside a room (a cupboard's outline, a corner behind a bin) is an
+#: extra room, not a wall that splits it.
+PIECE = 0.1
 
 
 def room_cell(grid: MetricGrid, cell_m: float) -> float:
@@ -125,6 +131,22 @@ def share_inside(features: Features, area: np.ndarray, grid: MetricGrid) -> np.n
     return np.bincount(room, weights=hit, minlength=len(features)) / np.maximum(total, 1)
 
 
+def drawn(truth: Features, map_: Features, most: float = 0.5,
+          piece: float = PIECE) -> np.ndarray:
+    """(T,) bool: the truth rooms over which the map drew a room of its own, one lying for at
+    least ``most`` of its cells within the truth room and holding at least ``piece`` of it."""
+    if truth.labels is None or map_.labels is None or truth.labels.shape != map_.labels.shape \
+            or not len(truth) or not len(map_):
+        return np.zeros(len(truth), dtype=bool)
+    shared = np.zeros((len(truth), len(map_)), dtype=np.int64)
+    found = overlap(truth.labels, map_.labels)
+    shared[:found.shape[0], :found.shape[1]] = found
+    t_cells = np.bincount(truth.labels.ravel(), minlength=len(truth) + 1)[1:len(truth) + 1]
+    m_cells = np.bincount(map_.labels.ravel(), minlength=len(map_) + 1)[1:len(map_) + 1]
+    return ((shared >= most * m_cells[None, :]) & (shared >= piece * t_cells[:, None])
+            & (shared > 0)).any(axis=1)
+
+
 def overlap(truth: np.ndarray, map_: np.ndarray) -> np.ndarray:
     """(T, M) cells shared by each truth room and each map room: two int label rasters of one
     shape, 0 no room, room k at k + 1."""
@@ -150,12 +172,6 @@ class RoomOverlap(NamedTuple):
     split: np.ndarray
     merging: np.ndarray
     pieces: np.ndarray
-
-
-#: A map room is a piece of a split truth room only when it holds at least this share of it: a
-#: pocket the map closed off inside a room (a cupboard's outline, a corner behind a bin) is an
-#: extra room, not a wall that splits it.
-PIECE = 0.1
 
 
 def room_overlap(truth: np.ndarray, map_: np.ndarray, most: float = 0.5,

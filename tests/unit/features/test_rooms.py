@@ -185,6 +185,66 @@ def test_a_room_the_map_never_entered_is_missing():
     assert (found.quality, found.precision) == (pytest.approx(2 / 3), 1.0)
 
 
+def third_room_cut(share: float, closed: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Walls of a plan of three rooms, and of its map ending ``share`` of the way into the
+    third room, the map's wall closing it there (``closed``) or its walls simply ending (a
+    partial map that saw no more); and the map's footprint, its cells to 0.3 m past the cut."""
+    truth = plan()
+    left = np.flatnonzero(truth.any(axis=0))[0]
+    cut = left + 2 * cells(4.0) + 2 * cells(0.1) + int(round(share * cells(4.0)))
+    walls = walls_of_plan(truth)
+    if closed:
+        seen = truth.copy()
+        seen[:, cut:] = False
+        map_walls = walls_of_plan(seen)
+    else:
+        map_walls = walls.copy()
+        map_walls[:, cut:] = False
+    footprint = np.zeros(truth.shape, dtype=bool)
+    footprint[:, :cut + cells(0.3)] = True
+    return walls, map_walls, footprint
+
+
+@pytest.mark.parametrize(("closed", "counted"), [(True, True), (False, False)])
+def test_a_room_seen_in_part_counts_where_the_map_drew_a_room_over_it(closed, counted):
+    """70 % of the third room inside the footprint: it counts when the map drew a room of its
+    own over it (a bent map's room out of place), not when the map's walls end open in it (a
+    partial map that saw it through its end); the two rooms seen whole count either way."""
+    from pcmapq.core.grid import MetricGrid
+    from pcmapq.evaluation.scoring import inside
+    from pcmapq.features import detect
+    from pcmapq.features.rooms import drawn, share_inside
+
+    walls, map_walls, footprint = third_room_cut(0.6, closed)
+    grid = MetricGrid(RES, (0.0, 0.0, 0.0), walls.shape)
+    t, m = detect("rooms", walls, grid), detect("rooms", map_walls, grid)
+    share = share_inside(t, footprint, grid)
+    assert share[:2].tolist() == [1.0, 1.0] and 0.6 < share[2] < 0.8
+    assert drawn(t, m).tolist() == [True, True, closed]
+    assert inside(t, footprint, grid).tolist() == [True, True, False]
+    assert inside(t, footprint, grid, other=m).tolist() == [True, True, counted]
+
+
+def test_a_pocket_or_a_room_mostly_elsewhere_is_no_room_drawn_over_a_truth_room():
+    from pcmapq.features.base import Features
+    from pcmapq.features.rooms import drawn
+
+    def rooms(labels: np.ndarray) -> Features:
+        n = int(labels.max())
+        return Features(xy=np.zeros((n, 2)), strength=np.ones(n), strong=np.ones(n, bool),
+                        labels=labels)
+
+    truth = np.zeros((10, 20), np.int32)
+    truth[:, :10], truth[:, 10:] = 1, 2
+    pocket = np.zeros_like(truth)
+    pocket[:2, :4] = 1  # 8 cells of the first room's 100
+    assert drawn(rooms(truth), rooms(pocket)).tolist() == [False, False]
+    across = np.zeros_like(truth)
+    across[:, 4:20] = 1  # 100 of its 160 cells in the second room, 60 in the first
+    assert drawn(rooms(truth), rooms(across)).tolist() == [False, True]
+    assert drawn(rooms(truth), rooms(np.zeros_like(truth))).tolist() == [False, False]
+
+
 def test_a_door_the_map_closed_leaves_the_rooms_matched():
     _, _, found = scored(plan(), plan(doors=(True, False)))
     assert found.quality == found.precision == 1.0
