@@ -134,17 +134,14 @@ def share_inside(features: Features, area: np.ndarray, grid: MetricGrid) -> np.n
 def drawn(truth: Features, map_: Features, most: float = 0.5,
           piece: float = PIECE) -> np.ndarray:
     """(T,) bool: the truth rooms over which the map drew a room of its own, one lying for at
-    least ``most`` of its cells within the truth room and holding at least ``piece`` of it."""
-    if truth.labels is None or map_.labels is None or truth.labels.shape != map_.labels.shape \
-            or not len(truth) or not len(map_):
-        return np.zeros(len(truth), dtype=bool)
-    shared = np.zeros((len(truth), len(map_)), dtype=np.int64)
-    found = overlap(truth.labels, map_.labels)
-    shared[:found.shape[0], :found.shape[1]] = found
-    t_cells = np.bincount(truth.labels.ravel(), minlength=len(truth) + 1)[1:len(truth) + 1]
-    m_cells = np.bincount(map_.labels.ravel(), minlength=len(map_) + 1)[1:len(map_) + 1]
-    return ((shared >= most * m_cells[None, :]) & (shared >= piece * t_cells[:, None])
-            & (shared > 0)).any(axis=1)
+    least ``most`` of its cells within the truth room and holding at least ``piece`` of it (a
+    piece of it, :func:`room_overlap`)."""
+    found = np.zeros(len(truth), dtype=bool)
+    if truth.labels is None or map_.labels is None or truth.labels.shape != map_.labels.shape:
+        return found
+    part = room_overlap(truth.labels, map_.labels, most, piece).part
+    found[:part.shape[0]] = part.any(axis=1)
+    return found
 
 
 def overlap(truth: np.ndarray, map_: np.ndarray) -> np.ndarray:
@@ -163,7 +160,9 @@ class RoomOverlap(NamedTuple):
     the pairs that may match, 0 for the others: a truth room merged (a map room holds most of
     it and of another truth room) or split (two or more map rooms lie mostly within it, each
     holding a piece of it), and the map rooms that merge or are its pieces. merged, split:
-    (T,) those truth rooms; merging, pieces: (M,) those map rooms."""
+    (T,) those truth rooms; merging, pieces: (M,) those map rooms. part: (T, M) whether the
+    map room is a piece of the truth room (lies mostly within it and holds a piece of it),
+    split or not."""
 
     shared: np.ndarray
     iou: np.ndarray
@@ -172,6 +171,7 @@ class RoomOverlap(NamedTuple):
     split: np.ndarray
     merging: np.ndarray
     pieces: np.ndarray
+    part: np.ndarray
 
 
 def room_overlap(truth: np.ndarray, map_: np.ndarray, most: float = 0.5,
@@ -195,7 +195,7 @@ def room_overlap(truth: np.ndarray, map_: np.ndarray, most: float = 0.5,
     # a merger, a split room and its pieces are what they are, not a match to one of them
     usable = np.where(merged[:, None] | split[:, None] | merging[None, :] | pieces[None, :],
                       0.0, iou)
-    return RoomOverlap(shared, iou, usable, merged, split, merging, pieces)
+    return RoomOverlap(shared, iou, usable, merged, split, merging, pieces, part)
 
 
 def candidates(truth: Features, map_: Features, threshold: float,
