@@ -106,8 +106,9 @@ def inside(features: Features, area: np.ndarray, grid: MetricGrid,
         p = params if isinstance(params, RoomParams) else RoomParams()
         share = share_inside(features, area, grid)
         seen = share >= p.min_seen
-        if other is not None:
-            seen |= (share >= p.min_drawn) & drawn(features, other)
+        maybe = (share >= p.min_drawn) & ~seen  # only these can count by the map's rooms
+        if other is not None and maybe.any():
+            seen |= maybe & drawn(features, other)
         return seen
     uv = np.floor(grid.xy_to_pixels(features.xy) + 0.5).astype(int)
     rows, cols = area.shape
