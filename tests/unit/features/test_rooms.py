@@ -225,26 +225,6 @@ def test_a_room_seen_in_part_counts_where_the_map_drew_a_room_over_it(closed, co
     assert inside(t, footprint, grid, other=m).tolist() == [True, True, counted]
 
 
-def test_a_pocket_or_a_room_mostly_elsewhere_is_no_room_drawn_over_a_truth_room():
-    from pcmapq.features.base import Features
-    from pcmapq.features.rooms import drawn
-
-    def rooms(labels: np.ndarray) -> Features:
-        n = int(labels.max())
-        return Features(xy=np.zeros((n, 2)), strength=np.ones(n), strong=np.ones(n, bool),
-                        labels=labels)
-
-    truth = np.zeros((10, 20), np.int32)
-    truth[:, :10], truth[:, 10:] = 1, 2
-    pocket = np.zeros_like(truth)
-    pocket[:2, :4] = 1  # 8 cells of the first room's 100
-    assert drawn(rooms(truth), rooms(pocket)).tolist() == [False, False]
-    across = np.zeros_like(truth)
-    across[:, 4:20] = 1  # 100 of its 160 cells in the second room, 60 in the first
-    assert drawn(rooms(truth), rooms(across)).tolist() == [False, True]
-    assert drawn(rooms(truth), rooms(np.zeros_like(truth))).tolist() == [False, False]
-
-
 def test_a_door_the_map_closed_leaves_the_rooms_matched():
     _, _, found = scored(plan(), plan(doors=(True, False)))
     assert found.quality == found.precision == 1.0

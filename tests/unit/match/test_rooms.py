@@ -111,3 +111,17 @@ def test_a_room_the_map_saw_too_little_of_is_unseen_even_when_a_map_room_overlap
     assert table["truth"][1]["iou"] == 1.0
     assert [r["status"] for r in table["map"]] == [MATCHED, MATCHED]
     assert table["counts"] == {"map matched": 2, "truth matched": 1, "truth unseen": 1}
+
+
+def test_a_pocket_or_a_room_mostly_elsewhere_is_no_room_drawn_over_a_truth_room():
+    from pcmapq.features.rooms import drawn
+
+    truth = features_of(strips(10, 10))
+    pocket = np.zeros_like(truth.labels)
+    pocket[:2, :4] = 1  # 8 cells of the first room's 100
+    assert drawn(truth, features_of(pocket)).tolist() == [False, False]
+    # 100 of its 160 cells in the second room, 60 in the first
+    across = features_of(strips(-4, 16))
+    assert drawn(truth, across).tolist() == [False, True]
+    none = truth.labels * 0
+    assert drawn(truth, features_of(none)).tolist() == [False, False]
