@@ -9,7 +9,6 @@ and scale (see :mod:`pcmapq.features.sift` for why ``cv2.SIFT``'s own detection 
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, fields
 
 import cv2
@@ -58,44 +57,87 @@ def octave_count(shape: tuple[int, int], sigma: float, layers: int, largest: flo
     return min(wanted, int(round(np.log2(max(min(shape), 1)))) - 2)
 
 
-def gaussian_pyramid(image: np.ndarray, sigma: float, layers: int,
-                     octaves: int) -> Iterator[np.ndarray]:
-    """SIFT's Gaussian scale space of ``image``, octave by octave: per octave a stack
-    (layers + 4, rows, cols) float32 of blurs ``sigma 2^(i / layers)`` pixels of the octave,
-    each octave starting from the previous one's layer ``layers``, halved (taken before the
-    stack is handed over: the consumer may overwrite it). ``cv2.SIFT`` has one layer fewer; the
-    extra one makes consecutive octaves share a DoG layer where extrema are searched, so an
-    extremum at an octave's scale limit is not lost between two octaves sampled differently.
-    Stops early when an octave has no sample left to search."""
+def blur_steps(sigma: float, layers: int) -> list[float]:
+    """The blurs, pixels of an octave, that take each layer of a SIFT octave to the next (the
+    first takes the input, counted as blurred by 0.5 px, to ``sigma``): ``layers + 4``."""
     k = 2.0 ** (1.0 / layers)
-    step = [np.sqrt(max(sigma * sigma - 0.25, 0.01))]  # the input counts as blurred by 0.5 px
-    step += [sigma * k ** (i - 1) * np.sqrt(k * k - 1.0) for i in range(1, layers + 4)]
-    current = image.astype(np.float32)
+    step = [np.sqrt(max(sigma * sigma - 0.25, 0.01))]
+    return step + [sigma * k ** (i - 1) * np.sqrt(k * k - 1.0) for i in range(1, layers + 4)]
+
+
+def blur_reach(sigma_px: float) -> int:
+    """How many pixels away ``cv2.GaussianBlur`` of a float32 image with ``sigma_px`` and no
+    kernel size looks: its kernel's half-width (OpenCV's rule, 4 sigma)."""
+    return (int(round(sigma_px * 8 + 1)) | 1) // 2
+
+
+#: Cells of one layer of a strip of an octave's stack: the stack of a large image is built and
+#: searched a strip of rows at a time (with the rows its blurs reach above and below), so it
+#: holds ``layers + 4`` such layers instead of the whole octave's.
+STACK_CELLS = 1 << 22
+
+
+def extrema(image: np.ndarray, sigma: float, layers: int, octaves: int,
+            floor: float) -> Extrema:
+    """Every sample of SIFT's DoG scale space of ``image`` (rows, cols) that is an extremum of
+    its 26 neighbours with ``|DoG| >= floor``, in layers 1 to ``layers + 1`` of each of at most
+    ``octaves`` octaves, refined by one quadratic step clipped to half a sample in space and
+    scale (a sample is an extremum's nearest one when the fit says more: the fit overshoots,
+    and stepping to the next sample is what loses keypoints). ``sigma``: the base blur, pixels.
+
+    Each octave is a stack (layers + 4) of blurs ``sigma 2^(i / layers)`` pixels of the octave,
+    starting from the previous octave's layer ``layers``, halved; ``cv2.SIFT`` has one layer
+    fewer: the extra one makes consecutive octaves share a DoG layer where extrema are searched,
+    so an extremum at an octave's scale limit is not lost between two octaves sampled
+    differently. An octave is built in strips of rows, each with the rows its blurs reach on
+    either side, and gives what the whole octave's stack gives, sample for sample. Stops early
+    when an octave has no sample left to search."""
+    steps = blur_steps(sigma, layers)
+    current = np.asarray(image, dtype=np.float32)
+    found: list[Extrema] = []
     for o in range(octaves):
-        stack = np.empty((layers + 4, *current.shape), np.float32)
-        for i in range(layers + 4):
-            if i > 0 or o == 0:
-                current = cv2.GaussianBlur(current, (0, 0), step[i])
-            stack[i] = current
-        last = min(current.shape) < 2 * BORDER + 3
-        prev = stack[layers]
-        current = np.ascontiguousarray(prev[: prev.shape[0] // 2 * 2 : 2,
-                                            : prev.shape[1] // 2 * 2 : 2])
-        yield stack
-        if last:
+        rows, cols = current.shape
+        blurs = steps if o == 0 else steps[1:]  # later octaves start from a blurred layer
+        halo = sum(blur_reach(s) for s in blurs) + 2  # and one row each side for the peaks
+        strip = max(2 * halo, STACK_CELLS // max(cols, 1)) // 2 * 2
+        halved = np.empty((rows // 2, cols // 2), np.float32)
+        keys, parts = [], []
+        for top in range(0, rows, strip):
+            lo, hi = max(0, top - halo), min(rows, top + strip + halo)
+            stack = _stack(current[lo:hi], blurs, layers)
+            # the next octave's rows of this strip: its even rows of layer ``layers``
+            even = np.arange(top, min(top + strip, rows // 2 * 2), 2)
+            halved[even // 2] = stack[layers][even - lo, : cols // 2 * 2 : 2]
+            part, key = _octave_extrema(_dog(stack), o, sigma, floor,
+                                        (top - lo, min(top + strip, rows) - lo), lo, rows)
+            parts.append(part)
+            keys.append(key)
+        lay, r, c = (np.concatenate(k) for k in zip(*keys, strict=True))
+        found.append(_joined(parts).where(np.lexsort((c, r, lay))))
+        if min(rows, cols) < 2 * BORDER + 3:
             break
+        current = halved
+    return _joined(found)
 
 
-def extrema(pyramid: Iterable[np.ndarray], sigma: float, floor: float) -> Extrema:
-    """Every DoG sample of :func:`gaussian_pyramid`'s ``pyramid`` that is an extremum of its 26
-    neighbours with ``|DoG| >= floor``, in layers 1 to ``layers + 1`` of each octave, refined by
-    one quadratic step clipped to half a sample in space and scale (a sample is an extremum's
-    nearest one when the fit says more: the fit overshoots, and stepping to the next sample is
-    what loses keypoints). ``sigma``: the pyramid's base blur, pixels. Each octave's stack is
-    turned into its DoG in place, so one octave is held at a time."""
-    found = [_octave_extrema(_dog(stack), o, sigma, floor) for o, stack in enumerate(pyramid)]
-    return Extrema(**{f.name: np.concatenate([getattr(e, f.name) for e in found])
+def _joined(parts: list[Extrema]) -> Extrema:
+    """The extrema of ``parts``, one after the other."""
+    return Extrema(**{f.name: np.concatenate([getattr(e, f.name) for e in parts])
                       for f in fields(Extrema)})
+
+
+def _stack(base: np.ndarray, blurs: list[float], layers: int) -> np.ndarray:
+    """(layers + 4, rows, cols) float32: ``base`` (rows, cols) blurred by each of ``blurs`` in
+    turn, each layer written where it is kept (a layer before the blurs when they are one
+    fewer than the layers)."""
+    stack = np.empty((layers + 4, *base.shape), np.float32)
+    first = len(stack) - len(blurs)
+    if first:
+        stack[0] = base
+    previous = base
+    for i, s in enumerate(blurs, start=first):
+        previous = cv2.GaussianBlur(previous, (0, 0), s, dst=stack[i])
+    return stack
 
 
 def _dog(stack: np.ndarray) -> np.ndarray:
@@ -111,20 +153,23 @@ def _dog(stack: np.ndarray) -> np.ndarray:
 STRIP_CELLS = 1 << 18
 
 
-def _peaks(dog: np.ndarray, floor: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(layer, row, column) of every sample of layers 1 to n - 2 of the DoG stack, at least
-    :data:`BORDER` from the image's edges, that equals the maximum (at least ``floor``) or the
-    minimum (at most ``-floor``) of its 3 x 3 x 3 neighbourhood: the 3 x 3 dilation (erosion)
-    of the largest (smallest) of three layers, by OpenCV, which ignores samples beyond the
-    border, as repeating the border would. Computed in strips of rows (each with one row of
-    the next strips around it); sorted by layer, row, column."""
+def _peaks(dog: np.ndarray, floor: float, searched: tuple[int, int], row: int,
+           total: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(layer, row, column) of every sample of layers 1 to n - 2 of the DoG stack, in its rows
+    ``searched`` (first, end) and at least :data:`BORDER` from the image's edges (the stack's
+    row 0 is the image's row ``row`` of ``total``), that equals the maximum (at least
+    ``floor``) or the minimum (at most ``-floor``) of its 3 x 3 x 3 neighbourhood: the 3 x 3
+    dilation (erosion) of the largest (smallest) of three layers, by OpenCV, which ignores
+    samples beyond the border, as repeating the border would. Computed in strips of rows (each
+    with one row of the next strips around it); rows of the stack, sorted by layer, row,
+    column."""
     square = np.ones((3, 3), np.uint8)
     layers, rows, cols = dog.shape
     strip = max(1, STRIP_CELLS // cols)
     found: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
-    for top in range(0, rows, strip):
+    for top in range(searched[0], searched[1], strip):
         lo, hi = max(0, top - 1), min(rows, top + strip + 1)
-        first, last = top - lo, top - lo + min(strip, rows - top)
+        first, last = top - lo, top - lo + min(strip, searched[1] - top)
         for i in range(1, layers - 1):
             below, here, above = dog[i - 1, lo:hi], dog[i, lo:hi], dog[i + 1, lo:hi]
             high = cv2.dilate(np.maximum(np.maximum(below, here), above), square)
@@ -132,17 +177,22 @@ def _peaks(dog: np.ndarray, floor: float) -> tuple[np.ndarray, np.ndarray, np.nd
             peak = ((here >= floor) & (here == high)) | ((here <= -floor) & (here == low))
             r, c = np.nonzero(peak[first:last])
             r += top
-            inner = (r >= BORDER) & (r < rows - BORDER) & (c >= BORDER) & (c < cols - BORDER)
+            inner = ((r + row >= BORDER) & (r + row < total - BORDER) & (c >= BORDER)
+                     & (c < cols - BORDER))
             found.append((np.full(inner.sum(), i), r[inner], c[inner]))
     lay, r, c = (np.concatenate(f) for f in zip(*found, strict=True))
     order = np.lexsort((c, r, lay))
     return lay[order], r[order], c[order]
 
 
-def _octave_extrema(dog: np.ndarray, octave: int, sigma: float, floor: float) -> Extrema:
-    """:func:`extrema` in one octave's DoG stack (layers + 3, rows, cols)."""
+def _octave_extrema(dog: np.ndarray, octave: int, sigma: float, floor: float,
+                    searched: tuple[int, int], row: int, total: int
+                    ) -> tuple[Extrema, tuple[np.ndarray, np.ndarray, np.ndarray]]:
+    """:func:`extrema` in the rows ``searched`` of a strip of one octave's DoG stack
+    (layers + 3, rows, cols), whose row 0 is the octave's row ``row`` of ``total``; with
+    each extremum's (layer, row, column) in the octave, to order them by."""
     layers = dog.shape[0] - 3
-    lay, r, c = _peaks(dog, floor)
+    lay, r, c = _peaks(dog, floor, searched, row, total)
 
     def at(dl: int, dr: int, dc: int) -> np.ndarray:
         return dog[lay + dl, r + dr, c + dc].astype(np.float64)
@@ -158,15 +208,15 @@ def _octave_extrema(dog: np.ndarray, octave: int, sigma: float, floor: float) ->
     dys = 0.25 * (at(1, 1, 0) - at(1, -1, 0) - at(-1, 1, 0) + at(-1, -1, 0))
     hess = np.stack([np.stack([dxx, dxy, dxs], 1), np.stack([dxy, dyy, dys], 1),
                      np.stack([dxs, dys, dss], 1)], 1)
-    offset = np.clip(-np.einsum("nij,nj->ni", np.linalg.pinv(hess), grad), -0.5, 0.5)
+    step = np.clip(-np.einsum("nij,nj->ni", np.linalg.pinv(hess), grad), -0.5, 0.5)
     det, trace = dxx * dyy - dxy * dxy, dxx + dyy
     scale = 2.0 ** octave  # input pixels per pixel of the octave
     return Extrema(
         octave=np.full(len(lay), octave),
         layer=lay,
-        pt=np.column_stack([c + offset[:, 0], r + offset[:, 1]]) * scale,
-        xi=offset[:, 2],
-        size=2.0 * sigma * 2.0 ** ((lay + offset[:, 2]) / layers) * scale,
-        contrast=v + 0.5 * np.sum(grad * offset, axis=1),
+        pt=np.column_stack([c + step[:, 0], r + row + step[:, 1]]) * scale,
+        xi=step[:, 2],
+        size=2.0 * sigma * 2.0 ** ((lay + step[:, 2]) / layers) * scale,
+        contrast=v + 0.5 * np.sum(grad * step, axis=1),
         edge_ratio=np.where(det > 0, trace * trace / np.where(det > 0, det, 1.0), np.inf),
-    )
+    ), (lay, r + row, c)

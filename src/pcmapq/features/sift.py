@@ -56,7 +56,7 @@ from pcmapq.features.base import (
     sorted_features,
     suppress,
 )
-from pcmapq.features.scale_space import Extrema, extrema, gaussian_pyramid, octave_count
+from pcmapq.features.scale_space import Extrema, extrema, octave_count
 from pcmapq.features.walls import WallImage
 
 #: Length of an OpenCV SIFT descriptor (L2 norm; its entries are non-negative).
@@ -133,8 +133,7 @@ def detect(walls: WallImage, params: Params) -> Features:
     octaves = octave_count(ent.shape, p.sigma, p.octave_layers, p.max_size / resolution)
     if octaves < 1:
         return empty_features(with_descriptors=True)
-    kp = extrema(gaussian_pyramid(ent, p.sigma, p.octave_layers, octaves), p.sigma,
-                 0.5 * p.support * p.threshold)
+    kp = extrema(ent, p.sigma, p.octave_layers, octaves, 0.5 * p.support * p.threshold)
     size = kp.size * resolution
     response = np.abs(kp.contrast)
 
