@@ -6,12 +6,16 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
+#: Where :func:`precise_distance` writes its output: this many bytes past a multiple of
+#: ALIGN bytes (see there).
+ALIGN, OFFSET = 64, 16
+
 
 def distance_to(mask: np.ndarray) -> np.ndarray:
     """Euclidean distance, in cells, from every cell to the nearest true cell of ``mask``.
 
     mask: (rows, cols) bool (or 0/nonzero). Returns (rows, cols) float32, inf everywhere when
-    ``mask`` has no true cell. OpenCV's precise transform (``DIST_MASK_PRECISE``, an exact
+    ``mask`` has no true cell. OpenCV's precise transform (:func:`precise_distance`, an exact
     Euclidean transform computed in float32): against SciPy's ``distance_transform_edt`` in
     float64 it differs by float32 rounding (relative 1.2e-7) on every real map tried (the
     largest 8904 x 6936 cells); on an 8000 x 8000 plan 12 of 64 M cells, about 600 cells from
@@ -19,8 +23,25 @@ def distance_to(mask: np.ndarray) -> np.ndarray:
     """
     if not mask.any():
         return np.full(mask.shape, np.inf, dtype=np.float32)
-    return cv2.distanceTransform(np.logical_not(mask).view(np.uint8), cv2.DIST_L2,
-                                 cv2.DIST_MASK_PRECISE)
+    return precise_distance(np.logical_not(mask).view(np.uint8))
+
+
+def precise_distance(image: np.ndarray) -> np.ndarray:
+    """``cv2.distanceTransform(image, DIST_L2, DIST_MASK_PRECISE)``: (rows, cols) float32
+    distance, in cells, from every cell to the nearest zero cell of the uint8 ``image``, the
+    same values wherever memory puts them.
+
+    OpenCV hands an image of fewer than 2^14 cells (or any image, on one OpenCV thread) to
+    IPP, whose result depends in its last bit on the output's address modulo 32 bytes; a
+    larger one on more threads goes to OpenCV's own transform, which does not. The output is
+    therefore always written at one such address, OFFSET bytes past a multiple of ALIGN: where
+    a large allocation lies (16 bytes past a page), so that those keep their values."""
+    rows, cols = image.shape
+    raw = np.empty(rows * cols * 4 + ALIGN, np.uint8)
+    start = (OFFSET - raw.ctypes.data) % ALIGN
+    out = raw[start:start + rows * cols * 4].view(np.float32).reshape(rows, cols)
+    cv2.distanceTransform(image, cv2.DIST_L2, cv2.DIST_MASK_PRECISE, dst=out)
+    return out
 
 
 def disc(radius: float) -> np.ndarray:

@@ -38,6 +38,7 @@ import cv2
 import numpy as np
 
 from pcmapq.core.bounds import on_edge
+from pcmapq.core.morphology import precise_distance
 from pcmapq.features.peaks import h_maxima
 
 #: The door test's slack: clearances are float32 metres, so a passage of exactly ``door_ratio``
@@ -227,8 +228,7 @@ def segment(free: np.ndarray, resolution: float, params: Params | None = None) -
 
     params = Params() if params is None else params
     free = without_furniture(np.asarray(free, dtype=bool), resolution, params.furniture_m)
-    clearance = cv2.distanceTransform(free.view(np.uint8), cv2.DIST_L2,
-                                      cv2.DIST_MASK_PRECISE) * np.float32(resolution)
+    clearance = precise_distance(free.view(np.uint8)) * np.float32(resolution)
     peaks = h_maxima(clearance, params.peak_h_m) & free
     _, markers = cv2.connectedComponents(peaks.view(np.uint8), connectivity=8)
     basin = watershed(-clearance, markers, mask=free).astype(np.int32)
