@@ -26,7 +26,7 @@ from pcmapq.evaluation.truth import PreparedTruth
 from pcmapq.features import Features
 from pcmapq.io import OccupancyMap, PointMap
 from pcmapq.io.extent import check_span, hint
-from pcmapq.metrics.distances import nearest_distance
+from pcmapq.metrics.distances import DistanceField, nearest_distance
 from pcmapq.raster.draw import OCCUPIED, UNKNOWN, points_to_grid, warp_state
 from pcmapq.raster.footprint import check_rule, footprint_rule, map_footprint
 from pcmapq.raster.seen import seen_on
@@ -52,7 +52,7 @@ class Placed:
     level: Levelling | None
     alignment: Alignment
     occupied: np.ndarray
-    to_map: np.ndarray
+    to_map: DistanceField
     cover: Overlap
     rule: str
     target: RigidTarget | None = None

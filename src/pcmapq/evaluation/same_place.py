@@ -17,6 +17,7 @@ from pcmapq.core.morphology import outline
 from pcmapq.evaluation.inputs import MAP_CROP, OUTLINE_M
 from pcmapq.io import OccupancyMap, PointMap
 from pcmapq.io.extent import far_points
+from pcmapq.metrics.distances import DistanceField
 from pcmapq.results.result import INCONSISTENT, OTHER, SAME, Overlap
 from pcmapq.settings import Settings
 
@@ -59,7 +60,7 @@ def confidence(distinct: float | None, recall: float, agreement: float = 0.0) ->
     return float(np.clip(max(min(terms), agreed), 0.0, 1.0))
 
 
-def overlap(truth_occ: np.ndarray, to_map: np.ndarray, footprint: np.ndarray,
+def overlap(truth_occ: np.ndarray, to_map: DistanceField, footprint: np.ndarray,
             alignment: Alignment, resolution: float) -> Overlap:
     """How much of the truth the map covers, how well the two agree there, and the confidence
     that they show one place; ``to_map`` is each cell's distance to the nearest map wall,

@@ -18,7 +18,7 @@ from pcmapq.evaluation.inputs import MAP_CROP, TRUTH_CROP, plan_points, truth_ce
 from pcmapq.features import Features, SideBySide
 from pcmapq.io import OccupancyMap, PointMap
 from pcmapq.io.extent import check_span, hint
-from pcmapq.metrics.distances import nearest_distance
+from pcmapq.metrics.distances import DistanceField, nearest_distance
 from pcmapq.settings import Settings
 
 #: Threads that find a truth's features when nothing else runs beside them.
@@ -41,7 +41,7 @@ class PreparedTruth:
     grid: MetricGrid
     occupied: np.ndarray
     found: dict[str, Features] | Future
-    to_truth: np.ndarray | None = None
+    to_truth: DistanceField | None = None
     aligner: RigidTarget | None = None
     maps: int = 1
     sides: SideBySide | None = None

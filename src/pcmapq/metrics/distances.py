@@ -39,17 +39,31 @@ class Distances:
     basis: str = ""
 
 
-def nearest_distance(target: np.ndarray, grid: MetricGrid) -> np.ndarray:
-    """Distance in metres from every cell to the nearest true cell of ``target`` (inf if none):
-    (rows, cols) float64, so that a distance of whole cells compares exactly with a threshold
-    in metres (the transform itself is float32, exact up to its rounding)."""
-    return np.multiply(distance_to(target), grid.resolution, dtype=np.float64)
+@dataclass(frozen=True)
+class DistanceField:
+    """Each cell's distance to the nearest true cell of a raster (inf everywhere when it has
+    none), kept in cells as the transform gives them (float32) and read in metres:
+    ``field[where]`` is the float64 metres of the cells ``where`` selects (any NumPy index),
+    so that a distance of whole cells compares exactly with a threshold in metres. The same
+    values as a float64 field of metres, in half its memory (256 MB for an 8000^2 grid)."""
+
+    cells: np.ndarray
+    resolution: float
+
+    def __getitem__(self, where: object) -> np.ndarray:
+        return np.multiply(self.cells[where], self.resolution, dtype=np.float64)
+
+
+def nearest_distance(target: np.ndarray, grid: MetricGrid) -> DistanceField:
+    """Distance in metres from every cell to the nearest true cell of ``target`` (inf if none),
+    on ``grid`` (the transform is float32 in cells, exact up to its rounding)."""
+    return DistanceField(distance_to(target), grid.resolution)
 
 
 def distances(truth_occ: np.ndarray, map_occ: np.ndarray, footprint: np.ndarray,
               grid: MetricGrid, taus: tuple[float, ...] = DEFAULT_TAUS,
-              to_map: np.ndarray | None = None,
-              to_truth: np.ndarray | None = None, band: str = "") -> Distances:
+              to_map: DistanceField | None = None,
+              to_truth: DistanceField | None = None, band: str = "") -> Distances:
     """Distance metrics between the occupied cells of the aligned map and of the truth.
 
     truth_occ, map_occ, footprint: (rows, cols) bool on ``grid``. Completeness and recall only
@@ -72,7 +86,7 @@ def cells_basis(resolution: float, band: str = "") -> str:
 
 
 def accuracy_2d(map_occ: np.ndarray, grid: MetricGrid,
-                to_truth: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+                to_truth: DistanceField) -> tuple[np.ndarray, np.ndarray]:
     """The points and distances :func:`distances`' accuracy is computed on: the centres (N, 2)
     of the map's occupied cells on ``grid`` and each one's distance to the truth (N,), metres
     (``to_truth``: the truth's :func:`nearest_distance` field)."""

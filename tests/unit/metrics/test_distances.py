@@ -59,13 +59,17 @@ def test_distance_transform_is_exact_euclidean():
     assert cells.dtype == np.float32 and cells[13, 24] == 5.0 and cells[10, 20] == 0.0
     grid = MetricGrid(0.05, (0.0, 0.0, 0.0), target.shape)
     metres = nearest_distance(target, grid)
-    assert metres.dtype == np.float64 and metres[14, 20] == 4 * 0.05  # as 4 cells times 0.05
+    assert metres[14, 20].dtype == np.float64 and metres[14, 20] == 4 * 0.05  # 4 cells x 0.05
+    # read in metres, any index: the values of a float64 field of metres, in half its memory
+    whole = np.multiply(cells, 0.05, dtype=np.float64)
+    assert np.array_equal(metres[...], whole) and metres.cells.dtype == np.float32
+    assert np.array_equal(metres[target | (cells > 30)], whole[target | (cells > 30)])
     rng = np.random.default_rng(0)
     sparse = rng.random((300, 400)) < 0.001
     exact = ndimage.distance_transform_edt(~sparse)
     np.testing.assert_allclose(distance_to(sparse), exact, rtol=1.2e-7, atol=0)
     assert np.isinf(distance_to(np.zeros((5, 5), bool))).all()
-    assert np.isinf(nearest_distance(np.zeros(GRID.shape, bool), GRID)).all()
+    assert np.isinf(nearest_distance(np.zeros(GRID.shape, bool), GRID)[...]).all()
 
 
 def test_distances_3d_are_the_kd_tree_distances_and_a_known_offset():
