@@ -1,7 +1,7 @@
 """Time and memory of the distance transform (metres to the nearest wall cell) on a large grid:
-pcmapq's ``nearest_distance`` (OpenCV's exact transform in float32, then metres in float64)
-against SciPy's ``distance_transform_edt`` (what it used before), and the float32 transform
-alone (:func:`pcmapq.core.morphology.distance_to`).
+pcmapq's ``nearest_distance`` (OpenCV's exact transform, kept in float32 cells and read in
+float64 metres where it is indexed) against SciPy's ``distance_transform_edt`` in metres, and
+the float32 transform alone (:func:`pcmapq.core.morphology.distance_to`).
 
     python bench/bench_distance.py [--size 8000] [--repeat 3]   prints a markdown table
 
@@ -44,7 +44,7 @@ run = {"scipy": lambda: ndimage.distance_transform_edt(~walls) * res,
 with open("/proc/self/statm") as f:  # resident pages now, not the peak of the imports
     before = int(f.read().split()[1]) * resource.getpagesize() / 1024
 if case == "difference":
-    scipy, ours = run["scipy"](), run["pcmapq"]()
+    scipy, ours = run["scipy"](), run["pcmapq"]()[...]
     print(json.dumps({"max_m": float(np.abs(scipy - ours).max()),
                       "max_rel": float((np.abs(scipy - ours) / np.maximum(scipy, res)).max()),
                       "farthest_m": float(scipy.max())}))
@@ -89,8 +89,8 @@ def main() -> None:
     print(f"{args.size} x {args.size} cells, {walls.mean():.2%} walls, farthest cell "
           f"{diff['farthest_m']:.1f} m; max |pcmapq - scipy| {diff['max_m']:.2g} m "
           f"(relative {diff['max_rel']:.2g}); best of {args.repeat}")
-    names = {"scipy": "SciPy `distance_transform_edt` x resolution (float64, before)",
-             "pcmapq": "`nearest_distance` (float64 metres, now)",
+    names = {"scipy": "SciPy `distance_transform_edt` x resolution (float64)",
+             "pcmapq": "`nearest_distance` (float32 cells, read in metres)",
              "distance_to": "`morphology.distance_to` alone (float32 cells)"}
     print("| transform | seconds | extra MB |")
     print("|---|---:|---:|")
