@@ -128,8 +128,8 @@ def _joined(parts: list[Extrema]) -> Extrema:
 
 def _stack(base: np.ndarray, blurs: list[float], layers: int) -> np.ndarray:
     """(layers + 4, rows, cols) float32: ``base`` (rows, cols) blurred by each of ``blurs`` in
-    turn, each layer written where it is kept (a layer before the blurs when they are one
-    fewer than the layers)."""
+    turn, each blur written straight into its layer; with one blur fewer than the layers (an
+    octave after the first, whose base is already blurred), ``base`` itself is layer 0."""
     stack = np.empty((layers + 4, *base.shape), np.float32)
     first = len(stack) - len(blurs)
     if first:
