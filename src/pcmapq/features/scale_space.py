@@ -161,8 +161,8 @@ def _peaks(dog: np.ndarray, floor: float, searched: tuple[int, int], row: int,
     ``floor``) or the minimum (at most ``-floor``) of its 3 x 3 x 3 neighbourhood: the 3 x 3
     dilation (erosion) of the largest (smallest) of three layers, by OpenCV, which ignores
     samples beyond the border, as repeating the border would. Computed in strips of rows (each
-    with one row of the next strips around it); rows of the stack, sorted by layer, row,
-    column."""
+    with one row of the next strips around it); rows of the stack, in no set order
+    (:func:`extrema` orders the octave's extrema once)."""
     square = np.ones((3, 3), np.uint8)
     layers, rows, cols = dog.shape
     strip = max(1, STRIP_CELLS // cols)
@@ -181,8 +181,7 @@ def _peaks(dog: np.ndarray, floor: float, searched: tuple[int, int], row: int,
                      & (c < cols - BORDER))
             found.append((np.full(inner.sum(), i), r[inner], c[inner]))
     lay, r, c = (np.concatenate(f) for f in zip(*found, strict=True))
-    order = np.lexsort((c, r, lay))
-    return lay[order], r[order], c[order]
+    return lay, r, c
 
 
 def _octave_extrema(dog: np.ndarray, octave: int, sigma: float, floor: float,
