@@ -26,8 +26,11 @@ from .rooms_halmstad import DETECTORS, ROOMS_SETTINGS, truth_rooms
 #: first by name among equals): a map with rooms to lose.
 MAPS = ("E5_07", "F5_12", "HIH_01", "KPT4A_01")
 #: How far the bend moves the far corner of the map's known pixels, a share of their box's
-#: diagonal (on these maps 1 % is about 0.4-0.6 m).
-LEVELS = (0.0, 0.01, 0.02, 0.04, 0.08)
+#: diagonal (on these maps 1 % is about 0.4-0.6 m): from a map a little off to one bent as
+#: much as the CARMEN ladders' last levels drift (several metres).
+LEVELS = (0.0, 0.01, 0.02, 0.04, 0.08, 0.16, 0.32)
+#: A quality "holds" while its mean over the draws stays within this of the unbent map's.
+HOLDS = 0.05
 #: The draws of every bend above 0: the map turned by k quarter turns, bent one way (+1) or the
 #: other (-1), and turned back, so that the bend grows along each side of the map in turn. The
 #: first is the bend alone.
@@ -99,7 +102,7 @@ def section(data: Path, record: Record) -> Section:
     """Per map and bend: each detector's quality averaged over the draws, and its rank
     correlation with the bend."""
     got = [case.run(record) for case in cases(data)]
-    lines = []
+    lines, holds = [], []
     for name in MAPS:
         means = []
         for level in LEVELS:
@@ -122,6 +125,7 @@ def section(data: Path, record: Record) -> Section:
         falls = [rho_cell(rho(list(LEVELS), [m[d] for m in means]))
                  for d in (*DETECTORS, "iou")]
         lines.append(row(["", "rho", "", "", "", *falls, ""]))
+        holds.append(f"{name} {_holds([m['rooms'] for m in means])}")
     return Section("\n".join([
         "## Rooms of bent real maps: Halmstad maps bent more and more", "",
         "The Halmstad maps do not span a range of drift (their keypoints' own fit residuals, "
@@ -144,5 +148,15 @@ def section(data: Path, record: Record) -> Section:
         "the same at every level.", "",
         header(["map", "bend % of diagonal", "draws", "scale", "scored",
                 *(f"q {d}" for d in DETECTORS), "rooms IoU", "truth rooms (first draw)"]),
-        *lines,
+        *lines, "",
+        f"The largest bend up to which the rooms' mean quality stays within {HOLDS} of the "
+        f"unbent map's: {'; '.join(holds)} (% of the diagonal).",
     ]))
+
+
+def _holds(quality: list[float]) -> str:
+    """The largest level (in %) up to which every mean ``quality`` (one per level of LEVELS)
+    stays within HOLDS of the first."""
+    ok = np.abs(np.asarray(quality) - quality[0]) <= HOLDS
+    last = len(ok) if ok.all() else int(np.argmin(ok))
+    return f"{100 * LEVELS[last - 1]:g}"
