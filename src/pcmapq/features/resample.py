@@ -28,6 +28,21 @@ def _whole(ratio: float) -> int:
     return k if k >= 2 and abs(ratio - k) < 1e-9 * ratio else 0
 
 
+def covered(mask: np.ndarray, grid: MetricGrid,
+            resolution: float) -> tuple[np.ndarray, MetricGrid]:
+    """The cells of a grid of ``resolution`` metres (same origin and yaw as ``grid``) that any
+    part of a set cell of ``mask`` (rows, cols, bool, on ``grid``) covers: uint8 0 or 1, and the
+    grid. Where each new cell lies in one old cell, it is that cell's value, found in bytes
+    (no area fractions); otherwise from :func:`resample`'s fractions."""
+    if _whole(grid.resolution / resolution):
+        work = grid.resampled(resolution)
+        return cv2.resize(np.asarray(mask, dtype=bool).view(np.uint8),
+                          (work.shape[1], work.shape[0]),
+                          interpolation=cv2.INTER_NEAREST_EXACT), work
+    frac, work = resample(mask, grid, resolution)
+    return (frac > 1e-6).astype(np.uint8), work
+
+
 def resample(image: np.ndarray, grid: MetricGrid,
              resolution: float) -> tuple[np.ndarray, MetricGrid]:
     """Resample ``image`` (rows, cols, on ``grid``) to cells of ``resolution`` metres by exact

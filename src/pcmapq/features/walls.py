@@ -56,7 +56,7 @@ from pcmapq.core.morphology import disc, distance_to
 from pcmapq.features.band import draw_band
 from pcmapq.features.pixels import flat_index, neighbour_pairs
 from pcmapq.features.pixels import pieces as connected
-from pcmapq.features.resample import resample
+from pcmapq.features.resample import covered, resample
 from pcmapq.features.thinning import skeletonize
 
 #: Working cells a side of a tile of a large raster, and the halo drawn around each, metres:
@@ -111,8 +111,7 @@ def centreline(occupied: np.ndarray, grid: MetricGrid, resolution: float, closin
 
     Returns the one-pixel bool centre lines, the bool object cores and their grid.
     """
-    frac, fine = resample(occupied, grid, resolution)
-    wall = (frac > 1e-6).astype(np.uint8)
+    wall, fine = covered(occupied, grid, resolution)
     kernel = disc(closing / resolution)
     pad = kernel.shape[0]
     wall = cv2.morphologyEx(np.pad(wall, pad), cv2.MORPH_CLOSE, kernel)[pad:-pad, pad:-pad]
