@@ -75,7 +75,10 @@ def away(xy: np.ndarray, seg: np.ndarray, distance: float, step: float) -> np.nd
     (M, 4) (tested at points every ``step`` along them). Metres."""
     if len(seg) == 0 or len(xy) == 0:
         return np.ones(len(xy), dtype=bool)
-    dist, _ = cKDTree(_points(seg, step)[0]).query(xy, distance_upper_bound=distance)
+    # many more samples than points asked about: the tree's build is most of the work, and a
+    # tree split at midpoints builds in less than half the time and gives the same distances
+    tree = cKDTree(_points(seg, step)[0], balanced_tree=False, compact_nodes=False)
+    dist, _ = tree.query(xy, distance_upper_bound=distance)
     return ~np.isfinite(dist)
 
 
