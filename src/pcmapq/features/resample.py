@@ -36,7 +36,7 @@ def covered(mask: np.ndarray, grid: MetricGrid,
     (no area fractions); otherwise from :func:`resample`'s fractions."""
     if _whole(grid.resolution / resolution):
         work = grid.resampled(resolution)
-        return cv2.resize(np.asarray(mask, dtype=bool).view(np.uint8),
+        return cv2.resize(np.ascontiguousarray(mask, dtype=bool).view(np.uint8),
                           (work.shape[1], work.shape[0]),
                           interpolation=cv2.INTER_NEAREST_EXACT), work
     frac, work = resample(mask, grid, resolution)
