@@ -36,11 +36,16 @@ def covered(mask: np.ndarray, grid: MetricGrid,
     (no area fractions); otherwise from :func:`resample`'s fractions."""
     if _whole(grid.resolution / resolution):
         work = grid.resampled(resolution)
-        return cv2.resize(np.ascontiguousarray(mask, dtype=bool).view(np.uint8),
-                          (work.shape[1], work.shape[0]),
-                          interpolation=cv2.INTER_NEAREST_EXACT), work
+        return _finer(np.ascontiguousarray(mask, dtype=bool).view(np.uint8), work), work
     frac, work = resample(mask, grid, resolution)
     return (frac > 1e-6).astype(np.uint8), work
+
+
+def _finer(image: np.ndarray, work: MetricGrid) -> np.ndarray:
+    """``image`` on the finer grid ``work``, each of whose cells lies in one of its cells (a
+    whole factor finer): that cell's value."""
+    return cv2.resize(image, (work.shape[1], work.shape[0]),
+                      interpolation=cv2.INTER_NEAREST_EXACT)
 
 
 def resample(image: np.ndarray, grid: MetricGrid,
@@ -55,9 +60,8 @@ def resample(image: np.ndarray, grid: MetricGrid,
         return image, grid
     work = grid.resampled(resolution)
     up, down = _whole(grid.resolution / resolution), _whole(resolution / grid.resolution)
-    if up:  # each new cell lies in one old cell
-        return cv2.resize(image, (work.shape[1], work.shape[0]),
-                          interpolation=cv2.INTER_NEAREST_EXACT), work
+    if up:
+        return _finer(image, work), work
     if down:  # each new cell is a block of old cells; blocks start at the lower-left corner
         rows, cols = work.shape[0] * down, work.shape[1] * down
         padded = image if (rows, cols) == image.shape else \
