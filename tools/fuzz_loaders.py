@@ -5,7 +5,7 @@ whose result holds the documented invariants or an :class:`InputError` of one li
 the file's path; anything else (another exception, a slow read, a large allocation, output on
 stdout or stderr, a warning) is a finding.
 
-``tests/unit/io/test_fuzz_loaders.py`` runs this for about a minute in CI; from the command line
+``tests/e2e/test_fuzz_loaders.py`` runs this for about ten seconds in CI; from the command line
 it runs longer and prints the examples run and the outcomes per format::
 
     python tools/fuzz_loaders.py [--minutes 10] [--seed 0] [--formats ply_binary,pcd_ascii]

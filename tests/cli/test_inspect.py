@@ -22,7 +22,6 @@ def _inspect(*args: str) -> tuple[int, str, str]:
     return got.exit_code, got.stdout, got.stderr
 
 
-@pytest.mark.unit
 def test_a_3d_cloud_gets_the_library_figures_and_the_same_json_twice(tmp_path):
     """A noisy floor and two walls (1 cm noise): the JSON holds noref.scores' MME and MPV of
     the same points (rounded: see pcmapq.core.stats.significant) and is byte-identical across

@@ -291,7 +291,6 @@ def test_lidar_pair_is_drawn_as_density_with_fewer_markers(moved_result):
     assert "occupied share" in " ".join(t.get_text() for t in fig.findobj(matplotlib.text.Text))
 
 
-@pytest.mark.unit
 def test_report_says_how_it_was_made(moved_result):
     """The report holds pcmapq's version, the command line and every setting, as the JSON
     does."""
