@@ -24,7 +24,7 @@ import numpy as np
 from pcmapq.align.parts import PIECES
 from pcmapq.core.transform import Similarity2D
 from pcmapq.evaluation.pipeline import evaluate
-from pcmapq.evaluation.same_place import MIN_AGREEING
+from pcmapq.evaluation.same_place import MIN_AGREEING, RECALL_NONE, STANDS_OUT
 from pcmapq.report.text import number
 from pcmapq.results.result import INCONSISTENT, OTHER, SAME
 from pcmapq.testing.corpus import (
@@ -333,7 +333,9 @@ def markdown(records: list[Record], names: tuple[str, ...] = ("confidence",),
         "`bench/validation/corpus.py` builds every pair, seeded). The verdict is the result's "
         f"`alignment.verdict`: \"{SAME}\" at confidence {CURRENT} or more; below it "
         f"\"{INCONSISTENT}\" when at least {MIN_AGREEING} of the map's {parts} parts, each "
-        "placed on its own by the global search, land near the map's pose; else "
+        "placed on its own by the global search, land near the map's pose, or when its "
+        f"pose's distinctiveness is at least {STANDS_OUT} with a truth recall above "
+        f"{RECALL_NONE}; else "
         f"\"{OTHER}\", refused unless forced. A pair is *scored* when its verdict is not "
         f"\"{OTHER}\". The whole corpus ran in {seconds:.0f} s.", "",
         "### What the corpus holds", "",

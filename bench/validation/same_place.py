@@ -21,7 +21,7 @@ from pathlib import Path
 
 from pcmapq.align.parts import PIECES
 from pcmapq.evaluation.pipeline import evaluate
-from pcmapq.evaluation.same_place import MIN_AGREEING
+from pcmapq.evaluation.same_place import MIN_AGREEING, RECALL_NONE, STANDS_OUT
 from pcmapq.report.text import number
 from pcmapq.results.result import INCONSISTENT, OTHER, SAME
 from pcmapq.testing.realdata.floorplans import FLOORPLANS
@@ -187,7 +187,9 @@ def section(data: Path, record: Record) -> Section:
         f"`alignment.verdict`: \"{SAME}\" at confidence {NEW_MIN_CONFIDENCE} or more; below it "
         f"\"{INCONSISTENT}\" when at least {MIN_AGREEING} of the map's {parts} parts, each "
         "placed on its own by the global search, land near the map's pose (\"parts "
-        f"agreeing\"; \"-\" when the confidence settled the verdict), else \"{OTHER}\", "
+        "agreeing\"; \"-\" when the confidence settled the verdict), or when its pose's "
+        f"distinctiveness is at least {STANDS_OUT} with a truth recall above {RECALL_NONE}, "
+        f"else \"{OTHER}\", "
         "refused unless forced. A wrong verdict is in bold. "
         "Same place: the Intel map through `--map-occupied-thresh "
         f"{FLOORPLANS[0].thresholds.occupied} --map-free-thresh "

@@ -3,12 +3,15 @@ annotated keypoints land where the layout has them."""
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import cv2
 import numpy as np
 
 from pcmapq.align import AlignParams, align
 from pcmapq.evaluation.pipeline import evaluate
-from pcmapq.results.result import SAME
+from pcmapq.evaluation.same_place import MIN_AGREEING, STANDS_OUT
+from pcmapq.results.result import INCONSISTENT, SAME
 from pcmapq.testing import synth
 from pcmapq.testing.paths import SHARED_DATA, shared
 from pcmapq.testing.realdata import halmstad
@@ -56,3 +59,23 @@ def test_bent_map_keeps_its_scale(tmp_path):
     result = evaluate(drawn, halmstad.halmstad_truth(layout, tmp_path), halmstad.SETTINGS)
     assert abs(result.alignment.transform.scale - 1.175) < 0.02
     assert result.overlap.verdict == SAME
+
+
+def test_a_map_bent_until_half_of_it_is_off_is_scored_not_refused(tmp_path):
+    """E5_07 bent so that its far corner moves 16 % of its diagonal: half the layout's walls it
+    covers lie off it (recall 0.51, confidence 0.28) and only 2 of its 8 parts, an eighth of an
+    office floor each, land near its pose; yet no pose elsewhere scores within 70 % of its
+    own (distinctiveness 0.42): a bad map of the right place, scored, not refused."""
+    map_path, layout = (shared(*p.relative_to(SHARED_DATA).parts)
+                        for p in halmstad.paths(SHARED_DATA, "E5_07"))
+    image = cv2.imread(str(map_path), cv2.IMREAD_UNCHANGED)
+    drawn = tmp_path / "E5_07_bent.png"
+    cv2.imwrite(str(drawn), synth.bend_image(image, 0.16, 127))
+    settings = replace(halmstad.SETTINGS, matching=replace(halmstad.SETTINGS.matching,
+                                                           detectors=()))
+    result = evaluate(drawn, halmstad.halmstad_truth(layout, tmp_path), settings)
+    cover = result.overlap
+    assert cover.verdict == INCONSISTENT
+    assert cover.confidence < 0.5 and sum(p.agrees for p in cover.parts) < MIN_AGREEING
+    assert result.alignment.distinctiveness >= STANDS_OUT
+

@@ -90,7 +90,8 @@ def place(source: OccupancyMap | PointMap, prepared: PreparedTruth, settings: Se
         parts = tuple(place_parts(map_xy, prepared.xy, alignment.transform, option.params,
                                   target))
     cover = replace(cover, parts=parts,
-                    verdict=verdict(cover.confidence, option.min_confidence, parts))
+                    verdict=verdict(cover.confidence, option.min_confidence, parts,
+                                    alignment.distinctiveness, cover.truth_recall))
     if cover.verdict == OTHER and not option.force:
         raise EvaluationError(refusal(source, truth.path, alignment, cover, settings, map_xy,
                                       prepared.xy))

@@ -32,14 +32,26 @@ OVERSIZE = 1.5
 #: its eight parts, each placed on its own, agree with its pose (:mod:`pcmapq.align.parts`):
 #: two let more maps of other, same-looking office floors through (docs/validation.md).
 MIN_AGREEING = 3
+#: A map below the minimum confidence also shows the truth's place when its pose stands out this
+#: much in the global search (no pose elsewhere scores within 70 % of it) and more than
+#: RECALL_NONE of the truth it covers lies near it: a map bent so far that half of it is off
+#: the truth, whose parts (an eighth of an office floor each) fit other offices as well as their
+#: own. Among the maps of other places in docs/validation.md (the corpus's 114 pairs and the
+#: Halmstad maps against the other layouts, 108) the most is 0.235.
+STANDS_OUT = 0.3
 
 
-def verdict(confidence: float, min_confidence: float, parts: Sequence[Part]) -> str:
+def verdict(confidence: float, min_confidence: float, parts: Sequence[Part],
+            distinct: float | None = None, recall: float = 0.0) -> str:
     """SAME when the confidence reaches ``min_confidence``; else INCONSISTENT when at least
-    MIN_AGREEING of the map's ``parts`` agree with its pose; else OTHER."""
+    MIN_AGREEING of the map's ``parts`` agree with its pose, or when its pose's distinctiveness
+    ``distinct`` reaches STANDS_OUT with a truth ``recall`` above RECALL_NONE; else OTHER."""
     if confidence >= min_confidence:
         return SAME
-    return INCONSISTENT if sum(p.agrees for p in parts) >= MIN_AGREEING else OTHER
+    if sum(p.agrees for p in parts) >= MIN_AGREEING:
+        return INCONSISTENT
+    stands_out = distinct is not None and distinct >= STANDS_OUT and recall > RECALL_NONE
+    return INCONSISTENT if stands_out else OTHER
 
 
 def confidence(distinct: float | None, recall: float, agreement: float = 0.0) -> float:

@@ -54,10 +54,15 @@ def alignment_words(result: Result) -> str:
         placed = "aligned"
     cover = result.overlap
     if cover.verdict == INCONSISTENT:
+        from pcmapq.evaluation.same_place import MIN_AGREEING  # its imports: the alignment
+
         agree = sum(p.agrees for p in cover.parts)
+        why = f"{agree} of its {len(cover.parts)} parts placed on their own land near its pose"
+        if agree < MIN_AGREEING:  # the pose stands out: see same_place.verdict
+            why = (f"its pose stands out in the search by "
+                   f"{result.alignment.distinctiveness:.2f}; {why}")
         return (f"{placed}: a map of the truth's place that no single pose fits (confidence "
-                f"{confidence:.2f}; {agree} of its {len(cover.parts)} parts placed on their own "
-                f"land near its pose){breaks(result)}")
+                f"{confidence:.2f}; {why}){breaks(result)}")
     if cover.verdict == OTHER:
         return (f"{placed}, but it may show another place (confidence {confidence:.2f} < 0.5, "
                 "scored because of --force)")

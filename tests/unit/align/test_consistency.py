@@ -32,6 +32,18 @@ def test_verdict_of_known_confidence_and_parts():
     assert verdict(0.0, 0.5, ()) == OTHER
 
 
+def test_a_pose_that_stands_out_shows_the_place_with_few_parts_agreeing():
+    """Below the minimum confidence, a pose whose distinctiveness reaches 0.3 with more than
+    0.4 of the truth near the map is the truth's place whatever its parts say; a less distinct
+    pose (another place's reach 0.235), or as distinct with 0.4 of the truth, is not."""
+    few = [_part(True)] + [_part(False)] * 7
+    assert verdict(0.28, 0.5, few, 0.42, 0.51) == INCONSISTENT
+    assert verdict(0.28, 0.5, (), 0.30, 0.41) == INCONSISTENT
+    assert verdict(0.05, 0.5, few, 0.24, 0.42) == OTHER
+    assert verdict(0.0, 0.5, few, 0.9, 0.40) == OTHER
+    assert verdict(0.28, 0.5, few, None, 0.51) == OTHER
+
+
 def test_pieces_cut_along_the_principal_axes():
     """A long, turned cloud is cut into 4 x 2 pieces of equal count, the first index along
     its length."""

@@ -108,6 +108,24 @@ def test_the_first_line_says_how_good_the_map_is_and_why():
             in first)
 
 
+def test_the_verdict_says_why_a_map_no_pose_fits_is_the_truths_place():
+    """Scored as the truth's place with too few parts agreeing, the first line says that its
+    pose stands out; with enough parts agreeing, it counts them alone."""
+    doc = copy.deepcopy(SAMPLE_DOC)
+    part = {"share": 0.125, "centre_m": [1.0, 2.0], "offset_m": 0.1, "turn_deg": 1.0,
+            "fitness": 0.5, "agrees": True, "pose": {"x_m": 0.0, "y_m": 0.0, "yaw_deg": 0.0,
+                                                     "scale": 1.0}}
+    far = {**part, "offset_m": 20.0, "agrees": False}
+    doc["alignment"].update(confidence=0.28, verdict="same place, inconsistent map",
+                            distinctiveness=0.42, parts=[part] * 2 + [far] * 6)
+    line = verdict(sample_result(doc))
+    assert ("no single pose fits (confidence 0.28; its pose stands out in the search by 0.42; "
+            "2 of its 8 parts placed on their own land near its pose)") in line
+    doc["alignment"]["parts"] = [part] * 3 + [far] * 5
+    line = verdict(sample_result(doc))
+    assert "(confidence 0.28; 3 of its 8 parts placed on their own land near its pose)" in line
+
+
 def test_the_verdict_says_plainly_when_a_score_is_undefined():
     doc = copy.deepcopy(SAMPLE_DOC)
     doc["detectors"]["harris"].update(quality=None, f1=None, truth_features=0, matched=0)
