@@ -4,13 +4,17 @@ Frames: transforms take source points to the target frame, ``p_target = T @ p_so
 
 Three stages with correspondence distances 2, 1 and 0.5 ``voxel``, the last on clouds
 downsampled at ``voxel / 2``; target normals from each target point's 20 nearest neighbours.
-small_gicp runs on one thread, so the result is the same bit for bit from run to run.
+The registration's sums run on one thread, so the result is the same bit for bit from run to run
+(on more, which points each thread sums depends on their timing); the target's KD-tree and
+normals, each point's own, are built on every core: the same tree and normals, bit for bit.
 
 small_gicp over Open3D's ICP: repeatable without holding Open3D to one thread, and closer to
 the truth on the KITTI pairs (docs/benchmarks.md, "Choices behind the code").
 """
 
 from __future__ import annotations
+
+import os
 
 import numpy as np
 import small_gicp
@@ -27,6 +31,9 @@ ICP_ITERATIONS = 50
 CONVERGED = 1e-4
 #: Neighbours of a target point that fit its normal.
 NORMAL_NEIGHBOURS = 20
+#: Threads that build a target's KD-tree and normals: the registration holds Python's lock
+#: meanwhile, so the pipeline's other threads leave the cores to it.
+PREPARE_THREADS = os.cpu_count() or 1
 
 
 def refine(source: np.ndarray, target: np.ndarray, guess: np.ndarray, voxel: float,
@@ -58,6 +65,7 @@ def _prepared(source: np.ndarray, target: np.ndarray
     """small_gicp clouds of source (N, 3) and target (M, 3), metres, the target with normals and
     its KD-tree."""
     src, tgt = small_gicp.PointCloud(source), small_gicp.PointCloud(target)
-    tree = small_gicp.KdTree(tgt, num_threads=1)
-    small_gicp.estimate_normals(tgt, tree, num_neighbors=NORMAL_NEIGHBOURS, num_threads=1)
+    tree = small_gicp.KdTree(tgt, num_threads=PREPARE_THREADS)
+    small_gicp.estimate_normals(tgt, tree, num_neighbors=NORMAL_NEIGHBOURS,
+                                num_threads=PREPARE_THREADS)
     return src, tgt, tree

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from pcmapq.align import refine3d
 from pcmapq.align.features3d import feature_matches, keypoints
 from pcmapq.align.rigid3d import align_3d
 from pcmapq.core.errors import EvaluationError, InputError
@@ -49,6 +50,18 @@ def test_initial_guess_skips_the_global_search() -> None:
     result = align_3d(source, target, voxel=0.2, init=np.eye(4))
     shift, angle = errors(result.transform, truth)
     assert shift < 0.02 and angle < 0.2
+
+
+def test_the_target_prepared_on_every_core_gives_the_same_registration(monkeypatch) -> None:
+    """The target's KD-tree and normals built on 4 threads give the transform of one thread,
+    bit for bit."""
+    target = room(0)
+    source = apply(np.linalg.inv(rigid((0.0, 0.0, 3.0), (0.2, -0.1, 0.0))), room(1))
+    got = []
+    for threads in (1, 4):
+        monkeypatch.setattr(refine3d, "PREPARE_THREADS", threads)
+        got.append(align_3d(source, target, voxel=0.2, init=np.eye(4)).transform)
+    assert np.array_equal(got[0], got[1])
 
 
 def test_keypoints_and_matches_are_small_and_mutual() -> None:
