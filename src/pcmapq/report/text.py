@@ -54,7 +54,8 @@ def alignment_words(result: Result) -> str:
         placed = "aligned"
     cover = result.overlap
     if cover.verdict == INCONSISTENT:
-        from pcmapq.evaluation.same_place import MIN_AGREEING  # its imports: the alignment
+        # imported here: same_place loads the alignment, which reading a result does not need
+        from pcmapq.evaluation.same_place import MIN_AGREEING
 
         agree = sum(p.agrees for p in cover.parts)
         why = f"{agree} of its {len(cover.parts)} parts placed on their own land near its pose"
