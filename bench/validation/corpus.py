@@ -408,6 +408,12 @@ def markdown(records: list[Record], names: tuple[str, ...] = ("confidence",),
     if other:
         top = max(other, key=lambda r: value(r, "confidence") or 0.0)
         lines += ["", f"Worst other-place pair: {describe(top)}."]
+        searched = [r for r in other if value(r, "distinctiveness") is not None]
+        if searched:
+            most = max(searched, key=lambda r: value(r, "distinctiveness"))
+            lines += ["", f"Most distinct other-place pose: {describe(most)}. A pose of "
+                          f"distinctiveness {STANDS_OUT} or more, with a truth recall above "
+                          f"{RECALL_NONE}, is the same place whatever its parts say."]
     refused = [r for r in same if not scored(r)]
     let_in = [r for r in other if scored(r)]
     lines += ["", "### Pairs that go wrong", "",

@@ -222,5 +222,18 @@ def section(data: Path, record: Record) -> Section:
         f"({sum(r.scored for r in g_other)} of {len(g_other)}), while the confidence refuses "
         f"{sum(not r.new_ok for r in g_same)} of the {len(g_same)} same-place maps and the "
         f"verdict {sum(not r.scored for r in g_same)}: geometry alone cannot always tell one "
-        "office floor from another.",
+        "office floor from another.", "",
+        _most_distinct(g_other),
     ]))
+
+
+def _most_distinct(other: list[Row]) -> str:
+    """The sentence on the other-place pose that stands out most: the margin of the verdict's
+    STANDS_OUT rule."""
+    searched = [r for r in other if r.distinct is not None]
+    if not searched:
+        return ""
+    top = max(searched, key=lambda r: r.distinct)
+    return (f"The other-place pose that stands out most in its search: {figures(top)}. A pose "
+            f"of distinctiveness {STANDS_OUT} or more, with a truth recall above {RECALL_NONE}, "
+            "is the same place whatever its parts say (docs/method.md).")
