@@ -13,7 +13,7 @@ import cv2
 import numpy as np
 
 from pcmapq.evaluation.pipeline import evaluate
-from pcmapq.evaluation.same_place import STANDS_OUT
+from pcmapq.evaluation.same_place import RECALL_NONE, STANDS_OUT
 from pcmapq.report.text import score
 from pcmapq.results.result import INCONSISTENT, OTHER
 from pcmapq.testing import synth
@@ -142,7 +142,7 @@ def section(data: Path, record: Record) -> Section:
         "alignment found; scored: the draws the verdict scores (the same place, or the same "
         "place with an inconsistent map: at least 3 of its 8 parts, placed on their own, "
         f"agree with its pose, or its pose stands out by a distinctiveness of at least "
-        f"{STANDS_OUT}), "
+        f"{STANDS_OUT} with a truth recall above {RECALL_NONE}), "
         "bold where not all, and how many of them it finds "
         "inconsistent; rooms IoU: the mean IoU of the matched truth rooms over the draws (how "
         "well the rooms the map still has right fit); truth rooms: the statuses of the first "
