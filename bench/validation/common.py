@@ -10,6 +10,7 @@ from typing import Generic, Protocol, TypeVar
 
 import numpy as np
 
+from pcmapq.evaluation.same_place import RECALL_NONE, STANDS_OUT
 from pcmapq.io.map_yaml import MapMeta
 from pcmapq.io.occupancy import read_levels
 from pcmapq.report.text import score
@@ -104,3 +105,10 @@ def row(cells: list[str]) -> str:
 def header(cells: list[str]) -> str:
     """A markdown table's header and rule."""
     return row(cells) + "\n|" + " --- |" * len(cells)
+
+
+def stand_out_rule() -> str:
+    """The verdict's stand-out rule in one sentence, beside the most distinct other place a
+    section measured (its margin)."""
+    return (f"A pose of distinctiveness {STANDS_OUT} or more, with a truth recall above "
+            f"{RECALL_NONE}, is the same place whatever its parts say (docs/method.md).")

@@ -58,7 +58,7 @@ from pcmapq.testing.corpus import (
 )
 from pcmapq.testing.corpus.records import _kind_key
 
-from .common import DATA, ROOT, Case, Section, header, row
+from .common import DATA, ROOT, Case, Section, header, row, stand_out_rule
 from .common import Record as Figures
 
 #: Where ``python -m bench.validation --only corpus`` writes its records (to analyse them
@@ -411,9 +411,8 @@ def markdown(records: list[Record], names: tuple[str, ...] = ("confidence",),
         searched = [r for r in other if value(r, "distinctiveness") is not None]
         if searched:
             most = max(searched, key=lambda r: value(r, "distinctiveness"))
-            lines += ["", f"Most distinct other-place pose: {describe(most)}. A pose of "
-                          f"distinctiveness {STANDS_OUT} or more, with a truth recall above "
-                          f"{RECALL_NONE}, is the same place whatever its parts say."]
+            lines += ["", f"Most distinct other-place pose: {describe(most)}. "
+                          f"{stand_out_rule()}"]
     refused = [r for r in same if not scored(r)]
     let_in = [r for r in other if scored(r)]
     lines += ["", "### Pairs that go wrong", "",

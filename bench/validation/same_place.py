@@ -34,7 +34,7 @@ from pcmapq.testing.realdata.same_place import (
 )
 from pcmapq.testing.reference import summary
 
-from .common import Case, Record, Section, header, row
+from .common import Case, Record, Section, header, row, stand_out_rule
 
 #: Former rule: refused below this agreement (the confidence: NEW_MIN_CONFIDENCE).
 OLD_MIN_AGREEMENT = 0.2
@@ -234,6 +234,5 @@ def _most_distinct(other: list[Row]) -> str:
     if not searched:
         return ""
     top = max(searched, key=lambda r: r.distinct)
-    return (f"The other-place pose that stands out most in its search: {figures(top)}. A pose "
-            f"of distinctiveness {STANDS_OUT} or more, with a truth recall above {RECALL_NONE}, "
-            "is the same place whatever its parts say (docs/method.md).")
+    return (f"The other-place pose that stands out most in its search: {figures(top)}. "
+            f"{stand_out_rule()}")
