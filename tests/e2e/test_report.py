@@ -11,14 +11,16 @@ import matplotlib
 import numpy as np
 import pytest
 
+from pcmapq.core.bounds import nonzero_window
 from pcmapq.core.grid import MetricGrid
 from pcmapq.evaluation.pipeline import evaluate
-from pcmapq.report.canvas import extent, overlay
+from pcmapq.report.canvas import MARGIN_MIN_M, extent, overlay, window
 from pcmapq.report.heatmap import distance_heatmap
 from pcmapq.report.html import report_html
 from pcmapq.report.plot import png_bytes, vectorial_figure
 from pcmapq.report.style import ARROW_SCALE, DPI, FIGURE_WIDTH_PX, MAP_LIGHT
 from pcmapq.report.text import number
+from pcmapq.report.viewer import viewer_html
 from pcmapq.settings import MatchingConfig, Settings
 from pcmapq.testing import synth
 from pcmapq.testing.files import write_image_map
@@ -185,11 +187,51 @@ def test_truth_shows_where_the_map_lies_on_it(perfect_result):
     """The truth scored against itself: every map wall lies on a truth wall, yet the truth's
     dark walls show (over the map's light ones, which show at their edges)."""
     fig = vectorial_figure(perfect_result)
-    img = region(fig, fig.axes[0], extent(perfect_result))
+    img = region(fig, fig.axes[0], extent(perfect_result, 1, window(perfect_result)))
     walls = int(np.count_nonzero(perfect_result.truth_occupied))
     dark = np.count_nonzero(img.max(axis=2) < 80)
     assert dark > 0.5 * walls
     assert np.count_nonzero(coloured(img, MAP_LIGHT)) > 0.5 * walls
+
+
+#: Empty grid added on every side of a result's: a building in the middle of a large plan image.
+PAD_M = 40.0
+
+
+def test_a_plan_in_a_large_image_fills_its_panels(moved_result):
+    """The moved result with PAD_M metres of empty grid on every side: every panel of the
+    figure and of the heatmap, and the viewer's first view, show the walls' box with its
+    margin, not the grid; drawn cell for cell, as the grid alone is."""
+    base = moved_result.grid
+    pad = round(PAD_M / base.resolution)
+    grid = MetricGrid(base.resolution, (base.origin[0] - pad * base.resolution,
+                                        base.origin[1] - pad * base.resolution, 0.0),
+                      (base.shape[0] + 2 * pad, base.shape[1] + 2 * pad))
+    padded = replace(
+        moved_result, grid=grid, truth_occupied=np.pad(moved_result.truth_occupied, pad),
+        map_occupied=np.pad(moved_result.map_occupied, pad),
+        overlap=replace(moved_result.overlap,
+                        footprint=np.pad(moved_result.overlap.footprint, pad)),
+        detectors={k: v for k, v in moved_result.detectors.items() if k != "rooms"}, rooms=None)
+    lo, hi, left, right = nonzero_window(padded.truth_occupied | padded.map_occupied)
+    walls = (grid.origin[0] + left * grid.resolution, grid.origin[0] + right * grid.resolution,
+             grid.origin[1] + (grid.shape[0] - hi) * grid.resolution,
+             grid.origin[1] + (grid.shape[0] - lo) * grid.resolution)
+    shown = window(padded)
+    box = extent(padded, 1, shown)
+    assert box[1] - box[0] < grid.size_m[0] - 2 * PAD_M + 2 * MARGIN_MIN_M + 10.0
+    assert box[0] <= walls[0] - MARGIN_MIN_M and box[1] >= walls[1] + MARGIN_MIN_M
+    assert box[2] <= walls[2] - MARGIN_MIN_M and box[3] >= walls[3] + MARGIN_MIN_M
+    for fig in (vectorial_figure(padded), distance_heatmap(padded)):
+        panels = [ax for ax in fig.axes if ax.images]
+        assert len(panels) >= 2
+        for ax in panels:
+            np.testing.assert_allclose([*ax.get_xlim(), *ax.get_ylim()], box)
+            assert ax.images[0].get_array().shape[:2] == padded.truth_occupied[shown].shape
+    view = re.search(r'viewBox="([^"]+)"', viewer_html(padded, ARROW_SCALE)).group(1)
+    np.testing.assert_allclose([float(v) for v in view.split()],
+                               [shown[1].start - 0.5, shown[0].start - 0.5,
+                                shown[1].stop - shown[1].start, shown[0].stop - shown[0].start])
 
 
 def _inside(inner, outer) -> bool:

@@ -58,7 +58,7 @@ def test_report_viewer_tells_the_moved_walls_displacement_in_chromium(moved_resu
     assert d > 0.49  # the wall moved by 0.5 m
     out = probed(report_html(moved_result), selector("hough", "matched", x, y),
                  ("hough", "matched"), tmp_path)
-    check_view(out, moved_result.grid)
+    check_view(out, moved_result)
     for text in (out["hover"], out["clicked"]):
         assert text.startswith(f"hough: matched\nx {x + 0.0:.3f} m, y {y + 0.0:.3f} m\n")
         assert f"displacement {d:.3f} m" in text

@@ -37,7 +37,7 @@ def test_viewer_zooms_pans_tells_and_toggles_in_chromium(tmp_path):
     page = f"<!DOCTYPE html><html><head><style>{STYLE}</style></head><body>" \
            f"{viewer_html(small_result(TURNED), 10.0)}</body></html>"
     out = probed(page, selector("harris", "matched", 2.0, 3.0), ("harris", "missing"), tmp_path)
-    check_view(out, TURNED)
+    check_view(out, small_result(TURNED))
     for text in (out["hover"], out["clicked"]):
         assert text == "harris: matched\nx 2.000 m, y 3.000 m\nmap feature: x 2.300 m, " \
                        "y 2.600 m\ndisplacement 0.500 m (dx 0.300, dy -0.400 m)"

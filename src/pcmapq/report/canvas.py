@@ -1,6 +1,11 @@
-"""What every picture of a result shares: the truth frame's extent and axes in metres, the
-pooling that brings a raster to display resolution, the shaded rasters (walls, or a 3D cloud's
-density) and the thinning of markers. Truth frame, metres."""
+"""What every picture of a result shares: the part of the truth frame it shows and its axes in
+metres, the pooling that brings a raster to display resolution, the shaded rasters (walls, or a
+3D cloud's density) and the thinning of markers. Truth frame, metres.
+
+A picture shows the cells that hold walls of either side (or the map's footprint), with a
+margin, not the whole truth grid: a building drawn in the middle of a large plan image fills its
+panels as a map of its own size does.
+"""
 
 from __future__ import annotations
 
@@ -11,6 +16,7 @@ from typing import TYPE_CHECKING
 import cv2
 import numpy as np
 
+from pcmapq.core.bounds import nonzero_window
 from pcmapq.raster.pool import max_pool, mean_pool
 from pcmapq.report.style import DPI, MAP_LIGHT, TEXT_PT, TRUTH_DARK
 from pcmapq.results.result import Result
@@ -22,17 +28,60 @@ if TYPE_CHECKING:
 #: Shade of a pixel with any occupied cell in a density picture (so a lone hit shows), and
 #: of the truth over the map.
 DENSITY_FLOOR, TRUTH_ALPHA = 0.3, 0.9
+#: Margin around what a picture shows: this share of its box's larger side, at least
+#: MARGIN_MIN_M metres.
+MARGIN, MARGIN_MIN_M = 0.05, 1.0
+
+#: Rows and columns of the truth grid (row 0 at the top), as slices.
+Window = tuple[slice, slice]
 
 
-def extent(result: Result, factor: int = 1) -> tuple[float, float, float, float]:
-    """(left, right, bottom, top), metres, of the truth grid's raster pooled ``factor``-fold: the
-    grid's extent (yaw of the grid ignored), grown right and down by the part of the last
-    column and row of blocks that lies past the grid (none at factor 1)."""
+def window(result: Result) -> Window:
+    """The rows and columns of the truth grid a picture shows: the box of the cells that hold
+    walls of either side (and the map's footprint, unless scored against the whole truth) and
+    of every feature of either side, grown by :data:`MARGIN` and cut to the grid; the whole
+    grid when there is none."""
+    shown = result.truth_occupied | result.map_occupied
+    if not result.full:
+        shown = shown | result.overlap.footprint
+    boxes = [box] if (box := nonzero_window(shown)) is not None else []
+    xy = [f.xy for d in result.detectors.values() for f in (d.truth, d.map) if len(f.xy)]
+    if xy:
+        u, v = result.grid.xy_to_pixels(np.vstack(xy)).T
+        boxes.append((math.floor(v.min() + 0.5), math.floor(v.max() + 0.5) + 1,
+                      math.floor(u.min() + 0.5), math.floor(u.max() + 0.5) + 1))
+    rows, cols = result.grid.shape
+    if not boxes:
+        return slice(0, rows), slice(0, cols)
+    lo, hi = min(b[0] for b in boxes), max(b[1] for b in boxes)
+    left, right = min(b[2] for b in boxes), max(b[3] for b in boxes)
+    margin = max(math.ceil(MARGIN * max(hi - lo, right - left)),
+                 math.ceil(MARGIN_MIN_M / result.grid.resolution))
+    return (slice(min(rows - 1, max(0, lo - margin)), max(1, min(rows, hi + margin))),
+            slice(min(cols - 1, max(0, left - margin)), max(1, min(cols, right + margin))))
+
+
+def size_m(result: Result, shown: Window) -> tuple[float, float]:
+    """(width, height), metres, of the ``shown`` window of the truth grid."""
+    rows, cols = shown
+    res = result.grid.resolution
+    return (cols.stop - cols.start) * res, (rows.stop - rows.start) * res
+
+
+def extent(result: Result, factor: int = 1,
+           shown: Window | None = None) -> tuple[float, float, float, float]:
+    """(left, right, bottom, top), metres, of the truth grid's raster, or of its ``shown``
+    window (:func:`window`), pooled ``factor``-fold: its extent (yaw of the grid ignored),
+    grown right and down by the part of the last column and row of blocks that lies past it
+    (none at factor 1)."""
     x0, y0, _ = result.grid.origin
     rows, cols = result.grid.shape
+    r, c = shown or (slice(0, rows), slice(0, cols))
     res = result.grid.resolution
-    blocks_down, blocks_across = -(-rows // factor) * factor, -(-cols // factor) * factor
-    return x0, x0 + blocks_across * res, y0 + (rows - blocks_down) * res, y0 + rows * res
+    blocks_down = -(-(r.stop - r.start) // factor) * factor
+    blocks_across = -(-(c.stop - c.start) // factor) * factor
+    left, top = x0 + c.start * res, y0 + (rows - r.start) * res
+    return left, left + blocks_across * res, top - blocks_down * res, top
 
 
 def pooling(fig: Figure, axes: Sequence[Axes], shape: tuple[int, int]) -> tuple[int, float]:
@@ -58,9 +107,10 @@ def pooling(fig: Figure, axes: Sequence[Axes], shape: tuple[int, int]) -> tuple[
     return factor, pixel_m
 
 
-def frame(ax: Axes, result: Result) -> None:
-    """Axes in metres over the truth grid's extent, one metre as long across as down."""
-    left, right, bottom, top = extent(result)
+def frame(ax: Axes, result: Result, shown: Window | None = None) -> None:
+    """Axes in metres over the truth grid's extent, or its ``shown`` window, one metre as long
+    across as down."""
+    left, right, bottom, top = extent(result, 1, shown)
     ax.set_xlim(left, right)
     ax.set_ylim(bottom, top)
     ax.set_xlabel("x [m]", fontsize=TEXT_PT)

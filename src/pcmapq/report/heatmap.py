@@ -14,7 +14,7 @@ from matplotlib.figure import Figure
 
 from pcmapq.core.morphology import distance_to
 from pcmapq.raster.pool import max_pool, min_pool
-from pcmapq.report.canvas import extent, frame, pooling
+from pcmapq.report.canvas import extent, frame, pooling, size_m, window
 from pcmapq.report.plot import WIDTH_IN, plt  # Agg backend
 from pcmapq.report.style import TEXT_PT, TITLE_PT
 from pcmapq.results.result import Result
@@ -42,17 +42,18 @@ def wall_distances(target: np.ndarray, source: np.ndarray, resolution: float,
     return np.multiply(min_pool(cells, factor), resolution, dtype=np.float64)
 
 
-def _heat_panel(ax: Axes, result: Result, factor: int, under: np.ndarray, shown: np.ndarray,
-                colours: ScalarMappable, title: str) -> None:
+def _heat_panel(ax: Axes, box: tuple[float, float, float, float], under: np.ndarray,
+                shown: np.ndarray, colours: ScalarMappable, title: str) -> None:
     """``under`` (pooled bool) in grey, then ``shown`` (pooled distances, NaN where none)
-    coloured by ``colours``, each coloured pixel grown by one pixel so lone cells show."""
+    coloured by ``colours``, each coloured pixel grown by one pixel so lone cells show; both
+    over the ``box`` (left, right, bottom, top; metres)."""
     base = np.ones((*under.shape, 3))
     base[under] = UNDER_GREY
-    ax.imshow(base, extent=extent(result, factor), origin="upper", interpolation="nearest")
+    ax.imshow(base, extent=box, origin="upper", interpolation="nearest")
     near = -cv2.dilate(np.nan_to_num(-shown, nan=-np.inf).astype(np.float32),
                        np.ones((3, 3), np.uint8), borderType=cv2.BORDER_REPLICATE)
     ax.imshow(np.where(np.isfinite(near), np.minimum(near, colours.norm.vmax), np.nan),
-              extent=extent(result, factor), origin="upper", cmap=colours.cmap,
+              extent=box, origin="upper", cmap=colours.cmap,
               norm=colours.norm, interpolation="nearest")
     ax.set_title(title, fontsize=TITLE_PT)
 
@@ -62,8 +63,11 @@ def distance_heatmap(result: Result, clip: float = 0.5) -> Figure:
     the nearest truth wall, the truth's walls grey beneath) and completeness (each truth wall
     cell the scores count, inside the footprint unless scored against the whole truth,
     coloured by its distance to the nearest map wall, the map's walls grey beneath); metres,
-    clipped at ``clip``. Pooled to display resolution (:func:`wall_distances`)."""
-    width, height = result.grid.size_m
+    clipped at ``clip``. Pooled to display resolution (:func:`wall_distances`); over the part
+    of the truth grid that holds walls (:func:`~pcmapq.report.canvas.window`)."""
+    shown = window(result)
+    res = result.grid.resolution
+    width, height = size_m(result, shown)
     panel_w = WIDTH_IN / 2
     fig, axes = plt.subplots(1, 2, figsize=(WIDTH_IN, float(np.clip(
         panel_w * height / width, 2.5, 9.0)) + 1.4), layout="constrained")
@@ -73,14 +77,16 @@ def distance_heatmap(result: Result, clip: float = 0.5) -> Figure:
                   fontsize=TEXT_PT)
     bar.ax.tick_params(labelsize=TEXT_PT)
     for ax in axes:
-        frame(ax, result)
-    factor, _ = pooling(fig, list(axes), result.grid.shape)
-    truth, walls, res = result.truth_occupied, result.map_occupied, result.grid.resolution
-    counted = truth if result.full else truth & result.overlap.footprint
-    _heat_panel(axes[0], result, factor, max_pool(truth, factor),
+        frame(ax, result, shown)
+    # every wall of both sides lies in the window, so its distances are the whole grid's
+    truth, walls = result.truth_occupied[shown], result.map_occupied[shown]
+    factor, _ = pooling(fig, list(axes), truth.shape)
+    box = extent(result, factor, shown)
+    counted = truth if result.full else truth & result.overlap.footprint[shown]
+    _heat_panel(axes[0], box, max_pool(truth, factor),
                 wall_distances(truth, walls, res, factor), colours,
                 "accuracy: map walls to the truth")
-    _heat_panel(axes[1], result, factor, max_pool(walls, factor),
+    _heat_panel(axes[1], box, max_pool(walls, factor),
                 wall_distances(walls, counted, res, factor), colours,
                 "completeness: truth walls to the map")
     return fig

@@ -46,7 +46,9 @@ from pcmapq.report.canvas import (  # noqa: E402
     overlay,
     pooling,
     shade,
+    size_m,
     thinned,
+    window,
 )
 from pcmapq.report.style import (  # noqa: E402
     ARROW_SCALE,
@@ -85,10 +87,10 @@ def _title(ax: Axes, result: Result, name: str) -> None:
                  fontsize=TITLE_PT)
 
 
-def _scale_bar(ax: Axes, result: Result) -> None:
-    """A bar of a round length, right-aligned under the axes at the x label's height."""
-    width = result.grid.size_m[0]
-    bar = _nice(width / 5)
+def _scale_bar(ax: Axes) -> None:
+    """A bar of a round length (about a fifth of the axes' width), right-aligned under the axes
+    at the x label's height."""
+    bar = _nice(abs(np.diff(ax.get_xlim())[0]) / 5)
     ax.add_artist(AnchoredSizeBar(ax.transData, bar, f"{bar:g} m", "upper right",
                                   bbox_to_anchor=(1.0, 0.0), bbox_transform=ax.transAxes,
                                   borderpad=1.9, pad=0, sep=2, frameon=False,
@@ -96,16 +98,16 @@ def _scale_bar(ax: Axes, result: Result) -> None:
     ax.artists[-1].size_bar.get_children()[0].set_linewidth(2.5)
 
 
-def _panel(ax: Axes, result: Result, factor: int, image: np.ndarray,
+def _panel(ax: Axes, result: Result, box: tuple[float, float, float, float], image: np.ndarray,
            footprint: np.ndarray | None, det: DetectorResult, gain: float,
            cell_m: float) -> None:
-    """One detector's panel over ``image`` and ``footprint``, the rasters pooled
-    ``factor``-fold; markers thinned to one per ``cell_m`` metres square, arrows ``gain``
-    times their displacement."""
-    ax.imshow(image, extent=extent(result, factor), origin="upper", interpolation="nearest")
+    """One detector's panel over ``image`` and ``footprint``, the pooled rasters of the
+    ``box`` (left, right, bottom, top; metres); markers thinned to one per ``cell_m`` metres
+    square, arrows ``gain`` times their displacement."""
+    ax.imshow(image, extent=box, origin="upper", interpolation="nearest")
     if footprint is not None:
-        ax.contour(footprint, levels=[0.5], colors=FOOTPRINT, linewidths=0.8,
-                   extent=extent(result, factor), origin="upper")
+        ax.contour(footprint, levels=[0.5], colors=FOOTPRINT, linewidths=0.8, extent=box,
+                   origin="upper")
     m = det.matching
     if det.truth.labels is not None and result.rooms is not None:  # rooms: shaded by status
         _rooms_overlay(ax, result, det)
@@ -123,7 +125,7 @@ def _panel(ax: Axes, result: Result, factor: int, image: np.ndarray,
     if len(matched):
         ax.quiver(*det.truth_xy[matched].T, *m.displacement[matched].T, angles="xy",
                   scale_units="xy", scale=1.0 / gain, color="black", width=0.003, zorder=4)
-    _scale_bar(ax, result)
+    _scale_bar(ax)
 
 
 #: Colours of the rooms' statuses (RGB; drawn translucent over the map).
@@ -183,13 +185,13 @@ def regions_gain(result: Result, arrow_scale: float) -> float:
     return float(np.clip(c.tile_m / max(largest, 1e-9), 1.0, arrow_scale))
 
 
-def _regions_panel(ax: Axes, result: Result, factor: int, image: np.ndarray,
-                   gain: float) -> None:
-    """The consistency map over ``image`` (pooled ``factor``-fold): at each region of the map,
-    the offset that fits it to the truth on its own, ``gain`` times its length; held regions
-    black, the others grey."""
+def _regions_panel(ax: Axes, result: Result, box: tuple[float, float, float, float],
+                   image: np.ndarray, gain: float) -> None:
+    """The consistency map over ``image`` (the pooled raster of the ``box``, metres): at each
+    region of the map, the offset that fits it to the truth on its own, ``gain`` times its
+    length; held regions black, the others grey."""
     c = result.consistency
-    ax.imshow(image, extent=extent(result, factor), origin="upper", interpolation="nearest")
+    ax.imshow(image, extent=box, origin="upper", interpolation="nearest")
     for held, colour in ((False, "0.6"), (True, "black")):
         k = c.held == held
         if k.any():
@@ -197,7 +199,7 @@ def _regions_panel(ax: Axes, result: Result, factor: int, image: np.ndarray,
                       scale=1.0 / gain, color=colour, width=0.004, zorder=4)
     if (largest := c.largest()) is not None:
         ax.scatter(*c.centre[largest], s=90, facecolors="none", edgecolors=MISSING, zorder=5)
-    _scale_bar(ax, result)
+    _scale_bar(ax)
 
 
 def _legend_handles(result: Result, gain: float, as_density: bool) -> list[Line2D]:
@@ -263,9 +265,11 @@ def _grid_shape(n: int) -> tuple[int, int]:
 def vectorial_figure(result: Result, arrow_scale: float = ARROW_SCALE) -> Figure:
     """One panel per detector: the truth dark over the aligned map light, matched features with
     their displacement arrows (``arrow_scale`` times their length), missing truth features and
-    extra map features (thinned where crowded), the footprint outline."""
+    extra map features (thinned where crowded), the footprint outline; over the part of the
+    truth grid that holds walls (:func:`~pcmapq.report.canvas.window`)."""
     names = list(result.detectors)
-    width, height = result.grid.size_m
+    shown = window(result)
+    width, height = size_m(result, shown)
     panels = len(names) + _has_regions(result)
     rows, cols = _grid_shape(panels)
     panel_w = WIDTH_IN / cols
@@ -287,16 +291,17 @@ def vectorial_figure(result: Result, arrow_scale: float = ARROW_SCALE) -> Figure
         axes[-1].set_title(f"{result.overlap.verdict}: each region's fit\n"
                            f"on its own, offsets x{gain:.3g}", fontsize=TITLE_PT)
     for ax in axes:
-        frame(ax, result)
-    factor, pixel_m = pooling(fig, axes, result.grid.shape)
-    image = overlay(shade(result.truth_occupied, factor, as_density),
-                    grown(shade(result.map_occupied, factor, as_density)))
-    footprint = None if result.full else max_pool(result.overlap.footprint, factor)
+        frame(ax, result, shown)
+    factor, pixel_m = pooling(fig, axes, result.truth_occupied[shown].shape)
+    box = extent(result, factor, shown)
+    image = overlay(shade(result.truth_occupied[shown], factor, as_density),
+                    grown(shade(result.map_occupied[shown], factor, as_density)))
+    footprint = None if result.full else max_pool(result.overlap.footprint[shown], factor)
     for ax, name in zip(axes, names, strict=False):
-        _panel(ax, result, factor, image, footprint, result.detectors[name], arrow_scale,
+        _panel(ax, result, box, image, footprint, result.detectors[name], arrow_scale,
                thin_px * pixel_m)
     if _has_regions(result):
-        _regions_panel(axes[-1], result, factor, image, gain)
+        _regions_panel(axes[-1], result, box, image, gain)
     return fig
 
 

@@ -13,7 +13,9 @@ and status holds its circles (Hough: its segments too; matched: the displacement
 checkbox shows or hides it. Markers keep their size on screen while the walls scale with the
 zoom, so where the markers crowd over thin walls (a street map seen whole) the walls are drawn
 over them and the features as rings (:data:`CROWDED_PX`, :data:`SMALL_CELL_PX`); zoomed in,
-the features are drawn over the walls. No network: the script is inline and plain JavaScript.
+the features are drawn over the walls. It opens on the part of the grid that holds walls
+(:func:`~pcmapq.report.canvas.window`), as the figures show it. No network: the script is
+inline and plain JavaScript.
 """
 
 from __future__ import annotations
@@ -26,7 +28,7 @@ import cv2
 import numpy as np
 from scipy.spatial import cKDTree
 
-from pcmapq.report.canvas import density, grown, shade
+from pcmapq.report.canvas import density, grown, shade, window
 from pcmapq.report.style import MAP_LIGHT, TRUTH_DARK
 from pcmapq.report.viewer_page import COLOURS, SCRIPT, STATUSES
 from pcmapq.results.result import DetectorResult, Result
@@ -189,9 +191,12 @@ def viewer_html(result: Result, arrow_scale: float) -> str:
     groups = "".join(f'<g id="f-{name}-{status}">{svg}</g>'
                      for name, det in result.detectors.items()
                      for status, svg in _groups(result, name, det, arrow_scale).items())
+    shown_rows, shown_cols = window(result)  # the first view: the walls, not the whole grid
+    across, down = shown_cols.stop - shown_cols.start, shown_rows.stop - shown_rows.start
     return f"""{_controls(result)}
-<div class="viewer"><svg id="viewer-svg" viewBox="-0.5 -0.5 {cols} {rows}"
- style="aspect-ratio: {cols} / {rows}" data-spacing="{gap:.3f}"
+<div class="viewer"><svg id="viewer-svg"
+ viewBox="{shown_cols.start - 0.5:g} {shown_rows.start - 0.5:g} {across} {down}"
+ style="aspect-ratio: {across} / {down}" data-spacing="{gap:.3f}"
  data-labels="{html.escape(json.dumps(STATUSES))}">
 {images}{groups}</svg>
 <div id="viewer-tip"></div></div>

@@ -14,6 +14,7 @@ import numpy as np
 from pcmapq.core.grid import MetricGrid
 from pcmapq.features import Features
 from pcmapq.match import Matching
+from pcmapq.report.canvas import window
 from pcmapq.results.result import DetectorResult, Result
 
 CIRCLE = re.compile(r"<circle ([^>]*)/>")
@@ -117,12 +118,14 @@ def probed(page: str, feature: str, toggle: tuple[str, str], tmp_path: Path) -> 
     return probe_of(chromium(path, tmp_path, 1400, 1000, "--dump-dom"))
 
 
-def check_view(out: dict, grid: MetricGrid) -> None:
-    """The view before (the whole grid), zoomed 2.1-fold about the cursor, then panned by the
-    pointer's 40, 20 pixels, reset; the feature on top where it is drawn, 4 pixels in radius."""
+def check_view(out: dict, result: Result) -> None:
+    """The view before (the part of the grid that holds walls), zoomed 2.1-fold about the
+    cursor, then panned by the pointer's 40, 20 pixels, reset; the feature on top where it is
+    drawn, 4 pixels in radius."""
     before, zoomed, panned = (np.array(out[k]) for k in ("before", "zoomed", "panned"))
-    rows, cols = grid.shape
-    np.testing.assert_allclose(before, [-0.5, -0.5, cols, rows])
+    rows, cols = window(result)
+    np.testing.assert_allclose(before, [cols.start - 0.5, rows.start - 0.5,
+                                        cols.stop - cols.start, rows.stop - rows.start])
     np.testing.assert_allclose(zoomed[2:], before[2:] * 1.0015 ** -500, rtol=1e-6)
     step = 1 / out["pxPerUnit"]  # one screen pixel, grid cells
     np.testing.assert_allclose(out["underAfter"], out["under"], atol=step)

@@ -1,11 +1,15 @@
 """What every picture shares (report/canvas.py, report/heatmap.py): wall distances keep the
-nearest cell of each block, thinned points keep one a square, density shades by occupied share."""
+nearest cell of each block, thinned points keep one a square, density shades by occupied share,
+a picture shows the part of the grid that holds walls."""
 
 from __future__ import annotations
 
+from types import SimpleNamespace
+
 import numpy as np
 
-from pcmapq.report.canvas import shade, thinned
+from pcmapq.core.grid import MetricGrid
+from pcmapq.report.canvas import extent, shade, thinned, window
 from pcmapq.report.heatmap import wall_distances
 
 
@@ -35,3 +39,47 @@ def test_density_shades_by_occupied_share():
     dens, walls = shade(mask, 4, True), shade(mask, 4, False)
     assert 0.3 <= dens[0, 0] < 0.6 and dens[0, 1] == 1.0
     np.testing.assert_array_equal(walls, [[1.0, 1.0]])
+
+
+def _walls_in(shape, rows, cols, full=True, footprint=None, features=()):
+    """A stand-in result on a 0.1 m grid with origin (10, 20): truth walls on ``rows`` x
+    ``cols`` (slices), none on the map's side; one detector whose truth has the ``features``
+    (x, y metres) and whose map has none."""
+    truth = np.zeros(shape, bool)
+    truth[rows, cols] = True
+    sides = SimpleNamespace(truth=SimpleNamespace(xy=np.array(features).reshape(-1, 2)),
+                            map=SimpleNamespace(xy=np.zeros((0, 2))))
+    return SimpleNamespace(grid=MetricGrid(0.1, (10.0, 20.0, 0.0), shape), truth_occupied=truth,
+                           map_occupied=np.zeros(shape, bool), full=full,
+                           overlap=SimpleNamespace(footprint=footprint),
+                           detectors={"harris": sides})
+
+
+def test_a_picture_shows_the_walls_with_a_margin():
+    """Walls on rows 400-599 and columns 300-399 of a 1000 x 1000 grid of 0.1 m: shown with a
+    margin of 5 % of the box's larger side (10 cells, 1 m: the least margin too); at the grid's
+    corner the window stops at the grid; an empty grid is shown whole."""
+    result = _walls_in((1000, 1000), slice(400, 600), slice(300, 400))
+    assert window(result) == (slice(390, 610), slice(290, 410))
+    left, right, bottom, top = extent(result, 1, window(result))
+    np.testing.assert_allclose([left, right, bottom, top], [39.0, 51.0, 59.0, 81.0])
+    wide = _walls_in((1000, 1000), slice(0, 10), slice(0, 600))  # margin 30 cells, cut at 0
+    assert window(wide) == (slice(0, 40), slice(0, 630))
+    assert window(_walls_in((50, 60), slice(0, 0), slice(0, 0))) == (slice(0, 50), slice(0, 60))
+
+
+def test_a_partial_maps_footprint_is_shown_whole():
+    """Scored within the map's footprint: the footprint's cells are shown with the walls."""
+    footprint = np.zeros((1000, 1000), bool)
+    footprint[700:800, 700:900] = True
+    result = _walls_in((1000, 1000), slice(400, 600), slice(300, 400), full=False,
+                       footprint=footprint)
+    assert window(result) == (slice(370, 830), slice(270, 930))  # margin: 5 % of 600
+
+
+def test_a_feature_off_the_walls_is_shown_too():
+    """A truth feature at (20.05, 100.05) m, the centre of row 199 and column 100, beyond the
+    walls of rows 400-599: shown, with the margin of the box that holds both."""
+    result = _walls_in((1000, 1000), slice(400, 600), slice(300, 400),
+                       features=[(20.05, 100.05)])
+    assert window(result) == (slice(178, 621), slice(79, 421))  # margin: 21 cells, 5 % of 401
