@@ -158,11 +158,11 @@ class RoomOverlap(NamedTuple):
 
     shared: (T, M) cells each pair shares. iou: (T, M) their IoU. usable: (T, M) the IoU of
     the pairs that may match, 0 for the others: a truth room merged (a map room holds most of
-    it and of another truth room) or split (two or more map rooms lie mostly within it, each
-    holding a piece of it), and the map rooms that merge or are its pieces. merged, split:
-    (T,) those truth rooms; merging, pieces: (M,) those map rooms. part: (T, M) whether the
-    map room is a piece of the truth room (lies mostly within it and holds a piece of it),
-    split or not."""
+    it and of another truth room, each a piece of the map room) or split (two or more map
+    rooms lie mostly within it, each holding a piece of it), and the map rooms that merge or
+    are its pieces. merged, split: (T,) those truth rooms; merging, pieces: (M,) those map
+    rooms. part: (T, M) whether the map room is a piece of the truth room (lies mostly within
+    it and holds a piece of it), split or not."""
 
     shared: np.ndarray
     iou: np.ndarray
@@ -186,8 +186,10 @@ def room_overlap(truth: np.ndarray, map_: np.ndarray, most: float = 0.5,
     iou = np.divide(shared, union, out=np.zeros(shared.shape), where=union > 0)
     of_truth = shared / np.maximum(t_cells, 1)[:, None]  # share of each truth room
     of_map = shared / np.maximum(m_cells, 1)[None, :]  # share of each map room
-    merging = (of_truth >= most).sum(axis=0) >= 2  # holds most of two or more truth rooms
-    merged = (of_truth[:, merging] >= most).any(axis=1)
+    # the map room holds most of the truth room, and the truth room is a piece of it
+    holds = (of_truth >= most) & (of_map >= piece)
+    merging = holds.sum(axis=0) >= 2  # holds two or more truth rooms
+    merged = holds[:, merging].any(axis=1)
     # the map room lies mostly in the truth room and holds a piece of it
     part = (of_map >= most) & (of_truth >= piece)
     split = (part.sum(axis=1) >= 2) & ~merged

@@ -5,8 +5,10 @@ Their overlaps (cells shared) give each pair's IoU; one assignment (scipy
 ``linear_sum_assignment``) maximises the summed IoU, and a pair counts as matched at an IoU of
 at least ``min_iou``. A room left over is:
 
-- **merged**: a map room holds at least ``most`` of each of two or more truth rooms (a wall
-  or door the map lacks joined them): those truth rooms and that map room;
+- **merged**: a map room holds at least ``most`` of each of two or more truth rooms, each of
+  them at least ``PIECE`` (a tenth) of the map room (a wall or door the map lacks joined
+  them): those truth rooms and that map room; a smaller truth room the map left open to a
+  room (a closet whose walls it lacks) is missing, and the room may match;
 - **split**: at least two map rooms lie each for at least ``most`` of their own cells within
   one truth room and hold each at least ``PIECE`` (a tenth) of it (the map put a wall or a
   door where the truth has none): that truth room and those map rooms; a smaller pocket the

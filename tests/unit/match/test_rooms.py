@@ -66,6 +66,22 @@ def test_a_pocket_closed_off_inside_a_room_is_extra_and_the_room_matched():
             assert list(found.map_status) == [MATCHED, EXTRA, MATCHED]
 
 
+def test_a_closet_the_map_joined_to_a_room_is_missing_and_the_room_matched():
+    """A truth closet of 1 column (10 cells) beside a room of 10 columns, the map's one room
+    over both (110 cells): the closet is less than a tenth of it, so no merger: the room
+    matches (IoU 100/110) and the closet is missing. A closet of 2 columns (20 of 120 cells,
+    a sixth) is a room the map merged, the room with it."""
+    for width, merged in ((1, False), (2, True)):
+        truth, map_ = strips(10, width, 8), strips(10 + width, 8)
+        found = match(truth, map_)
+        if merged:
+            assert list(found.truth_status) == [MERGED, MERGED, MATCHED]
+            assert list(found.map_status) == [MERGED, MATCHED]
+        else:
+            assert list(found.truth_status) == [MATCHED, MISSING, MATCHED]
+            assert list(found.map_status) == [MATCHED, MATCHED]
+
+
 def test_a_room_not_entered_is_missing_and_a_room_outside_the_truth_is_extra():
     truth, map_ = strips(5, 5, -5), strips(5, -5, 5)
     found = match(truth, map_)
