@@ -63,10 +63,10 @@ class Params:
     min_seen: as a detector, the least share of a truth room inside the map's footprint for
         it to count (a room the map saw only in part cannot be judged as a room).
     min_drawn: as a detector, the least share inside the footprint of a truth room over which
-        the map drew a room (one lying mostly within it and holding a tenth of it) for it to
-        count: a room a bent map drew out of place, partly off the footprint, is judged; a
-        room a partial map saw only in part is open to its unknown cells, draws no room, and
-        counts at ``min_seen`` only.
+        the map drew a room (one lying mostly within it and holding a tenth of it, or one that
+        holds most of it and of another truth room) for it to count: a room a bent map drew out
+        of place, partly off the footprint, is judged; a room a partial map saw only in part is
+        open to its unknown cells, draws no room, and counts at ``min_seen`` only.
     """
 
     door_ratio: float = 0.7

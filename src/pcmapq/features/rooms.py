@@ -133,14 +133,15 @@ def share_inside(features: Features, area: np.ndarray, grid: MetricGrid) -> np.n
 
 def drawn(truth: Features, map_: Features, most: float = 0.5,
           piece: float = PIECE) -> np.ndarray:
-    """(T,) bool: the truth rooms over which the map drew a room of its own, one lying for at
-    least ``most`` of its cells within the truth room and holding at least ``piece`` of it (a
-    piece of it, :func:`room_overlap`)."""
+    """(T,) bool: the truth rooms over which the map drew a room: one lying for at least
+    ``most`` of its cells within the truth room and holding at least ``piece`` of it (a piece
+    of it), or one that holds ``most`` of it and of another truth room (a merger; see
+    :func:`room_overlap`)."""
     found = np.zeros(len(truth), dtype=bool)
     if truth.labels is None or map_.labels is None or truth.labels.shape != map_.labels.shape:
         return found
-    part = room_overlap(truth.labels, map_.labels, most, piece).part
-    found[:part.shape[0]] = part.any(axis=1)
+    o = room_overlap(truth.labels, map_.labels, most, piece)
+    found[:o.part.shape[0]] = o.part.any(axis=1) | o.merged
     return found
 
 

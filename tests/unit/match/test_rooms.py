@@ -130,14 +130,20 @@ def test_a_room_the_map_saw_too_little_of_is_unseen_even_when_a_map_room_overlap
 
 
 def test_a_pocket_or_a_room_mostly_elsewhere_is_no_room_drawn_over_a_truth_room():
+    """A map room drawn over a truth room is a piece of it or a room that merged it with
+    another (holding most of each); a pocket, or a room holding less than half of it, is
+    not."""
     from pcmapq.features.rooms import drawn
 
     truth = features_of(strips(10, 10))
     pocket = np.zeros_like(truth.labels)
     pocket[:2, :4] = 1  # 8 cells of the first room's 100
     assert drawn(truth, features_of(pocket)).tolist() == [False, False]
-    # 100 of its 160 cells in the second room, 60 in the first
-    across = features_of(strips(-4, 16))
+    # 100 of its 140 cells in the second room, 40 in the first: less than half of the first
+    across = features_of(strips(-6, 14))
     assert drawn(truth, across).tolist() == [False, True]
+    # 100 of its 160 cells in the second room, 60 in the first: it merged the two rooms
+    merger = features_of(strips(-4, 16))
+    assert drawn(truth, merger).tolist() == [True, True]
     none = truth.labels * 0
     assert drawn(truth, features_of(none)).tolist() == [False, False]
