@@ -42,7 +42,7 @@ def section(data: Path, record: Record) -> Section:
             f"{tf.yaw_deg:.1f} ({plan.yaw_deg:.0f})",
             "yes" if recovered(plan, r) else "**no**", number(r.alignment.fitness, 2),
             number(r.overlap.coverage, 2), number(r.overlap.confidence, 2),
-            *(q_p(r, k) for k in ("harris", "hough", "sift")),
+            *(q_p(r, k) for k in ("harris", "hough", "sift", "rooms")),
             number(r.distances.accuracy.mean), number(r.distances.completeness.mean),
             f"{run.seconds:.1f}"]))
         files[plan.figure] = figure_png(r)
@@ -67,6 +67,7 @@ def section(data: Path, record: Record) -> Section:
         "",
         header(["pair", "scale (survey)", "yaw deg (expected)", "recovered", "fitness",
                 "coverage", "confidence", "Harris q / p", "Hough q / p", "SIFT q / p",
+                "rooms q / p",
                 "acc mean m", "comp mean m", "s"]),
         *lines, "",
         f"'recovered': yaw within {YAW_TOLERANCE_DEG:g} degrees of the expected one and scale "
