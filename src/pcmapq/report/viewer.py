@@ -6,16 +6,16 @@ The SVG's user unit is one cell of the truth grid (cell centres at integers, as
 :meth:`~pcmapq.core.grid.MetricGrid.xy_to_pixels` gives them), so the walls, drawn in the grid's own
 rows and columns, and the features, placed from their metric (truth frame) coordinates, stand
 where the grid puts them for any grid origin and yaw. The walls are two embedded PNGs (the
-truth dark over the aligned map light, as in the figures), pooled to at most
+truth dark over the aligned map light, as in the figures) of the part of the grid that holds
+walls (:func:`~pcmapq.report.canvas.window`, where the view opens), pooled to at most
 :data:`VIEWER_PX` pixels across and down (:mod:`pcmapq.raster.pool`), so a map of any size
 costs pictures of bounded size; every feature is kept, none thinned. One ``<g>`` per detector
 and status holds its circles (Hough: its segments too; matched: the displacement arrows), and a
 checkbox shows or hides it. Markers keep their size on screen while the walls scale with the
 zoom, so where the markers crowd over thin walls (a street map seen whole) the walls are drawn
 over them and the features as rings (:data:`CROWDED_PX`, :data:`SMALL_CELL_PX`); zoomed in,
-the features are drawn over the walls. It opens on the part of the grid that holds walls
-(:func:`~pcmapq.report.canvas.window`), as the figures show it. No network: the script is
-inline and plain JavaScript.
+the features are drawn over the walls. No network: the script is inline and plain
+JavaScript.
 """
 
 from __future__ import annotations
@@ -176,14 +176,17 @@ def _controls(result: Result) -> str:
 def viewer_html(result: Result, arrow_scale: float) -> str:
     """The interactive map as an HTML fragment (its style, controls, SVG and script inline);
     matched features' arrows ``arrow_scale`` times their displacement."""
-    rows, cols = result.grid.shape
-    factor = max(1, -(-max(rows, cols) // VIEWER_PX))
+    shown = window(result)  # every wall lies in it: the first view, and the walls drawn
+    shown_rows, shown_cols = shown
+    across, down = shown_cols.stop - shown_cols.start, shown_rows.stop - shown_rows.start
+    factor = max(1, -(-max(across, down) // VIEWER_PX))
     as_density = density(result)
-    truth = shade(result.truth_occupied, factor, as_density)
-    walls = grown(shade(result.map_occupied, factor, as_density))
+    truth = shade(result.truth_occupied[shown], factor, as_density)
+    walls = grown(shade(result.map_occupied[shown], factor, as_density))
     w, h = walls.shape[1] * factor, walls.shape[0] * factor
     images = "".join(
-        f'<g id="{layer}"><image x="-0.5" y="-0.5" width="{w}" height="{h}" '
+        f'<g id="{layer}"><image x="{shown_cols.start - 0.5:g}" y="{shown_rows.start - 0.5:g}" '
+        f'width="{w}" height="{h}" '
         f'preserveAspectRatio="none" href="{_png(alpha, rgb, opacity)}"/></g>'
         for layer, alpha, rgb, opacity in (("walls-map", walls, MAP_LIGHT, 1.0),
                                            ("walls-truth", truth, TRUTH_DARK, TRUTH_OPACITY)))
@@ -191,8 +194,6 @@ def viewer_html(result: Result, arrow_scale: float) -> str:
     groups = "".join(f'<g id="f-{name}-{status}">{svg}</g>'
                      for name, det in result.detectors.items()
                      for status, svg in _groups(result, name, det, arrow_scale).items())
-    shown_rows, shown_cols = window(result)  # the first view: the walls, not the whole grid
-    across, down = shown_cols.stop - shown_cols.start, shown_rows.stop - shown_rows.start
     return f"""{_controls(result)}
 <div class="viewer"><svg id="viewer-svg"
  viewBox="{shown_cols.start - 0.5:g} {shown_rows.start - 0.5:g} {across} {down}"

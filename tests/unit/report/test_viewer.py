@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import base64
 import re
+from dataclasses import replace
 
 import cv2
 import numpy as np
@@ -57,3 +58,24 @@ def test_viewer_pools_large_grids_and_is_deterministic():
         img = cv2.imdecode(np.frombuffer(base64.b64decode(uri), np.uint8), cv2.IMREAD_UNCHANGED)
         assert img.shape == (-(-3000 // factor), -(-5000 // factor), 4)
         assert max(img.shape[:2]) <= VIEWER_PX and img[..., 3].any()
+
+
+def test_viewer_draws_the_walls_window_of_a_sparse_grid():
+    """The small result in a corner of a 6000 x 6000 grid: the walls' PNGs cover the window
+    only, where the view opens, pooled for its size, not the grid's."""
+    from pcmapq.report.canvas import window
+
+    grid = MetricGrid(0.1, (1.0, 2.0, 0.0), (6000, 6000))
+    walls = np.zeros(grid.shape, bool)
+    walls[5950, :80] = True  # beside the features, 0.5 m below y = 2.5 m
+    result = replace(small_result(grid), truth_occupied=walls,
+                     map_occupied=np.roll(walls, 2, axis=0))
+    rows, cols = window(result)
+    assert rows.stop - rows.start < VIEWER_PX and cols.stop - cols.start < VIEWER_PX
+    page = viewer_html(result, 10.0)
+    assert "(here 1 x 1\ncells a pixel)" in page
+    x, y, w, h = re.findall(r'<image x="([-\d.]+)" y="([-\d.]+)" width="(\d+)" '
+                            r'height="(\d+)"', page)[0]
+    assert (float(x), float(y)) == (cols.start - 0.5, rows.start - 0.5)
+    assert (int(w), int(h)) == (cols.stop - cols.start, rows.stop - rows.start)
+    assert f'viewBox="{cols.start - 0.5:g} {rows.start - 0.5:g} {w} {h}"' in page
