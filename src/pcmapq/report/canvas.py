@@ -2,9 +2,9 @@
 metres, the pooling that brings a raster to display resolution, the shaded rasters (walls, or a
 3D cloud's density) and the thinning of markers. Truth frame, metres.
 
-A picture shows the cells that hold walls of either side (or the map's footprint), with a
-margin, not the whole truth grid: a building drawn in the middle of a large plan image fills its
-panels as a map of its own size does.
+A picture shows the cells that hold walls of either side, their features and the map's
+footprint, with a margin, not the whole truth grid: a building drawn in the middle of a large
+plan image fills its panels as a map of its own size does.
 """
 
 from __future__ import annotations
