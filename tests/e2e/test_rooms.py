@@ -134,7 +134,8 @@ def test_hovering_a_room_in_chromium_tells_its_fit(result, tmp_path):
 def test_the_picture_draws_the_rooms_graph_with_its_wrong_and_missing_doors(doors):
     from matplotlib.collections import LineCollection
 
-    from pcmapq.report.plot import DOOR_COLOURS, vectorial_figure
+    from pcmapq.report.plot import vectorial_figure
+    from pcmapq.report.rooms_layer import DOOR_COLOURS
 
     fig = vectorial_figure(doors)
     ax = fig.axes[0]

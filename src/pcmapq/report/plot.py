@@ -1,6 +1,6 @@
 """Pictures of a Result: the vectorial map per detector and the figure files (what every
-picture shares is :mod:`pcmapq.report.canvas`; the distance heatmaps are
-:mod:`pcmapq.report.heatmap`).
+picture shares is :mod:`pcmapq.report.canvas`; the rooms over a panel,
+:mod:`pcmapq.report.rooms_layer`; the distance heatmaps, :mod:`pcmapq.report.heatmap`).
 
 Everything is drawn in the truth frame, axes in metres (matplotlib, headless Agg backend). The
 truth's walls are drawn dark over the aligned map's, light and one pixel wider, so both show
@@ -36,7 +36,6 @@ from matplotlib.legend import Legend  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
 from mpl_toolkits.axes_grid1.anchored_artists import AnchoredSizeBar  # noqa: E402
 
-from pcmapq.features.rooms import label_cell  # noqa: E402
 from pcmapq.raster.pool import max_pool  # noqa: E402
 from pcmapq.report.canvas import (  # noqa: E402
     density,
@@ -50,6 +49,7 @@ from pcmapq.report.canvas import (  # noqa: E402
     thinned,
     window,
 )
+from pcmapq.report.rooms_layer import draw_rooms, rooms_legend  # noqa: E402
 from pcmapq.report.style import (  # noqa: E402
     ARROW_SCALE,
     DPI,
@@ -110,7 +110,7 @@ def _panel(ax: Axes, result: Result, box: tuple[float, float, float, float], ima
                    origin="upper")
     m = det.matching
     if det.truth.labels is not None and result.rooms is not None:  # rooms: shaded by status
-        _rooms_overlay(ax, result, det)
+        draw_rooms(ax, result, det)
     if det.truth.segments is not None:  # Hough: draw the segments themselves
         for idx, feats, colour in ((m.truth_idx, det.truth, MATCHED),
                                    (m.missing, det.truth, MISSING), (m.extra, det.map, EXTRA)):
@@ -126,55 +126,6 @@ def _panel(ax: Axes, result: Result, box: tuple[float, float, float, float], ima
         ax.quiver(*det.truth_xy[matched].T, *m.displacement[matched].T, angles="xy",
                   scale_units="xy", scale=1.0 / gain, color="black", width=0.003, zorder=4)
     _scale_bar(ax)
-
-
-#: Colours of the rooms' statuses (RGB; drawn translucent over the map).
-ROOM_COLOURS = {"matched": MATCHED, "merged": "#e6ab02", "split": "#7570b3",
-                "missing": MISSING, "unseen": "#bbbbbb", "extra": EXTRA}
-
-
-def _rooms_overlay(ax: Axes, result: Result, det: DetectorResult) -> None:
-    """The truth's rooms shaded by status, and the map's extra rooms, on their cells: the
-    rooms' grid shares the truth grid's lower-left corner."""
-    from matplotlib.colors import to_rgba
-
-    truth, map_ = det.truth, det.map
-    cell = label_cell(truth)
-    if not cell:
-        return
-    rows, cols = truth.labels.shape
-    x0, y0 = result.grid.origin[0], result.grid.origin[1]
-    colours = np.zeros((len(truth) + 1, 4))
-    for k, row in enumerate(result.rooms["truth"]):
-        colours[k + 1] = to_rgba(ROOM_COLOURS.get(row["status"], "#bbbbbb"), 0.28)
-    overlay = colours[truth.labels]
-    extra = [j + 1 for j, row in enumerate(result.rooms["map"]) if row["status"] == "extra"]
-    if extra and map_.labels is not None and map_.labels.shape == truth.labels.shape:
-        overlay[np.isin(map_.labels, extra)] = to_rgba(ROOM_COLOURS["extra"], 0.45)
-    ax.imshow(overlay, extent=(x0, x0 + cols * cell, y0, y0 + rows * cell), origin="upper",
-              interpolation="nearest", zorder=2)
-    _room_graph(ax, result)
-
-
-#: Colours of the doors' statuses in the rooms' graph.
-DOOR_COLOURS = {"found": "0.35", "not judged": "0.7", "missing": MISSING, "wrong": EXTRA}
-
-
-def _room_graph(ax: Axes, result: Result) -> None:
-    """The rooms' graph over the rooms: each door an edge from one room's centroid through the
-    door to the other's, grey when found (light: not judged), red when the map misses it;
-    the map's wrong doors (joining rooms the truth does not) orange, through the map's rooms."""
-    for side, statuses in (("truth", ("found", "not judged", "missing")), ("map", ("wrong",))):
-        rooms, doors = result.rooms[side], result.rooms["doors"][side]
-        for status in statuses:
-            paths = [[(rooms[a]["x_m"], rooms[a]["y_m"]), (d["x_m"], d["y_m"]),
-                      (rooms[b]["x_m"], rooms[b]["y_m"])]
-                     for d in doors if d["status"] == status for a, b in [d["rooms"]]]
-            if paths:
-                ax.add_collection(LineCollection(
-                    paths, colors=DOOR_COLOURS[status], zorder=2.5,
-                    linewidths=0.8 if status in ("found", "not judged") else 1.4,
-                    linestyles="solid" if status in ("found", "not judged") else "dashed"))
 
 
 def regions_gain(result: Result, arrow_scale: float) -> float:
@@ -217,18 +168,7 @@ def _legend_handles(result: Result, gain: float, as_density: bool) -> list[Line2
         handles.append(Line2D([], [], color=MISSING, marker="o", mfc="none", ls="",
                               label="regions: largest offset (grey: not held)"))
     if result.rooms is not None:
-        shown = {row["status"] for side in ("truth", "map") for row in result.rooms[side]}
-        handles += [Line2D([], [], color=colour, lw=6, alpha=0.45, label=f"room {status}")
-                    for status, colour in ROOM_COLOURS.items() if status in shown]
-        doors = result.rooms.get("doors", {})
-        drawn = {d["status"] for side in ("truth", "map") for d in doors.get(side, [])} - \
-            {"found"}
-        handles += [Line2D([], [], color=DOOR_COLOURS[status], lw=1.4, ls="--",
-                           label=f"door {status}") for status in ("missing", "wrong")
-                    if status in drawn]
-        if doors.get("truth"):
-            handles.append(Line2D([], [], color=DOOR_COLOURS["found"], lw=0.8,
-                                  label="rooms joined by a door (truth)"))
+        handles += rooms_legend(result.rooms)
     return handles
 
 
