@@ -21,6 +21,8 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
+from pcmapq.align import free_space
+from pcmapq.align.free_space import CLEAR_M, FreeSpace
 from pcmapq.core.bounds import bounds
 from pcmapq.core.grid import MetricGrid
 from pcmapq.core.morphology import distance_to
@@ -149,7 +151,7 @@ def auto_resolution(map_xy: np.ndarray) -> float:
 def coarse_search(map_xy: np.ndarray, truth_xy: np.ndarray, *,
                   resolution: float | None = None, sigma: float | None = None,
                   angle_step_deg: float | None = None, overhang: float = 2.0,
-                  top_k: int = 6, per_angle: int = 3) -> Search:
+                  top_k: int = 6, per_angle: int = 3, free: FreeSpace | None = None) -> Search:
     """The ``top_k`` best distinct poses (map frame -> truth frame) of a yaw sweep over 360 degrees.
 
     map_xy, truth_xy: (N, 2) metres, each in its own frame.
@@ -158,6 +160,9 @@ def coarse_search(map_xy: np.ndarray, truth_xy: np.ndarray, *,
     the angle that moves the map's farthest point by sigma, clipped to [0.5, 3]). overhang: how
     far, metres, the map's centroid may lie outside the truth's bounding box. per_angle: peaks
     kept from each yaw's response.
+    free: the map's free space and the truth's solid cells; given, each pose's score is
+    multiplied by one minus its contradiction, the share of the map's clear free cells on
+    solid truth cells (:mod:`~pcmapq.align.free_space`).
     Candidates come best first; yaws within three steps and positions within 4 cells of a better one
     are dropped, so near-symmetric alternatives survive to be settled by refinement.
     """
@@ -168,17 +173,27 @@ def coarse_search(map_xy: np.ndarray, truth_xy: np.ndarray, *,
     radius = _radius(centred)
     if angle_step_deg is None:
         angle_step_deg = float(np.clip(np.degrees(sigma / max(radius, 1e-6)), 0.5, 3.0))
-    half = int(np.ceil(radius / resolution)) + 1
+    clear = _clear(free, map_xy, resolution) - centre
+    half = int(np.ceil(max(radius, _radius(clear) if len(clear) else 0.0) / resolution)) + 1
     tgrid = _template_grid(half, resolution)
     fgrid = MetricGrid.covering(truth_xy, resolution, margin=(half + 1) * resolution + overhang)
     field = likelihood_field(truth_xy, fgrid, sigma)
+    solid = known = None
+    if free is not None:
+        solid = (hit_counts(free.solid_xy(), fgrid) > 0).astype(np.float32)
+        known = np.maximum(solid, hit_counts(free.known_xy(resolution), fgrid) > 0
+                           ).astype(np.float32)
     # Field pixel of the template's centre cell when the response peaks at (0, 0).
     offset = fgrid.pixels_to_xy(np.array([[half, half]]))[0]
     yaws = np.radians(np.arange(0.0, 360.0, angle_step_deg))
     rows = []
     for yaw in yaws:
-        template = (hit_counts(centred @ _rotation(yaw).T, tgrid) > 0).astype(np.float32)
+        turn = _rotation(yaw).T
+        template = (hit_counts(centred @ turn, tgrid) > 0).astype(np.float32)
         response = cv2.matchTemplate(field, template, cv2.TM_CCORR) / template.sum()
+        if solid is not None and len(clear):
+            response *= np.exp(-free_space.PENALTY *
+                               _contradicted(solid, known, clear @ turn, tgrid))
         v, u = _peaks(response, per_angle, radius=2)
         xy = offset + np.column_stack([u, -v]) * resolution
         rows.append(np.column_stack([response[v, u], np.full(len(v), yaw), xy]))
@@ -187,6 +202,26 @@ def coarse_search(map_xy: np.ndarray, truth_xy: np.ndarray, *,
     best = _suppress(poses, top_k, np.radians(3 * angle_step_deg), 4 * resolution)
     return Search([Candidate(_pose(yaw, xy, centre), float(score)) for score, yaw, *xy in best],
                   poses, centre, radius, resolution, float(np.radians(angle_step_deg)))
+
+
+def _clear(free: FreeSpace | None, map_xy: np.ndarray, cell: float) -> np.ndarray:
+    """The map's free points (map frame, metres) that are evidence on a raster of ``cell``
+    metres: thinned to half a cell, farther than CLEAR_M and 1.5 cells from its walls
+    ``map_xy``; none without ``free``."""
+    if free is None:
+        return np.zeros((0, 2))
+    return free.clear(map_xy, 0.5 * cell, max(CLEAR_M, 1.5 * cell))
+
+
+def _contradicted(solid: np.ndarray, known: np.ndarray, free_xy: np.ndarray,
+                  tgrid: MetricGrid) -> np.ndarray:
+    """For every template position, the share of the free points ``free_xy`` (about the
+    template's centre, metres) on ``known`` truth cells that lie on ``solid`` ones: a
+    (rows, cols) float32 response in [0, 1] laid out as cv2.matchTemplate's."""
+    template = (hit_counts(free_xy, tgrid) > 0).astype(np.float32)
+    on_solid = cv2.matchTemplate(solid, template, cv2.TM_CCORR)
+    on_known = cv2.matchTemplate(known, template, cv2.TM_CCORR)
+    return np.clip(on_solid / np.maximum(on_known, 1.0), 0.0, 1.0)
 
 
 def _pose(yaw: float, centre_truth: np.ndarray, centre_map: np.ndarray,

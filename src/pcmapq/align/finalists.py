@@ -1,6 +1,7 @@
 """The choice among a map's candidate poses: each refined roughly, the best few (and any
-close one elsewhere) refined to the end, the best of those by fitness, then RMSE; with the
-scale free, a near tie broken by the share of the truth each pose covers."""
+close one elsewhere) refined to the end, the best of those by support (fitness, times one minus
+the contradiction of the map's free space where it has one), then RMSE; with the scale free, a
+near tie broken by the share of the truth each pose covers."""
 
 from __future__ import annotations
 
@@ -9,9 +10,10 @@ from typing import Protocol
 
 import numpy as np
 
+from pcmapq.align.free_space import PENALTY
 from pcmapq.core.transform import Similarity2D, wrapped
 
-#: A rough-stage result whose fitness is at least this share of the best one's goes through the
+#: A rough-stage result whose support is at least this share of the best one's goes through the
 #: fine stages too, beyond the ``finalists``: clutter can drag the rough stage of the right
 #: start below a wrong pose's, which the fine stages then overtake
 #: (``tests/e2e/test_placement.py``, a plan under 800 boxes).
@@ -37,14 +39,15 @@ class Scored(Protocol):
     transform: Similarity2D
     fitness: float
     rmse_m: float
+    contradiction: float | None
 
 
 def refine_best(starts: Sequence[Similarity2D], rough: Refine, fine: Refine,
                 scored: Callable[[Similarity2D], Scored], finalists: int, *,
                 covered: Callable[[Similarity2D], float] | None = None) -> Similarity2D:
-    """Every start refined by ``rough``; the ``finalists`` best of those (highest fitness, then
-    lowest RMSE, by ``scored``), and any other pose within CLOSE_FINALISTS of the best
-    fitness, refined by ``fine``; the best of these. Given ``covered`` (the share of the
+    """Every start refined by ``rough``; the ``finalists`` best of those (highest support, then
+    lowest RMSE, by ``scored``; see :func:`support`), and any other pose within
+    CLOSE_FINALISTS of the best support, refined by ``fine``; the best of these. Given ``covered`` (the share of the
     truth a pose covers), the one covering most among those within TIE_FITNESS of the best
     fitness wins instead when it covers TIE_COVERAGE more than the best. A single start (an
     ``init``, every step of ``pcmapq track``) is refined without scoring: there is no choice
@@ -54,7 +57,7 @@ def refine_best(starts: Sequence[Similarity2D], rough: Refine, fine: Refine,
     firsts = sorted((scored(rough(s)) for s in starts), key=_rank)
     chosen = firsts[:finalists]
     for r in firsts[finalists:]:
-        if r.fitness >= CLOSE_FINALISTS * firsts[0].fitness and \
+        if support(r) >= CLOSE_FINALISTS * support(firsts[0]) and \
                 not any(_same_pose(r.transform, c.transform) for c in chosen):
             chosen.append(r)
     finals = sorted((scored(fine(r.transform)) for r in chosen), key=_rank)
@@ -75,6 +78,12 @@ def _same_pose(a: Similarity2D, b: Similarity2D) -> bool:
     return bool(np.hypot(a.tx - b.tx, a.ty - b.ty) < SAME_POSE_M and turn < SAME_POSE_DEG)
 
 
+def support(a: Scored) -> float:
+    """What a pose's score rests on, [0, 1]: its fitness, times one minus the contradiction of
+    the map's free space (:mod:`~pcmapq.align.free_space`) where the map has free space."""
+    return a.fitness * float(np.exp(-PENALTY * (a.contradiction or 0.0)))
+
+
 def _rank(a: Scored) -> tuple[float, float]:
-    """Sort key: higher fitness first, then lower RMSE."""
-    return -a.fitness, a.rmse_m
+    """Sort key: higher support first, then lower RMSE."""
+    return -support(a), a.rmse_m

@@ -24,6 +24,7 @@ from pcmapq.align.coarse import (
     similarity_search,
 )
 from pcmapq.align.finalists import refine_best
+from pcmapq.align.free_space import FreeSpace
 from pcmapq.align.params import AlignParams
 from pcmapq.align.point_to_line import LineTarget, refine_point_to_line
 from pcmapq.align.point_to_point import DEFAULT_SCHEDULE, IcpTarget, refine_point_to_point
@@ -53,6 +54,13 @@ class Alignment:
     "init+icp", "init" or "none". distinctiveness: how far the final pose's score in the global
     search stands above the best score elsewhere, [0, 1] (see
     :func:`~pcmapq.align.coarse.distinctiveness`); None when there was no global search.
+    contradiction: share of the map's free cells (those farther than
+    :data:`~pcmapq.align.free_space.CLEAR_M` from its walls) on the truth's known cells that
+    the pose puts on a truth wall or solid block, [0, 1]; None for a map without free space.
+    free_on_truth: share of those free cells that the pose puts on the truth's known cells,
+    [0, 1]; None for a map without free space.
+    poses: the global search's two best distinct poses with their scores (see
+    :class:`~pcmapq.align.coarse.Candidate`); empty when there was no search.
     """
 
     transform: Similarity2D
@@ -61,6 +69,9 @@ class Alignment:
     tolerance_m: float
     method: str
     distinctiveness: float | None = None
+    contradiction: float | None = None
+    free_on_truth: float | None = None
+    poses: tuple[tuple[Similarity2D, float], ...] = ()
 
 
 def _score_tree(map_xy: np.ndarray, tree: cKDTree, tf: Similarity2D,
@@ -110,7 +121,8 @@ class RigidTarget:
 
 def align(map_xy: np.ndarray, truth_xy: np.ndarray, params: AlignParams = AlignParams(), *,
           init: Similarity2D | None = None, refine: bool = True,
-          scale: bool = False, target: RigidTarget | None = None) -> Alignment:
+          scale: bool = False, target: RigidTarget | None = None,
+          free: FreeSpace | None = None) -> Alignment:
     """Align a map to the truth with no initial guess needed; never fails on a bad match (an
     empty map or truth gives fitness 0).
 
@@ -123,6 +135,8 @@ def align(map_xy: np.ndarray, truth_xy: np.ndarray, params: AlignParams = AlignP
     scale: also estimate the scale, for a map in an unknown unit (see :func:`align_similarity`).
     target: these truth points prepared by :class:`RigidTarget` (used without ``scale``, when
     it fits ``params``): the same result, without the truth's work.
+    free: the map's free space and the truth's solid cells (rigid alignment): the search and
+    the choice among its poses weigh each pose by it, and the result gives its contradiction.
     """
     map_xy = np.asarray(map_xy, dtype=np.float64).reshape(-1, 2)
     truth_xy = np.asarray(truth_xy, dtype=np.float64).reshape(-1, 2)
@@ -130,11 +144,12 @@ def align(map_xy: np.ndarray, truth_xy: np.ndarray, params: AlignParams = AlignP
         return align_similarity(map_xy, truth_xy, params, init=init, refine=refine)
     if target is None or not target.fits(params):
         target = RigidTarget(truth_xy, params)
-    return _align_rigid(map_xy, target, params, init, refine)
+    return _align_rigid(map_xy, target, params, init, refine, free)
 
 
 def _align_rigid(map_xy: np.ndarray, target: RigidTarget, params: AlignParams,
-                 init: Similarity2D | None, refine: bool) -> Alignment:
+                 init: Similarity2D | None, refine: bool,
+                 free: FreeSpace | None = None) -> Alignment:
     """:func:`align` with scale 1: the search of :func:`~pcmapq.align.coarse.coarse_search`,
     Open3D point-to-point ICP stages (:data:`~pcmapq.align.point_to_point.DEFAULT_SCHEDULE`,
     the first widened to twice the search's cell; see :func:`_icp_inputs` for a thinned map),
@@ -145,9 +160,13 @@ def _align_rigid(map_xy: np.ndarray, target: RigidTarget, params: AlignParams,
     start = Similarity2D() if init is None else init
     if len(map_ds) == 0 or len(truth_ds) == 0:
         return Alignment(start, 0.0, 0.0, tolerance, "none")
+    clear = None if free is None else free.clear(map_ds, voxel)
 
     def scored(tf: Similarity2D) -> Alignment:
-        return _scored(map_ds, tree, tf, tolerance)
+        fit = _scored(map_ds, tree, tf, tolerance)
+        return fit if free is None else replace(
+            fit, contradiction=free.contradiction(clear, tf),
+            free_on_truth=free.on_truth(clear, tf))
 
     if not refine:
         return replace(scored(start), method="none" if init is None else "init")
@@ -155,7 +174,8 @@ def _align_rigid(map_xy: np.ndarray, target: RigidTarget, params: AlignParams,
     search = None
     if init is None:
         resolution = auto_resolution(map_ds) if params.resolution is None else params.resolution
-        search = coarse_search(map_ds, truth_ds, resolution=resolution, top_k=params.top_k)
+        search = coarse_search(map_ds, truth_ds, resolution=resolution, top_k=params.top_k,
+                               free=free)
         if search.cell > params.finest:
             search = descend(search, map_ds, truth_ds, finest=params.finest, beam=params.beam,
                              top_k=params.top_k)
@@ -248,7 +268,8 @@ def _labelled(best: Alignment, search: Search | None, method: str) -> Alignment:
     """``best`` with its method ("init+icp" with no search) and its distinctiveness."""
     if search is None:
         return replace(best, method="init+icp")
-    return replace(best, method=method, distinctiveness=distinctiveness(search, best.transform))
+    return replace(best, method=method, distinctiveness=distinctiveness(search, best.transform),
+                   poses=tuple((c.transform, c.score) for c in search.candidates[:2]))
 
 
 def _scored(map_xy: np.ndarray, tree: cKDTree, tf: Similarity2D, tolerance: float) -> Alignment:

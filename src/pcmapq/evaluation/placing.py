@@ -12,6 +12,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from pcmapq.align import Alignment, align
+from pcmapq.align.free_space import FreeSpace
 from pcmapq.align.parts import place_parts
 from pcmapq.align.planar import RigidTarget
 from pcmapq.align.rigid3d import Registration3D, align_3d, apply
@@ -27,7 +28,7 @@ from pcmapq.features import Features
 from pcmapq.io import OccupancyMap, PointMap
 from pcmapq.io.extent import check_span, hint
 from pcmapq.metrics.distances import DistanceField, nearest_distance
-from pcmapq.raster.draw import OCCUPIED, UNKNOWN, points_to_grid, warp_state
+from pcmapq.raster.draw import FREE, OCCUPIED, UNKNOWN, points_to_grid, warp_state
 from pcmapq.raster.footprint import check_rule, footprint_rule, map_footprint
 from pcmapq.raster.seen import seen_on
 from pcmapq.results.result import OTHER, Overlap
@@ -77,7 +78,8 @@ def place(source: OccupancyMap | PointMap, prepared: PreparedTruth, settings: Se
     target = prepared.aligner
     if target is None or not target.fits(option.params):
         target = RigidTarget(prepared.xy, option.params)
-    alignment = align_plan(source, map_xy, prepared.xy, registration, settings, target)
+    alignment = align_plan(source, map_xy, prepared.xy, registration, settings, target,
+                           free_space(source, prepared))
 
     progress("rasterising")
     map_occ, footprint = map_raster(source, map_xy, alignment.transform, prepared.grid,
@@ -91,7 +93,8 @@ def place(source: OccupancyMap | PointMap, prepared: PreparedTruth, settings: Se
                                   target))
     cover = replace(cover, parts=parts,
                     verdict=verdict(cover.confidence, option.min_confidence, parts,
-                                    alignment.distinctiveness, cover.truth_recall))
+                                    alignment.distinctiveness, cover.truth_recall,
+                                    alignment.contradiction, alignment.free_on_truth))
     if cover.verdict == OTHER and not option.force:
         raise EvaluationError(refusal(source, truth.path, alignment, cover, settings, map_xy,
                                       prepared.xy))
@@ -190,16 +193,34 @@ def check_size(source: OccupancyMap | PointMap, map_xy: np.ndarray, truth_xy: np
                               f"large to be a map of its place: {why}")
 
 
+def free_space(source: OccupancyMap | PointMap, prepared: PreparedTruth) -> FreeSpace | None:
+    """The evidence of the map's free space against the truth's occupied and known cells
+    (:mod:`pcmapq.align.free_space`): an image's free cells; None for a map that has none
+    (an image with no free cell, a cloud). A truth image knows its free and occupied cells, a
+    truth cloud every cell of its grid."""
+    if not isinstance(source, OccupancyMap):
+        return None
+    free = source.state == FREE
+    if not free.any():
+        return None
+    truth = prepared.source
+    known = (truth.state != UNKNOWN if isinstance(truth, OccupancyMap)
+             else np.ones(prepared.grid.shape, bool))
+    return FreeSpace(source.grid.cell_centres(free), prepared.occupied, known | prepared.occupied,
+                     prepared.grid)
+
+
 def align_plan(source: OccupancyMap | PointMap, map_xy: np.ndarray, truth_xy: np.ndarray,
                registration: Registration3D | None, settings: Settings,
-               target: RigidTarget | None = None) -> Alignment:
+               target: RigidTarget | None = None, free: FreeSpace | None = None) -> Alignment:
     """The 2D alignment of the map's plan points to the truth's (both (N, 2) metres, in their
     own frames): the search and ICP of :func:`pcmapq.align.align` (``target``: the truth's
-    points prepared for it), or, after a 3D registration, the plan scored as it is."""
+    points prepared for it; ``free``: the map's free space, for a rigid alignment), or, after
+    a 3D registration, the plan scored as it is."""
     option = settings.alignment
     if registration is None:
         check_size(source, map_xy, truth_xy, settings)
         return align(map_xy, truth_xy, option.params, init=option.init, refine=option.enabled,
-                     scale=option.scale, target=target)
+                     scale=option.scale, target=target, free=free)
     return replace(align(map_xy, truth_xy, option.params, init=Similarity2D(), refine=False),
                    method="3d")

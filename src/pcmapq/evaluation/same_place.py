@@ -18,7 +18,7 @@ from pcmapq.evaluation.inputs import MAP_CROP, OUTLINE_M
 from pcmapq.io import OccupancyMap, PointMap
 from pcmapq.io.extent import far_points
 from pcmapq.metrics.distances import DistanceField
-from pcmapq.results.result import INCONSISTENT, OTHER, SAME, Overlap
+from pcmapq.results.result import INCONSISTENT, LOW, OTHER, SAME, Overlap
 from pcmapq.settings import Settings
 
 #: Confidence terms (see :func:`confidence`): the distinctiveness worth full confidence, the
@@ -39,19 +39,34 @@ MIN_AGREEING = 3
 #: own. Among the maps of other places in docs/validation.md (the corpus's 114 pairs and the
 #: Halmstad maps against the other layouts, 108) the most is 0.235.
 STANDS_OUT = 0.3
+#: A map with free space whose pose is not sure is still scored, with low confidence, when at
+#: that pose less than CONTRADICTS of its free cells on the truth lie on truth walls (a laser
+#: sees nothing through a wall; :mod:`pcmapq.align.free_space`), at least ON_TRUTH of them lie
+#: on the truth, and at least RECALL_FULL of the truth it covers lies near its walls. Maps of
+#: other places reach the first two (a cluttered room fits an open hall of another building)
+#: but not the third (docs/validation.md).
+CONTRADICTS, ON_TRUTH = 0.1, 0.9
 
 
 def verdict(confidence: float, min_confidence: float, parts: Sequence[Part],
-            distinct: float | None = None, recall: float = 0.0) -> str:
+            distinct: float | None = None, recall: float = 0.0,
+            contradiction: float | None = None, on_truth: float | None = None) -> str:
     """SAME when the confidence reaches ``min_confidence``; else INCONSISTENT when at least
     MIN_AGREEING of the map's ``parts`` agree with its pose, or when its pose's distinctiveness
-    ``distinct`` reaches STANDS_OUT with a truth ``recall`` above RECALL_NONE; else OTHER."""
+    ``distinct`` reaches STANDS_OUT with a truth ``recall`` above RECALL_NONE; else, for a map
+    with free space (``contradiction`` and ``on_truth`` not None), LOW when its free space lies
+    on the truth (ON_TRUTH) without contradicting it (below CONTRADICTS) and ``recall`` reaches
+    RECALL_FULL; else OTHER."""
     if confidence >= min_confidence:
         return SAME
     if sum(p.agrees for p in parts) >= MIN_AGREEING:
         return INCONSISTENT
-    stands_out = distinct is not None and distinct >= STANDS_OUT and recall > RECALL_NONE
-    return INCONSISTENT if stands_out else OTHER
+    if distinct is not None and distinct >= STANDS_OUT and recall > RECALL_NONE:
+        return INCONSISTENT
+    if (contradiction is not None and on_truth is not None and contradiction < CONTRADICTS
+            and on_truth >= ON_TRUTH and recall >= RECALL_FULL):
+        return LOW
+    return OTHER
 
 
 def confidence(distinct: float | None, recall: float, agreement: float = 0.0) -> float:
@@ -96,6 +111,8 @@ def refusal(source: OccupancyMap | PointMap, truth_path: Path, alignment: Alignm
     map_path = source.path
     distinct = alignment.distinctiveness
     why = (f"{cover.truth_recall:.0%} of the truth it covers lies near the map" +
+           ("" if alignment.contradiction is None else
+            f", {alignment.contradiction:.0%} of its free space lies on the truth's walls") +
            ("" if distinct is None else
             f", the best pose scores {distinct:.0%} above the best one elsewhere") +
            ("" if not cover.parts else
@@ -112,6 +129,12 @@ def refusal(source: OccupancyMap | PointMap, truth_path: Path, alignment: Alignm
     elif not option.scale and size > OVERSIZE:
         cause = (f"a scale that differs: the map spans {size:.1f} times the truth; try "
                  "--scale auto")
+    elif alignment.contradiction is not None and alignment.contradiction >= CONTRADICTS:
+        cause = ("a map of another place: where its walls fit, the robot saw through the "
+                 "truth's walls" + ("" if option.scale else " (or of another scale: --scale auto)"))
+    elif cover.truth_recall >= RECALL_FULL:
+        cause = ("a map too cluttered or distorted for its pose to stand out (the truth's walls "
+                 "lie near it); --init with a rough pose places it")
     elif not option.scale:
         cause = "a map of another place, or of another scale (--scale auto)"
     else:

@@ -46,6 +46,9 @@ NO_RESOLUTION = "no resolution"
 #: (:func:`open_outside`): a plan's usual wall, whose centre line then lies where a plan drawn
 #: with walls would put it, about half this beyond the face a laser sees.
 FACE_M = 0.15
+#: The grey values map_saver writes in trinary mode: occupied, unknown, free.
+SAVER_VALUES = (0, 205, 254)
+SAVER_UNKNOWN = 205
 #: Parts of such a region thinner than this, metres, are walls or furniture joined to it, and
 #: kept (the building's own thickest wall, :data:`pcmapq.features.walls.THICKEST`).
 OUTSIDE_M = 2.0
@@ -96,6 +99,8 @@ def load_occupancy(path: Path, resolution: float | None = None,
         raise InputError(f"{path}: {NO_RESOLUTION}: give --map-resolution/--truth-resolution "
                          "or a YAML beside it")
     state = classify(levels, channels, scale, transparent, meta)
+    if thresholds is None or thresholds.free is None:
+        state = saver_unknown(state, levels, channels, scale, meta, path)
     empty = "" if (state == OCCUPIED).any() else _darkest(levels, channels, scale, transparent,
                                                           meta)
     state = open_outside(state, meta.resolution)
@@ -118,6 +123,30 @@ def _darkest(levels: np.ndarray, channels: int, scale: float, transparent: np.nd
     return (f"its darkest pixels read p = {top:.2f}, not above occupied_thresh "
             f"{meta.occupied_thresh:g}; walls drawn grey need a lower --map-occupied-thresh "
             "or --truth-occupied-thresh (occupied_thresh in its YAML)")
+
+
+def saver_unknown(state: np.ndarray, levels: np.ndarray, channels: int, scale: float,
+                  meta: MapMeta, path: Path) -> np.ndarray:
+    """``state`` with map_saver's unknown pixels (grey SAVER_UNKNOWN) read as unknown, with a
+    warning, where a trinary YAML's ``free_thresh`` reads them as free and the image holds no
+    grey value but map_saver's three (SAVER_VALUES): Nav2's map_saver wrote free_thresh 0.25
+    beside such images (fixed in navigation2 #5278), and map_server reads every cell the robot
+    never saw as free then. The state itself otherwise."""
+    if meta.mode != "trinary" or meta.negate:
+        return state
+    if occupancy_of(np.array([float(SAVER_UNKNOWN)]), meta)[0] >= meta.free_thresh:
+        return state
+    counts = np.bincount(levels.ravel())
+    grey = np.nonzero(counts)[0] / channels * scale
+    if not (np.isin(grey, SAVER_VALUES).all() and SAVER_UNKNOWN in grey):
+        return state
+    _warn(f"{path}: free_thresh {meta.free_thresh:g} reads map_saver's unknown grey "
+          f"{SAVER_UNKNOWN} as free; the image holds only map_saver's values "
+          f"{', '.join(map(str, SAVER_VALUES))}, so its {SAVER_UNKNOWN} cells are read as "
+          "unknown (Nav2's map_saver wrote such YAMLs before navigation2 #5278; "
+          "--map-free-thresh or --truth-free-thresh reads them as map_server does)")
+    unknown = levels == round(SAVER_UNKNOWN * channels / scale)
+    return np.where(unknown & (state == FREE), np.int8(UNKNOWN), state).astype(np.int8)
 
 
 def open_outside(state: np.ndarray, resolution: float) -> np.ndarray:

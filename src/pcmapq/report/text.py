@@ -6,7 +6,7 @@ from __future__ import annotations
 import re
 from collections.abc import Sequence
 
-from pcmapq.results.result import INCONSISTENT, OTHER, Result
+from pcmapq.results.result import INCONSISTENT, LOW, OTHER, Result
 
 #: What the terms of the table mean, in one short paragraph (their definitions:
 #: docs/metrics.md).
@@ -64,6 +64,12 @@ def alignment_words(result: Result) -> str:
                    f"{result.alignment.distinctiveness:.2f}; {why}")
         return (f"{placed}: a map of the truth's place that no single pose fits (confidence "
                 f"{confidence:.2f}; {why}){breaks(result)}")
+    if cover.verdict == LOW:
+        poses = "; ".join(f"({tf.tx:.2f} m, {tf.ty:.2f} m, {tf.yaw_deg:.1f} deg) scoring "
+                          f"{score:.2f}" for tf, score in result.alignment.poses)
+        return (f"{placed} with low confidence ({confidence:.2f}): its free space does not "
+                f"contradict the truth there, but no pose stands out; the search's two best "
+                f"poses: {poses}{breaks(result)}")
     if cover.verdict == OTHER:
         return (f"{placed}, but it may show another place (confidence {confidence:.2f} < 0.5, "
                 "scored because of --force)")

@@ -30,6 +30,9 @@ DECIMALS = 6
 #: :mod:`pcmapq.evaluation.same_place`): one pose fits it; it is of the truth's place but no
 #: single pose fits it whole (scored); it shows another place (refused unless ``--force``).
 SAME, INCONSISTENT, OTHER = "same place", "same place, inconsistent map", "another place"
+#: A map with free space placed below the minimum confidence where that free space does not
+#: contradict the truth: scored, and flagged with the search's two best poses.
+LOW = "same place, low confidence"
 
 
 @dataclass(frozen=True)
@@ -72,7 +75,8 @@ class Overlap:
     confidence: that one pose places the map on the truth's place, [0, 1] (see
         same_place.confidence).
     verdict: SAME (confidence at least the minimum), INCONSISTENT (below it, but its parts
-        placed on their own agree with its pose) or OTHER.
+        placed on their own agree with its pose), LOW (below it, a map whose free space does
+        not contradict the truth at its pose) or OTHER.
     parts: the map's parts placed on their own (:mod:`pcmapq.align.parts`); empty when the
         confidence alone settled the verdict.
     """
@@ -169,6 +173,10 @@ class Result:
                           "truth_recall": self.overlap.truth_recall,
                           "agreement": self.overlap.agreement,
                           "distinctiveness": self.alignment.distinctiveness,
+                          "contradiction": self.alignment.contradiction,
+                          "free_on_truth": self.alignment.free_on_truth,
+                          "poses": [{**tf.to_dict(), "score": score}
+                                    for tf, score in self.alignment.poses],
                           "confidence": self.overlap.confidence,
                           "verdict": self.overlap.verdict,
                           "parts": [{**asdict(p), "centre_m": list(p.centre_m),
