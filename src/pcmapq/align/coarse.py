@@ -186,14 +186,15 @@ def coarse_search(map_xy: np.ndarray, truth_xy: np.ndarray, *,
     # Field pixel of the template's centre cell when the response peaks at (0, 0).
     offset = fgrid.pixels_to_xy(np.array([[half, half]]))[0]
     yaws = np.radians(np.arange(0.0, 360.0, angle_step_deg))
+    contradicted = (free_space.contradictions(solid, known, _templates(clear / resolution,
+                                                                        yaws, half))
+                    if solid is not None and len(clear) else None)
     rows = []
     for yaw in yaws:
-        turn = _rotation(yaw).T
-        template = (hit_counts(centred @ turn, tgrid) > 0).astype(np.float32)
+        template = (hit_counts(centred @ _rotation(yaw).T, tgrid) > 0).astype(np.float32)
         response = cv2.matchTemplate(field, template, cv2.TM_CCORR) / template.sum()
-        if solid is not None and len(clear):
-            response *= np.exp(-free_space.PENALTY *
-                               _contradicted(solid, known, clear @ turn, tgrid))
+        if contradicted is not None:
+            response *= np.exp(-free_space.PENALTY * next(contradicted))
         v, u = _peaks(response, per_angle, radius=2)
         xy = offset + np.column_stack([u, -v]) * resolution
         rows.append(np.column_stack([response[v, u], np.full(len(v), yaw), xy]))
@@ -211,17 +212,6 @@ def _clear(free: FreeSpace | None, map_xy: np.ndarray, cell: float) -> np.ndarra
     if free is None:
         return np.zeros((0, 2))
     return free.clear(map_xy, 0.5 * cell, max(CLEAR_M, 1.5 * cell))
-
-
-def _contradicted(solid: np.ndarray, known: np.ndarray, free_xy: np.ndarray,
-                  tgrid: MetricGrid) -> np.ndarray:
-    """For every template position, the share of the free points ``free_xy`` (about the
-    template's centre, metres) on ``known`` truth cells that lie on ``solid`` ones: a
-    (rows, cols) float32 response in [0, 1] laid out as cv2.matchTemplate's."""
-    template = (hit_counts(free_xy, tgrid) > 0).astype(np.float32)
-    on_solid = cv2.matchTemplate(solid, template, cv2.TM_CCORR)
-    on_known = cv2.matchTemplate(known, template, cv2.TM_CCORR)
-    return np.clip(on_solid / np.maximum(on_known, 1.0), 0.0, 1.0)
 
 
 def _pose(yaw: float, centre_truth: np.ndarray, centre_map: np.ndarray,

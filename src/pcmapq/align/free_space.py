@@ -17,9 +17,11 @@ depends on how each side draws it and on the pose's last few centimetres.
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.fft
 from scipy.spatial import cKDTree
 
 from pcmapq.core.grid import MetricGrid
@@ -31,6 +33,8 @@ from pcmapq.core.voxels import evenly, voxel_centroids
 CLEAR_M = 0.25
 #: A pose's score is multiplied by exp(-PENALTY x its contradiction).
 PENALTY = 20.0
+#: Memory for the templates' spectra held at once, bytes.
+FFT_BYTES = 64e6
 #: Free points a final pose is checked with: a share is sure to about 1 % with this many.
 CHECK_POINTS = 20_000
 
@@ -88,6 +92,28 @@ class FreeSpace:
             return 0.0
         return float(on_solid(self.known, self.grid,
                               tf.apply(evenly(clear_xy, CHECK_POINTS))).mean())
+
+
+def contradictions(solid: np.ndarray, known: np.ndarray,
+                   templates: np.ndarray) -> Iterator[np.ndarray]:
+    """For each binary template (yaws, size, size) of a map's free cells, the contradiction
+    at every place of it on the truth's rasters ``solid`` and ``known`` (rows, cols; 1 on a
+    solid or known cell): the share of its cells on known cells that lie on solid ones, a
+    (rows - size + 1, cols - size + 1) array laid out as cv2.matchTemplate's responses (0
+    where none is known). The rasters' spectra are taken once and the templates' a batch at a
+    time (scipy.fft in single precision: the counts, whole numbers below 2^20, come back
+    exact once rounded)."""
+    rows, cols = solid.shape
+    size = templates.shape[-1]
+    # no wrap: a valid place reads up to rows - 1, cols - 1
+    shape = (scipy.fft.next_fast_len(rows, True), scipy.fft.next_fast_len(cols, True))
+    spectra = scipy.fft.rfft2(np.stack([solid, known]).astype(np.float32), s=shape)
+    batch = max(1, int(FFT_BYTES // (8 * shape[0] * (shape[1] // 2 + 1))))
+    for start in range(0, len(templates), batch):
+        chunk = scipy.fft.rfft2(templates[start:start + batch], s=shape)
+        counts = scipy.fft.irfft2(spectra[:, None] * np.conj(chunk)[None], s=shape)
+        counts = np.rint(counts[:, :, :rows - size + 1, :cols - size + 1])
+        yield from (counts[0] / np.maximum(counts[1], 1.0)).astype(np.float32)
 
 
 def on_solid(solid: np.ndarray, grid: MetricGrid, xy: np.ndarray) -> np.ndarray:

@@ -80,7 +80,7 @@ def run_row(task: Task) -> Outcome:
         with ONE_AT_A_TIME, glibc_thresholds():
             return _run(task)
     except (InputError, EvaluationError) as exc:
-        return failed(task, exc.exit_code, one_line(exc))
+        return failed(task, exc.exit_code, one_line(exc), getattr(exc, "verdict", None))
     except Exception as exc:  # noqa: BLE001 - any error is the row's, never the batch's
         return failed(task, 1, f"{type(exc).__name__}: {one_line(exc)}")
 
@@ -157,9 +157,10 @@ def _compute(task: Task, key: dict) -> Outcome:
                    _pcmapq_warnings(caught))
 
 
-def failed(task: Task, exit_code: int, error: str) -> Outcome:
-    """A failed row: its record says so, and no output of an earlier run stays under its
-    name (it would not be this row's result)."""
+def failed(task: Task, exit_code: int, error: str, verdict: str | None = None) -> Outcome:
+    """A failed row (``verdict``: "another place" for a map refused as such): its record says
+    so, and no output of an earlier run stays under its name (it would not be this row's
+    result)."""
     row = task.row
     for path in Task(row, task.out_dir, True, True).outputs().values():
         with contextlib.suppress(OSError):
@@ -172,7 +173,7 @@ def failed(task: Task, exit_code: int, error: str) -> Outcome:
     except (InputError, OSError):
         pass  # the table still records the failure
     return Outcome(row.name, "failed", exit_code, error,
-                   failed_row(row.name, str(row.map), str(row.truth), exit_code, error))
+                   failed_row(row.name, str(row.map), str(row.truth), exit_code, error, verdict))
 
 
 def _write_record(task: Task, record: dict, staged: OutputSet) -> None:

@@ -1,4 +1,5 @@
-"""The two ways a run can fail, each with its exit code."""
+"""The two ways a run can fail, each with its exit code, and the refusal of a map of another
+place (an evaluation error whose verdict a table keeps)."""
 
 
 class InputError(Exception):
@@ -14,3 +15,10 @@ class EvaluationError(Exception):
     """The inputs were read but could not be evaluated (e.g. alignment failed). Exit code 1."""
 
     exit_code = 1
+
+
+class Refused(EvaluationError):
+    """A map that does not seem to show the truth's place, refused (exit code 1): its
+    ``verdict`` ("another place") goes into a batch's row beside the one-line reason."""
+
+    verdict = "another place"

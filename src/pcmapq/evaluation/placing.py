@@ -17,7 +17,7 @@ from pcmapq.align.parts import place_parts
 from pcmapq.align.planar import RigidTarget
 from pcmapq.align.rigid3d import Registration3D, align_3d, apply
 from pcmapq.core.bounds import bounds, radius
-from pcmapq.core.errors import EvaluationError, InputError
+from pcmapq.core.errors import EvaluationError, InputError, Refused
 from pcmapq.core.frames import Levelling
 from pcmapq.core.grid import MetricGrid
 from pcmapq.core.transform import Similarity2D
@@ -26,6 +26,7 @@ from pcmapq.evaluation.same_place import OVERSIZE, overlap, refusal, verdict
 from pcmapq.evaluation.truth import PreparedTruth
 from pcmapq.features import Features
 from pcmapq.io import OccupancyMap, PointMap
+from pcmapq.io.clouds import SEEN_CELL
 from pcmapq.io.extent import check_span, hint
 from pcmapq.metrics.distances import DistanceField, nearest_distance
 from pcmapq.raster.draw import FREE, OCCUPIED, UNKNOWN, points_to_grid, warp_state
@@ -96,8 +97,8 @@ def place(source: OccupancyMap | PointMap, prepared: PreparedTruth, settings: Se
                                     alignment.distinctiveness, cover.truth_recall,
                                     alignment.contradiction, alignment.free_on_truth))
     if cover.verdict == OTHER and not option.force:
-        raise EvaluationError(refusal(source, truth.path, alignment, cover, settings, map_xy,
-                                      prepared.xy))
+        raise Refused(refusal(source, truth.path, alignment, cover, settings, map_xy,
+                              prepared.xy))
     return Placed(given, source, registration, map_xy, map_level, alignment, map_occ, to_map,
                   cover, rule, target)
 
@@ -195,19 +196,22 @@ def check_size(source: OccupancyMap | PointMap, map_xy: np.ndarray, truth_xy: np
 
 def free_space(source: OccupancyMap | PointMap, prepared: PreparedTruth) -> FreeSpace | None:
     """The evidence of the map's free space against the truth's occupied and known cells
-    (:mod:`pcmapq.align.free_space`): an image's free cells; None for a map that has none
-    (an image with no free cell, a cloud). A truth image knows its free and occupied cells, a
-    truth cloud every cell of its grid."""
-    if not isinstance(source, OccupancyMap):
+    (:mod:`pcmapq.align.free_space`): an image's free cells, or the area a cloud's scans saw
+    (a map that ``pcmapq track`` builds); None for a map that has neither. A truth image
+    knows its free and occupied cells, a truth cloud every cell of its grid."""
+    if isinstance(source, OccupancyMap):
+        free_xy = source.grid.cell_centres(source.state == FREE)
+    elif source.seen is not None:
+        rows, cols = np.nonzero(source.seen.cells)
+        free_xy = (np.column_stack([cols, rows]) + np.add(source.seen.corner, 0.5)) * SEEN_CELL
+    else:
         return None
-    free = source.state == FREE
-    if not free.any():
+    if len(free_xy) == 0:
         return None
     truth = prepared.source
     known = (truth.state != UNKNOWN if isinstance(truth, OccupancyMap)
              else np.ones(prepared.grid.shape, bool))
-    return FreeSpace(source.grid.cell_centres(free), prepared.occupied, known | prepared.occupied,
-                     prepared.grid)
+    return FreeSpace(free_xy, prepared.occupied, known | prepared.occupied, prepared.grid)
 
 
 def align_plan(source: OccupancyMap | PointMap, map_xy: np.ndarray, truth_xy: np.ndarray,

@@ -10,7 +10,7 @@ from pathlib import Path
 
 from pcmapq.core.errors import InputError
 from pcmapq.io.writers import OutputSet, one_line, write_atomic
-from pcmapq.results.figures import HEADERS, SCORES, TAIL, columns
+from pcmapq.results.figures import HEADERS, SCORES, TAIL, columns, ranked
 from pcmapq.results.result import DECIMALS
 from pcmapq.settings import DEFAULT_DETECTORS, DETECTOR_NAMES
 
@@ -21,11 +21,13 @@ COLOURS = {"harris": "#4477aa", "hough": "#ee6677", "sift": "#228833"}
 
 
 def table_csv(rows: Sequence[dict[str, object]]) -> str:
-    """The rows as CSV, one per map in the order given, :func:`columns` order: floats with
+    """The rows as CSV, one per map in the order given with its rank
+    (:func:`~pcmapq.results.figures.ranked`), :func:`columns` order: floats with
     :data:`~pcmapq.results.result.DECIMALS` decimals, an empty cell for None."""
     import csv
     import io
 
+    rows = ranked(list(rows))
     cols = columns(rows)
     out = io.StringIO()
     writer = csv.writer(out, lineterminator="\n")
@@ -37,7 +39,9 @@ def table_csv(rows: Sequence[dict[str, object]]) -> str:
 def table_md(rows: Sequence[dict[str, object]]) -> str:
     """The rows as a markdown table (units in the headers): scores 'n/a' when undefined,
     other figures '-' when there is none, blank in a failed row, whose status says its exit
-    code and error."""
+    code and error; each row's rank (:func:`~pcmapq.results.figures.ranked`) beside its
+    name."""
+    rows = ranked(list(rows))
     cols = [c for c in columns(rows) if c not in TAIL]
     headers = [_header(c) for c in cols] + ["status"]
     lines = ["| " + " | ".join(headers) + " |",
@@ -76,13 +80,15 @@ def print_summary(rows: Sequence[dict[str, object]], console) -> None:
                   title="feature quality per detector; accuracy, completeness: mean wall "
                   "distances", title_justify="left")
     table.add_column("name", no_wrap=True)
+    table.add_column("rank", justify="right", no_wrap=True)
+    rows = ranked(list(rows))
     columns = terminal_columns(rows)
     for header in columns.values():
         table.add_column(header, justify="right", no_wrap=True)
     table.add_column("status", no_wrap=True)
     for row in rows:
         failed = bool(row.get("exit_code"))
-        table.add_row(Text(str(row.get("name"))),
+        table.add_row(Text(str(row.get("name"))), str(row["rank"]),
                       *(_md_cell(c, row.get(c), failed) for c in columns),
                       f"exit {row['exit_code']}" if failed else "ok")
     console.print(table, highlight=False)
@@ -180,6 +186,8 @@ def _header(column: str) -> str:
 def _md_cell(column: str, value: object, failed: bool) -> str:
     """A markdown cell: a score 'n/a' when undefined, another figure '-' when there is none,
     blank in a failed row."""
+    if column == "rank":
+        return str(value)
     if value is None:
         if failed:
             return ""

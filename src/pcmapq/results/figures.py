@@ -16,7 +16,8 @@ from pcmapq.settings import DETECTOR_NAMES
 SCORES = ("quality", "precision", "f1")
 #: The figures of ``alignment`` a gate reaches by their own JSON name.
 ALIGNMENT_FIELDS = ("confidence", "fitness", "rmse_m", "truth_recall", "agreement",
-                    "distinctiveness", "x_m", "y_m", "yaw_deg", "scale")
+                    "distinctiveness", "contradiction", "free_on_truth", "x_m", "y_m",
+                    "yaw_deg", "scale")
 
 
 @dataclass(frozen=True)
@@ -75,13 +76,14 @@ REQUIRED = ("map", "truth", "detectors", "alignment", "distances")
 #: An F-score's name and column, one per tau of the result (``f_score@0.05``,
 #: ``f_score@0.05m``); ``f_score_3d@TAU`` for two 3D clouds.
 F_SCORE, F_SCORE_COLUMN = "f_score{dim}@{tau:g}", "f_score@{tau:g}m"
-#: Columns before the F-scores: the name and inputs, then every figure that has a column.
-HEAD = ("name", "map", "truth", *(f.column for f in FIGURES if f.column))
+#: Columns before the F-scores: the name, its rank among the table's rows (:func:`ranked`)
+#: and inputs, then every figure that has a column.
+HEAD = ("name", "rank", "map", "truth", *(f.column for f in FIGURES if f.column))
 #: Columns after the F-scores: the gates' verdict ("" without gates, "pass", or "fail: " and
 #: the failing keys) and how the evaluation ended (0 and "" when it finished).
 TAIL = ("gates", "exit_code", "error")
 #: Markdown headers of the columns (units in brackets); an F-score's is ``F@0.05 m``.
-HEADERS = {"name": "name", "map": "map", "truth": "truth",
+HEADERS = {"name": "name", "rank": "rank", "map": "map", "truth": "truth",
            **{f.column: f.header for f in FIGURES if f.column},
            "gates": "gates", "exit_code": "exit code", "error": "error"}
 
@@ -120,12 +122,30 @@ def table_row(name: str, doc: dict) -> dict[str, object]:
 
 
 def failed_row(name: str, map_path: str, truth_path: str, exit_code: int,
-               error: str) -> dict[str, object]:
+               error: str, verdict: str | None = None) -> dict[str, object]:
     """The row of an evaluation that failed: its inputs, exit code and one-line error, every
-    figure None."""
+    figure None but the ``verdict`` of a map refused as another place."""
     row: dict[str, object] = dict.fromkeys(HEAD)
     return {**row, "name": name, "map": str(map_path), "truth": str(truth_path),
-            "gates": "", "exit_code": int(exit_code), "error": " ".join(str(error).split())}
+            "verdict": verdict, "gates": "", "exit_code": int(exit_code),
+            "error": " ".join(str(error).split())}
+
+
+def ranked(rows: list[dict[str, object]]) -> list[dict[str, object]]:
+    """The rows, in their order, each with its ``rank`` (1 the best): maps scored as showing
+    the truth's place first, by the mean f1 of their detectors (those defined), highest first;
+    then scored maps with no f1; then maps of another place (refused, or scored with
+    ``--force``); then rows that failed otherwise. Ties keep the rows' order."""
+    def key(i: int) -> tuple[int, float, int]:
+        row = rows[i]
+        f1 = [v for k, v in row.items() if k.endswith("_f1") and isinstance(v, float)]
+        group = (3 if row.get("exit_code") and row.get("verdict") is None else
+                 2 if row.get("verdict") == "another place" else 0 if f1 else 1)
+        return group, -(sum(f1) / len(f1)) if f1 else 0.0, i
+
+    order = sorted(range(len(rows)), key=key)
+    rank = {i: r for r, i in enumerate(order, 1)}
+    return [{**row, "rank": rank[i]} for i, row in enumerate(rows)]
 
 
 def gates_verdict(gates: list[dict] | None) -> str:

@@ -35,3 +35,17 @@ def test_distinctiveness_of_known_scores():
     scaled = Search([], np.column_stack([poses, np.log([1.0, 1.0, 1.0, 1.0])]), np.zeros(2), 10)
     assert distinctiveness(scaled, tf) == pytest.approx(0.25)
     assert distinctiveness(scaled, Similarity2D(5.0, 5.0, 0.0, 1.5)) == 0.0  # other scale
+
+
+def test_low_confidence_needs_free_space_that_agrees():
+    """Below the minimum confidence, a map with free space is scored with low confidence only
+    when its free space lies on the truth (0.9) without contradicting it (under 0.1) and 0.8
+    of the truth it covers lies near it; a binary map (no free space) is refused as before."""
+    from pcmapq.evaluation.same_place import verdict
+    from pcmapq.results.result import LOW, OTHER
+
+    assert verdict(0.0, 0.5, (), 0.0, 0.86, 0.016, 0.998) == LOW
+    assert verdict(0.0, 0.5, (), 0.0, 0.73, 0.021, 0.96) == OTHER  # recall of another place
+    assert verdict(0.0, 0.5, (), 0.0, 0.86, 0.10, 0.998) == OTHER  # it sees through walls
+    assert verdict(0.0, 0.5, (), 0.0, 0.86, 0.016, 0.37) == OTHER  # off the truth
+    assert verdict(0.0, 0.5, (), 0.0, 0.86) == OTHER  # no free space

@@ -399,3 +399,21 @@ def test_stderr_captures_in_threads_at_once_restore_descriptor_2():
     after = os.fstat(2)
     assert (after.st_dev, after.st_ino) == (before.st_dev, before.st_ino)
     assert got == {k: [f"library says {k}"] for k in range(8)}
+
+
+def test_map_saver_unknown_read_as_unknown(tmp_path: Path) -> None:
+    """An image of map_saver's three values beside a trinary YAML with free_thresh 0.25 (as
+    Nav2's map_saver wrote them): 205 reads as unknown, with a warning naming the file; given
+    thresholds read it as map_server does (free), and so does an image with other greys."""
+    from pcmapq.io.map_yaml import Thresholds
+
+    write_png(tmp_path / "map.png", [[0, 205, 254, 254]])
+    path = write_yaml(tmp_path / "map.yaml", mode="trinary", free_thresh=0.25)
+    with pytest.warns(UserWarning, match=r"map\.yaml: free_thresh 0\.25 reads map_saver"):
+        m = load_map(path)
+    np.testing.assert_array_equal(m.state, [[OCCUPIED, UNKNOWN, FREE, FREE]])
+    given = load_map(path, thresholds=Thresholds(free=0.25))
+    np.testing.assert_array_equal(given.state, [[OCCUPIED, FREE, FREE, FREE]])
+    write_png(tmp_path / "grey.png", [[0, 205, 254, 128]])
+    grey = load_map(write_yaml(tmp_path / "grey.yaml", image="grey.png", free_thresh=0.25))
+    np.testing.assert_array_equal(grey.state, [[OCCUPIED, FREE, FREE, UNKNOWN]])

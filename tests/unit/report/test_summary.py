@@ -30,3 +30,24 @@ def test_gates_verdict_in_a_word():
                           {"key": "coverage", "passed": True},
                           {"key": "accuracy.mean", "passed": False}]) == \
         "fail: harris.quality, accuracy.mean"
+
+
+def test_rank_puts_refused_and_failed_maps_last():
+    """Scored maps by their mean f1, then a scored map without f1, then a map of another
+    place (refused, or forced: by f1 too), then a map that failed otherwise; the rows keep
+    their order."""
+    from pcmapq.report.summary import table_md
+    from pcmapq.results.figures import ranked
+
+    def scored(name, f1, verdict="same place"):
+        return {**failed_row(name, name, "t", 0, ""), "verdict": verdict, "exit_code": 0,
+                "error": "", "harris_f1": f1, "sift_f1": None if f1 is None else f1 / 2}
+
+    rows = [failed_row("broken", "broken", "t", 2, "broken: cannot be read"),
+            failed_row("other", "other", "t", 1, "other: does not seem...", "another place"),
+            scored("forced", 0.9, "another place"), scored("good", 0.8), scored("none", None),
+            scored("better", 0.9, "same place, low confidence")]
+    assert [r["rank"] for r in ranked(rows)] == [6, 5, 4, 2, 3, 1]
+    md = table_md(rows).splitlines()
+    assert md[0].startswith("| name | rank |") and md[2].startswith("| broken | 6 |")
+    assert "another place" in md[3]
