@@ -50,7 +50,12 @@ def summary(doc: dict) -> dict:
     return _pick(doc, FIELDS)
 
 
-def differences(got: Any, want: Any, where: str = "", tol: float = 1e-6) -> list[str]:
+#: Numbers differ when more than this apart: saved numbers are rounded to 6 decimals, and a
+#: library's last-bit change in a figure can move one of them by a unit of the 6th decimal.
+TOLERANCE = 1.5e-6
+
+
+def differences(got: Any, want: Any, where: str = "", tol: float = TOLERANCE) -> list[str]:
     """Where two JSON values differ: keys of the reference that are gone, lengths, strings, or
     numbers by more than ``tol``. Keys the reference does not have are new fields, not changes."""
     if isinstance(want, dict) and isinstance(got, dict):
