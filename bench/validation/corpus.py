@@ -24,9 +24,16 @@ import numpy as np
 from pcmapq.align.parts import PIECES
 from pcmapq.core.transform import Similarity2D
 from pcmapq.evaluation.pipeline import evaluate
-from pcmapq.evaluation.same_place import MIN_AGREEING, RECALL_NONE, STANDS_OUT
+from pcmapq.evaluation.same_place import (
+    CONTRADICTS,
+    MIN_AGREEING,
+    ON_TRUTH,
+    RECALL_FULL,
+    RECALL_NONE,
+    STANDS_OUT,
+)
 from pcmapq.report.text import number
-from pcmapq.results.result import INCONSISTENT, OTHER, SAME
+from pcmapq.results.result import INCONSISTENT, LOW, OTHER, SAME
 from pcmapq.testing.corpus import (
     CURRENT,
     DRIFT_LOGS,
@@ -335,7 +342,9 @@ def markdown(records: list[Record], names: tuple[str, ...] = ("confidence",),
         f"\"{INCONSISTENT}\" when at least {MIN_AGREEING} of the map's {parts} parts, each "
         "placed on its own by the global search, land near the map's pose, or when its "
         f"pose's distinctiveness is at least {STANDS_OUT} with a truth recall above "
-        f"{RECALL_NONE}; else "
+        f"{RECALL_NONE}; \"{LOW}\" for a map with free space whose free cells lie on the "
+        f"truth (at least {ON_TRUTH}) without lying on its walls (under {CONTRADICTS}) with "
+        f"a truth recall of at least {RECALL_FULL}; else "
         f"\"{OTHER}\", refused unless forced. A pair is *scored* when its verdict is not "
         f"\"{OTHER}\". The whole corpus ran in {seconds:.0f} s.", "",
         "### What the corpus holds", "",
@@ -396,7 +405,8 @@ def markdown(records: list[Record], names: tuple[str, ...] = ("confidence",),
     lines += [f"The verdict as the accept rule scores {100 * _share(same):.0f} % of the "
               f"same-place pairs ({sum(scored(r) for r in same)} of {len(same)}, "
               f"{sum(r.alignment.get('verdict') == INCONSISTENT for r in same)} of them as "
-              f"\"{INCONSISTENT}\") and {100 * _share(other):.0f} % of the other-place pairs "
+              f"\"{INCONSISTENT}\", {sum(r.alignment.get('verdict') == LOW for r in same)} as "
+              f"\"{LOW}\") and {100 * _share(other):.0f} % of the other-place pairs "
               f"({sum(scored(r) for r in other)} of {len(other)}); the confidence alone at "
               f"{CURRENT} accepts {sum(accepted(r, CURRENT) for r in same)} and "
               f"{sum(accepted(r, CURRENT) for r in other)}."]

@@ -47,11 +47,11 @@ def refine_best(starts: Sequence[Similarity2D], rough: Refine, fine: Refine,
                 covered: Callable[[Similarity2D], float] | None = None) -> Similarity2D:
     """Every start refined by ``rough``; the ``finalists`` best of those (highest support, then
     lowest RMSE, by ``scored``; see :func:`support`), and any other pose within
-    CLOSE_FINALISTS of the best support, refined by ``fine``; the best of these. Given ``covered`` (the share of the
-    truth a pose covers), the one covering most among those within TIE_FITNESS of the best
-    fitness wins instead when it covers TIE_COVERAGE more than the best. A single start (an
-    ``init``, every step of ``pcmapq track``) is refined without scoring: there is no choice
-    to make."""
+    CLOSE_FINALISTS of the best support, refined by ``fine``; the best of these. Given
+    ``covered`` (the share of the truth a pose covers), the one covering most among those
+    within TIE_FITNESS of the best fitness wins instead when it covers TIE_COVERAGE more than
+    the best. A single start (an ``init``, every step of ``pcmapq track``) is refined without
+    scoring: there is no choice to make."""
     if len(starts) == 1:
         return fine(rough(starts[0]))
     firsts = sorted((scored(rough(s)) for s in starts), key=_rank)

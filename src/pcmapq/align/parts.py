@@ -4,7 +4,11 @@ on its own by the same global search and ICP, lands near where the map's pose pu
 of another place has parts that land anywhere: each fits some walls somewhere.
 
 The map is cut into eight parts of equal point count: four along its points' first principal
-axis, each cut in two across (the quarters of a long corridor map are its stretches). Each part
+axis, each cut in two across (the quarters of a long corridor map are its stretches). A map of
+more points than the alignment keeps (``AlignParams.max_points``) is cut from the points the
+alignment keeps of it (:func:`pcmapq.core.voxels.thinned`: voxel centroids, the voxel grown
+until about that many remain), so its parts are of equal wall length rather than equal raw
+point count, and placing them costs what it costs for a map of that size. Each part
 is aligned to the truth with no initial guess (:func:`pcmapq.align.align`); it agrees with the
 map's pose when its centroid lands within :data:`AGREE_M` (or :data:`AGREE_RADIUS` of the
 map's radius, the larger) of where the map's pose puts it, turned by at most
@@ -22,6 +26,7 @@ from pcmapq.align.params import AlignParams
 from pcmapq.align.planar import RigidTarget, align
 from pcmapq.core.bounds import radius
 from pcmapq.core.transform import Similarity2D, wrapped
+from pcmapq.core.voxels import thinned
 
 #: Agreement: a part's centroid within this many metres of where the map's pose puts it ...
 AGREE_M = 3.0
@@ -81,6 +86,8 @@ def place_parts(map_xy: np.ndarray, truth_xy: np.ndarray, pose: Similarity2D,
     metres, truth frame; ``target``: those points prepared for the rigid alignment) with no
     initial guess, against the map's ``pose``."""
     scaled = np.asarray(map_xy, dtype=np.float64).reshape(-1, 2) * pose.scale
+    if len(scaled) > params.max_points:
+        scaled, _ = thinned(scaled, params.voxel, params.max_points)
     rigid = Similarity2D(pose.tx, pose.ty, pose.yaw)
     if target is None or not target.fits(params):
         target = RigidTarget(truth_xy, params)

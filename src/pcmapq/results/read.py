@@ -74,7 +74,8 @@ def result_of(doc: dict) -> Result:
         map_path=Path(doc["map"]["path"]), map_kind=doc["map"]["kind"],
         truth_path=Path(t["path"]), truth_kind=t["kind"], grid=grid,
         alignment=Alignment(frames.planar, a["fitness"], a["rmse_m"], a["tolerance_m"],
-                            a["method"], a["distinctiveness"], a.get("contradiction"), a.get("free_on_truth"),
+                            a["method"], a["distinctiveness"], a.get("contradiction"),
+                            a.get("free_on_truth"),
                             tuple((Similarity2D.from_dict(q), q["score"])
                                   for q in a.get("poses", ()))),
         overlap=Overlap(None, doc["coverage"], a["truth_recall"], a["agreement"],

@@ -11,7 +11,7 @@ from collections.abc import Iterable
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
-from pcmapq.results.result import INCONSISTENT, SAME
+from pcmapq.results.result import INCONSISTENT, LOW, SAME
 
 from .pairs import CURRENT, KINDS
 
@@ -184,9 +184,9 @@ def kept(records: list[Record]) -> list[Record]:
 
 
 def scored(record: Record) -> bool:
-    """Scored by the verdict: "same place" or "same place, inconsistent map" (a failed run or
-    a result without a verdict is not)."""
-    return record.alignment.get("verdict") in (SAME, INCONSISTENT)
+    """Scored by the verdict: "same place", "same place, inconsistent map" or "same place, low
+    confidence" (a failed run or a result without a verdict is not)."""
+    return record.alignment.get("verdict") in (SAME, INCONSISTENT, LOW)
 
 
 def agreeing(record: Record) -> str:
