@@ -19,6 +19,7 @@ from . import (
     fr79,
     gazebo,
     halmstad,
+    house,
     kitti,
     lidar,
     noref,
@@ -38,7 +39,8 @@ COMMAND = "python -m bench.validation --write"
 SECTIONS: dict[str, ModuleType] = {
     "drawings": drawings, "fr79": fr79, "lidar": lidar, "kitti": kitti, "gazebo": gazebo,
     "halmstad": halmstad, "floorplans": floorplans, "carmen": carmen, "noref": noref,
-    "same_place": same_place, "corpus": corpus, "consistency": consistency, "track": track,
+    "same_place": same_place, "house": house,
+    "corpus": corpus, "consistency": consistency, "track": track,
     "recording": recording, "rooms": rooms, "rooms_drift": rooms_drift,
     "rooms_halmstad": rooms_halmstad, "rooms_bent": rooms_bent,
 }

@@ -49,7 +49,8 @@ class Search:
     with a fifth column, the log of the scale (similarity search); sorted by score, descending.
     x, y: where the map's centroid lands, truth units. centre: the map's centroid, map frame;
     radius: the map's largest distance from it, map units. cell: the raster cell, truth units;
-    yaw_step: the yaw step, radians (rigid search).
+    yaw_step: the yaw step, radians (rigid search). plain: when the scores weigh the map's free
+    space, the per-yaw peaks of the walls' score alone, rows as ``poses``'; None otherwise.
     """
 
     candidates: list[Candidate]
@@ -58,6 +59,7 @@ class Search:
     radius: float
     cell: float = 0.0
     yaw_step: float = 0.0
+    plain: np.ndarray | None = None
 
 
 #: Poses within these of the final one are "near" it (see :func:`distinctiveness`): yaw,
@@ -71,8 +73,11 @@ def distinctiveness(search: Search, tf: Similarity2D) -> float:
     the poses near it). Near: within NEAR_DEG degrees, NEAR_RADIUS map radii of centroid
     position and (similarity search) a scale ratio of NEAR_SCALE. 0 when the search scored no
     pose near ``tf`` higher than one elsewhere (refinement left the search's peak, or another
-    pose scores as well); 1 when nothing elsewhere scores above zero."""
-    poses = search.poses
+    pose scores as well); 1 when nothing elsewhere scores above zero. The scores are the
+    walls' alone (``search.plain`` where the search weighed free space): the free space's
+    cost falls on nearly every pose of a map laid over another place, so the one it spares
+    would stand out (maps of other offices at 0.33-0.51, docs/validation.md)."""
+    poses = search.poses if search.plain is None else search.plain
     if len(poses) == 0:
         return 0.0
     centre = tf.apply(search.centre.reshape(1, 2))[0]
@@ -160,9 +165,9 @@ def coarse_search(map_xy: np.ndarray, truth_xy: np.ndarray, *,
     the angle that moves the map's farthest point by sigma, clipped to [0.5, 3]). overhang: how
     far, metres, the map's centroid may lie outside the truth's bounding box. per_angle: peaks
     kept from each yaw's response.
-    free: the map's free space and the truth's solid cells; given, each pose's score is
-    multiplied by one minus its contradiction, the share of the map's clear free cells on
-    solid truth cells (:mod:`~pcmapq.align.free_space`).
+    free: the map's free space and the truth's solid and known cells; given, each pose's
+    score is multiplied by exp(-PENALTY x the cost of the map's free space there)
+    (:func:`~pcmapq.align.free_space.cost`).
     Candidates come best first; yaws within three steps and positions within 4 cells of a better one
     are dropped, so near-symmetric alternatives survive to be settled by refinement.
     """
@@ -189,20 +194,26 @@ def coarse_search(map_xy: np.ndarray, truth_xy: np.ndarray, *,
     contradicted = (free_space.contradictions(solid, known, _templates(clear / resolution,
                                                                         yaws, half))
                     if solid is not None and len(clear) else None)
-    rows = []
+    rows, plain = [], []
+
+    def peaks(response: np.ndarray, yaw: float) -> np.ndarray:
+        v, u = _peaks(response, per_angle, radius=2)
+        xy = offset + np.column_stack([u, -v]) * resolution
+        return np.column_stack([response[v, u], np.full(len(v), yaw), xy])
+
     for yaw in yaws:
         template = (hit_counts(centred @ _rotation(yaw).T, tgrid) > 0).astype(np.float32)
         response = cv2.matchTemplate(field, template, cv2.TM_CCORR) / template.sum()
         if contradicted is not None:
-            response *= np.exp(-free_space.PENALTY * next(contradicted))
-        v, u = _peaks(response, per_angle, radius=2)
-        xy = offset + np.column_stack([u, -v]) * resolution
-        rows.append(np.column_stack([response[v, u], np.full(len(v), yaw), xy]))
+            plain.append(peaks(response, yaw))
+            response = response * np.exp(-free_space.PENALTY * next(contradicted))
+        rows.append(peaks(response, yaw))
     poses = np.vstack(rows)
     poses = poses[np.argsort(-poses[:, 0], kind="stable")]
     best = _suppress(poses, top_k, np.radians(3 * angle_step_deg), 4 * resolution)
     return Search([Candidate(_pose(yaw, xy, centre), float(score)) for score, yaw, *xy in best],
-                  poses, centre, radius, resolution, float(np.radians(angle_step_deg)))
+                  poses, centre, radius, resolution, float(np.radians(angle_step_deg)),
+                  np.vstack(plain) if plain else None)
 
 
 def _clear(free: FreeSpace | None, map_xy: np.ndarray, cell: float) -> np.ndarray:

@@ -1,6 +1,6 @@
 """The choice among a map's candidate poses: each refined roughly, the best few (and any
-close one elsewhere) refined to the end, the best of those by support (fitness, times one minus
-the contradiction of the map's free space where it has one), then RMSE; with the scale free, a
+close one elsewhere) refined to the end, the best of those by support (fitness, lowered by what
+the map's free space costs the pose where it has free space), then RMSE; with the scale free, a
 near tie broken by the share of the truth each pose covers."""
 
 from __future__ import annotations
@@ -10,7 +10,7 @@ from typing import Protocol
 
 import numpy as np
 
-from pcmapq.align.free_space import PENALTY
+from pcmapq.align.free_space import PENALTY, cost
 from pcmapq.core.transform import Similarity2D, wrapped
 
 #: A rough-stage result whose support is at least this share of the best one's goes through the
@@ -40,6 +40,7 @@ class Scored(Protocol):
     fitness: float
     rmse_m: float
     contradiction: float | None
+    free_on_truth: float | None
 
 
 def refine_best(starts: Sequence[Similarity2D], rough: Refine, fine: Refine,
@@ -79,9 +80,10 @@ def _same_pose(a: Similarity2D, b: Similarity2D) -> bool:
 
 
 def support(a: Scored) -> float:
-    """What a pose's score rests on, [0, 1]: its fitness, times one minus the contradiction of
-    the map's free space (:mod:`~pcmapq.align.free_space`) where the map has free space."""
-    return a.fitness * float(np.exp(-PENALTY * (a.contradiction or 0.0)))
+    """What a pose's score rests on, [0, 1]: its fitness, times exp(-PENALTY x what the map's
+    free space costs the pose) where the map has free space
+    (:func:`~pcmapq.align.free_space.cost`)."""
+    return a.fitness * float(np.exp(-PENALTY * cost(a.contradiction, a.free_on_truth)))
 
 
 def _rank(a: Scored) -> tuple[float, float]:

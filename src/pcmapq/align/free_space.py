@@ -31,8 +31,14 @@ from pcmapq.core.voxels import evenly, voxel_centroids
 #: Free cells nearer than this to a map wall are left out, metres (at least 1.5 raster cells
 #: where a raster is coarser).
 CLEAR_M = 0.25
-#: A pose's score is multiplied by exp(-PENALTY x its contradiction).
+#: A pose's score is multiplied by exp(-PENALTY x its cost, :func:`cost`): a tenth of the
+#: map's free space on truth walls divides it by 7.4.
 PENALTY = 20.0
+#: The cost of a free cell off the truth's known cells, against 1 for one on a truth wall: the
+#: truth says nothing there, yet a map of its place sees little beyond it (at most 6 % of the
+#: free cells of the real maps of docs/validation.md's free-space section at their right
+#: poses), and a map of another place placed to hang off the truth would go free.
+OFF_TRUTH = 0.3
 #: Memory for the templates' spectra held at once, bytes.
 FFT_BYTES = 64e6
 #: Free points a final pose is checked with: a share is sure to about 1 % with this many.
@@ -94,15 +100,22 @@ class FreeSpace:
                               tf.apply(evenly(clear_xy, CHECK_POINTS))).mean())
 
 
+def cost(contradiction: float | None, on_truth: float | None) -> float:
+    """What a pose's free space costs it, [0, 1]: the share of the map's free cells on truth
+    walls, plus OFF_TRUTH times the share off the truth's known cells; 0 without free space."""
+    if contradiction is None or on_truth is None:
+        return 0.0
+    return contradiction * on_truth + OFF_TRUTH * (1.0 - on_truth)
+
+
 def contradictions(solid: np.ndarray, known: np.ndarray,
                    templates: np.ndarray) -> Iterator[np.ndarray]:
-    """For each binary template (yaws, size, size) of a map's free cells, the contradiction
-    at every place of it on the truth's rasters ``solid`` and ``known`` (rows, cols; 1 on a
-    solid or known cell): the share of its cells on known cells that lie on solid ones, a
-    (rows - size + 1, cols - size + 1) array laid out as cv2.matchTemplate's responses (0
-    where none is known). The rasters' spectra are taken once and the templates' a batch at a
-    time (scipy.fft in single precision: the counts, whole numbers below 2^20, come back
-    exact once rounded)."""
+    """For each binary template (yaws, size, size) of a map's free cells, the :func:`cost` of
+    every place of it on the truth's rasters ``solid`` and ``known`` (rows, cols; 1 on a
+    solid or known cell): a (rows - size + 1, cols - size + 1) array laid out as
+    cv2.matchTemplate's responses. The rasters' spectra are taken once and the templates' a
+    batch at a time (scipy.fft in single precision: the counts, whole numbers below 2^20, come
+    back exact once rounded)."""
     rows, cols = solid.shape
     size = templates.shape[-1]
     # no wrap: a valid place reads up to rows - 1, cols - 1
@@ -110,10 +123,12 @@ def contradictions(solid: np.ndarray, known: np.ndarray,
     spectra = scipy.fft.rfft2(np.stack([solid, known]).astype(np.float32), s=shape)
     batch = max(1, int(FFT_BYTES // (8 * shape[0] * (shape[1] // 2 + 1))))
     for start in range(0, len(templates), batch):
-        chunk = scipy.fft.rfft2(templates[start:start + batch], s=shape)
-        counts = scipy.fft.irfft2(spectra[:, None] * np.conj(chunk)[None], s=shape)
-        counts = np.rint(counts[:, :, :rows - size + 1, :cols - size + 1])
-        yield from (counts[0] / np.maximum(counts[1], 1.0)).astype(np.float32)
+        chunk = templates[start:start + batch]
+        total = np.maximum(chunk.sum(axis=(1, 2)), 1.0)[:, None, None]
+        counts = scipy.fft.irfft2(spectra[:, None] * np.conj(scipy.fft.rfft2(chunk, s=shape)),
+                                  s=shape)
+        on_solid, on_known = np.rint(counts[:, :, :rows - size + 1, :cols - size + 1])
+        yield from ((on_solid + OFF_TRUTH * (total - on_known)) / total).astype(np.float32)
 
 
 def on_solid(solid: np.ndarray, grid: MetricGrid, xy: np.ndarray) -> np.ndarray:

@@ -86,7 +86,8 @@ def place(source: OccupancyMap | PointMap, prepared: PreparedTruth, settings: Se
     map_occ, footprint = map_raster(source, map_xy, alignment.transform, prepared.grid,
                                     settings, rule)
     to_map = nearest_distance(map_occ, prepared.grid)
-    cover = overlap(prepared.occupied, to_map, footprint, alignment, prepared.grid.resolution)
+    cover = overlap(prepared.occupied, to_map, footprint, alignment, prepared.grid.resolution,
+                    free_on_grid(source, alignment.transform, prepared.grid))
     parts = ()
     if cover.confidence < option.min_confidence and alignment.distinctiveness is not None:
         progress("placing the map's parts on their own")
@@ -95,7 +96,7 @@ def place(source: OccupancyMap | PointMap, prepared: PreparedTruth, settings: Se
     cover = replace(cover, parts=parts,
                     verdict=verdict(cover.confidence, option.min_confidence, parts,
                                     alignment.distinctiveness, cover.truth_recall,
-                                    alignment.contradiction, alignment.free_on_truth))
+                                    cover.seen_through))
     if cover.verdict == OTHER and not option.force:
         raise Refused(refusal(source, truth.path, alignment, cover, settings, map_xy,
                               prepared.xy))
@@ -212,6 +213,16 @@ def free_space(source: OccupancyMap | PointMap, prepared: PreparedTruth) -> Free
     known = (truth.state != UNKNOWN if isinstance(truth, OccupancyMap)
              else np.ones(prepared.grid.shape, bool))
     return FreeSpace(free_xy, prepared.occupied, known | prepared.occupied, prepared.grid)
+
+
+def free_on_grid(source: OccupancyMap | PointMap, transform: Similarity2D,
+                 grid: MetricGrid) -> np.ndarray | None:
+    """The map's free cells drawn on the truth's ``grid`` under ``transform`` (bool): an
+    image's free cells, or the area a cloud's scans saw; None for a map with neither."""
+    if isinstance(source, OccupancyMap):
+        free = warp_state(source.state, source.grid, transform, grid) == FREE
+        return free if free.any() else None
+    return None if source.seen is None else seen_on(source.seen, transform, grid)
 
 
 def align_plan(source: OccupancyMap | PointMap, map_xy: np.ndarray, truth_xy: np.ndarray,

@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from pcmapq.align import Alignment
+from pcmapq.align.free_space import CLEAR_M
 from pcmapq.align.parts import Part
 from pcmapq.core.bounds import radius
 from pcmapq.core.morphology import outline
@@ -39,32 +40,35 @@ MIN_AGREEING = 3
 #: own. Among the maps of other places in docs/validation.md (the corpus's 114 pairs and the
 #: Halmstad maps against the other layouts, 108) the most is 0.235.
 STANDS_OUT = 0.3
-#: A map with free space whose pose is not sure is still scored, with low confidence, when at
-#: that pose less than CONTRADICTS of its free cells on the truth lie on truth walls (a laser
-#: sees nothing through a wall; :mod:`pcmapq.align.free_space`), at least ON_TRUTH of them lie
-#: on the truth, and at least RECALL_FULL of the truth it covers lies near its walls. Maps of
-#: other places reach the first two (a cluttered room fits an open hall of another building)
-#: but not the third (docs/validation.md).
-CONTRADICTS, ON_TRUTH = 0.1, 0.9
+#: A map with free space is of another place only with evidence that it is: at its pose it
+#: saw through SEEN_THROUGH or more of the truth's walls it covers (they lie on its free cells:
+#: a laser sees nothing through a wall; :mod:`pcmapq.align.free_space`), or RECALL_NONE or
+#: less of the truth it covers lies near its walls. Without such evidence it is scored and
+#: flagged as placed with low confidence: a cluttered room fits another room of its house, or
+#: of another building, and nothing it holds tells which. Real maps of their own place see
+#: through at most 0.06 of the truth's walls, of other places at least 0.16, but for a
+#: one-room map that fits a room of another office (docs/validation.md).
+SEEN_THROUGH = 0.1
+#: The refusal's cause names a map's free space on the truth's walls from this share on.
+CONTRADICTS = 0.1
 
 
 def verdict(confidence: float, min_confidence: float, parts: Sequence[Part],
             distinct: float | None = None, recall: float = 0.0,
-            contradiction: float | None = None, on_truth: float | None = None) -> str:
+            seen_through: float | None = None) -> str:
     """SAME when the confidence reaches ``min_confidence``; else INCONSISTENT when at least
     MIN_AGREEING of the map's ``parts`` agree with its pose, or when its pose's distinctiveness
     ``distinct`` reaches STANDS_OUT with a truth ``recall`` above RECALL_NONE; else, for a map
-    with free space (``contradiction`` and ``on_truth`` not None), LOW when its free space lies
-    on the truth (ON_TRUTH) without contradicting it (below CONTRADICTS) and ``recall`` reaches
-    RECALL_FULL; else OTHER."""
+    with free space (``seen_through`` not None), LOW when it saw through less than
+    SEEN_THROUGH of the truth's walls it covers and ``recall`` is above RECALL_NONE; else
+    OTHER."""
     if confidence >= min_confidence:
         return SAME
     if sum(p.agrees for p in parts) >= MIN_AGREEING:
         return INCONSISTENT
     if distinct is not None and distinct >= STANDS_OUT and recall > RECALL_NONE:
         return INCONSISTENT
-    if (contradiction is not None and on_truth is not None and contradiction < CONTRADICTS
-            and on_truth >= ON_TRUTH and recall >= RECALL_FULL):
+    if seen_through is not None and seen_through < SEEN_THROUGH and recall > RECALL_NONE:
         return LOW
     return OTHER
 
@@ -88,20 +92,27 @@ def confidence(distinct: float | None, recall: float, agreement: float = 0.0) ->
 
 
 def overlap(truth_occ: np.ndarray, to_map: DistanceField, footprint: np.ndarray,
-            alignment: Alignment, resolution: float) -> Overlap:
+            alignment: Alignment, resolution: float, free: np.ndarray | None = None) -> Overlap:
     """How much of the truth the map covers, how well the two agree there, and the confidence
     that they show one place; ``to_map`` is each cell's distance to the nearest map wall,
-    metres, on a grid of ``resolution`` metres. The recall counts the truth's walls by their
+    metres, on a grid of ``resolution`` metres; ``free``: the map's free cells on that grid
+    (None for a map without free space). The recall counts the truth's walls by their
     outline (:data:`~pcmapq.evaluation.inputs.OUTLINE_M`): a map sees a filled block's faces,
-    not its inside."""
+    not its inside; so does the share of them the map saw through (on its free cells farther
+    than :data:`~pcmapq.align.free_space.CLEAR_M` from its walls)."""
     seen = truth_occ & footprint
     coverage = float(seen.sum() / truth_occ.sum()) if truth_occ.any() else 0.0
     tolerance = alignment.tolerance_m
     faces = outline(truth_occ, OUTLINE_M / resolution) & footprint
-    recall = float((to_map[faces] <= tolerance).mean()) if faces.any() else 0.0
+    near = to_map[faces]
+    recall = float((near <= tolerance).mean()) if faces.any() else 0.0
+    through = None
+    if free is not None:
+        through = float((free[faces] & (near > CLEAR_M)).mean()) if faces.any() else 0.0
     agreement = alignment.fitness * recall
     return Overlap(footprint, coverage, recall, agreement,
-                   confidence(alignment.distinctiveness, recall, agreement))
+                   confidence(alignment.distinctiveness, recall, agreement),
+                   seen_through=through)
 
 
 def refusal(source: OccupancyMap | PointMap, truth_path: Path, alignment: Alignment,
@@ -111,8 +122,8 @@ def refusal(source: OccupancyMap | PointMap, truth_path: Path, alignment: Alignm
     map_path = source.path
     distinct = alignment.distinctiveness
     why = (f"{cover.truth_recall:.0%} of the truth it covers lies near the map" +
-           ("" if alignment.contradiction is None else
-            f", {alignment.contradiction:.0%} of its free space lies on the truth's walls") +
+           ("" if cover.seen_through is None else
+            f", it saw through {cover.seen_through:.0%} of the truth's walls there") +
            ("" if distinct is None else
             f", the best pose scores {distinct:.0%} above the best one elsewhere") +
            ("" if not cover.parts else
@@ -129,8 +140,8 @@ def refusal(source: OccupancyMap | PointMap, truth_path: Path, alignment: Alignm
     elif not option.scale and size > OVERSIZE:
         cause = (f"a scale that differs: the map spans {size:.1f} times the truth; try "
                  "--scale auto")
-    elif alignment.contradiction is not None and alignment.contradiction >= CONTRADICTS:
-        cause = ("a map of another place: where its walls fit, the robot saw through the "
+    elif cover.seen_through is not None and cover.seen_through >= SEEN_THROUGH:
+        cause = ("a map of another place: where its walls fit best, the robot saw through the "
                  "truth's walls" + ("" if option.scale else " (or of another scale: --scale auto)"))
     elif cover.truth_recall >= RECALL_FULL:
         cause = ("a map too cluttered or distorted for its pose to stand out (the truth's walls "

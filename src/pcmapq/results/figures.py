@@ -15,9 +15,9 @@ from pcmapq.settings import DETECTOR_NAMES
 #: A detector's scores, each in [0, 1], in table order.
 SCORES = ("quality", "precision", "f1")
 #: The figures of ``alignment`` a gate reaches by their own JSON name.
-ALIGNMENT_FIELDS = ("confidence", "fitness", "rmse_m", "truth_recall", "agreement",
-                    "distinctiveness", "contradiction", "free_on_truth", "x_m", "y_m",
-                    "yaw_deg", "scale")
+ALIGNMENT_FIELDS = ("confidence", "fitness", "rmse_m", "truth_recall", "seen_through",
+                    "agreement", "distinctiveness", "contradiction", "free_on_truth", "x_m",
+                    "y_m", "yaw_deg", "scale")
 
 
 @dataclass(frozen=True)

@@ -82,7 +82,7 @@ def result_of(doc: dict) -> Result:
                         a["confidence"], a["verdict"],
                         tuple(Part(**{**p, "centre_m": tuple(p["centre_m"]),
                                  "pose": Similarity2D.from_dict(p["pose"])})
-                              for p in a["parts"])),
+                              for p in a["parts"]), a.get("seen_through")),
         distances=_distances_of(doc["distances"]),
         registration_3d=None if reg is None else Registration3D(
             np.asarray(reg["matrix"], dtype=np.float64), reg["fitness"], reg["rmse_m"]),

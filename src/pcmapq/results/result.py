@@ -30,9 +30,10 @@ DECIMALS = 6
 #: :mod:`pcmapq.evaluation.same_place`): one pose fits it; it is of the truth's place but no
 #: single pose fits it whole (scored); it shows another place (refused unless ``--force``).
 SAME, INCONSISTENT, OTHER = "same place", "same place, inconsistent map", "another place"
-#: A map with free space placed below the minimum confidence where that free space does not
-#: contradict the truth: scored, and flagged with the search's two best poses.
-LOW = "same place, low confidence"
+#: A map with free space placed below the minimum confidence where nothing it saw contradicts
+#: the truth: scored, and flagged with the search's two best poses (it may show the truth's
+#: place or another that looks alike; nothing it holds tells which).
+LOW = "placed with low confidence"
 
 
 @dataclass(frozen=True)
@@ -75,10 +76,14 @@ class Overlap:
     confidence: that one pose places the map on the truth's place, [0, 1] (see
         same_place.confidence).
     verdict: SAME (confidence at least the minimum), INCONSISTENT (below it, but its parts
-        placed on their own agree with its pose), LOW (below it, a map whose free space does
-        not contradict the truth at its pose) or OTHER.
+        placed on their own agree with its pose), LOW (below it, a map with free space that saw
+        through few of the truth's walls) or OTHER.
     parts: the map's parts placed on their own (:mod:`pcmapq.align.parts`); empty when the
         confidence alone settled the verdict.
+    seen_through: for a map with free space, the share of the truth's wall faces inside the
+        footprint that lie on the map's free cells farther than
+        :data:`~pcmapq.align.free_space.CLEAR_M` from its walls: walls the map saw through,
+        [0, 1]; None for a map without free space.
     """
 
     footprint: np.ndarray | None
@@ -88,6 +93,7 @@ class Overlap:
     confidence: float = 0.0
     verdict: str = SAME
     parts: tuple[Part, ...] = ()
+    seen_through: float | None = None
 
 
 @dataclass(frozen=True)
@@ -171,6 +177,7 @@ class Result:
                           "tolerance_m": self.alignment.tolerance_m,
                           "method": self.alignment.method,
                           "truth_recall": self.overlap.truth_recall,
+                          "seen_through": self.overlap.seen_through,
                           "agreement": self.overlap.agreement,
                           "distinctiveness": self.alignment.distinctiveness,
                           "contradiction": self.alignment.contradiction,

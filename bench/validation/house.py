@@ -1,0 +1,136 @@
+"""Real robot maps with free space against real plans and reference maps: the right pose and
+the verdict, by the evidence of the maps' free space (docs/method.md, "Another place").
+
+The maps are ROS maps of three buildings (../shared/data/plans): a house's architectural plan
+and two Cartographer maps of it (``gopi5go_house``), an office floor's furniture-free reference
+map and two robot maps of it (``bonn_youbot_tmcl``), and a real robot map of an office against
+the map of its simulation model (``strands_g4s``). Every map is scored against its own
+building's truth (same place) and against the other buildings' truths (another place), with
+``force`` and no detectors, as ``pcmapq eval`` places it by default.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from pcmapq.evaluation.pipeline import evaluate
+from pcmapq.evaluation.same_place import CONTRADICTS, ON_TRUTH, RECALL_FULL
+from pcmapq.results.result import LOW, OTHER
+from pcmapq.settings import AlignmentConfig, MatchingConfig, Settings
+from pcmapq.testing import reference
+
+from .common import Case, Record, Section, header, row
+
+SETTINGS = Settings(alignment=AlignmentConfig(force=True), matching=MatchingConfig(detectors=()))
+#: Each map: its building, the path under plans/, and the reference placement on its own
+#: building's truth (x m, y m, yaw deg) where one is known (the house's README; the Bonn robot
+#: map is drawn in its reference map's frame).
+MAPS = {
+    "house_tile_cart": ("house", "gopi5go_house/house_tile_cart.yaml", (0.405, -0.433, 1.63)),
+    "cart_office": ("house", "gopi5go_house/cart_office.yaml", (0.371, -0.922, 2.55)),
+    "GMap": ("bonn", "bonn_youbot_tmcl/GMap/GMap.yaml", (0.0, 0.0, 0.0)),
+    "YouBotMap": ("bonn", "bonn_youbot_tmcl/2021_10_27/YouBotMap.yaml", None),
+    "g4s_y2": ("g4s", "strands_g4s/g4s_y2.yaml", None),
+}
+TRUTHS = {"house": "gopi5go_house/floorplan.map.yaml", "bonn": "bonn_youbot_tmcl/Faro/FMap.yaml",
+          "g4s": "strands_g4s/g4s_sim_cropped.yaml"}
+
+
+@dataclass(frozen=True)
+class Placed:
+    """One pair's figures (its reference keeps them) and whether the map shows the place."""
+
+    map_name: str
+    truth_name: str
+    same: bool
+    figures: dict
+    error: tuple[float, float] | None
+
+    def summary(self) -> dict:
+        return self.figures
+
+
+def pairs() -> list[tuple[str, str, bool]]:
+    """(map, truth building, same place) of every map against every building's truth."""
+    return [(name, building, building == own)
+            for name, (own, _, _) in MAPS.items() for building in TRUTHS]
+
+
+def measure(data: Path, name: str, building: str) -> Placed:
+    """One map scored against one building's truth."""
+    own, path, ref = MAPS[name]
+    result = evaluate(data / "plans" / path, data / "plans" / TRUTHS[building], SETTINGS)
+    doc = result.to_dict()
+    figures = reference.summary(doc)
+    figures["alignment"].update({k: doc["alignment"][k] for k in
+                                 ("verdict", "contradiction", "free_on_truth")})
+    error = None
+    if ref is not None and own == building:
+        tf = result.transform
+        error = (float(np.hypot(tf.tx - ref[0], tf.ty - ref[1])),
+                 abs((tf.yaw_deg - ref[2] + 180.0) % 360.0 - 180.0))
+    return Placed(name, building, own == building, figures, error)
+
+
+def cases(data: Path) -> list[Case]:
+    return [Case(f"house-{name}-{building}", lambda n=name, b=building: measure(data, n, b))
+            for name, building, _ in pairs()]
+
+
+def _cell(value: float | None, digits: int = 2) -> str:
+    return "-" if value is None else f"{value:.{digits}f}"
+
+
+def section(data: Path, record: Record) -> Section:
+    """The table of every pair, and what the verdict made of them."""
+    placed = [case.run(record) for case in cases(data)]
+    lines = [header(["map", "truth", "place", "verdict", "pose error", "contradiction",
+                     "free on truth", "truth recall", "fitness", "distinctiveness",
+                     "confidence"])]
+    for p in placed:
+        a = p.figures["alignment"]
+        wrong = (a["verdict"] == OTHER) == p.same
+        lines.append(row([
+            p.map_name, p.truth_name, "same" if p.same else "other",
+            f"**{a['verdict']}**" if wrong else a["verdict"],
+            "-" if p.error is None else f"{p.error[0]:.2f} m, {p.error[1]:.1f} deg",
+            _cell(a["contradiction"], 3), _cell(a["free_on_truth"]), _cell(a["truth_recall"]),
+            _cell(a["fitness"]), _cell(a["distinctiveness"]), _cell(a["confidence"])]))
+    same = [p for p in placed if p.same]
+    other = [p for p in placed if not p.same]
+    refused = sum(p.figures["alignment"]["verdict"] == OTHER for p in other)
+    scored = sum(p.figures["alignment"]["verdict"] != OTHER for p in same)
+    low = [p for p in placed if p.figures["alignment"]["verdict"] == LOW]
+    quiet = [p for p in other if p.figures["alignment"]["contradiction"] < CONTRADICTS
+             and p.figures["alignment"]["free_on_truth"] >= ON_TRUTH]
+    top = max(quiet, key=lambda p: p.figures["alignment"]["truth_recall"], default=None)
+    return Section("\n".join([
+        "## Maps with free space: real robot maps against real plans", "",
+        "Five ROS maps of three buildings (`../shared/data/plans`): the Cartographer maps of a "
+        "house (`gopi5go_house`: most of the house, and one cluttered office) against the "
+        "house's architectural plan (cabinets drawn as solid blocks), two robot maps of an "
+        "office floor (`bonn_youbot_tmcl`) against its furniture-free reference map, and a "
+        "robot map of an office (`strands_g4s`) against the map of its simulation model; each "
+        "against its own building's truth and the two others', with `force` and no detectors "
+        "(`python -m bench.validation --only house`). The house's maps are saved by Nav2's "
+        "map_saver with `free_thresh: 0.25`, read with their grey 205 unknown "
+        "(docs/formats.md). \"pose error\": from the reference placement, where one is "
+        "known (the house's README; the Bonn robot map shares its reference map's frame); "
+        "\"contradiction\": the share of the map's free cells on the truth's known cells that "
+        "lie on its walls; \"free on truth\": the share of the map's free cells on the "
+        "truth's known cells (docs/metrics.md). A wrong verdict is in bold.", "",
+        *lines, "",
+        f"The verdict scores {scored} of the {len(same)} same-place pairs and refuses "
+        f"{refused} of the {len(other)} other-place pairs. "
+        + ("Scored with low confidence: "
+           + ", ".join(f"{p.map_name} on {p.truth_name}" for p in low) + ". " if low else "")
+        + (f"Maps of other places whose free space lies on the truth without contradicting "
+           f"it (contradiction under {CONTRADICTS}, free on truth {ON_TRUTH} or more): "
+           f"{len(quiet)}, the highest truth recall among them "
+           f"{top.figures['alignment']['truth_recall']:.2f} ({top.map_name} on "
+           f"{top.truth_name}), below the {RECALL_FULL} the low-confidence verdict asks."
+           if top is not None else ""),
+    ]))
