@@ -24,14 +24,7 @@ import numpy as np
 from pcmapq.align.parts import PIECES
 from pcmapq.core.transform import Similarity2D
 from pcmapq.evaluation.pipeline import evaluate
-from pcmapq.evaluation.same_place import (
-    CONTRADICTS,
-    MIN_AGREEING,
-    ON_TRUTH,
-    RECALL_FULL,
-    RECALL_NONE,
-    STANDS_OUT,
-)
+from pcmapq.evaluation.same_place import MIN_AGREEING, RECALL_NONE, SEEN_THROUGH, STANDS_OUT
 from pcmapq.report.text import number
 from pcmapq.results.result import INCONSISTENT, LOW, OTHER, SAME
 from pcmapq.testing.corpus import (
@@ -342,9 +335,9 @@ def markdown(records: list[Record], names: tuple[str, ...] = ("confidence",),
         f"\"{INCONSISTENT}\" when at least {MIN_AGREEING} of the map's {parts} parts, each "
         "placed on its own by the global search, land near the map's pose, or when its "
         f"pose's distinctiveness is at least {STANDS_OUT} with a truth recall above "
-        f"{RECALL_NONE}; \"{LOW}\" for a map with free space whose free cells lie on the "
-        f"truth (at least {ON_TRUTH}) without lying on its walls (under {CONTRADICTS}) with "
-        f"a truth recall of at least {RECALL_FULL}; else "
+        f"{RECALL_NONE}; \"{LOW}\" for a map with free space (the images: their walls' "
+        f"hull is free) that saw through less than {SEEN_THROUGH} of the truth's walls it "
+        f"covers, with a truth recall above {RECALL_NONE}; else "
         f"\"{OTHER}\", refused unless forced. A pair is *scored* when its verdict is not "
         f"\"{OTHER}\". The whole corpus ran in {seconds:.0f} s.", "",
         "### What the corpus holds", "",

@@ -45,23 +45,27 @@ class Scored(Protocol):
 
 def refine_best(starts: Sequence[Similarity2D], rough: Refine, fine: Refine,
                 scored: Callable[[Similarity2D], Scored], finalists: int, *,
-                covered: Callable[[Similarity2D], float] | None = None) -> Similarity2D:
+                covered: Callable[[Similarity2D], float] | None = None,
+                finals_out: list[Scored] | None = None) -> Similarity2D:
     """Every start refined by ``rough``; the ``finalists`` best of those (highest support, then
     lowest RMSE, by ``scored``; see :func:`support`), and any other pose within
     CLOSE_FINALISTS of the best support, refined by ``fine``; the best of these. Given
     ``covered`` (the share of the truth a pose covers), the one covering most among those
     within TIE_FITNESS of the best fitness wins instead when it covers TIE_COVERAGE more than
     the best. A single start (an ``init``, every step of ``pcmapq track``) is refined without
-    scoring: there is no choice to make."""
+    scoring: there is no choice to make. ``finals_out``, given, receives the finalists scored
+    after the fine stages, best first, then every start scored after the rough one."""
     if len(starts) == 1:
         return fine(rough(starts[0]))
     firsts = sorted((scored(rough(s)) for s in starts), key=_rank)
     chosen = firsts[:finalists]
     for r in firsts[finalists:]:
         if support(r) >= CLOSE_FINALISTS * support(firsts[0]) and \
-                not any(_same_pose(r.transform, c.transform) for c in chosen):
+                not any(same_pose(r.transform, c.transform) for c in chosen):
             chosen.append(r)
     finals = sorted((scored(fine(r.transform)) for r in chosen), key=_rank)
+    if finals_out is not None:
+        finals_out.extend(finals + firsts)
     if covered is None:
         return finals[0].transform
     tied = [f.transform for f in finals if f.fitness >= finals[0].fitness - TIE_FITNESS]
@@ -72,7 +76,7 @@ def refine_best(starts: Sequence[Similarity2D], rough: Refine, fine: Refine,
     return tied[most] if shares[most] >= shares[0] + TIE_COVERAGE else tied[0]
 
 
-def _same_pose(a: Similarity2D, b: Similarity2D) -> bool:
+def same_pose(a: Similarity2D, b: Similarity2D) -> bool:
     """Whether two poses are one for the choice of finalists: within SAME_POSE_M of
     translation and SAME_POSE_DEG of yaw."""
     turn = abs(np.degrees(wrapped(a.yaw - b.yaw)))

@@ -23,7 +23,7 @@ from pcmapq.align.coarse import (
     similarity_resolution,
     similarity_search,
 )
-from pcmapq.align.finalists import refine_best
+from pcmapq.align.finalists import refine_best, same_pose, support
 from pcmapq.align.free_space import FreeSpace
 from pcmapq.align.params import AlignParams
 from pcmapq.align.point_to_line import LineTarget, refine_point_to_line
@@ -59,8 +59,10 @@ class Alignment:
     the pose puts on a truth wall or solid block, [0, 1]; None for a map without free space.
     free_on_truth: share of those free cells that the pose puts on the truth's known cells,
     [0, 1]; None for a map without free space.
-    poses: the global search's two best distinct poses with their scores (see
-    :class:`~pcmapq.align.coarse.Candidate`); empty when there was no search.
+    poses: the two best distinct poses refined from the global search's candidates (the
+    finalists, then the other candidates after the rough ICP stage), best first, with their
+    support (:func:`~pcmapq.align.finalists.support`: the fitness, lowered by what the
+    map's free space costs the pose); empty when there was no search.
     """
 
     transform: Similarity2D
@@ -183,14 +185,15 @@ def _align_rigid(map_xy: np.ndarray, target: RigidTarget, params: AlignParams,
     icp_map, schedule = _icp_inputs(map_ds, map_voxel > voxel,
                                     ((first_dist, first_voxel), *fine_stages))
     icp = IcpTarget(truth_ds, schedule, target.clouds)
+    finals: list[Alignment] = []
     best = refine_best(
         _starts(search, start),
         lambda tf: refine_point_to_point(icp_map, icp, tf, stages=slice(1)),
         lambda tf: refine_point_to_point(icp_map, icp, tf, stages=slice(1, None)), scored,
-        params.finalists_for(scale=False))
+        params.finalists_for(scale=False), finals_out=finals)
     # Point-to-line on the winner only: finishing both finalists moves no bench_align pose.
     tf = refine_point_to_line(map_ds, target.lines, best, fine_stages[-1][0])
-    return _labelled(scored(tf), search, "coarse+icp")
+    return _labelled(scored(tf), search, "coarse+icp", finals)
 
 
 def _icp_inputs(map_ds: np.ndarray, thinned: bool, schedule: tuple[tuple[float, float], ...]
@@ -254,9 +257,11 @@ def align_similarity(map_xy: np.ndarray, truth_xy: np.ndarray,
         return float(np.mean(np.isfinite(
             near.query(truth_ds, distance_upper_bound=tolerance)[0])))
 
+    finals: list[Alignment] = []
     best = refine_best(_starts(search, start), lambda tf: refine_similarity(map_xy, rough, tf),
-                       finish, scored, params.finalists_for(scale=True), covered=covered)
-    return _labelled(scored(best), search, "similarity+icp")
+                       finish, scored, params.finalists_for(scale=True), covered=covered,
+                       finals_out=finals)
+    return _labelled(scored(best), search, "similarity+icp", finals)
 
 
 def _starts(search: Search | None, init: Similarity2D) -> list[Similarity2D]:
@@ -264,12 +269,17 @@ def _starts(search: Search | None, init: Similarity2D) -> list[Similarity2D]:
     return [init] if search is None else [c.transform for c in search.candidates]
 
 
-def _labelled(best: Alignment, search: Search | None, method: str) -> Alignment:
-    """``best`` with its method ("init+icp" with no search) and its distinctiveness."""
+def _labelled(best: Alignment, search: Search | None, method: str,
+              finals: list[Alignment] = ()) -> Alignment:
+    """``best`` with its method ("init+icp" with no search), its distinctiveness and the two
+    best distinct refined ``finals`` (best first; one pose within SAME_POSE_M and
+    SAME_POSE_DEG of a better one is the same) with their support."""
     if search is None:
         return replace(best, method="init+icp")
+    distinct = [f for i, f in enumerate(finals)
+                if not any(same_pose(f.transform, g.transform) for g in finals[:i])]
     return replace(best, method=method, distinctiveness=distinctiveness(search, best.transform),
-                   poses=tuple((c.transform, c.score) for c in search.candidates[:2]))
+                   poses=tuple((f.transform, support(f)) for f in distinct[:2]))
 
 
 def _scored(map_xy: np.ndarray, tree: cKDTree, tf: Similarity2D, tolerance: float) -> Alignment:

@@ -65,11 +65,12 @@ def alignment_words(result: Result) -> str:
         return (f"{placed}: a map of the truth's place that no single pose fits (confidence "
                 f"{confidence:.2f}; {why}){breaks(result)}")
     if cover.verdict == LOW:
-        poses = "; ".join(f"({tf.tx:.2f} m, {tf.ty:.2f} m, {tf.yaw_deg:.1f} deg) scoring "
+        poses = "; ".join(f"({tf.tx:.2f} m, {tf.ty:.2f} m, {tf.yaw_deg:.1f} deg), support "
                           f"{score:.2f}" for tf, score in result.alignment.poses)
-        return (f"{placed} with low confidence ({confidence:.2f}): its free space does not "
-                f"contradict the truth there, but no pose stands out; the search's two best "
-                f"poses: {poses}{breaks(result)}")
+        through = cover.seen_through or 0.0
+        return (f"{placed} with low confidence ({confidence:.2f}): no pose stands out, yet "
+                f"nothing refutes this one (it saw through {through:.0%} of the truth's walls "
+                f"there); the two best poses: {poses}{breaks(result)}")
     if cover.verdict == OTHER:
         return (f"{placed}, but it may show another place (confidence {confidence:.2f} < 0.5, "
                 "scored because of --force)")

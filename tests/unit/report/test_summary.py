@@ -46,7 +46,7 @@ def test_rank_puts_refused_and_failed_maps_last():
     rows = [failed_row("broken", "broken", "t", 2, "broken: cannot be read"),
             failed_row("other", "other", "t", 1, "other: does not seem...", "another place"),
             scored("forced", 0.9, "another place"), scored("good", 0.8), scored("none", None),
-            scored("better", 0.9, "same place, low confidence")]
+            scored("better", 0.9, "placed with low confidence")]
     assert [r["rank"] for r in ranked(rows)] == [6, 5, 4, 2, 3, 1]
     md = table_md(rows).splitlines()
     assert md[0].startswith("| name | rank |") and md[2].startswith("| broken | 6 |")
