@@ -31,7 +31,8 @@ def cases(data: Path) -> list[Case]:
 def section(data: Path, record: Record) -> Section:
     """The table of the turned map's figures, and what the turns that resample change."""
     runs = {d: case.run(record) for d, case in zip(TURNS, cases(data), strict=True)}
-    lines = [header(["turn", "recovered yaw", "Harris", "Hough", "SIFT"])]
+    names = list(next(iter(runs.values())).result.detectors)
+    lines = [header(["turn", "recovered yaw", *names])]
     for deg, run in runs.items():
         cells = [f"{deg:g} deg", f"{run.result.transform.yaw_deg:.3f}"]
         for det in run.result.detectors.values():
