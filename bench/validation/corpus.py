@@ -24,7 +24,13 @@ import numpy as np
 from pcmapq.align.parts import PIECES
 from pcmapq.core.transform import Similarity2D
 from pcmapq.evaluation.pipeline import evaluate
-from pcmapq.evaluation.same_place import MIN_AGREEING, RECALL_NONE, SEEN_THROUGH, STANDS_OUT
+from pcmapq.evaluation.same_place import (
+    MIN_AGREEING,
+    ON_TRUTH,
+    RECALL_NONE,
+    SEEN_THROUGH,
+    STANDS_OUT,
+)
 from pcmapq.report.text import number
 from pcmapq.results.result import INCONSISTENT, LOW, OTHER, SAME
 from pcmapq.testing.corpus import (
@@ -337,7 +343,8 @@ def markdown(records: list[Record], names: tuple[str, ...] = ("confidence",),
         f"pose's distinctiveness is at least {STANDS_OUT} with a truth recall above "
         f"{RECALL_NONE}; \"{LOW}\" for a map with free space (the images: their walls' "
         f"hull is free) that saw through less than {SEEN_THROUGH} of the truth's walls it "
-        f"covers, with a truth recall above {RECALL_NONE}; else "
+        f"covers, with {ON_TRUTH} or more of its free space on the truth and a truth recall "
+        f"above {RECALL_NONE}; else "
         f"\"{OTHER}\", refused unless forced. A pair is *scored* when its verdict is not "
         f"\"{OTHER}\". The whole corpus ran in {seconds:.0f} s.", "",
         "### What the corpus holds", "",

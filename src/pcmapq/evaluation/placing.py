@@ -96,7 +96,7 @@ def place(source: OccupancyMap | PointMap, prepared: PreparedTruth, settings: Se
     cover = replace(cover, parts=parts,
                     verdict=verdict(cover.confidence, option.min_confidence, parts,
                                     alignment.distinctiveness, cover.truth_recall,
-                                    cover.seen_through))
+                                    cover.seen_through, alignment.free_on_truth))
     if cover.verdict == OTHER and not option.force:
         raise Refused(refusal(source, truth.path, alignment, cover, settings, map_xy,
                               prepared.xy))

@@ -42,25 +42,29 @@ MIN_AGREEING = 3
 STANDS_OUT = 0.3
 #: A map with free space is of another place only with evidence that it is: at its pose it
 #: saw through SEEN_THROUGH or more of the truth's walls it covers (they lie on its free cells:
-#: a laser sees nothing through a wall; :mod:`pcmapq.align.free_space`), or RECALL_NONE or
-#: less of the truth it covers lies near its walls. Without such evidence it is scored and
-#: flagged as placed with low confidence: a cluttered room fits another room of its house, or
-#: of another building, and nothing it holds tells which. Real maps of their own place see
-#: through at most 0.06 of the truth's walls, of other places at least 0.16, but for a
-#: one-room map that fits a room of another office (docs/validation.md).
-SEEN_THROUGH = 0.1
+#: a laser sees nothing through a wall; :mod:`pcmapq.align.free_space`), or less than
+#: ON_TRUTH of its free cells lie on the truth's known cells, or RECALL_NONE or less of the
+#: truth it covers lies near its walls. Without such evidence it is scored and flagged as
+#: placed with low confidence: a cluttered room fits another room of its house, or of another
+#: building, and nothing it holds tells which. Real maps of their own place see through at most
+#: 0.045 of the truth's walls, with 0.94 or more of their free space on it; of other places
+#: 0.22 or more, but for a one-room map that fits a room of another office; a map under 800
+#: boxes of clutter sees through few walls anywhere, but a tenth of another layout's free
+#: space lies off it at best (docs/validation.md).
+SEEN_THROUGH, ON_TRUTH = 0.1, 0.8
 #: The refusal's cause names a map's free space on the truth's walls from this share on.
 CONTRADICTS = 0.1
 
 
 def verdict(confidence: float, min_confidence: float, parts: Sequence[Part],
             distinct: float | None = None, recall: float = 0.0,
-            seen_through: float | None = None) -> str:
+            seen_through: float | None = None, on_truth: float | None = None) -> str:
     """SAME when the confidence reaches ``min_confidence``; else INCONSISTENT when at least
     MIN_AGREEING of the map's ``parts`` agree with its pose, or when its pose's distinctiveness
     ``distinct`` reaches STANDS_OUT with a truth ``recall`` above RECALL_NONE; else, for a map
     with free space (``seen_through`` not None), LOW when it saw through less than
-    SEEN_THROUGH of the truth's walls it covers and ``recall`` is above RECALL_NONE; else
+    SEEN_THROUGH of the truth's walls it covers, ``on_truth`` (the share of its free cells on
+    the truth's known cells) reaches ON_TRUTH and ``recall`` is above RECALL_NONE; else
     OTHER."""
     if confidence >= min_confidence:
         return SAME
@@ -68,7 +72,8 @@ def verdict(confidence: float, min_confidence: float, parts: Sequence[Part],
         return INCONSISTENT
     if distinct is not None and distinct >= STANDS_OUT and recall > RECALL_NONE:
         return INCONSISTENT
-    if seen_through is not None and seen_through < SEEN_THROUGH and recall > RECALL_NONE:
+    if (seen_through is not None and seen_through < SEEN_THROUGH and recall > RECALL_NONE
+            and (on_truth is None or on_truth >= ON_TRUTH)):
         return LOW
     return OTHER
 
@@ -143,6 +148,11 @@ def refusal(source: OccupancyMap | PointMap, truth_path: Path, alignment: Alignm
     elif cover.seen_through is not None and cover.seen_through >= SEEN_THROUGH:
         cause = ("a map of another place: where its walls fit best, the robot saw through the "
                  "truth's walls" + ("" if option.scale else " (or of another scale: --scale auto)"))
+    elif (alignment.free_on_truth is not None and cover.seen_through is not None
+          and alignment.free_on_truth < ON_TRUTH):
+        cause = (f"a map of another place: where its walls fit best, "
+                 f"{1 - alignment.free_on_truth:.0%} of its free space lies off the truth"
+                 + ("" if option.scale else " (or of another scale: --scale auto)"))
     elif cover.truth_recall >= RECALL_FULL:
         cause = ("a map too cluttered or distorted for its pose to stand out (the truth's walls "
                  "lie near it); --init with a rough pose places it")

@@ -39,12 +39,15 @@ def test_distinctiveness_of_known_scores():
 
 def test_low_confidence_needs_free_space_that_agrees():
     """Below the minimum confidence, a map with free space is scored with low confidence
-    unless it saw through 0.1 or more of the truth's walls it covers, or 0.4 or less of them
-    lie near its walls; a binary map (no free space) is refused as before."""
+    unless it saw through 0.1 or more of the truth's walls it covers, less than 0.8 of its
+    free cells lie on the truth, or 0.4 or less of the truth's walls lie near its walls; a
+    binary map (no free space) is refused as before."""
     from pcmapq.evaluation.same_place import verdict
     from pcmapq.results.result import LOW, OTHER
 
     assert verdict(0.0, 0.5, (), 0.0, 0.86, 0.048) == LOW  # the one-room house map
     assert verdict(0.0, 0.5, (), 0.0, 0.63, 0.327) == OTHER  # it saw through the walls
     assert verdict(0.0, 0.5, (), 0.0, 0.40, 0.0) == OTHER  # the truth's walls not near it
+    assert verdict(0.0, 0.5, (), 0.0, 0.90, 0.061, 0.52) == OTHER  # its free space off it
+    assert verdict(0.0, 0.5, (), 0.0, 0.86, 0.048, 0.998) == LOW
     assert verdict(0.0, 0.5, (), 0.0, 0.86) == OTHER  # no free space
