@@ -62,18 +62,18 @@ def verdict(confidence: float, min_confidence: float, parts: Sequence[Part],
     """SAME when the confidence reaches ``min_confidence``; else INCONSISTENT when at least
     MIN_AGREEING of the map's ``parts`` agree with its pose, or when its pose's distinctiveness
     ``distinct`` reaches STANDS_OUT with a truth ``recall`` above RECALL_NONE; else, for a map
-    with free space (``seen_through`` not None), LOW when it saw through less than
-    SEEN_THROUGH of the truth's walls it covers, ``on_truth`` (the share of its free cells on
-    the truth's known cells) reaches ON_TRUTH and ``recall`` is above RECALL_NONE; else
-    OTHER."""
+    with free space placed by a rigid search that weighed it (``seen_through`` and
+    ``on_truth`` not None), LOW when it saw through less than SEEN_THROUGH of the truth's
+    walls it covers, ``on_truth`` (the share of its free cells on the truth's known cells)
+    reaches ON_TRUTH and ``recall`` is above RECALL_NONE; else OTHER."""
     if confidence >= min_confidence:
         return SAME
     if sum(p.agrees for p in parts) >= MIN_AGREEING:
         return INCONSISTENT
     if distinct is not None and distinct >= STANDS_OUT and recall > RECALL_NONE:
         return INCONSISTENT
-    if (seen_through is not None and seen_through < SEEN_THROUGH and recall > RECALL_NONE
-            and (on_truth is None or on_truth >= ON_TRUTH)):
+    if (seen_through is not None and on_truth is not None and seen_through < SEEN_THROUGH
+            and on_truth >= ON_TRUTH and recall > RECALL_NONE):
         return LOW
     return OTHER
 

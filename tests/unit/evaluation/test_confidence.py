@@ -45,9 +45,9 @@ def test_low_confidence_needs_free_space_that_agrees():
     from pcmapq.evaluation.same_place import verdict
     from pcmapq.results.result import LOW, OTHER
 
-    assert verdict(0.0, 0.5, (), 0.0, 0.86, 0.048) == LOW  # the one-room house map
-    assert verdict(0.0, 0.5, (), 0.0, 0.63, 0.327) == OTHER  # it saw through the walls
-    assert verdict(0.0, 0.5, (), 0.0, 0.40, 0.0) == OTHER  # the truth's walls not near it
+    assert verdict(0.0, 0.5, (), 0.0, 0.86, 0.048, 0.998) == LOW  # the one-room house map
+    assert verdict(0.0, 0.5, (), 0.0, 0.63, 0.327, 0.93) == OTHER  # it saw through the walls
+    assert verdict(0.0, 0.5, (), 0.0, 0.40, 0.0, 1.0) == OTHER  # the truth's walls not near it
+    assert verdict(0.0, 0.5, (), 0.0, 0.86, 0.048) == OTHER  # not weighed by a rigid search
     assert verdict(0.0, 0.5, (), 0.0, 0.90, 0.061, 0.52) == OTHER  # its free space off it
-    assert verdict(0.0, 0.5, (), 0.0, 0.86, 0.048, 0.998) == LOW
     assert verdict(0.0, 0.5, (), 0.0, 0.86) == OTHER  # no free space
