@@ -22,7 +22,7 @@ from pcmapq.batch.run import run_local as pool_run
 from pcmapq.cli import app
 from pcmapq.core.errors import InputError
 from pcmapq.settings import Settings
-from pcmapq.testing.batch import write_inputs
+from pcmapq.testing.batch import MAPS, write_inputs
 
 
 def cli_run(*args: str):
@@ -283,3 +283,23 @@ def test_cli_failed_row_and_missing_dask(inputs, tmp_path, monkeypatch):
     assert code == 2
     assert err == ("pcmapq: error: --scheduler: needs dask.distributed, which is not "
                    "installed: pip install 'pcmapq[cluster]'\n")
+
+
+def test_refused_row_keeps_its_verdict_and_ranks_last(inputs, tmp_path):
+    """A map of another place (three round rooms) refused in a batch: its row says "another
+    place", and it ranks below the scored map and above a row that failed otherwise."""
+    from pcmapq.testing import synth
+    from pcmapq.testing.files import write_image_map
+
+    rooms = write_image_map(synth.round_rooms(), tmp_path / "rooms.png")
+    truth = inputs / "truth.png"
+    manifest = tmp_path / "mixed.csv"
+    manifest.write_text(f"map,truth\n{inputs / 'maps' / 'broken.png'},{truth}\n{rooms},{truth}\n"
+                        f"{inputs / 'maps' / MAPS[0][0]}.png,{truth}\n")
+    code, _, err = cli_run("batch", str(manifest), "--out", str(tmp_path / "o"), "--workers", "1")
+    assert code == 1 and "rooms: " in err and "does not seem to show the place" in err
+    with open(tmp_path / "o" / "table.csv", newline="") as f:
+        rows = {r["name"]: r for r in csv.DictReader(f)}
+    assert rows["rooms"]["verdict"] == "another place" and rows["rooms"]["exit_code"] == "1"
+    assert [rows[n]["rank"] for n in ("broken", "rooms", MAPS[0][0])] == ["3", "2", "1"]
+    assert rows["broken"]["verdict"] == ""

@@ -127,8 +127,8 @@ def contradictions(solid: np.ndarray, known: np.ndarray,
         total = np.maximum(chunk.sum(axis=(1, 2)), 1.0)[:, None, None]
         counts = scipy.fft.irfft2(spectra[:, None] * np.conj(scipy.fft.rfft2(chunk, s=shape)),
                                   s=shape)
-        on_solid, on_known = np.rint(counts[:, :, :rows - size + 1, :cols - size + 1])
-        yield from ((on_solid + OFF_TRUTH * (total - on_known)) / total).astype(np.float32)
+        walls, known_cells = np.rint(counts[:, :, :rows - size + 1, :cols - size + 1])
+        yield from ((walls + OFF_TRUTH * (total - known_cells)) / total).astype(np.float32)
 
 
 def on_solid(solid: np.ndarray, grid: MetricGrid, xy: np.ndarray) -> np.ndarray:

@@ -49,11 +49,9 @@ STANDS_OUT = 0.3
 #: building, and nothing it holds tells which. Real maps of their own place see through at most
 #: 0.045 of the truth's walls, with 0.94 or more of their free space on it; of other places
 #: 0.22 or more, but for a one-room map that fits a room of another office; a map under 800
-#: boxes of clutter sees through few walls anywhere, but a tenth of another layout's free
-#: space lies off it at best (docs/validation.md).
+#: boxes of clutter sees through few walls anywhere, but a third or more of its free space
+#: lies off another layout at its best pose (docs/validation.md).
 SEEN_THROUGH, ON_TRUTH = 0.1, 0.8
-#: The refusal's cause names a map's free space on the truth's walls from this share on.
-CONTRADICTS = 0.1
 
 
 def verdict(confidence: float, min_confidence: float, parts: Sequence[Part],
