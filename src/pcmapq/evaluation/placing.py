@@ -197,10 +197,13 @@ def check_size(source: OccupancyMap | PointMap, map_xy: np.ndarray, truth_xy: np
 
 def free_space(source: OccupancyMap | PointMap, prepared: PreparedTruth) -> FreeSpace | None:
     """The evidence of the map's free space against the truth's occupied and known cells
-    (:mod:`pcmapq.align.free_space`): an image's free cells, or the area a cloud's scans saw
-    (a map that ``pcmapq track`` builds); None for a map that has neither. A truth image
-    knows its free and occupied cells, a truth cloud every cell of its grid."""
+    (:mod:`pcmapq.align.free_space`): the free cells of an image that also has unknown ones
+    (:func:`observed_free`), or the area a cloud's scans saw (a map that ``pcmapq track``
+    builds); None for a map that has neither. A truth image knows its free and occupied
+    cells, a truth cloud every cell of its grid."""
     if isinstance(source, OccupancyMap):
+        if not observed_free(source):
+            return None
         free_xy = source.grid.cell_centres(source.state == FREE)
     elif source.seen is not None:
         rows, cols = np.nonzero(source.seen.cells)
@@ -215,11 +218,21 @@ def free_space(source: OccupancyMap | PointMap, prepared: PreparedTruth) -> Free
     return FreeSpace(free_xy, prepared.occupied, known | prepared.occupied, prepared.grid)
 
 
+def observed_free(source: OccupancyMap) -> bool:
+    """Whether an image's free cells say what its robot saw: it has unknown cells too (a ROS
+    map of what was explored). A black-and-white image's white is its background, free by
+    map_server's rule but not seen to be."""
+    return bool((source.state == UNKNOWN).any())
+
+
 def free_on_grid(source: OccupancyMap | PointMap, transform: Similarity2D,
                  grid: MetricGrid) -> np.ndarray | None:
     """The map's free cells drawn on the truth's ``grid`` under ``transform`` (bool): an
-    image's free cells, or the area a cloud's scans saw; None for a map with neither."""
+    image's free cells (:func:`observed_free`), or the area a cloud's scans saw; None for a
+    map with neither."""
     if isinstance(source, OccupancyMap):
+        if not observed_free(source):
+            return None
         free = warp_state(source.state, source.grid, transform, grid) == FREE
         return free if free.any() else None
     return None if source.seen is None else seen_on(source.seen, transform, grid)
