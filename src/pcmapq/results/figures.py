@@ -110,9 +110,10 @@ def figures(doc: dict) -> dict[str, float | str | None]:
 def table_row(name: str, doc: dict) -> dict[str, object]:
     """One flat row of a result JSON document (``pcmapq eval --json``): the inputs' paths,
     every figure that has a column (:data:`HEAD`), the F-score at each tau and the verdict of
-    its gates (:func:`gates_verdict`); exit_code 0, error "". ValueError as :func:`figures`."""
+    its gates (:func:`gates_verdict`); exit_code 0, error ""; its rank None until the table's
+    rows are ranked (:func:`ranked`). ValueError as :func:`figures`."""
     values = figures(doc)
-    row: dict[str, object] = {"name": name, "map": _get(doc, "map", "path"),
+    row: dict[str, object] = {"name": name, "rank": None, "map": _get(doc, "map", "path"),
                               "truth": _get(doc, "truth", "path")}
     row.update((f.column, values[f.name]) for f in FIGURES if f.column)
     for f in _get(doc, "distances", "f_score"):
