@@ -50,7 +50,7 @@ class Search:
     x, y: where the map's centroid lands, truth units. centre: the map's centroid, map frame;
     radius: the map's largest distance from it, map units. cell: the raster cell, truth units;
     yaw_step: the yaw step, radians (rigid search). plain: when the scores weigh the map's free
-    space, the per-yaw peaks of the walls' score alone, rows as ``poses``'; None otherwise.
+    space, the per-yaw peaks of the walls' score alone, rows as ``poses``; None otherwise.
     """
 
     candidates: list[Candidate]

@@ -137,8 +137,9 @@ def align(map_xy: np.ndarray, truth_xy: np.ndarray, params: AlignParams = AlignP
     scale: also estimate the scale, for a map in an unknown unit (see :func:`align_similarity`).
     target: these truth points prepared by :class:`RigidTarget` (used without ``scale``, when
     it fits ``params``): the same result, without the truth's work.
-    free: the map's free space and the truth's solid cells (rigid alignment): the search and
-    the choice among its poses weigh each pose by it, and the result gives its contradiction.
+    free: the map's free space and the truth's solid and known cells (rigid alignment): the
+    search and the choice among its poses weigh each pose by it, and the result gives its
+    contradiction and free_on_truth.
     """
     map_xy = np.asarray(map_xy, dtype=np.float64).reshape(-1, 2)
     truth_xy = np.asarray(truth_xy, dtype=np.float64).reshape(-1, 2)
