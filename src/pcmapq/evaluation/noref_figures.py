@@ -98,8 +98,8 @@ DEFER_FROM = 2_000_000
 class EarlyFigures:
     """The no-reference figures of an evaluation's 3D clouds and of an image map, found on a
     thread of their own while the map is placed (they need neither the alignment nor the
-    truth's features). The thread is a daemon's, so a map refused before its figures are
-    wanted does not wait for them. A map whose scale is estimated, a 2D cloud, and an image
+    truth's features). A map refused before its figures are wanted waits only for the input
+    the thread is on (:meth:`cancel`). A map whose scale is estimated, a 2D cloud, and an image
     truth (whose corners the truth's own Harris features give) are left to
     :func:`input_figures` after the alignment. With a map cloud of DEFER_FROM to
     STRIPE_POINTS points the thread starts its work once :meth:`walls_found` is called (or
@@ -128,9 +128,14 @@ class EarlyFigures:
         self._go.set()
 
     def cancel(self) -> None:
-        """The evaluation stopped: a thread still waiting to start does no work."""
+        """The evaluation stopped: a thread still waiting to start does no work, a running one
+        stops after the input it is on, and this returns when it has: a process that exits
+        while the thread is inside a library's compiled code is aborted by that library
+        ("terminate called without an active exception"), after its error line."""
         self._cancelled = True
         self._go.set()
+        if self._thread.is_alive():
+            self._thread.join()
 
     def _run(self, config: NoRefConfig) -> None:
         try:
@@ -142,6 +147,8 @@ class EarlyFigures:
             return
         try:
             for side, source in self._sources.items():
+                if self._cancelled:
+                    return
                 self._figures[side] = input_figures(source, config)
             release_free_memory()  # the reduction's table and chunks, freed into the heap
         except BaseException as exc:  # handed to the caller by get()
