@@ -11,6 +11,7 @@ occupied (not walls: a picture read inverted).
 from __future__ import annotations
 
 from concurrent.futures import Future, ThreadPoolExecutor
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -21,10 +22,13 @@ from pcmapq.core.errors import EvaluationError, InputError
 from pcmapq.core.frames import Levelling
 from pcmapq.core.grid import MetricGrid
 from pcmapq.core.morphology import outline
+from pcmapq.features.walls import CLOSING
 from pcmapq.io import OccupancyMap, PointMap, load_map
+from pcmapq.io.carmen import read_laser_scans
 from pcmapq.io.extent import crop
 from pcmapq.io.occupancy import NO_RESOLUTION
 from pcmapq.raster.draw import OCCUPIED, points_to_grid
+from pcmapq.raster.seen import seen_of_scans
 from pcmapq.raster.slice import wall_band
 from pcmapq.settings import Settings, SourceConfig
 
@@ -54,10 +58,22 @@ def load_input(path: str | Path, config: SourceConfig, option: str,
                fallback: float | None = None,
                memory_limit: int | None = None) -> OccupancyMap | PointMap:
     """An input read as ``config`` says (resolution, thresholds; ``fallback``: the resolution of
-    an image that has none) and cut to its crop box; see :func:`pcmapq.io.load_map`."""
-    return cropped(load_map(path, config.resolution, fallback, config.thresholds, memory_limit,
-                            config.topic, config.at, option.replace("crop", "topic")),
-                   config, option)
+    an image that has none) and cut to its crop box; see :func:`pcmapq.io.load_map`. A CARMEN
+    log given as the map, uncropped, carries the area its scans saw (:func:`with_seen`)."""
+    source = load_map(path, config.resolution, fallback, config.thresholds, memory_limit,
+                      config.topic, config.at, option.replace("crop", "topic"))
+    if option == MAP_CROP and config.crop is None:
+        source = with_seen(source)
+    return cropped(source, config, option)
+
+
+def with_seen(source: OccupancyMap | PointMap) -> OccupancyMap | PointMap:
+    """A CARMEN log's map with the area its scans saw at their logged poses (its free space,
+    the evidence :mod:`pcmapq.align.free_space` weighs), as ``pcmapq track`` gives its steps;
+    any other input as it is."""
+    if not (isinstance(source, PointMap) and source.kind == "carmen" and source.seen is None):
+        return source
+    return replace(source, seen=seen_of_scans(read_laser_scans(source.path), 2 * CLOSING))
 
 
 def load_pair(map_path: str | Path | PointMap, truth_path: str | Path, settings: Settings,

@@ -150,6 +150,17 @@ def endpoints(poses: np.ndarray, ranges: np.ndarray, angles: np.ndarray,
     return np.column_stack([poses[k, 0] + r * np.cos(a), poses[k, 1] + r * np.sin(a)])
 
 
+def endpoint_scans(poses: np.ndarray, ranges: np.ndarray, angles: np.ndarray,
+                   max_range: float = DEFAULT_MAX_RANGE) -> np.ndarray:
+    """(M,) the scan index of each of :func:`endpoints`' points (same arguments)."""
+    poses = np.asarray(poses, dtype=np.float64).reshape(-1, 3)
+    ranges = np.asarray(ranges, dtype=np.float64).reshape(len(poses), -1)
+    heading = poses[:, 2:3] + np.broadcast_to(angles, ranges.shape)
+    with np.errstate(invalid="ignore"):
+        keep = (ranges > 0) & (ranges <= max_range) & np.isfinite(heading)
+    return np.repeat(np.arange(len(poses)), np.count_nonzero(keep, axis=1))
+
+
 def beam_angles(n: int) -> np.ndarray:
     """Angles of the n beams of a FLASER scan in the laser frame, radians (x ahead, y left):
     ``-pi/2 + i * step``, with CARMEN's guess of ``step`` for a SICK (see the module doc)."""

@@ -16,7 +16,9 @@ import numpy as np
 from pcmapq.core.bounds import bounds
 from pcmapq.core.grid import MetricGrid
 from pcmapq.core.transform import Similarity2D
+from pcmapq.io.carmen import DEFAULT_MAX_RANGE, LaserScans, endpoint_scans, endpoints
 from pcmapq.io.clouds import SEEN_CELL, SeenCells
+from pcmapq.raster.footprint import joined_readings, view_outlines
 
 #: Fractional bits of the vertices given to OpenCV's polygon filling.
 SHIFT = 8
@@ -60,3 +62,21 @@ def seen_on(seen: SeenCells, transform: Similarity2D, grid: MetricGrid) -> np.nd
                            flags=cv2.INTER_NEAREST | cv2.WARP_INVERSE_MAP,
                            borderMode=cv2.BORDER_CONSTANT, borderValue=0)
     return drawn.view(bool)
+
+
+def scan_views(origins: np.ndarray, xy: np.ndarray, scan: np.ndarray, gap: float) -> np.ndarray:
+    """The views of K scans (K, V, 2; metres, map frame; :func:`view_outlines`) from their
+    scanners at ``origins`` (K, 2), drawn by the readings ``xy`` (N, 2; ``scan`` (N,) the scan
+    of each, in beam order) that draw a wall as a line, their neighbours within ``gap`` metres
+    (:func:`joined_readings`): a lone reading far away does not stretch a view."""
+    joined = joined_readings(xy, scan, gap)
+    return view_outlines(origins, xy[joined], scan[joined])
+
+
+def seen_of_scans(scans: LaserScans, gap: float,
+                  max_range: float = DEFAULT_MAX_RANGE) -> SeenCells:
+    """The area a CARMEN log's scans saw at their logged poses (readings up to ``max_range``
+    metres; ``gap``: see :func:`scan_views`), in the log's world frame."""
+    xy = endpoints(scans.poses, scans.ranges, scans.angles, max_range)
+    scan = endpoint_scans(scans.poses, scans.ranges, scans.angles, max_range)
+    return add_views(NO_VIEW, scan_views(scans.poses[:, :2], xy, scan, gap))

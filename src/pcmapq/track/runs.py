@@ -41,8 +41,8 @@ from pcmapq.mapping import (
     scanner_poses,
 )
 from pcmapq.mapping.reference import scans_for_poses
-from pcmapq.raster.footprint import joined_readings, view_outlines
-from pcmapq.raster.seen import NO_VIEW, add_views
+from pcmapq.raster.footprint import view_outlines
+from pcmapq.raster.seen import NO_VIEW, add_views, scan_views
 
 #: Cell of the voxel map a scan sequence grows into, metres (``pcmapq map``'s default).
 SCAN_VOXEL = 0.1
@@ -100,8 +100,7 @@ class LaserRun:
         counts = np.count_nonzero(kept, axis=1)
         offsets = np.concatenate([[0], np.cumsum(counts)])
         scan = np.repeat(np.arange(len(self)), counts)
-        joined = joined_readings(xy, scan, 2 * CLOSING)
-        views = view_outlines(self.poses[:, :2, 3], xy[joined], scan[joined])
+        views = scan_views(self.poses[:, :2, 3], xy, scan, 2 * CLOSING)
         points = np.column_stack([xy, np.zeros(len(xy))])
         before, seen = 0, NO_VIEW
         for end in ends:
