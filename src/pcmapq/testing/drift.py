@@ -17,12 +17,13 @@ CARMEN section (``bench/validation/carmen.py``) and the tests use it too.
 from __future__ import annotations
 
 import tempfile
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
 
+from pcmapq.core.errors import Refused
 from pcmapq.io.carmen import DEFAULT_MAX_RANGE, endpoints, read_flaser
 from pcmapq.report.text import number, score
 from pcmapq.settings import AlignmentConfig, Settings
@@ -39,10 +40,12 @@ class Rung:
 
     pose_error_m: largest distance between a drifted and a corrected laser position (both in
         the world frame, unaligned: drift starts at the first pose); yaw_error_deg: largest
-        heading difference; figures: what the rung's reference keeps of its result.
+        heading difference; verdict: the settings' verdict (scored forced when it is "another
+        place"); figures: what the rung's reference keeps of its result.
     """
 
     level: float
+    verdict: str
     pose_error_m: float
     yaw_error_deg: float
     fitness: float
@@ -114,7 +117,9 @@ def _scans(log: Path, scans: int | None) -> tuple[np.ndarray, np.ndarray, np.nda
 def rung(log: Path, level: float, seed: int = 0, max_range: float = DEFAULT_MAX_RANGE,
          settings: Settings | None = None, scans: int | None = None) -> Rung:
     """Score the map of ``log`` at one drift level against its corrected map, both made of its
-    first ``scans`` scans (all by default) and their readings up to ``max_range`` metres."""
+    first ``scans`` scans (all by default) and their readings up to ``max_range`` metres, with
+    ``settings`` (default: forced); a map those settings refuse is scored forced, its verdict
+    kept."""
     settings = Settings(alignment=AlignmentConfig(force=True)) if settings is None else settings
     poses, ranges, angles = _scans(log, scans)
     path_poses = drifted(poses, level, seed)
@@ -123,10 +128,15 @@ def rung(log: Path, level: float, seed: int = 0, max_range: float = DEFAULT_MAX_
                                Path(tmp) / "reference.npy")
         cloud = save_cloud(endpoints(path_poses, ranges, angles, max_range),
                            Path(tmp) / f"drift_{level:g}.npy")
-        run = timed_evaluate(cloud, reference, settings)
+        try:
+            run = timed_evaluate(cloud, reference, settings)
+            verdict = run.result.overlap.verdict
+        except Refused as refused:
+            forced = replace(settings, alignment=replace(settings.alignment, force=True))
+            run, verdict = timed_evaluate(cloud, reference, forced), refused.verdict
     result, dist = run.result, run.result.distances
     return Rung(
-        level=level,
+        level=level, verdict=verdict,
         pose_error_m=float(np.max(np.linalg.norm(path_poses[:, :2] - poses[:, :2], axis=1))),
         yaw_error_deg=float(np.degrees(np.max(np.abs(wrap(path_poses[:, 2] - poses[:, 2]))))),
         fitness=result.alignment.fitness,
@@ -135,7 +145,7 @@ def rung(log: Path, level: float, seed: int = 0, max_range: float = DEFAULT_MAX_
         f1={k: d.matching.f1 for k, d in result.detectors.items()},
         accuracy_mean_m=dist.accuracy.mean, completeness_mean_m=dist.completeness.mean,
         chamfer_m=dist.chamfer_m, f_at_01=f_at(result, 0.1), seconds=run.seconds,
-        figures=run.summary())
+        figures={**run.summary(), "verdict": verdict})
 
 
 def ladder(log: Path, levels: tuple[float, ...] = DEFAULT_LEVELS, seed: int = 0,
@@ -148,14 +158,14 @@ def ladder(log: Path, levels: tuple[float, ...] = DEFAULT_LEVELS, seed: int = 0,
 def markdown(rungs: list[Rung]) -> str:
     """The ladder as a markdown table."""
     names = list(rungs[0].quality) if rungs else []
-    head = (["drift %", "max pose err m", "max yaw err deg", "fitness"]
+    head = (["drift %", "max pose err m", "max yaw err deg", "verdict", "fitness"]
             + [f"q {n}" for n in names] + [f"prec {n}" for n in names]
             + [f"f1 {n}" for n in names]
             + ["acc mean m", "comp mean m", "Chamfer m", "F@0.1", "s"])
     lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for r in rungs:
         cells = ([f"{100 * r.level:g}", number(r.pose_error_m, 2), number(r.yaw_error_deg, 1),
-                  number(r.fitness)] + [score(r.quality[n]) for n in names]
+                  r.verdict, number(r.fitness)] + [score(r.quality[n]) for n in names]
                  + [score(r.precision[n]) for n in names] + [score(r.f1[n]) for n in names]
                  + [number(r.accuracy_mean_m), number(r.completeness_mean_m), number(r.chamfer_m),
                     number(r.f_at_01), f"{r.seconds:.1f}"])

@@ -7,8 +7,9 @@ from pcmapq.testing import drift
 
 def test_not_falling_lists_the_steps_where_f1_does_not_fall() -> None:
     def rung(level: float, harris: float, sift: float | None):
-        return drift.Rung(level=level, pose_error_m=0.0, yaw_error_deg=0.0, fitness=1.0,
-                          quality={}, precision={}, f1={"harris": harris, "sift": sift},
+        return drift.Rung(level=level, verdict="same place", pose_error_m=0.0,
+                          yaw_error_deg=0.0, fitness=1.0, quality={}, precision={},
+                          f1={"harris": harris, "sift": sift},
                           accuracy_mean_m=None, completeness_mean_m=None, chamfer_m=None,
                           f_at_01=None, seconds=0.0)
 
