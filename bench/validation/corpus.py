@@ -298,6 +298,11 @@ KIND_TEXT = {
     "clutter": "plans 0-2 with that many boxes of 0.5 m added in the free space",
     "broken half": "plans 0-2 with the walls right of x = 12 m turned by the level about the "
                    "plan's middle (12, 8) m",
+    "doubled half": "plans 0-2 with the walls right of x = 12 m drawn a second time, the level "
+                    "higher (a map that drew a stretch twice); images: the hull of both drawn "
+                    "free",
+    "partial view": "plans 0-2 cut to the walls in that share of their width, from the left "
+                    "(a map of part of the building), against the whole plan",
     "drift": f"the first {DRIFT_SCANS} scans of the CARMEN logs "
              f"{', '.join(DRIFT_LOGS)} placed along their poses re-integrated with a relative "
              "gain error of the level on every rotation and translation increment (seed 0), "
@@ -351,8 +356,8 @@ def markdown(records: list[Record], names: tuple[str, ...] = ("confidence",),
         holdings_table(records), "",
         "\"walls moved\" is how far the degradation moves the map's walls (median of the "
         "level's pairs): the noise's sigma along each axis; the largest move of a wall point "
-        "for a bend or a broken half (the plan's far corner); 0 where walls are dropped or "
-        "boxes added; for drift, the largest position error of the drifted trajectory.", "",
+        "for a bend or a broken half (the plan's far corner); the offset of a doubled half; 0 "
+        "where walls are dropped, cut off or boxes added; for drift, the largest position error of the drifted trajectory.", "",
         *(f"- {kind}: {KIND_TEXT[kind]}." for kind in kinds if kind in KIND_TEXT),
     ]
     if screened:
@@ -380,7 +385,7 @@ def markdown(records: list[Record], names: tuple[str, ...] = ("confidence",),
                       f"{sum(scored(r) for r in synth_other)} of {len(synth_other)}."]
     growth = []
     for kind, unit in (("bend", "m of the far corner"), ("broken half", "degrees"),
-                       ("drift", "% of drift")):
+                       ("doubled half", "m of offset"), ("drift", "% of drift")):
         levels = offsets(records, kind)
         if levels:
             values = [v for _, v in levels]

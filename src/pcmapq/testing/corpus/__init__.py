@@ -20,7 +20,8 @@ Same place:
   plan's lower-left corner, see :data:`BENDS`: the far corner (24, 16) m moves 0.2 / 0.5 / 1.0 m,
   the far end of the bottom wall (24, 0) 0.83 times that); clutter (``clutter`` 200 / 400 / 800
   boxes of 0.5 m); a broken half (the walls right of x = 12 m turned by 5 / 10 / 15 degrees about
-  the plan's middle (12, 8) m).
+  the plan's middle (12, 8) m); a doubled half (those walls drawn again 0.5 / 1 / 2 m higher);
+  a partial view (the walls in the left 0.6 / 0.45 / 0.3 of the plan's width).
 - CARMEN drift: the first :data:`DRIFT_SCANS` scans of the intel, fhw and aces logs placed along
   their poses re-integrated with drift 1 / 2 / 3 / 4 % (the unit of :mod:`pcmapq.testing.drift`:
   relative gain errors of the rotation and translation increments, ``1 + e * (1 + z)``,

@@ -1,8 +1,8 @@
 """The corpus's synthetic places and maps: building plans (``synth.building_plan``) of the
 usual 24 x 16 m size and of other outlines, and the round rooms, each drawn as an image or
 sampled as points in a known map frame, degraded by a ladder's level (wall noise, missing
-walls, a bend, clutter, a broken half); and the screening of two layouts for the walls they
-share."""
+walls, a bend, clutter, a broken half, a doubled half, a partial view); and the screening of
+two layouts for the walls they share."""
 
 from __future__ import annotations
 
@@ -41,6 +41,11 @@ MISSING = (0.2, 0.4, 0.6)
 BEND = (0.2, 0.5, 1.0)
 CLUTTER = (200, 400, 800)
 BROKEN = (5.0, 10.0, 15.0)
+#: A doubled half: the right half drawn a second time this many metres up (a SLAM map that
+#: closed no loop drew it twice); a partial view: the share of the plan's width kept, from
+#: its left side (a robot that saw part of the building).
+DOUBLED = (0.5, 1.0, 2.0)
+PARTIAL = (0.6, 0.45, 0.3)
 
 
 #: Other places: building plans of these sizes (width, height, metres), seeds 10 + 5 * (index
@@ -169,6 +174,21 @@ def broken(segments: np.ndarray, degrees: float) -> np.ndarray:
     return out
 
 
+def doubled(segments: np.ndarray, offset: float) -> np.ndarray:
+    """The plan with its right half (pieces of at most 0.1 m whose middle lies right of
+    WIDTH / 2) drawn a second time, ``offset`` metres up: a map that drew a stretch twice."""
+    fine = synth.densify(segments, 0.1)
+    right = fine[(fine[:, 0] + fine[:, 2]) / 2 > WIDTH / 2]
+    return np.vstack([fine, right + np.array([0.0, offset, 0.0, offset])])
+
+
+def partial(segments: np.ndarray, share: float) -> np.ndarray:
+    """The pieces of the plan (at most 0.1 m) whose middle lies in the left ``share`` of its
+    width: a map of part of the building."""
+    fine = synth.densify(segments, 0.1)
+    return fine[(fine[:, 0] + fine[:, 2]) / 2 <= share * WIDTH]
+
+
 def degrade(kind: str, level: float, segments: np.ndarray, seed: int) -> tuple[np.ndarray, float]:
     """The plan degraded at ``level`` of ladder ``kind``, and the wall noise to draw it with."""
     if kind == "noise":
@@ -181,6 +201,10 @@ def degrade(kind: str, level: float, segments: np.ndarray, seed: int) -> tuple[n
         return synth.clutter(segments, int(level), seed), 0.0
     if kind == "broken half":
         return broken(segments, float(level)), 0.0
+    if kind == "doubled half":
+        return doubled(segments, float(level)), 0.0
+    if kind == "partial view":
+        return partial(segments, float(level)), 0.0
     raise ValueError(f"unknown degradation {kind!r}")
 
 
@@ -204,9 +228,9 @@ def synthetic_map(form: str, seed: int | Layout, kind: str | None = None, level:
 def moved(kind: str, level: float) -> float:
     """How far degradation ``kind`` at ``level`` moves the walls of plan 0, metres: the wall
     noise's sigma (each point's offset along each axis); the largest move of a wall point for
-    the bend and the broken half (the plan's far corner); 0 where walls are dropped or boxes
-    added."""
-    if kind == "noise":
+    the bend and the broken half (the plan's far corner); the offset of a doubled half; 0 where
+    walls are dropped, cut off or boxes added."""
+    if kind in ("noise", "doubled half"):
         return float(level)
     if kind not in ("bend", "broken half"):
         return 0.0

@@ -24,10 +24,12 @@ from .maps import (
     BEND,
     BROKEN,
     CLUTTER,
+    DOUBLED,
     MISSING,
     NOISE,
     OTHER_SEED,
     OTHER_SIZES,
+    PARTIAL,
     Layout,
     bend_note,
     frame,
@@ -63,6 +65,8 @@ KINDS: dict[str, str] = {
     "bend": "far corner moved, m",
     "clutter": "boxes of 0.5 m",
     "broken half": "right half turned, degrees",
+    "doubled half": "right half drawn again, offset m",
+    "partial view": "share of the plan's width kept",
     "drift": "gain error, %",
     "drift full log": "gain error, %",
     "other carmen": "",
@@ -75,7 +79,8 @@ KINDS: dict[str, str] = {
 #: Other places made of synthetic layouts (screened for shared walls, see :func:`screen`).
 SYNTHETIC_OTHER = ("other layout", "other rooms", "other degraded")
 #: The degradation ladders.
-LADDERS = ("noise", "missing walls", "bend", "clutter", "broken half", "drift")
+LADDERS = ("noise", "missing walls", "bend", "clutter", "broken half", "doubled half",
+           "partial view", "drift")
 
 
 @dataclass(frozen=True)
@@ -222,7 +227,8 @@ def synthetic_pairs() -> Iterator[Pair]:
             yield Pair(name, "clean", None, True, form, synthetic_map(form, s, name=name),
                        truth_plan(s), known=frame(s))
     ladders: dict[str, tuple] = {"noise": NOISE, "missing walls": MISSING, "bend": BEND,
-                                 "clutter": CLUTTER, "broken half": BROKEN}
+                                 "clutter": CLUTTER, "broken half": BROKEN,
+                                 "doubled half": DOUBLED, "partial view": PARTIAL}
     for kind, levels in ladders.items():
         for form in ("points", "image"):
             for level in levels:
