@@ -1,5 +1,5 @@
-"""What every picture shares, defined once and loadable without matplotlib (the command line
-reads its ``--arrow-scale`` default here): the arrow scale, colours, sizes.
+"""What every picture shares, defined once and loadable without matplotlib: the rule of the
+arrows' scale, colours, sizes.
 
 Sizes are chosen for the HTML report: a figure is at most :data:`FIGURE_WIDTH_PX` pixels wide
 at :data:`DPI`, the width the report shows it at, unscaled, so a font of ``s`` points reads as
@@ -8,9 +8,11 @@ at :data:`DPI`, the width the report shows it at, unscaled, so a font of ``s`` p
 
 from __future__ import annotations
 
-#: Displacement arrows are drawn this many times longer than the displacement, in every panel
-#: of every run (``--arrow-scale``): a 0.1 m displacement is a 1 m arrow on the map's axes.
-ARROW_SCALE = 10.0
+#: Displacement arrows go from the truth's feature (or region) to where the map has it: the
+#: map's error. One scale holds for every panel of a figure: unless ``--arrow-scale`` sets it,
+#: the largest of 1, 2 or 5 times a power of ten, from 1 to MAX_ARROW_SCALE, that draws the
+#: longest arrow no longer than ARROW_SHARE of a panel's larger side.
+ARROW_SHARE, MAX_ARROW_SCALE = 0.12, 100.0
 #: Dots per inch of the PNGs; rasters are pooled to the pixels their panel has at this
 #: resolution (saved at fewer dpi, matplotlib skips some of their rows again).
 DPI = 130
