@@ -22,6 +22,18 @@ FIGURE_WIDTH_PX = 1350
 TITLE_PT, TEXT_PT = 10.0, 9.0
 #: The truth's walls, dark, drawn over the aligned map's, light, so both show where they meet.
 TRUTH_DARK, MAP_LIGHT = (0.16, 0.16, 0.16), (0.55, 0.76, 1.0)
+#: The Okabe-Ito palette (Okabe and Ito, "Color Universal Design", 2008): told apart with
+#: every common colour-vision deficiency. Black, orange, sky blue, bluish green, yellow, blue,
+#: vermillion, reddish purple.
+OKABE_ITO = ("#000000", "#E69F00", "#56B4E9", "#009E73", "#F0E442", "#0072B2", "#D55E00",
+             "#CC79A7")
+#: Each detector's colour wherever detectors are told apart by colour (the compare figure,
+#: the track curves): one Okabe-Ito colour each, of those that read on white (no yellow, no
+#: black) four no two of which are closer than 147 in RGB (0-255 a channel; none closer).
+DETECTOR_COLOURS = {"harris": OKABE_ITO[2], "hough": OKABE_ITO[6], "sift": OKABE_ITO[3],
+                    "rooms": OKABE_ITO[7]}
+#: Colours of the other curves beside the detectors' (the palette's rest, then grey).
+OTHER_COLOURS = (OKABE_ITO[0], OKABE_ITO[1], OKABE_ITO[5], "#999999", OKABE_ITO[4])
 #: Features and the footprint outline.
 MATCHED, MISSING, EXTRA, FOOTPRINT = "#1a9850", "#d73027", "#f28e2b", "#7b3294"
 #: Markers of one kind are thinned to at most one per square of this many pixels: walls, and
