@@ -14,11 +14,12 @@ import pytest
 from pcmapq.core.bounds import nonzero_window
 from pcmapq.core.grid import MetricGrid
 from pcmapq.evaluation.pipeline import evaluate
+from pcmapq.report.arrows import auto_arrow_scale
 from pcmapq.report.canvas import MARGIN_MIN_M, extent, overlay, window
 from pcmapq.report.heatmap import distance_heatmap
 from pcmapq.report.html import report_html
 from pcmapq.report.plot import png_bytes, vectorial_figure
-from pcmapq.report.style import ARROW_SCALE, DPI, FIGURE_WIDTH_PX, MAP_LIGHT
+from pcmapq.report.style import DPI, FIGURE_WIDTH_PX, MAP_LIGHT
 from pcmapq.report.text import number
 from pcmapq.report.viewer import viewer_html
 from pcmapq.settings import MatchingConfig, Settings
@@ -60,10 +61,10 @@ def region(fig, ax, box: tuple[float, float, float, float], dpi: int = 130):
 
 
 def test_vectorial_figure_draws_the_displacements(moved_result, perfect_result):
-    """Black arrows where the wall moved, ARROW_SCALE times its 0.5 m long, none there when
-    nothing moved (Hough panel: the arm's displacement is drawn at its midpoint; the truth's
-    dark walls are lighter than the arrows)."""
-    arrows = (MOVED_ARM[0], MOVED_ARM[0] + 0.5 * ARROW_SCALE, *MOVED_ARM[2:])
+    """Black arrows where the wall moved, the figure's scale times its 0.5 m long, none there
+    when nothing moved (Hough panel: the arm's displacement is drawn at its midpoint; the
+    truth's dark walls are lighter than the arrows)."""
+    arrows = (MOVED_ARM[0], MOVED_ARM[0] + 0.5 * auto_arrow_scale(moved_result), *MOVED_ARM[2:])
 
     def black(result) -> int:
         fig = vectorial_figure(result)
@@ -93,7 +94,7 @@ def test_report_is_self_contained(moved_result):
     page = report_html(moved_result)
     assert not re.search(r'(src|href)="(https?:)?//', page)  # nothing fetched from a network
     assert page.count("data:image/png;base64,") == 4  # two figures, the viewer's two walls
-    assert f"displacement x{ARROW_SCALE:g}" not in page  # the legend is in the figure
+    assert f"displacement x{auto_arrow_scale(moved_result):g}" not in page  # in the figure
     q = moved_result.detectors["harris"].matching.quality
     assert f"{q:.3f}" in page and "coverage" in page
 
@@ -228,7 +229,7 @@ def test_a_plan_in_a_large_image_fills_its_panels(moved_result):
         for ax in panels:
             np.testing.assert_allclose([*ax.get_xlim(), *ax.get_ylim()], box)
             assert ax.images[0].get_array().shape[:2] == padded.truth_occupied[shown].shape
-    view = re.search(r'viewBox="([^"]+)"', viewer_html(padded, ARROW_SCALE)).group(1)
+    view = re.search(r'viewBox="([^"]+)"', viewer_html(padded, 10.0)).group(1)
     np.testing.assert_allclose([float(v) for v in view.split()],
                                [shown[1].start - 0.5, shown[0].start - 0.5,
                                 shown[1].stop - shown[1].start, shown[0].stop - shown[0].start])
@@ -266,15 +267,15 @@ def test_legend_and_scale_bars_inside_the_canvas_and_off_the_data(moved_result, 
 
 
 def test_arrow_scale_is_one_for_every_panel_and_run(moved_result, fine_result):
-    """Two maps of different grids: every panel's arrows are ARROW_SCALE times their
+    """Two maps of different grids: every panel's arrows are one scale times their
     displacement in metres, and the legend says so; --arrow-scale changes every one."""
     for result in (moved_result, fine_result):
-        for gain in (ARROW_SCALE, 3.0):
-            fig = vectorial_figure(result, gain)
+        for gain, chosen in ((auto_arrow_scale(result), None), (3.0, 3.0)):
+            fig = vectorial_figure(result, chosen)
             quivers = [c for ax in fig.axes for c in ax.collections if hasattr(c, "scale_units")]
             assert quivers and {(q.scale_units, q.scale) for q in quivers} == {("xy", 1 / gain)}
             legend = (fig.legends or [ax.get_legend() for ax in fig.axes if ax.get_legend()])[0]
-            assert f"displacement x{gain:g} (0.1 m drawn {0.1 * gain:g} m)" in \
+            assert f"displacement x{gain:g} (0.1 m drawn {0.1 * gain:g} m), truth to map" in \
                 [t.get_text() for t in legend.get_texts()]
 
 

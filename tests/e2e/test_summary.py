@@ -1,5 +1,6 @@
 """The comparison table and figure of many results (report/summary.py): rows from real result
-JSONs, nulls kept as nulls (empty cell, 'n/a', a gap in the figure), failed rows, outputs
+JSONs, nulls kept as nulls (empty cell, 'n/a', a gap in the figure), the maps' names never
+over one another, failed rows, outputs
 written whole and the same bytes every time."""
 
 from __future__ import annotations
@@ -8,6 +9,7 @@ import csv
 import io
 import json
 
+import numpy as np
 import pytest
 
 from pcmapq.core.errors import InputError
@@ -189,3 +191,56 @@ def test_a_detector_run_by_choice_is_shown_where_a_row_has_it(table_rows, monkey
     assert "rooms_quality" in summary.terminal_columns(with_rooms)
     bars = {c.get_label() for c in summary_figure(with_rooms).axes[0].containers}
     assert "rooms" in bars
+
+
+def _names_apart(fig, ax, names: list[str]) -> None:
+    """The names under the bars of ``ax`` lie inside ``fig`` and none overlaps another, each
+    under its own bars, in order; names are left out (every k-th shown) only where even
+    upright ones would touch."""
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    n = len(names)
+    labels = [t for t in ax.get_xticklabels() if t.get_visible() and t.get_text()]
+    boxes = [t.get_window_extent(renderer) for t in labels]
+    for i, box in enumerate(boxes):
+        assert box.x0 >= -0.5 and box.x1 <= fig.bbox.x1 + 0.5 and box.y0 >= -0.5, box
+        assert not any(box.overlaps(other) for other in boxes[i + 1:]), labels[i].get_text()
+    shown = [t.get_text().replace("\n", "") for t in labels]
+    ticks = [int(round(t.get_position()[0])) for t in labels]
+    assert shown == [names[k] for k in ticks] and ticks == sorted(ticks)
+    if len(shown) < n:  # every step-th name, and the names of step - 1 would touch
+        step = ticks[1] - ticks[0]
+        assert np.diff(ticks).tolist() == [step] * (len(ticks) - 1)
+        per_name = (boxes[1].x0 - boxes[0].x0) / step
+        assert (step - 1) * per_name < 1.3 * boxes[0].width
+    assert len(shown) == n or all(t.get_rotation() == 90 for t in labels)
+
+
+def test_names_too_many_to_show_upright_are_thinned():
+    """120 names under a 4-inch axes (3 pixels a name): every k-th, upright, apart."""
+    from pcmapq.report.plot import plt
+    from pcmapq.report.summary import _name_labels
+
+    fig, ax = plt.subplots(figsize=(4.0, 3.0), layout="constrained")
+    ax.set_xlim(-0.6, 119.6)
+    names = [f"intel_drift_{i}pc" for i in range(120)]
+    _name_labels(fig, ax, names)
+    _names_apart(fig, ax, names)
+    assert 10 < len([t for t in ax.get_xticklabels() if t.get_text()]) < 60
+
+
+@pytest.mark.parametrize(("n", "stem", "lines"), [
+    (3, "m{}", 1), (4, "run_{}_gopi5go_house_tile_cart", 0),
+    (9, "run_{}_gopi5go_house_tile_cart", 4),
+    (12, "a_very_long_map_name_without_breaks{}xxxxxxxxxxxxxxxx", 0)])
+def test_the_maps_names_never_overlap(n, stem, lines):
+    """Few maps of short names: level; more, or longer names: wrapped (here onto 4 lines)
+    where that fits, else upright (``lines`` 0); never over one another."""
+    names = [stem.format(i) for i in range(n)]
+    rows = [{**failed_row(name, name, "t", 0, ""), "exit_code": 0, "harris_quality": 0.5}
+            for name in names]
+    fig = summary_figure(rows)
+    _names_apart(fig, fig.axes[-1], names)
+    labels = fig.axes[-1].get_xticklabels()
+    assert {t.get_text().count("\n") + 1 if t.get_rotation() == 0 else 0
+            for t in labels} == {lines}

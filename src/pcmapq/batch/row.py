@@ -21,7 +21,6 @@ from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.io.digest import sha256_file
 from pcmapq.io.targets import input_files
 from pcmapq.io.writers import OutputSet, one_line, write_atomic
-from pcmapq.report.style import ARROW_SCALE
 from pcmapq.results.figures import failed_row, table_row
 
 #: The folder of DIR where each row's record (its inputs' checksums, settings, outputs) is
@@ -143,9 +142,9 @@ def _compute(task: Task, key: dict) -> Outcome:
             from pcmapq.report.html import report_html
             from pcmapq.report.plot import figure_bytes, vectorial_figure
         if task.plot:
-            files[outputs["--plot"]] = figure_bytes(vectorial_figure(result, ARROW_SCALE), "png")
+            files[outputs["--plot"]] = figure_bytes(vectorial_figure(result), "png")
         if task.report:
-            files[outputs["--report"]] = report_html(result, ARROW_SCALE).encode("utf-8")
+            files[outputs["--report"]] = report_html(result).encode("utf-8")
     with OutputSet() as staged:
         for path, data in files.items():
             write_atomic(path, data, staged)

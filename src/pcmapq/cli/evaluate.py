@@ -25,7 +25,7 @@ from pcmapq.mapping import (
     build_map_kiss,
 )
 from pcmapq.report import export
-from pcmapq.report.style import ARROW_SCALE
+from pcmapq.report.style import ARROW_SHARE, MAX_ARROW_SCALE
 from pcmapq.report.table import print_table
 from pcmapq.results import gates
 from pcmapq.results.result import Result
@@ -65,9 +65,12 @@ def eval_command(
         "extension.")] = None,
     report: Annotated[Path | None, typer.Option(
         help="Write a self-contained HTML report (figures embedded).")] = None,
-    arrow_scale: Annotated[float, typer.Option(
-        help="Displacement arrows of --plot and --report are drawn this many times their "
-        "length, in every panel of every run.", min=1e-6, callback=options.finite)] = ARROW_SCALE,
+    arrow_scale: Annotated[float | None, typer.Option(
+        help="Draw the displacement arrows of --plot and --report this many times their "
+        f"length, in every panel (default: a round scale, 1 to {MAX_ARROW_SCALE:g}, that "
+        f"draws the longest arrow within {ARROW_SHARE * 100:g}\u00a0% of a panel's larger "
+        "side; stated in the legend).", min=1e-6, callback=options.finite,
+        show_default=False)] = None,
     max_memory: MaxMemory = None,
     aligned: Annotated[Path | None, typer.Option(
         help="Write the map moved into the truth's frame: .ply/.pcd for a cloud map (a 3D "
@@ -139,7 +142,7 @@ def eval_command(
 
 
 def _write_outputs(result: Result, map_path: Path | PointMap, settings: Settings,
-                   arrow_scale: float, *, json_path: str | None, vectors: Path | None,
+                   arrow_scale: float | None, *, json_path: str | None, vectors: Path | None,
                    regions: Path | None, plot: Path | None, report: Path | None,
                    exports: dict[str, Path | None], json_text: str | None = None) -> list[Path]:
     """Write the run's output files, all or nothing: each is produced into a temporary file

@@ -11,9 +11,10 @@ import numpy as np
 
 from pcmapq import __version__
 from pcmapq.core.stats import Stats
+from pcmapq.report.arrows import arrow_scale
 from pcmapq.report.heatmap import distance_heatmap
 from pcmapq.report.plot import png_bytes, vectorial_figure
-from pcmapq.report.style import ARROW_SCALE, FIGURE_WIDTH_PX
+from pcmapq.report.style import FIGURE_WIDTH_PX
 from pcmapq.report.text import number, score
 from pcmapq.report.viewer import nearest_distances, viewer_html
 from pcmapq.report.viewer_page import STYLE as VIEWER_STYLE
@@ -115,9 +116,10 @@ def _run(result: Result) -> str:
             f"<details><summary>settings</summary><pre>{settings}</pre></details>")
 
 
-def report_html(result: Result, arrow_scale: float = ARROW_SCALE) -> str:
+def report_html(result: Result, scale: float | None = None) -> str:
     """The whole report as one HTML document (figures as embedded PNGs, no network needed);
-    displacement arrows ``arrow_scale`` times their length."""
+    every arrow, of the interactive map and of the figure, ``scale`` times its length (None:
+    :func:`~pcmapq.report.arrows.auto_arrow_scale`)."""
     a, tf, o = result.alignment, result.transform, result.overlap
     inputs = _table(["", "path", "kind"], [
         ["map", str(result.map_path), result.map_kind],
@@ -160,8 +162,9 @@ def report_html(result: Result, arrow_scale: float = ARROW_SCALE) -> str:
                 "clouds:</p>"
         dist += _stats_table("points", [("3D accuracy (map to truth)", d3.accuracy),
                                         ("3D completeness (truth to map)", d3.completeness)])
-    viewer = viewer_html(result, arrow_scale)
-    vectors = _img(png_bytes(vectorial_figure(result, arrow_scale)), "vectorial map per detector")
+    gain = arrow_scale(result, scale)
+    viewer = viewer_html(result, gain)
+    vectors = _img(png_bytes(vectorial_figure(result, gain)), "vectorial map per detector")
     heat = _img(png_bytes(distance_heatmap(result)),
                 "distance heatmaps: accuracy (map to truth) and completeness (truth to map)")
     lists = "".join(_lists(name, det) for name, det in result.detectors.items())

@@ -4,9 +4,10 @@ picture shares is :mod:`pcmapq.report.canvas`; the rooms over a panel,
 
 Everything is drawn in the truth frame, axes in metres (matplotlib, headless Agg backend). The
 truth's walls are drawn dark over the aligned map's, light and one pixel wider, so both show
-where they meet; displacement arrows are :data:`~pcmapq.report.style.ARROW_SCALE` times their
-length (``--arrow-scale``) in every panel of every run; legends and scale bars stand outside the
-axes, never over data; a figure is at most as wide as the HTML report shows it (style.py).
+where they meet; every arrow goes from the truth to where the map has it (the map's error), at
+one scale in every panel of a figure (:mod:`pcmapq.report.arrows`), stated in the legend;
+legends and scale bars stand outside the axes, never over data; a figure is at most as wide as
+the HTML report shows it (style.py).
 
 Rasters are drawn at display resolution: a grid with more cells across or down than its panel
 has pixels at :data:`DPI` is pooled (:mod:`pcmapq.raster.pool`) to fit, so a map of any size
@@ -37,6 +38,14 @@ from matplotlib.lines import Line2D  # noqa: E402
 from mpl_toolkits.axes_grid1.anchored_artists import AnchoredSizeBar  # noqa: E402
 
 from pcmapq.raster.pool import max_pool  # noqa: E402
+from pcmapq.report.arrows import (  # noqa: E402
+    ARROW_WORDS,
+    NICE,
+    arrow_label,
+    arrow_scale,
+    feature_arrows,
+    region_arrows,
+)
 from pcmapq.report.canvas import (  # noqa: E402
     density,
     extent,
@@ -51,7 +60,6 @@ from pcmapq.report.canvas import (  # noqa: E402
 )
 from pcmapq.report.rooms_layer import draw_rooms, rooms_legend  # noqa: E402
 from pcmapq.report.style import (  # noqa: E402
-    ARROW_SCALE,
     DPI,
     EXTRA,
     FIGURE_WIDTH_PX,
@@ -68,7 +76,6 @@ from pcmapq.report.style import (  # noqa: E402
 from pcmapq.report.text import score  # noqa: E402
 from pcmapq.results.result import DetectorResult, Result  # noqa: E402
 
-NICE = (1, 2, 5)
 #: Figure width, inches: the report's figure width at DPI.
 WIDTH_IN = FIGURE_WIDTH_PX / DPI
 
@@ -123,33 +130,27 @@ def _panel(ax: Axes, result: Result, box: tuple[float, float, float, float], ima
     ax.scatter(*missing.T, s=28, c=MISSING, marker="x", zorder=3)
     ax.scatter(*extra.T, s=28, c=EXTRA, marker="+", zorder=3)
     if len(matched):
-        ax.quiver(*det.truth_xy[matched].T, *m.displacement[matched].T, angles="xy",
-                  scale_units="xy", scale=1.0 / gain, color="black", width=0.003, zorder=4)
+        tails, vectors = feature_arrows(det)
+        ax.quiver(*tails[matched].T, *vectors[matched].T, angles="xy", scale_units="xy",
+                  scale=1.0 / gain, color="black", width=0.003, zorder=4)
     _scale_bar(ax)
-
-
-def regions_gain(result: Result, arrow_scale: float) -> float:
-    """How many times its length a region's offset is drawn: ``arrow_scale``, less where the
-    largest offset would then be longer than a tile (drawn a tile long), at least 1."""
-    c = result.consistency
-    largest = float(c.offset_m.max()) if len(c.offset_m) else 0.0
-    return float(np.clip(c.tile_m / max(largest, 1e-9), 1.0, arrow_scale))
 
 
 def _regions_panel(ax: Axes, result: Result, box: tuple[float, float, float, float],
                    image: np.ndarray, gain: float) -> None:
     """The consistency map over ``image`` (the pooled raster of the ``box``, metres): at each
-    region of the map, the offset that fits it to the truth on its own, ``gain`` times its
-    length; held regions black, the others grey."""
+    region of the map, an arrow from where the region fits the truth on its own to where the
+    map has it, ``gain`` times its length; held regions black, the others grey."""
     c = result.consistency
     ax.imshow(image, extent=box, origin="upper", interpolation="nearest")
+    tails, vectors = region_arrows(result)
     for held, colour in ((False, "0.6"), (True, "black")):
         k = c.held == held
         if k.any():
-            ax.quiver(*c.centre[k].T, *c.offset[k].T, angles="xy", scale_units="xy",
+            ax.quiver(*tails[k].T, *vectors[k].T, angles="xy", scale_units="xy",
                       scale=1.0 / gain, color=colour, width=0.004, zorder=4)
-    if (largest := c.largest()) is not None:
-        ax.scatter(*c.centre[largest], s=90, facecolors="none", edgecolors=MISSING, zorder=5)
+    if (largest := c.largest()) is not None:  # ringed where its arrow starts
+        ax.scatter(*tails[largest], s=90, facecolors="none", edgecolors=MISSING, zorder=5)
     _scale_bar(ax)
 
 
@@ -159,14 +160,15 @@ def _legend_handles(result: Result, gain: float, as_density: bool) -> list[Line2
                Line2D([], [], color=MAP_LIGHT, lw=4, label=f"aligned map {what}"),
                Line2D([], [], color=MATCHED, marker="o", ls="", label="matched (truth)"),
                Line2D([], [], color="black", marker=r"$\rightarrow$", ls="", ms=12,
-                      label=f"displacement x{gain:g} ({0.1:g} m drawn {0.1 * gain:g} m)"),
+                      label=arrow_label(gain)),
                Line2D([], [], color=MISSING, marker="x", ls="", label="missing in the map"),
                Line2D([], [], color=EXTRA, marker="+", ls="", label="extra in the map")]
     if not result.full:
         handles.append(Line2D([], [], color=FOOTPRINT, lw=1, label="map footprint"))
     if _has_regions(result):
         handles.append(Line2D([], [], color=MISSING, marker="o", mfc="none", ls="",
-                              label="regions: largest offset (grey: not held)"))
+                              label="region with the largest offset (grey arrow: not "
+                              "held)"))
     if result.rooms is not None:
         handles += rooms_legend(result.rooms)
     return handles
@@ -202,11 +204,13 @@ def _grid_shape(n: int) -> tuple[int, int]:
     return -(-n // cols), cols
 
 
-def vectorial_figure(result: Result, arrow_scale: float = ARROW_SCALE) -> Figure:
+def vectorial_figure(result: Result, scale: float | None = None) -> Figure:
     """One panel per detector: the truth dark over the aligned map light, matched features with
-    their displacement arrows (``arrow_scale`` times their length), missing truth features and
-    extra map features (thinned where crowded), the footprint outline; over the part of the
-    truth grid that holds walls (:func:`~pcmapq.report.canvas.window`)."""
+    their displacement arrows, missing truth features and extra map features (thinned where
+    crowded), the footprint outline; then the regions' panel; over the part of the truth grid
+    that holds walls (:func:`~pcmapq.report.canvas.window`). Every arrow is ``scale`` times its
+    length (None: :func:`~pcmapq.report.arrows.auto_arrow_scale`)."""
+    gain = arrow_scale(result, scale)
     names = list(result.detectors)
     shown = window(result)
     width, height = size_m(result, shown)
@@ -220,16 +224,15 @@ def vectorial_figure(result: Result, arrow_scale: float = ARROW_SCALE) -> Figure
     axes = list(grid.flat[:panels])
     as_density = density(result)
     thin_px = THIN_PX_DENSITY if as_density else THIN_PX
-    fitted_legend(fig, _legend_handles(result, arrow_scale, as_density),
+    fitted_legend(fig, _legend_handles(result, gain, as_density),
                   f"markers thinned to one per {thin_px} px square where crowded; "
                   f"{'shade: share of occupied cells per pixel; ' if as_density else ''}"
-                  "axes and arrows in metres", grid.flat[-1] if spare else None)
+                  f"{ARROW_WORDS}; axes and arrows in metres", grid.flat[-1] if spare else None)
     for ax, name in zip(axes, names, strict=False):
         _title(ax, result, name)
     if _has_regions(result):
-        gain = regions_gain(result, arrow_scale)
-        axes[-1].set_title(f"{result.overlap.verdict}: each region's fit\n"
-                           f"on its own, offsets x{gain:.3g}", fontsize=TITLE_PT)
+        axes[-1].set_title(f"{result.overlap.verdict}: each region's fit\non its own",
+                           fontsize=TITLE_PT)
     for ax in axes:
         frame(ax, result, shown)
     factor, pixel_m = pooling(fig, axes, result.truth_occupied[shown].shape)
@@ -238,7 +241,7 @@ def vectorial_figure(result: Result, arrow_scale: float = ARROW_SCALE) -> Figure
                     grown(shade(result.map_occupied[shown], factor, as_density)))
     footprint = None if result.full else max_pool(result.overlap.footprint[shown], factor)
     for ax, name in zip(axes, names, strict=False):
-        _panel(ax, result, box, image, footprint, result.detectors[name], arrow_scale,
+        _panel(ax, result, box, image, footprint, result.detectors[name], gain,
                thin_px * pixel_m)
     if _has_regions(result):
         _regions_panel(axes[-1], result, box, image, gain)

@@ -5,19 +5,22 @@ the paper's Figure 7). Metres and degrees; an undefined figure stays None: an em
 
 from __future__ import annotations
 
+import math
+import re
 from collections.abc import Sequence
 from pathlib import Path
 
+import numpy as np
+
 from pcmapq.core.errors import InputError
 from pcmapq.io.writers import OutputSet, one_line, write_atomic
+from pcmapq.report.style import DETECTOR_COLOURS
 from pcmapq.results.figures import HEADERS, SCORES, TAIL, columns, ranked
 from pcmapq.results.result import DECIMALS
 from pcmapq.settings import DEFAULT_DETECTORS, DETECTOR_NAMES
 
 #: Decimals of the markdown table: scale 4, degrees 2, everything else 3 (as the terminal).
 MD_DECIMALS = {"scale": 4, "yaw_deg": 2}
-#: Bar colours of the detectors in the figure.
-COLOURS = {"harris": "#4477aa", "hough": "#ee6677", "sift": "#228833"}
 
 
 def table_csv(rows: Sequence[dict[str, object]]) -> str:
@@ -120,23 +123,94 @@ def summary_figure(rows: Sequence[dict[str, object]]):
         ax.set_ylabel(label)
     axes[0].set_title("feature quality, precision and f1 per map")
     axes[0].legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), frameon=False)
-    axes[-1].set_xticks(range(n), [str(row.get("name")) for row in rows],
-                        rotation=30 if n > 6 else 0, ha="right" if n > 6 else "center")
     axes[-1].set_xlim(-0.6, n - 0.4)
+    # laid out before the gaps' marks, which stand inside the panels: a layout measures them
+    _name_labels(fig, axes[-1], [str(row.get("name")) for row in rows])
+    for ax, (score, _) in zip(axes, PANELS, strict=True):
+        _gap_marks(ax, rows, score, width)
     return fig
 
 
-def _score_panel(ax, rows: Sequence[dict[str, object]], score: str, width: float) -> None:
-    """One panel of :func:`summary_figure`: ``score`` of every detector, per map."""
+#: Most lines a map's name is wrapped onto under its bars; the characters it breaks after.
+NAME_LINES, NAME_BREAKS = 4, "_-./ "
+
+
+def wrapped(name: str, width: int) -> list[str]:
+    """``name`` cut after its NAME_BREAKS characters into lines of at most ``width``
+    characters, each as long as it can be; a piece longer than ``width`` stays whole."""
+    pieces = re.findall(rf"[^{re.escape(NAME_BREAKS)}]*[{re.escape(NAME_BREAKS)}]|.+$", name)
+    lines: list[str] = []
+    for piece in pieces:
+        if lines and len(lines[-1]) + len(piece) <= width:
+            lines[-1] += piece
+        else:
+            lines.append(piece)
+    return lines or [name]
+
+
+def _name_labels(fig, ax, names: list[str]) -> None:
+    """The maps' names under the bars of ``ax`` (one unit apart), none over another: level
+    when each fits the width of its group of bars; else wrapped at NAME_BREAKS onto at most
+    NAME_LINES lines; else upright, every k-th name where even upright ones would touch."""
+    renderer = fig.canvas.get_renderer()
+
+    def slot() -> float:
+        """Pixels a name has across once ``fig`` is laid out (with 5 % to spare)."""
+        fig.get_layout_engine().execute(fig)
+        return 0.95 * ax.get_window_extent(renderer).width / np.ptp(ax.get_xlim())
+
+    def widest() -> float:
+        return max(t.get_window_extent(renderer).width for t in ax.get_xticklabels())
+
+    ax.set_xticks(range(len(names)), names)
+    across = slot()
+    if widest() <= across:
+        return
+    level = ax.get_xticklabels()[0].get_window_extent(renderer).height  # one line's
+    width = int(max(len(n) for n in names) * across / widest())
+    lines = [wrapped(n, width) for n in names]
+    if width > 0 and max(len(w) for w in lines) <= NAME_LINES:
+        ax.set_xticks(range(len(names)), ["\n".join(w) for w in lines])
+        if widest() <= across:
+            return _taller(fig, ax, level)
+    ax.set_xticks(range(len(names)), names, rotation=90)
+    step = max(1, math.ceil(1.3 * level / slot()))
+    ax.set_xticks(range(0, len(names), step), names[::step], rotation=90)
+    _taller(fig, ax, level)
+
+
+def _taller(fig, ax, level: float) -> None:
+    """``fig`` made taller by what the tick labels of ``ax`` take below one level line of
+    ``level`` pixels, so that the panels keep their height."""
+    renderer = fig.canvas.get_renderer()
+    high = max(t.get_window_extent(renderer).height for t in ax.get_xticklabels())
+    fig.set_figheight(fig.get_figheight() + max(0.0, high - level) / fig.dpi)
+
+
+def _bars(rows: Sequence[dict[str, object]], score: str, width: float):
+    """Per detector shown: its name, the x of its bar in each map's group (maps one unit apart)
+    and its ``score`` in each row (None: undefined)."""
     names = shown_detectors(rows)
-    k = len(names)
     for j, det in enumerate(names):
-        xs = [i + (j - (k - 1) / 2) * width for i in range(len(rows))]
-        values = [row.get(f"{det}_{score}") for row in rows]
+        yield (det, [i + (j - (len(names) - 1) / 2) * width for i in range(len(rows))],
+               [row.get(f"{det}_{score}") for row in rows])
+
+
+def _score_panel(ax, rows: Sequence[dict[str, object]], score: str, width: float) -> None:
+    """One panel of :func:`summary_figure`: the bars of ``score`` of every detector, per
+    map."""
+    for det, xs, values in _bars(rows, score, width):
         shown = [(x, v) for x, v, row in zip(xs, values, rows, strict=True)
                  if v is not None and not row.get("exit_code")]
-        ax.bar([x for x, _ in shown], [v for _, v in shown], width, color=COLOURS.get(det),
+        ax.bar([x for x, _ in shown], [v for _, v in shown], width, color=DETECTOR_COLOURS[det],
                label=det)
+    ax.set_ylim(0.0, 1.05)
+
+
+def _gap_marks(ax, rows: Sequence[dict[str, object]], score: str, width: float) -> None:
+    """The marks of one panel of :func:`summary_figure`: 'n/a' where ``score`` is undefined,
+    'failed (exit N)' over a failed map's group."""
+    for _, xs, values in _bars(rows, score, width):
         for x, v, row in zip(xs, values, rows, strict=True):
             if v is None and not row.get("exit_code"):
                 ax.text(x, 0.02, "n/a", rotation=90, ha="center", va="bottom", fontsize=7,
@@ -145,7 +219,6 @@ def _score_panel(ax, rows: Sequence[dict[str, object]], score: str, width: float
         if row.get("exit_code"):
             ax.text(i, 0.5, f"failed (exit {row['exit_code']})", rotation=90, ha="center",
                     va="center", fontsize=8, color="#aa3377")
-    ax.set_ylim(0.0, 1.05)
 
 
 def write_summary(rows: Sequence[dict[str, object]], out_dir: Path) -> list[Path]:

@@ -12,7 +12,7 @@ from matplotlib.figure import Figure
 
 from pcmapq.report.html import STYLE, _img, _table
 from pcmapq.report.plot import WIDTH_IN, png_bytes, vectorial_figure
-from pcmapq.report.summary import COLOURS
+from pcmapq.report.style import DETECTOR_COLOURS, OTHER_COLOURS
 from pcmapq.report.text import number
 from pcmapq.results.result import Result
 
@@ -31,8 +31,6 @@ FAMILIES = (
     ("relative pose error, RPE: translation [m]", ("rpe_rmse_m",)),
     ("relative pose error, RPE: rotation [deg]", ("rpe_rot_rmse_deg",)),
 )
-#: Colours of the columns that are not a detector's.
-OTHER = ("#222222", "#aa3377", "#66ccee", "#ccbb44", "#bbbbbb")
 #: The least height of a panel in metres (degrees): centimetre (tenth-degree) noise stays flat.
 MIN_METRES, MIN_DEGREES = 0.1, 0.5
 #: The path over the vectorial map, drawn over a white edge above every marker.
@@ -54,10 +52,11 @@ TABLE = {"step": 0, "scans": 0, "distance_m": 1, "harris_quality": 3, "hough_qua
 
 
 def _colour(column: str, index: int) -> str:
-    for name, colour in COLOURS.items():
-        if column.startswith(name):
+    """A curve's colour: its detector's (``harris_quality``), else the ``index``-th other."""
+    for name, colour in DETECTOR_COLOURS.items():
+        if column.startswith(f"{name}_"):
             return colour
-    return OTHER[index % len(OTHER)]
+    return OTHER_COLOURS[index % len(OTHER_COLOURS)]
 
 
 def drop_words(rows: list[dict], drop: dict | None) -> str:

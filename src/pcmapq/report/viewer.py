@@ -203,8 +203,8 @@ def viewer_html(result: Result, arrow_scale: float) -> str:
 <div id="viewer-tip"></div></div>
 <p class="note">Wheel: zoom; drag: pan; hover or click a feature: its detector, match, position
 and displacement (truth frame, metres). Arrows: {arrow_scale:g} times the displacement, from
-the truth feature towards the map feature; rings: missing truth features (red) and extra map
-features (orange). Walls shown at up to {VIEWER_PX} pixels across (here {factor} x {factor}
+the truth feature to the map feature (the map's error); rings: missing truth features
+(red) and extra map features (orange). Walls shown at up to {VIEWER_PX} px (here {factor} x {factor}
 cells a pixel); every feature is shown. Where the features crowd over thin walls (zoomed out),
 the walls are drawn over them and every feature as a ring; zoom in to draw them over the
 walls.</p>

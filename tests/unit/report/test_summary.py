@@ -3,8 +3,15 @@ no figures, the CSV's columns are the union of the taus in order, the gates' ver
 
 from __future__ import annotations
 
-from pcmapq.report.summary import table_csv
+from itertools import combinations
+
+import numpy as np
+from matplotlib.colors import to_rgb
+
+from pcmapq.report.style import DETECTOR_COLOURS
+from pcmapq.report.summary import summary_figure, table_csv
 from pcmapq.results.figures import HEAD, failed_row
+from pcmapq.settings import DETECTOR_NAMES
 
 
 def test_failed_row_has_no_figures():
@@ -51,3 +58,21 @@ def test_rank_puts_refused_and_failed_maps_last():
     md = table_md(rows).splitlines()
     assert md[0].startswith("| name | rank |") and md[2].startswith("| broken | 6 |")
     assert "another place" in md[3]
+
+
+def test_every_detector_has_its_own_colour_in_the_figure():
+    """One colour per detector, from one table: every detector has one, no two closer than
+    100 (RGB, 0-255 a channel: harris and rooms were 38 apart), and each detector's bars in the
+    compare figure have it."""
+    assert set(DETECTOR_NAMES) <= set(DETECTOR_COLOURS)
+    for a, b in combinations(DETECTOR_NAMES, 2):
+        gap = 255 * np.linalg.norm(np.subtract(to_rgb(DETECTOR_COLOURS[a]),
+                                               to_rgb(DETECTOR_COLOURS[b])))
+        assert gap > 100, (a, b, gap)
+    row = {**failed_row("m", "m", "t", 0, ""), "exit_code": 0,
+           **{f"{d}_{s}": 0.5 for d in DETECTOR_NAMES for s in ("quality", "precision", "f1")}}
+    bars = {c.get_label(): c.patches[0].get_facecolor()[:3]
+            for c in summary_figure([row]).axes[0].containers}
+    assert set(bars) == set(DETECTOR_NAMES)
+    for name, rgb in bars.items():
+        np.testing.assert_allclose(rgb, to_rgb(DETECTOR_COLOURS[name]), atol=1e-6)
