@@ -184,7 +184,7 @@ class Settings:
     def to_dict(self) -> dict:
         """Every option as plain JSON types, one object per stage, in metres and degrees:
         ``init`` as ``{"x_m", "y_m", "yaw_deg", "scale"}``, tuples as lists."""
-        return _plain(self)
+        return plain(self)
 
     @classmethod
     def from_dict(cls, doc: dict) -> Settings:
@@ -213,14 +213,14 @@ class Settings:
             noref=NoRefConfig(**doc.get("noref", {"enabled": False})))  # saved before noref
 
 
-def _plain(value):
+def plain(value):
     """A settings value as plain JSON types (see :meth:`Settings.to_dict`)."""
     if isinstance(value, Similarity2D):
         return value.to_dict()
     if is_dataclass(value):
-        return {f.name: _plain(getattr(value, f.name)) for f in fields(value)}
+        return {f.name: plain(getattr(value, f.name)) for f in fields(value)}
     if isinstance(value, dict):
-        return {k: _plain(v) for k, v in value.items()}
+        return {k: plain(v) for k, v in value.items()}
     if isinstance(value, tuple):
-        return [_plain(v) for v in value]
+        return [plain(v) for v in value]
     return value
