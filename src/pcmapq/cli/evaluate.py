@@ -20,6 +20,7 @@ from pcmapq.core.errors import InputError
 from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.io import PointMap, targets
 from pcmapq.io.clouds import flat
+from pcmapq.io.formats import map_formats, scan_formats
 from pcmapq.io.writers import OutputSet, write_atomic
 from pcmapq.mapping import (
     build_map_kiss,
@@ -39,12 +40,11 @@ from pcmapq.settings import (
 def eval_command(
     ctx: typer.Context,
     paths: Annotated[list[Path], typer.Argument(
-        metavar="MAP TRUTH", help="Map to score: image (.png/.pgm, with its ROS YAML), YAML, "
-        "cloud (.ply/.pcd/.xyz/.npy/.bin) or CARMEN log; then the ground truth, same kinds. "
-        "With --scans, TRUTH only.")],
+        metavar="MAP TRUTH", help=f"Map to score: {map_formats()}; then the ground truth, "
+        "same kinds. With --scans, TRUTH only.")],
     scans: Annotated[Path | None, typer.Option(
-        help="Build the map from this scan sequence with KISS-ICP (see 'pcmapq map') and "
-        "score it.")] = None,
+        help=f"Build the map from this scan sequence (a folder of {scan_formats()} scans, or a "
+        "ROS recording) with KISS-ICP (see 'pcmapq map') and score it.")] = None,
     max_scans: Annotated[int | None, typer.Option(
         help="With --scans: use only the first N scans.", min=1)] = None,
     scan_topic: Annotated[str | None, typer.Option(

@@ -22,6 +22,7 @@ from pcmapq.io import OccupancyMap, PointMap, load_map, targets
 from pcmapq.io.clouds import flat
 from pcmapq.io.extent import Box, check_span, hint
 from pcmapq.io.extent import crop as crop_input
+from pcmapq.io.formats import map_formats, scan_formats
 from pcmapq.io.writers import OutputSet, write_atomic
 from pcmapq.mapping import (
     posed_map,
@@ -52,12 +53,11 @@ def checked(source: OccupancyMap | PointMap, box: Box | None,
 def inspect_command(
     ctx: typer.Context,
     map_path: Annotated[Path | None, typer.Argument(
-        metavar="[MAP]", help="Map to inspect: cloud (.ply/.pcd/.xyz/.npy/.bin), CARMEN log, or "
-        "image (.png/.pgm with its ROS YAML, or the YAML). Or --scans with --poses.",
+        metavar="[MAP]", help=f"Map to inspect: {map_formats()}. Or --scans with --poses.",
         show_default=False)] = None,
     scans: Annotated[Path | None, typer.Option(
-        help="Inspect these scans placed at --poses instead: a folder of .bin/.ply/.pcd/.npy "
-        "scans, a ROS bag or an MCAP file.")] = None,
+        help=f"Inspect these scans placed at --poses instead: a folder of {scan_formats()} "
+        "scans, or a ROS recording (.bag, .db3, .mcap, a ROS 2 bag folder).")] = None,
     poses: Annotated[Path | None, typer.Option(
         help="With --scans: one pose per scan, a KITTI or TUM file or a folder of 4x4 text "
         "files (name order); the map is in the first scan's frame.")] = None,

@@ -17,6 +17,7 @@ from pcmapq.cli.terminal import (
 )
 from pcmapq.core.errors import InputError
 from pcmapq.io import targets
+from pcmapq.io.formats import scan_formats
 from pcmapq.io.writers import OutputSet, write_cloud
 from pcmapq.mapping import (
     build_map_from_poses,
@@ -34,7 +35,7 @@ from pcmapq.mapping import (
 @app.command("map", help=HELP["map"])
 def map_command(
     source: Annotated[Path, typer.Argument(
-        help="Scan sequence: a folder of KITTI .bin / .ply / .pcd / .npy scans, or a ROS "
+        help=f"Scan sequence: a folder of {scan_formats()} scans (KITTI's .bin), or a ROS "
         "recording (.bag, .db3, .mcap, a ROS 2 bag folder) of PointCloud2 or LaserScan "
         "messages.")],
     out: Annotated[Path, typer.Option(help="The map, .ply or .pcd (voxel centroids).")],

@@ -19,6 +19,7 @@ from pcmapq.cli.terminal import (
 )
 from pcmapq.core.errors import InputError
 from pcmapq.io import targets
+from pcmapq.io.formats import scan_formats
 from pcmapq.io.writers import OutputSet, write_atomic
 
 
@@ -28,7 +29,7 @@ def track_command(
     ctx: typer.Context,
     paths: Annotated[list[Path], typer.Argument(
         metavar="RUN TRUTH", help="The run: a CARMEN log (.log/.log.gz), scans (a folder of "
-        ".bin/.ply/.pcd/.npy scans, a ROS bag, an MCAP file), or a ROS recording of the maps a "
+        f"{scan_formats()} scans, a ROS bag, an MCAP file), or a ROS recording of the maps a "
         "SLAM system published (nav_msgs/OccupancyGrid, scored on the recording's time "
         "axis); then the ground truth, as eval's.")],
     out: Annotated[Path, typer.Option(

@@ -56,7 +56,8 @@ def load_input(path: str | Path, config: SourceConfig, option: str,
     """An input read as ``config`` says (resolution, thresholds; ``fallback``: the resolution of
     an image that has none) and cut to its crop box; see :func:`pcmapq.io.load_map`."""
     return cropped(load_map(path, config.resolution, fallback, config.thresholds, memory_limit,
-                            config.topic, config.at, option.replace("crop", "topic")),
+                            config.topic, config.at, option.replace("crop", "topic"),
+                            option.replace("crop", "resolution")),
                    config, option)
 
 

@@ -32,10 +32,8 @@ import numpy as np
 
 from pcmapq.core.errors import InputError
 from pcmapq.io.clouds import PointMap
+from pcmapq.io.formats import CARMEN_SUFFIXES
 from pcmapq.io.writers import one_line
-
-#: File name endings read as CARMEN logs (lower case).
-CARMEN_SUFFIXES = (".log", ".log.gz")
 
 #: Readings above this are dropped by default, metres.
 DEFAULT_MAX_RANGE = 30.0

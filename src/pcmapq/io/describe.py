@@ -16,7 +16,8 @@ from pcmapq.core.errors import InputError
 from pcmapq.io import load_map
 from pcmapq.io.bags import is_bag, opened, span, topics
 from pcmapq.io.clouds import PointMap
-from pcmapq.io.map_yaml import YAML_SUFFIXES, MapMeta, read_yaml
+from pcmapq.io.formats import YAML_SUFFIXES
+from pcmapq.io.map_yaml import MapMeta, read_yaml
 from pcmapq.io.occupancy import NO_RESOLUTION, OccupancyMap
 
 

@@ -13,8 +13,6 @@ import numpy as np
 from pcmapq.core.errors import InputError
 from pcmapq.io.writers import one_line
 
-#: Survey cloud formats.
-LAS_SUFFIXES, E57_SUFFIXES = (".las", ".laz"), (".e57",)
 #: Points read from a LAS file at a time (a record is up to 64 kB: a few MB a chunk).
 LAS_CHUNK = 100_000
 
