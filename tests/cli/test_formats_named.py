@@ -7,7 +7,6 @@ only packages pcmapq depends on."""
 from __future__ import annotations
 
 import re
-import tomllib
 from pathlib import Path
 
 import pytest
@@ -100,6 +99,7 @@ def test_an_image_without_resolution_names_the_option_the_command_has(args, opti
 
 def dependencies() -> set[str]:
     """The names of pcmapq's dependencies and their extras, optional ones too."""
+    tomllib = pytest.importorskip("tomllib")  # Python 3.11+
     project = tomllib.loads((REPO / "pyproject.toml").read_text())["project"]
     specs = project["dependencies"] + [s for group in project["optional-dependencies"].values()
                                        for s in group]

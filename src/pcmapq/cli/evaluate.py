@@ -1,11 +1,12 @@
-"""``pcmapq eval``: one map against its truth."""
+"""``pcmapq eval``: one map against its truth. The pipeline, the mapping and the reports are
+imported when the command runs, not when its help is shown (tests/cli/test_startup.py)."""
 
 from __future__ import annotations
 
 import sys
 from dataclasses import replace
 from pathlib import Path
-from typing import Annotated, Any
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 from rich.console import Console
@@ -17,22 +18,18 @@ from pcmapq.cli.terminal import (
     step_progress,
 )
 from pcmapq.core.errors import InputError
-from pcmapq.evaluation.pipeline import evaluate
-from pcmapq.io import PointMap, targets
-from pcmapq.io.clouds import flat
+from pcmapq.io import targets
 from pcmapq.io.formats import map_formats, scan_formats
 from pcmapq.io.writers import OutputSet, write_atomic
-from pcmapq.mapping import (
-    build_map_kiss,
-)
-from pcmapq.report import export
 from pcmapq.report.style import ARROW_SCALE
-from pcmapq.report.table import print_table
 from pcmapq.results import gates
-from pcmapq.results.result import Result
 from pcmapq.settings import (
     Settings,
 )
+
+if TYPE_CHECKING:
+    from pcmapq.io import PointMap
+    from pcmapq.results.result import Result
 
 
 @app.command("eval", help=HELP["eval"])
@@ -88,6 +85,11 @@ def eval_command(
 
     **settings_values: Any,
 ) -> None:
+    from pcmapq.evaluation.pipeline import evaluate
+    from pcmapq.io.clouds import PointMap, flat
+    from pcmapq.mapping import build_map_kiss
+    from pcmapq.report.table import print_table
+
     if len(paths) != (1 if scans else 2):
         raise typer.BadParameter("give MAP and TRUTH, or --scans DIR and TRUTH",
                                  param_hint="MAP TRUTH")
@@ -146,6 +148,8 @@ def _write_outputs(result: Result, map_path: Path | PointMap, settings: Settings
     beside its target, and all are renamed into place only once every one is produced
     (:class:`OutputSet`); the JSON is ``json_text`` when given (with gates), else the result's.
     The files written (an ``--aligned`` image's YAML too)."""
+    from pcmapq.report import export
+
     with OutputSet() as outputs:
         wrote: list[Path] = []
         if json_path not in (None, "-"):

@@ -13,7 +13,6 @@ from rich.console import Console
 from pcmapq.cli.commands import HELP, MaxMemory, app, memory_limit
 from pcmapq.cli.terminal import report_errors
 from pcmapq.io import targets
-from pcmapq.io.describe import describe, lines
 from pcmapq.io.formats import map_formats
 from pcmapq.io.writers import OutputSet, write_atomic
 
@@ -26,6 +25,8 @@ def info_command(
         "--json", help="Write the record as JSON to this path ('-' for stdout only).")] = None,
     max_memory: MaxMemory = None,
 ) -> None:
+    from pcmapq.io.describe import describe, lines
+
     err = Console(stderr=True)
     json_path = targets.kept(json_path)
     with report_errors(err):

@@ -1,4 +1,5 @@
-"""``pcmapq map``: a map from LiDAR scans (KISS-ICP or given poses)."""
+"""``pcmapq map``: a map from LiDAR scans (KISS-ICP or given poses). The LiDAR front end is
+imported when the command runs, not when its help is shown."""
 
 from __future__ import annotations
 
@@ -19,17 +20,6 @@ from pcmapq.core.errors import InputError
 from pcmapq.io import targets
 from pcmapq.io.formats import scan_formats
 from pcmapq.io.writers import OutputSet, write_cloud
-from pcmapq.mapping import (
-    build_map_from_poses,
-    build_map_kiss,
-    describe_scans,
-    open_scans,
-    recorded_poses,
-    scanner_poses,
-    scans_for_poses,
-    write_kitti_poses,
-    write_tum_poses,
-)
 
 
 @app.command("map", help=HELP["map"])
@@ -65,6 +55,18 @@ def map_command(
     quiet: Annotated[bool, typer.Option(
         "--quiet", "-q", help="Print nothing but warnings and errors.")] = False,
 ) -> None:
+    from pcmapq.mapping import (
+        build_map_from_poses,
+        build_map_kiss,
+        describe_scans,
+        open_scans,
+        recorded_poses,
+        scanner_poses,
+        scans_for_poses,
+        write_kitti_poses,
+        write_tum_poses,
+    )
+
     err = Console(stderr=True)
     poses_out, tum_out = targets.kept(poses_out), targets.kept(tum_out)
     with report_errors(err), terminal.show_warnings(err):

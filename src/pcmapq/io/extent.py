@@ -12,14 +12,12 @@ from dataclasses import replace
 
 import numpy as np
 
-from pcmapq.core.bounds import bounds
+from pcmapq.core.bounds import Box, bounds
 from pcmapq.core.cells import OCCUPIED, UNKNOWN
 from pcmapq.core.errors import InputError
 from pcmapq.core.grid import MetricGrid
 from pcmapq.io.clouds import PointMap
 from pcmapq.io.occupancy import OccupancyMap
-
-Box = tuple[float, float, float, float]
 
 #: An input wider than this, metres, is refused: no map scored on a grid of centimetres spans it.
 MAX_SPAN = 100_000.0
