@@ -124,3 +124,11 @@ def test_the_install_guide_names_only_packages_pcmapq_depends_on():
 def test_the_formats_page_names_every_format():
     text = (Path(REPO) / "docs" / "formats.md").read_text()
     assert [s for s in MAP_SUFFIXES if not named(s, text)] == []
+
+
+def test_info_counts_one_point_in_the_singular(tmp_path):
+    path = tmp_path / "one.xyz"
+    path.write_text("1 2 0\n")
+    got = CliRunner().invoke(app, ["info", str(path)])
+    assert got.exit_code == 0, got.stderr
+    assert got.stdout.startswith(f"{path}: 1 point (")

@@ -17,6 +17,7 @@ from pcmapq.cli.terminal import (
     scan_bar,
 )
 from pcmapq.core.errors import InputError
+from pcmapq.core.words import count
 from pcmapq.io import targets
 from pcmapq.io.formats import scan_formats
 from pcmapq.io.writers import OutputSet, write_cloud
@@ -100,13 +101,14 @@ def map_command(
                 points = build_map_from_poses(scans, trajectory, voxel=voxel, progress=tick)
         with OutputSet() as outputs:  # the map and its poses: all or none
             write_cloud(out, points, outputs)
-            wrote = [f"wrote {out}: {len(points)} points from {len(trajectory)} scans"]
+            wrote = [f"wrote {out}: {count(len(points), 'point')} from "
+                     f"{count(len(trajectory), 'scan')}"]
             if poses_out is not None:
                 write_kitti_poses(poses_out, trajectory, outputs)
-                wrote.append(f"wrote {poses_out}: {len(trajectory)} poses (KITTI)")
+                wrote.append(f"wrote {poses_out}: {count(len(trajectory), 'pose')} (KITTI)")
             if tum_out is not None:
                 write_tum_poses(tum_out, trajectory, outputs=outputs)
-                wrote.append(f"wrote {tum_out}: {len(trajectory)} poses (TUM)")
+                wrote.append(f"wrote {tum_out}: {count(len(trajectory), 'pose')} (TUM)")
             outputs.commit()
     if not quiet:
         for line in wrote:

@@ -6,6 +6,7 @@ from __future__ import annotations
 import re
 from collections.abc import Sequence
 
+from pcmapq.core.words import count
 from pcmapq.results.result import INCONSISTENT, LOW, OTHER, Result
 
 #: What the terms of the table mean, in one short paragraph (their definitions:
@@ -58,7 +59,8 @@ def alignment_words(result: Result) -> str:
         from pcmapq.evaluation.same_place import MIN_AGREEING
 
         agree = sum(p.agrees for p in cover.parts)
-        why = f"{agree} of its {len(cover.parts)} parts placed on their own land near its pose"
+        why = (f"{agree} of its {count(len(cover.parts), 'part')} placed on their own land near "
+               "its pose")
         if agree < MIN_AGREEING:  # the pose stands out: see same_place.verdict
             why = (f"its pose stands out in the search by "
                    f"{result.alignment.distinctiveness:.2f}; {why}")

@@ -165,6 +165,19 @@ def test_a_detector_with_nothing_to_find_reads_n_a_with_why():
     assert result.to_dict()["detectors"]["rooms"]["note"] == why
 
 
+def test_the_regions_line_counts_in_words_and_rounds_the_tile_as_metres():
+    """'44 regions of 6.6 m', not '6.64829 m'; one region is 'a region', not '1 regions'."""
+    doc = copy.deepcopy(SAMPLE_DOC)
+    doc["consistency"]["tile_m"] = 6.64829
+    text = " ".join(shown(sample_result(doc), 132).split())
+    regions = len(doc["consistency"]["regions"])
+    assert f"{regions} regions of 6.6 m" in text and "6.64829" not in text
+    doc["consistency"]["regions"] = doc["consistency"]["regions"][:1]
+    doc["consistency"]["largest_at_m"] = 0
+    text = " ".join(shown(sample_result(doc), 132).split())
+    assert "1 region of 6.6 m" in text
+
+
 def test_lines_break_between_values_only():
     assert wrap(["x 6.016 m", "y 7.985 m", "yaw 36.99 deg"], 21) == [
         "x 6.016 m, y 7.985 m,", "yaw 36.99 deg"]
