@@ -37,7 +37,7 @@ STAGES = [
     ("  the plan's alignment", "evaluation/placing.py", "align_plan"),
     ("  rasterising", "evaluation/placing.py", "map_raster"),
     ("scoring", "evaluation/scoring.py", "score"),
-    ("  the map's features", "features/__init__.py", "features"),
+    ("  the map's features", "features/registry.py", "features"),
     ("  waiting for a thread", "threading.py", "wait"),
 ]
 

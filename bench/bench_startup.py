@@ -8,8 +8,9 @@ The runs, each a fresh process started as a user starts it (``python -m pcmapq .
 checkout's ``src``):
 
 - ``python -c pass``: the interpreter's own start, the floor of any command;
-- ``pcmapq --help``, ``pcmapq inspect --help``, ``pcmapq eval --help``: start-up alone (the
-  listing; one command with the libraries its module imports);
+- ``pcmapq --version``, ``pcmapq --help``, ``pcmapq inspect --help``, ``pcmapq eval --help``:
+  start-up alone (the listing; one command's help, which loads its options and their defaults
+  but none of the pipeline, tests/cli/test_startup.py);
 - ``pcmapq inspect --scans ...``: MME, MPV and MOM of map-metrics' depth data (28 clouds,
   103,975 points, radius 0.2 m, MOM's planes from ``orth_subset/orth-0091.npy``), the command
   docs/commands/inspect.md gives;
@@ -104,7 +105,8 @@ def main() -> None:
     for index, (label, src) in enumerate(trees.items()):
         env = environment(src)
         pcmapq = [python, "-m", "pcmapq"]
-        runs |= {f"`pcmapq --help`{label}": (pcmapq + ["--help"], env),
+        runs |= {f"`pcmapq --version`{label}": (pcmapq + ["--version"], env),
+                 f"`pcmapq --help`{label}": (pcmapq + ["--help"], env),
                  f"`pcmapq inspect --help`{label}": (pcmapq + ["inspect", "--help"], env),
                  f"`pcmapq eval --help`{label}": (pcmapq + ["eval", "--help"], env),
                  f"`pcmapq inspect` on the depth data{label}":

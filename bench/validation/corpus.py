@@ -357,7 +357,8 @@ def markdown(records: list[Record], names: tuple[str, ...] = ("confidence",),
         "\"walls moved\" is how far the degradation moves the map's walls (median of the "
         "level's pairs): the noise's sigma along each axis; the largest move of a wall point "
         "for a bend or a broken half (the plan's far corner); the offset of a doubled half; 0 "
-        "where walls are dropped, cut off or boxes added; for drift, the largest position error of the drifted trajectory.", "",
+        "where walls are dropped, cut off or boxes added; for drift, the largest position "
+        "error of the drifted trajectory.", "",
         *(f"- {kind}: {KIND_TEXT[kind]}." for kind in kinds if kind in KIND_TEXT),
     ]
     if screened:

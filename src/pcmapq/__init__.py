@@ -14,7 +14,7 @@ from typing import Any
 
 __version__ = "0.1.0"
 __all__ = ["NoRefConfig", "Result", "Settings", "Tracked", "__version__", "evaluate", "inspect",
-           "load_map", "track_quality"]
+           "load_map", "read_settings", "track_quality"]
 
 
 def __getattr__(name: str) -> Any:

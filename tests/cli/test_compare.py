@@ -80,7 +80,7 @@ def test_names_replace_the_file_stems(saved, tmp_path):
     proc = run("compare", str(saved["a"]), str(saved["b"]), "--names", "one",
                "--out", str(tmp_path / "x"))
     assert proc.returncode == 2
-    assert proc.stderr == "pcmapq: error: --names gives 1 names for 2 result(s)\n"
+    assert proc.stderr == "pcmapq: error: --names gives 1 name for 2 results\n"
 
 
 def test_results_of_different_truths_are_refused_unless_allowed(saved, tmp_path):

@@ -148,7 +148,7 @@ def _scans(folder: Path) -> tuple[Path, Path]:
 def test_map_outputs_all_or_none(tmp_path: Path, monkeypatch):
     """`pcmapq map`: the poses failing after the map is produced leaves no map; a pose output
     on the input poses is refused before any work, the poses byte for byte as they were."""
-    import pcmapq.cli.map_scans
+    import pcmapq.mapping
 
     scans, poses = _scans(tmp_path)
     before = _files(tmp_path)
@@ -160,7 +160,7 @@ def test_map_outputs_all_or_none(tmp_path: Path, monkeypatch):
     def broken(path: Path, *_: object, **__: object) -> None:
         raise InputError(f"{path}: cannot write: No space left on device")
 
-    monkeypatch.setattr(pcmapq.cli.map_scans, "write_tum_poses", broken)
+    monkeypatch.setattr(pcmapq.mapping, "write_tum_poses", broken)  # imported as map runs
     code, _, err = _cli("map", scans, "--poses", poses, "--out", tmp_path / "m.ply",
                         "--poses-out", tmp_path / "p.txt", "--tum-out", tmp_path / "t.tum")
     assert code == 2 and err.strip().endswith("t.tum: cannot write: No space left on device")

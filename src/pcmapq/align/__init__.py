@@ -10,13 +10,31 @@ Modules: :mod:`~pcmapq.align.params` (:class:`AlignParams`, the tunables),
 :mod:`~pcmapq.align.coarse` (the global search), :mod:`~pcmapq.align.point_to_point`,
 :mod:`~pcmapq.align.point_to_line` and :mod:`~pcmapq.align.similarity_icp` (the ICP stages),
 :mod:`~pcmapq.align.rigid3d` (3D clouds; it loads Open3D on import, so it is not imported
-here). Importing this package loads no Open3D: it is imported where ICP runs.
+here). Importing this package loads no Open3D: it is imported where ICP runs. The planar
+alignment (SciPy, Numba) loads on first use of its names, so that the settings, which hold
+:class:`AlignParams`, load none of it.
 """
 
 from __future__ import annotations
 
+import importlib
+from typing import TYPE_CHECKING, Any
+
 from pcmapq.align.params import AlignParams
-from pcmapq.align.planar import Alignment, align, align_similarity, score
 from pcmapq.core.transform import Similarity2D
 
+if TYPE_CHECKING:
+    from pcmapq.align.planar import Alignment, align, align_similarity, score
+
 __all__ = ["AlignParams", "Alignment", "Similarity2D", "align", "align_similarity", "score"]
+
+#: The names of :mod:`pcmapq.align.planar`, loaded on first use.
+_PLANAR = ("Alignment", "align", "align_similarity", "score")
+
+
+def __getattr__(name: str) -> Any:
+    if name in _PLANAR:
+        value = getattr(importlib.import_module("pcmapq.align.planar"), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -6,7 +6,8 @@
 
 :func:`evaluate` is ``pcmapq eval``, :func:`inspect` ``pcmapq inspect``,
 :func:`track_quality` ``pcmapq track`` (without its files; ``pcmapq.track`` is the package that
-does the work), :func:`load_map` the loader every command uses.
+does the work), :func:`load_map` the loader every command uses, :func:`read_settings` what
+``--config FILE`` reads.
 Frames: ``p_truth = s * R(yaw) * p_map + t``.
 """
 
@@ -20,11 +21,12 @@ from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.io import OccupancyMap, PointMap, load_map
 from pcmapq.results.result import Result
 from pcmapq.settings import NoRefConfig, Settings
+from pcmapq.settings.file import read_settings
 from pcmapq.track import Tracked, open_run, step_ends, track_run, travelled
 from pcmapq.track.runs import reference_poses_of
 
 __all__ = ["NoRefConfig", "Result", "Settings", "Tracked", "evaluate", "inspect", "load_map",
-           "track_quality"]
+           "read_settings", "track_quality"]
 
 
 def inspect(map_path: str | Path, config: NoRefConfig | None = None,

@@ -17,6 +17,7 @@ from pathlib import Path
 import yaml
 
 from pcmapq.core.errors import InputError
+from pcmapq.core.words import count
 from pcmapq.settings import Settings
 from pcmapq.settings.build import build, option_words
 from pcmapq.settings.file import read_settings
@@ -183,7 +184,7 @@ def _csv_cells(manifest: Path, text: str) -> list[dict[str, object]]:
     for i, row in enumerate(reader, 1):
         if "\0extra" in row:
             raise InputError(f"{manifest}: row {i}: more cells than the header's "
-                             f"{len(reader.fieldnames)} columns")
+                             f"{count(len(reader.fieldnames), 'column')}")
         rows.append({k.strip(): ("" if v is None else v.strip()) for k, v in row.items()})
     return [row for row in rows if any(row.values())]
 

@@ -17,6 +17,7 @@ from pcmapq.cli.terminal import (
     report_errors,
 )
 from pcmapq.core.errors import InputError
+from pcmapq.core.words import count
 from pcmapq.io import targets
 from pcmapq.io.writers import OutputSet, same_file, write_atomic
 from pcmapq.results import gates
@@ -121,7 +122,8 @@ def batch_command(
         counts = {s: sum(o.status == s for o in outcomes) for s in ("computed", "skipped",
                                                                     "failed")}
         gated = sum(o.exit_code == gates.EXIT_CODE for o in outcomes)
-        err.print(f"{len(outcomes)} rows: " + ", ".join(f"{n} {s}" for s, n in counts.items())
+        err.print(f"{count(len(outcomes), 'row')}: "
+                  + ", ".join(f"{n} {s}" for s, n in counts.items())
                   + (f", {gated} failing a gate" if rules else "")
                   + f"; wrote {out / 'table.csv'}, table.md, figure.png", markup=False,
                   highlight=False, soft_wrap=True)

@@ -1,11 +1,12 @@
-"""``pcmapq eval``: one map against its truth."""
+"""``pcmapq eval``: one map against its truth. The pipeline, the mapping and the reports are
+imported when the command runs, not when its help is shown (tests/cli/test_startup.py)."""
 
 from __future__ import annotations
 
 import sys
 from dataclasses import replace
 from pathlib import Path
-from typing import Annotated, Any
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 from rich.console import Console
@@ -17,21 +18,18 @@ from pcmapq.cli.terminal import (
     step_progress,
 )
 from pcmapq.core.errors import InputError
-from pcmapq.evaluation.pipeline import evaluate
-from pcmapq.io import PointMap, targets
-from pcmapq.io.clouds import flat
+from pcmapq.io import targets
+from pcmapq.io.formats import map_formats, scan_formats
 from pcmapq.io.writers import OutputSet, write_atomic
-from pcmapq.mapping import (
-    build_map_kiss,
-)
-from pcmapq.report import export
 from pcmapq.report.style import ARROW_SHARE, MAX_ARROW_SCALE
-from pcmapq.report.table import print_table
 from pcmapq.results import gates
-from pcmapq.results.result import Result
 from pcmapq.settings import (
     Settings,
 )
+
+if TYPE_CHECKING:
+    from pcmapq.io import PointMap
+    from pcmapq.results.result import Result
 
 
 @app.command("eval", help=HELP["eval"])
@@ -39,12 +37,11 @@ from pcmapq.settings import (
 def eval_command(
     ctx: typer.Context,
     paths: Annotated[list[Path], typer.Argument(
-        metavar="MAP TRUTH", help="Map to score: image (.png/.pgm, with its ROS YAML), YAML, "
-        "cloud (.ply/.pcd/.xyz/.npy/.bin) or CARMEN log; then the ground truth, same kinds. "
-        "With --scans, TRUTH only.")],
+        metavar="MAP TRUTH", help=f"Map to score: {map_formats()}; then the ground truth, "
+        "same kinds. With --scans, TRUTH only.")],
     scans: Annotated[Path | None, typer.Option(
-        help="Build the map from this scan sequence with KISS-ICP (see 'pcmapq map') and "
-        "score it.")] = None,
+        help=f"Build the map from this scan sequence (a folder of {scan_formats()} scans, or a "
+        "ROS recording) with KISS-ICP (see 'pcmapq map') and score it.")] = None,
     max_scans: Annotated[int | None, typer.Option(
         help="With --scans: use only the first N scans.", min=1)] = None,
     scan_topic: Annotated[str | None, typer.Option(
@@ -91,6 +88,11 @@ def eval_command(
 
     **settings_values: Any,
 ) -> None:
+    from pcmapq.evaluation.pipeline import evaluate
+    from pcmapq.io.clouds import PointMap, flat
+    from pcmapq.mapping import build_map_kiss
+    from pcmapq.report.table import print_table
+
     if len(paths) != (1 if scans else 2):
         raise typer.BadParameter("give MAP and TRUTH, or --scans DIR and TRUTH",
                                  param_hint="MAP TRUTH")
@@ -149,6 +151,8 @@ def _write_outputs(result: Result, map_path: Path | PointMap, settings: Settings
     beside its target, and all are renamed into place only once every one is produced
     (:class:`OutputSet`); the JSON is ``json_text`` when given (with gates), else the result's.
     The files written (an ``--aligned`` image's YAML too)."""
+    from pcmapq.report import export
+
     with OutputSet() as outputs:
         wrote: list[Path] = []
         if json_path not in (None, "-"):

@@ -13,20 +13,20 @@ from rich.console import Console
 from pcmapq.cli.commands import HELP, MaxMemory, app, memory_limit
 from pcmapq.cli.terminal import report_errors
 from pcmapq.io import targets
-from pcmapq.io.describe import describe, lines
+from pcmapq.io.formats import map_formats
 from pcmapq.io.writers import OutputSet, write_atomic
 
 
 @app.command("info", help=HELP["info"])
 def info_command(
     path: Annotated[Path, typer.Argument(
-        metavar="FILE", help="Any input: an image or its YAML, a cloud (.ply/.pcd/.xyz/.npy/.bin/"
-        ".las/.laz/.e57), a CARMEN log, a ROS recording (.bag, .db3, .mcap or a ROS 2 bag "
-        "folder).")],
+        metavar="FILE", help=f"Any input: {map_formats()}.")],
     json_path: Annotated[str | None, typer.Option(
         "--json", help="Write the record as JSON to this path ('-' for stdout only).")] = None,
     max_memory: MaxMemory = None,
 ) -> None:
+    from pcmapq.io.describe import describe, lines
+
     err = Console(stderr=True)
     json_path = targets.kept(json_path)
     with report_errors(err):

@@ -1,10 +1,11 @@
-"""``pcmapq inspect``: no-reference figures of one map."""
+"""``pcmapq inspect``: no-reference figures of one map. The figures, the loaders and the
+LiDAR front end are imported when the command runs, not when its help is shown."""
 
 from __future__ import annotations
 
 import sys
 from pathlib import Path
-from typing import Annotated, Any
+from typing import TYPE_CHECKING, Annotated, Any
 
 import numpy as np
 import typer
@@ -16,19 +17,13 @@ from pcmapq.cli.terminal import (
     report_errors,
 )
 from pcmapq.core import memory
-from pcmapq.evaluation.inspect_map import inspect_map, summary_lines, to_json
-from pcmapq.evaluation.truth import needed_memory
-from pcmapq.io import OccupancyMap, PointMap, load_map, targets
-from pcmapq.io.clouds import flat
-from pcmapq.io.extent import Box, check_span, hint
-from pcmapq.io.extent import crop as crop_input
+from pcmapq.core.bounds import Box
+from pcmapq.io import load_map, targets
+from pcmapq.io.formats import map_formats, scan_formats
 from pcmapq.io.writers import OutputSet, write_atomic
-from pcmapq.mapping import (
-    posed_map,
-    read_pose_matrix,
-    read_poses,
-)
-from pcmapq.metrics.posed import place_subset, read_orthogonal_subset
+
+if TYPE_CHECKING:
+    from pcmapq.io import OccupancyMap, PointMap
 
 #: The crop option of inspect, named in messages.
 CROP = "--crop"
@@ -39,6 +34,11 @@ def checked(source: OccupancyMap | PointMap, box: Box | None,
     """The map cut to ``box``, after the checks eval makes on its inputs: no wider than it
     can score (:func:`~pcmapq.io.extent.check_span`) and, for an image, within the memory
     limit its walls' image takes, each refused in one line that says what looks wrong."""
+    from pcmapq.evaluation.truth import needed_memory
+    from pcmapq.io.extent import check_span, hint
+    from pcmapq.io.extent import crop as crop_input
+    from pcmapq.io.occupancy import OccupancyMap
+
     source = source if box is None else crop_input(source, box, CROP)
     check_span(source, CROP)
     if isinstance(source, OccupancyMap):
@@ -52,12 +52,11 @@ def checked(source: OccupancyMap | PointMap, box: Box | None,
 def inspect_command(
     ctx: typer.Context,
     map_path: Annotated[Path | None, typer.Argument(
-        metavar="[MAP]", help="Map to inspect: cloud (.ply/.pcd/.xyz/.npy/.bin), CARMEN log, or "
-        "image (.png/.pgm with its ROS YAML, or the YAML). Or --scans with --poses.",
+        metavar="[MAP]", help=f"Map to inspect: {map_formats()}. Or --scans with --poses.",
         show_default=False)] = None,
     scans: Annotated[Path | None, typer.Option(
-        help="Inspect these scans placed at --poses instead: a folder of .bin/.ply/.pcd/.npy "
-        "scans, a ROS bag or an MCAP file.")] = None,
+        help=f"Inspect these scans placed at --poses instead: a folder of {scan_formats()} "
+        "scans, or a ROS recording (.bag, .db3, .mcap, a ROS 2 bag folder).")] = None,
     poses: Annotated[Path | None, typer.Option(
         help="With --scans: one pose per scan, a KITTI or TUM file or a folder of 4x4 text "
         "files (name order); the map is in the first scan's frame.")] = None,
@@ -75,6 +74,11 @@ def inspect_command(
 
     **settings_values: Any,
 ) -> None:
+    from pcmapq.evaluation.inspect_map import inspect_map, summary_lines, to_json
+    from pcmapq.io.clouds import PointMap, flat
+    from pcmapq.mapping import posed_map, read_pose_matrix, read_poses
+    from pcmapq.metrics.posed import place_subset, read_orthogonal_subset
+
     err = Console(stderr=True)
     json_path = targets.kept(json_path)
     with report_errors(err), terminal.show_warnings(err):

@@ -1,4 +1,5 @@
-"""``pcmapq map``: a map from LiDAR scans (KISS-ICP or given poses)."""
+"""``pcmapq map``: a map from LiDAR scans (KISS-ICP or given poses). The LiDAR front end is
+imported when the command runs, not when its help is shown."""
 
 from __future__ import annotations
 
@@ -16,25 +17,16 @@ from pcmapq.cli.terminal import (
     scan_bar,
 )
 from pcmapq.core.errors import InputError
+from pcmapq.core.words import count
 from pcmapq.io import targets
+from pcmapq.io.formats import scan_formats
 from pcmapq.io.writers import OutputSet, write_cloud
-from pcmapq.mapping import (
-    build_map_from_poses,
-    build_map_kiss,
-    describe_scans,
-    open_scans,
-    recorded_poses,
-    scanner_poses,
-    scans_for_poses,
-    write_kitti_poses,
-    write_tum_poses,
-)
 
 
 @app.command("map", help=HELP["map"])
 def map_command(
     source: Annotated[Path, typer.Argument(
-        help="Scan sequence: a folder of KITTI .bin / .ply / .pcd / .npy scans, or a ROS "
+        help=f"Scan sequence: a folder of {scan_formats()} scans (KITTI's .bin), or a ROS "
         "recording (.bag, .db3, .mcap, a ROS 2 bag folder) of PointCloud2 or LaserScan "
         "messages.")],
     out: Annotated[Path, typer.Option(help="The map, .ply or .pcd (voxel centroids).")],
@@ -64,6 +56,18 @@ def map_command(
     quiet: Annotated[bool, typer.Option(
         "--quiet", "-q", help="Print nothing but warnings and errors.")] = False,
 ) -> None:
+    from pcmapq.mapping import (
+        build_map_from_poses,
+        build_map_kiss,
+        describe_scans,
+        open_scans,
+        recorded_poses,
+        scanner_poses,
+        scans_for_poses,
+        write_kitti_poses,
+        write_tum_poses,
+    )
+
     err = Console(stderr=True)
     poses_out, tum_out = targets.kept(poses_out), targets.kept(tum_out)
     with report_errors(err), terminal.show_warnings(err):
@@ -97,13 +101,14 @@ def map_command(
                 points = build_map_from_poses(scans, trajectory, voxel=voxel, progress=tick)
         with OutputSet() as outputs:  # the map and its poses: all or none
             write_cloud(out, points, outputs)
-            wrote = [f"wrote {out}: {len(points)} points from {len(trajectory)} scans"]
+            wrote = [f"wrote {out}: {count(len(points), 'point')} from "
+                     f"{count(len(trajectory), 'scan')}"]
             if poses_out is not None:
                 write_kitti_poses(poses_out, trajectory, outputs)
-                wrote.append(f"wrote {poses_out}: {len(trajectory)} poses (KITTI)")
+                wrote.append(f"wrote {poses_out}: {count(len(trajectory), 'pose')} (KITTI)")
             if tum_out is not None:
                 write_tum_poses(tum_out, trajectory, outputs=outputs)
-                wrote.append(f"wrote {tum_out}: {len(trajectory)} poses (TUM)")
+                wrote.append(f"wrote {tum_out}: {count(len(trajectory), 'pose')} (TUM)")
             outputs.commit()
     if not quiet:
         for line in wrote:

@@ -15,7 +15,7 @@ from typing import Annotated, Any
 import typer
 
 from pcmapq.settings import Settings
-from pcmapq.settings.build import base_settings, build, get_path
+from pcmapq.settings.build import base_settings, build, default_of
 from pcmapq.settings.file import read_settings
 from pcmapq.settings.table import FLOAT, INT, SWITCH, Option, OptionError, options_of
 
@@ -57,15 +57,13 @@ def settings_options(command: str) -> Callable:
     """A decorator that gives a typer command ``--config`` and the settings options of
     ``command`` from the option table, after its own: the command takes them as
     ``**settings_values`` and builds its Settings with :func:`settings_of`."""
-    defaults = base_settings(command)
-
     def wrap(func: Callable) -> Callable:
         signature = inspect.signature(func, eval_str=True)
         own = [p for p in signature.parameters.values() if p.kind != p.VAR_KEYWORD]
         extra = [inspect.Parameter("config", inspect.Parameter.KEYWORD_ONLY, default=None,
                                    annotation=Annotated[Path | None, typer.Option(
                                        help=CONFIG_HELP, metavar="FILE")])]
-        extra += [_parameter(o, command, defaults) for o in options_of(command)]
+        extra += [_parameter(o, command) for o in options_of(command)]
 
         @functools.wraps(func)
         def command_function(*args: Any, **kwargs: Any) -> Any:
@@ -92,9 +90,9 @@ def settings_of(ctx: typer.Context, command: str, values: dict[str, Any]) -> Set
         raise typer.BadParameter(exc.message, param_hint=exc.option) from None
 
 
-def _parameter(option: Option, command: str, defaults: Settings) -> inspect.Parameter:
+def _parameter(option: Option, command: str) -> inspect.Parameter:
     """The typer parameter of one table option; its default is the setting's default."""
-    default = option.show(get_path(defaults, option.path))
+    default = option.show(default_of(command, option.path))
     kind = TYPES.get(option.kind, str | None)
     decls = [option.flag] if option.flag else []
     bounds = {k: v for k, v in (("min", option.lo), ("max", option.hi)) if math.isfinite(v)}

@@ -18,7 +18,9 @@ from pcmapq.cli.terminal import (
     step_progress,
 )
 from pcmapq.core.errors import InputError
+from pcmapq.core.words import count
 from pcmapq.io import targets
+from pcmapq.io.formats import scan_formats
 from pcmapq.io.writers import OutputSet, write_atomic
 
 
@@ -28,7 +30,7 @@ def track_command(
     ctx: typer.Context,
     paths: Annotated[list[Path], typer.Argument(
         metavar="RUN TRUTH", help="The run: a CARMEN log (.log/.log.gz), scans (a folder of "
-        ".bin/.ply/.pcd/.npy scans, a ROS bag, an MCAP file), or a ROS recording of the maps a "
+        f"{scan_formats()} scans, a ROS bag, an MCAP file), or a ROS recording of the maps a "
         "SLAM system published (nav_msgs/OccupancyGrid, scored on the recording's time "
         "axis); then the ground truth, as eval's.")],
     out: Annotated[Path, typer.Option(
@@ -114,7 +116,7 @@ def track_command(
                                       memory_limit=limit)
             _check_step(step, len(tracked.steps), "recording")
             rule: dict = {"every_s": every_s, "map_topic": map_topic}
-            total = f"{tracked.steps[-1].scans} maps published"
+            total = f"{count(tracked.steps[-1].scans, 'map')} published"
         else:
             if every_s is not None or map_topic is not None:
                 raise InputError(f"{run_path}: --every-s and --map-topic apply to a ROS "
@@ -127,7 +129,7 @@ def track_command(
                                                                   delta),
                                          progress=progress, limit=limit,
                                          bar=lambda: scan_bar(err, enabled=shown))
-            total = f"{len(tracked.run)} scans"
+            total = count(len(tracked.run), "scan")
         wrote = write_track(tracked, out, rule, options.command_line(ctx))
         if json_path not in (None, "-"):
             with OutputSet() as outputs:
@@ -138,7 +140,7 @@ def track_command(
         sys.stdout.write(wrote[1].read_text())
     elif not quiet:
         drop = None if tracked.drop is None else asdict(tracked.drop)
-        err.print(f"{len(tracked.steps)} steps ({scored} scored) of {total}; "
+        err.print(f"{count(len(tracked.steps), 'step')} ({scored} scored) of {total}; "
                   f"{drop_words(tracked.rows, drop)}; wrote {out}/track.csv, "
                   "track.json, track.png, track.html", markup=False, highlight=False,
                   soft_wrap=True)
@@ -173,7 +175,8 @@ def _track_scans(run_path: Path, truth_path: Path, settings, *, poses: Path | No
     tracked = track_run(run, truth_path, settings, ends, reference=reference,
                         pose_options=pose_options, reference_path=reference_poses, show=step,
                         progress=progress,
-                        tick=lambda done: progress(f"scoring: {done} of {len(run)} scans"),
+                        tick=lambda done: progress(f"scoring: {done} of "
+                                                   f"{count(len(run), 'scan')}"),
                         memory_limit=limit)
     return tracked, {"every_scans": None if every_m is not None else (every or 20),
                      "every_m": every_m}
@@ -182,5 +185,6 @@ def _track_scans(run_path: Path, truth_path: Path, settings, *, poses: Path | No
 def _check_step(step: int | None, steps: int, what: str) -> None:
     """Refuse a --step the run does not have."""
     if step is not None and step >= steps:
-        raise typer.BadParameter(f"{step}: the {what} has {steps} steps, 0 to {steps - 1}",
+        raise typer.BadParameter(f"{step}: the {what} has {count(steps, 'step')}, 0 to "
+                                 f"{steps - 1}",
                                  param_hint="--step")

@@ -9,6 +9,9 @@ from __future__ import annotations
 
 import numpy as np
 
+#: A box ``(x0, y0, x1, y1)``, metres, in some input's own frame (a crop: :mod:`pcmapq.io.extent`).
+Box = tuple[float, float, float, float]
+
 
 def bounds(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The least and the greatest value of each column of ``points`` (N, d), N >= 1: two (d,)

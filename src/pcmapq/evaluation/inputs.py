@@ -61,7 +61,8 @@ def load_input(path: str | Path, config: SourceConfig, option: str,
     an image that has none) and cut to its crop box; see :func:`pcmapq.io.load_map`. A CARMEN
     log given as the map, uncropped, carries the area its scans saw (:func:`with_seen`)."""
     source = load_map(path, config.resolution, fallback, config.thresholds, memory_limit,
-                      config.topic, config.at, option.replace("crop", "topic"))
+                      config.topic, config.at, option.replace("crop", "topic"),
+                      option.replace("crop", "resolution"))
     if option == MAP_CROP and config.crop is None:
         source = with_seen(source)
     return cropped(source, config, option)

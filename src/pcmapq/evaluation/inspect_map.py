@@ -15,6 +15,7 @@ import numpy as np
 
 from pcmapq import __version__
 from pcmapq.core.stats import significant
+from pcmapq.core.words import count
 from pcmapq.evaluation.noref_figures import input_figures
 from pcmapq.io import OccupancyMap, PointMap
 from pcmapq.settings import NoRefConfig
@@ -48,7 +49,8 @@ def summary_lines(record: dict[str, Any]) -> list[str]:
     lines = [f"map       {Path(record['map']['path']).name}, {record['map']['kind']}"]
     noref, grid = record["cloud"], record["grid"]
     if noref is not None:
-        near = f"within {noref['radius_m']:g} m, more than {noref['min_knn']} neighbours"
+        near = (f"within {noref['radius_m']:g} m, more than "
+                f"{count(noref['min_knn'], 'neighbour')}")
         drawn = noref.get("sampled_points")
         among = "" if drawn is None else f" of {drawn:,} drawn at random"
         lines += [f"points    {noref['points']:,} ({noref['mpv_points']:,}{among} with "
@@ -68,7 +70,7 @@ def summary_lines(record: dict[str, Any]) -> list[str]:
                   f"corners   {grid['corners']:,}",
                   "enclosed  " + ("n/a (a cloud has no free cells)"
                                   if grid["enclosed_areas"] is None else
-                                  f"{grid['enclosed_areas']:,} areas, "
+                                  f"{count(grid['enclosed_areas'], 'area')}, "
                                   f"{grid['enclosed_area_m2']:.2f} m²")]
     return lines
 

@@ -15,6 +15,7 @@ from pcmapq.align.free_space import CLEAR_M
 from pcmapq.align.parts import Part
 from pcmapq.core.bounds import radius
 from pcmapq.core.morphology import outline
+from pcmapq.core.words import count
 from pcmapq.evaluation.inputs import MAP_CROP, OUTLINE_M
 from pcmapq.io import OccupancyMap, PointMap
 from pcmapq.io.extent import far_points
@@ -130,8 +131,8 @@ def refusal(source: OccupancyMap | PointMap, truth_path: Path, alignment: Alignm
            ("" if distinct is None else
             f", the best pose scores {distinct:.0%} above the best one elsewhere") +
            ("" if not cover.parts else
-            f", {sum(p.agrees for p in cover.parts)} of its {len(cover.parts)} parts placed "
-            "on their own land near that pose"))
+            f", {sum(p.agrees for p in cover.parts)} of its "
+            f"{count(len(cover.parts), 'part')} placed on their own land near that pose"))
     size = radius(map_xy) / max(radius(truth_xy), 1e-12)
     option = settings.alignment
     far = far_points(source, MAP_CROP)

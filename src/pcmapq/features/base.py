@@ -75,6 +75,10 @@ class Detector:
         documented ones (``params()``), lengths in metres.
     by_default: whether an evaluation runs it when no detectors are named.
     from_paper: one of the paper's detectors (Harris, Hough, SIFT), listed before the others.
+    min_truth: the fewest features (counted or not) the truth must have for the detector to
+        have anything to find; with fewer its three scores are undefined (rooms: 2, since a
+        place that is one room has no rooms to tell apart; 0: no such minimum).
+    noun: what one feature is called in a sentence ("corner", "room").
     """
 
     name: str
@@ -83,6 +87,8 @@ class Detector:
     params: type
     by_default: bool = True
     from_paper: bool = True
+    min_truth: int = 0
+    noun: str = "feature"
 
     def checked(self, params: Any = None) -> Any:
         """``params``, or the defaults when None; InputError when they are not this

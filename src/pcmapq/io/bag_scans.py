@@ -13,6 +13,7 @@ from typing import Any
 import numpy as np
 
 from pcmapq.core.errors import InputError
+from pcmapq.core.words import plural
 from pcmapq.io.bags import (
     CLOUD,
     LASER,
@@ -82,7 +83,7 @@ def cloud_points(msg: Any, path: Path, topic: str) -> tuple[np.ndarray, np.ndarr
         data = np.ascontiguousarray(rows).reshape(-1)
     if data.size < count * msg.point_step:
         raise InputError(f"{path}: {topic}: a PointCloud2 holds {data.size} bytes for {count} "
-                         f"points of {msg.point_step}")
+                         f"{plural(count, 'point')} of {msg.point_step}")
     records = np.frombuffer(data[:count * msg.point_step].tobytes(), dtype=dtype, count=count)
     points = np.column_stack([records[a].astype(np.float64) for a in "xyz"])
     times = records[wanted[3]].astype(np.float64) if len(wanted) == 4 else np.empty(0)

@@ -14,10 +14,9 @@ from pathlib import Path
 from typing import Any
 
 from pcmapq.core.errors import InputError
+from pcmapq.io.formats import BAG_SUFFIXES
 from pcmapq.io.writers import one_line
 
-#: Recording files: ROS 1 bags, ROS 2 storage files (alone or in their bag folder), MCAP.
-BAG_SUFFIXES = (".bag", ".db3", ".mcap")
 #: Message types by role, as rosbags names them (ROS 2 spelling; ROS 1 names are mapped).
 GRID = "nav_msgs/msg/OccupancyGrid"
 CLOUD, LASER = "sensor_msgs/msg/PointCloud2", "sensor_msgs/msg/LaserScan"

@@ -31,11 +31,10 @@ from typing import NoReturn
 import numpy as np
 
 from pcmapq.core.errors import InputError
+from pcmapq.core.words import plural
 from pcmapq.io.clouds import PointMap
+from pcmapq.io.formats import CARMEN_SUFFIXES
 from pcmapq.io.writers import one_line
-
-#: File name endings read as CARMEN logs (lower case).
-CARMEN_SUFFIXES = (".log", ".log.gz")
 
 #: Readings above this are dropped by default, metres.
 DEFAULT_MAX_RANGE = 30.0
@@ -254,7 +253,7 @@ def _line_problem(line: str) -> str | None:
     if n < 1:
         return "FLASER beam count missing or not positive"
     if len(fields) != n + _EXTRA_FIELDS:
-        return (f"FLASER with {n} beams needs {n + _EXTRA_FIELDS + 1} fields, "
+        return (f"FLASER with {n} {plural(n, 'beam')} needs {n + _EXTRA_FIELDS + 1} fields, "
                 f"got {len(fields) + 1}")
     names = [f"range {i}" for i in range(1, n + 1)] + [
         "x", "y", "theta", "odom_x", "odom_y", "odom_theta", "timestamp"]

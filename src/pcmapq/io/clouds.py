@@ -31,7 +31,6 @@ from pcmapq.io.stderr import stderr_captured
 from pcmapq.io.survey import read_e57, read_las
 from pcmapq.io.writers import one_line
 
-CLOUD_SUFFIXES = (".ply", ".pcd", ".xyz", ".txt", ".npy", ".bin", ".las", ".laz", ".e57")
 #: A PCD's coordinate fields.
 XYZ = ("x", "y", "z")
 

@@ -13,10 +13,12 @@ import numpy as np
 from pcmapq.core.bounds import bounds
 from pcmapq.core.cells import FREE, OCCUPIED, UNKNOWN
 from pcmapq.core.errors import InputError
+from pcmapq.core.words import count
 from pcmapq.io import load_map
 from pcmapq.io.bags import is_bag, opened, span, topics
 from pcmapq.io.clouds import PointMap
-from pcmapq.io.map_yaml import YAML_SUFFIXES, MapMeta, read_yaml
+from pcmapq.io.formats import YAML_SUFFIXES
+from pcmapq.io.map_yaml import MapMeta, read_yaml
 from pcmapq.io.occupancy import NO_RESOLUTION, OccupancyMap
 
 
@@ -51,12 +53,13 @@ def lines(record: dict[str, Any]) -> list[str]:
     if record["kind"] == "recording":
         out = [f"{record['file']}: a ROS recording, {record['duration_s']:.1f} s "
                f"({record['start_s']:.3f} to {record['end_s']:.3f} s)"]
-        out += [f"  {t['name']}: {t['type']}, {t['count']} messages" for t in record["topics"]]
+        out += [f"  {t['name']}: {t['type']}, {count(t['count'], 'message')}"
+                for t in record["topics"]]
         return out
     if "points" in record:
         lo, hi = record["bounds_m"]["min"], record["bounds_m"]["max"]
         fields = f"; fields {', '.join(record['fields'])}" if record["fields"] else ""
-        return [f"{record['file']}: {record['points']:,} points ({record['kind']}, "
+        return [f"{record['file']}: {count(record['points'], 'point')} ({record['kind']}, "
                 f"{'3D' if record['is_3d'] else '2D'}){fields}",
                 "  bounds " + " to ".join("(" + ", ".join(f"{v:.3f}" for v in b) + ") m"
                                           for b in (lo, hi))]

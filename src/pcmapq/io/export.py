@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from pcmapq.core.errors import InputError
+from pcmapq.core.words import plural
 from pcmapq.io.writers import OutputSet, atomic_file
 
 #: The scalar field of a distance cloud: metres. CloudCompare reads a PLY property named
@@ -68,7 +69,8 @@ def write_records(path: Path, count: int, chunks: Iterable[np.ndarray], dtype: n
         with atomic_file(path, outputs) as f:
             written = _write_las(f, suffix == ".laz", chunks, dtype)
         if written != count:
-            raise InputError(f"{path}: {written} points written, {count} announced")
+            raise InputError(f"{path}: {written} {plural(written, 'point')} written, {count} "
+                             "announced")
         return
     if suffix == ".pcd" and dtype.names != ("x", "y", "z"):
         raise InputError(f"{path}: a cloud with a scalar field is written as .ply")
@@ -80,7 +82,8 @@ def write_records(path: Path, count: int, chunks: Iterable[np.ndarray], dtype: n
             f.write(np.ascontiguousarray(chunk, dtype=dtype).tobytes())
             written += len(chunk)
         if written != count:
-            raise InputError(f"{path}: {written} points written, {count} announced")
+            raise InputError(f"{path}: {written} {plural(written, 'point')} written, {count} "
+                             "announced")
 
 
 def write_matrix(path: Path, matrix: np.ndarray, outputs: OutputSet | None = None) -> None:

@@ -12,14 +12,13 @@ from dataclasses import replace
 
 import numpy as np
 
-from pcmapq.core.bounds import bounds
+from pcmapq.core.bounds import Box, bounds
 from pcmapq.core.cells import OCCUPIED, UNKNOWN
 from pcmapq.core.errors import InputError
 from pcmapq.core.grid import MetricGrid
+from pcmapq.core.words import plural
 from pcmapq.io.clouds import PointMap
 from pcmapq.io.occupancy import OccupancyMap
-
-Box = tuple[float, float, float, float]
 
 #: An input wider than this, metres, is refused: no map scored on a grid of centimetres spans it.
 MAX_SPAN = 100_000.0
@@ -122,7 +121,9 @@ def far_points(source: OccupancyMap | PointMap, option: str) -> str:
     width, height = span(source)
     far = outside(source, box)
     verb = "lies" if far == 1 else "lie"
-    return (f"{far:,} of its {_count(source):,} points {verb} far from the others, which lie "
+    total = _count(source)
+    return (f"{far:,} of its {total:,} {plural(total, 'point')} {verb} far from the others, "
+            "which lie "
             f"within {_box_text(box)} ({box[2] - box[0]:.0f} x {box[3] - box[1]:.0f} m; it "
             f"spans {width:.3g} x {height:.3g} m): outliers, or two maps in one file? "
             f"{option} {_box_text(box)} keeps that part")

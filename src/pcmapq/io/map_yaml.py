@@ -15,7 +15,6 @@ import yaml
 from pcmapq.core.errors import InputError
 from pcmapq.io.writers import one_line
 
-YAML_SUFFIXES = (".yaml", ".yml")
 MODES = ("trinary", "scale", "raw")
 _T = TypeVar("_T")
 #: A decimal number as text, exponent allowed: ``5e-2``, ``1.0e9``, ``-.5``. PyYAML (YAML 1.1)

@@ -25,9 +25,9 @@ from pcmapq.core.cells import FREE, OCCUPIED, UNKNOWN
 from pcmapq.core.errors import InputError
 from pcmapq.core.grid import MetricGrid
 from pcmapq.core.morphology import disc, outline, reaching_border
+from pcmapq.io.formats import YAML_SUFFIXES
 from pcmapq.io.image_header import check_image_size
 from pcmapq.io.map_yaml import (
-    YAML_SUFFIXES,
     MapMeta,
     Thresholds,
     after_path,
@@ -39,7 +39,6 @@ from pcmapq.io.map_yaml import (
 from pcmapq.io.stderr import stderr_captured, stderr_uncaptured
 from pcmapq.io.writers import same_file
 
-IMAGE_SUFFIXES = (".png", ".pgm", ".jpg", ".jpeg", ".bmp")
 #: The problem of an image read without a resolution.
 NO_RESOLUTION = "no resolution"
 #: The outside of a building drawn solid is read as a wall this thick along its face, metres
@@ -74,13 +73,14 @@ class OccupancyMap:
 def load_occupancy(path: Path, resolution: float | None = None,
                    fallback: float | None = None,
                    thresholds: Thresholds | None = None,
-                   memory_limit: int | None = None) -> OccupancyMap:
+                   memory_limit: int | None = None,
+                   resolution_option: str = "--map-resolution") -> OccupancyMap:
     """Load an occupancy image or a map_server YAML. ``resolution`` (metres per cell), if given,
     overrides the YAML's; an image without a YAML beside it (same stem) needs it, or a
-    ``fallback`` resolution (a starting guess for a map whose scale will be estimated).
-    ``thresholds`` override the YAML's occupied_thresh, free_thresh and negate; an image whose
-    header declares more pixels than ``memory_limit`` bytes hold (None: the default) is refused
-    unread."""
+    ``fallback`` resolution (a starting guess for a map whose scale will be estimated); without
+    either it is refused, naming ``resolution_option``. ``thresholds`` override the YAML's
+    occupied_thresh, free_thresh and negate; an image whose header declares more pixels than
+    ``memory_limit`` bytes hold (None: the default) is refused unread."""
     if path.suffix.lower() in YAML_SUFFIXES:
         meta, image = read_yaml(path)
         if not image.is_file():
@@ -96,8 +96,8 @@ def load_occupancy(path: Path, resolution: float | None = None,
     if meta.resolution is None and fallback is not None:
         meta = replace(meta, resolution=resolution_of(path, fallback))
     if meta.resolution is None:
-        raise InputError(f"{path}: {NO_RESOLUTION}: give --map-resolution/--truth-resolution "
-                         "or a YAML beside it")
+        raise InputError(f"{path}: {NO_RESOLUTION}: give {resolution_option} or a YAML beside "
+                         "it")
     state = classify(levels, channels, scale, transparent, meta)
     if thresholds is None or thresholds.free is None:
         state = saver_unknown(state, levels, channels, scale, meta, path)

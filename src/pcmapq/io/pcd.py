@@ -22,6 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from pcmapq.core.errors import InputError
+from pcmapq.core.words import plural
 from pcmapq.io.ply import count_lines
 
 __all__ = ["PcdField", "PcdHeader", "check_size", "read_fields", "read_header"]
@@ -140,7 +141,8 @@ def check_size(path: Path) -> PcdHeader:
     else:
         held = _compressed_points(path, header, size)
     if held < header.points:
-        raise InputError(f"{path}: truncated: header declares {header.points} points, "
+        raise InputError(f"{path}: truncated: header declares {header.points} "
+                         f"{plural(header.points, 'point')}, "
                          f"the file holds {held}")
     return header
 

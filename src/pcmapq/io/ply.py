@@ -19,6 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from pcmapq.core.errors import InputError
+from pcmapq.core.words import plural
 
 __all__ = ["VertexBlock", "check_size", "count_lines", "vertex_block"]
 
@@ -100,7 +101,8 @@ def vertex_block(path: Path) -> VertexBlock | None:
             size = path.stat().st_size
             need = offset + count * dtype.itemsize
             if size < need:
-                raise InputError(f"{path}: truncated: header declares {count} points, the file "
+                raise InputError(f"{path}: truncated: header declares {count} "
+                                 f"{plural(count, 'point')}, the file "
                                  f"holds {max(size - offset, 0) // dtype.itemsize}")
             return VertexBlock(path, count, offset, dtype)
         offset += count * dtype.itemsize
@@ -130,7 +132,8 @@ def check_size(path: Path) -> int:
         vertex = [props for name, _, props in elements if name == "vertex"]
         per_point = 1 if fmt == "ascii" or not vertex else _smallest_record(vertex[0])
         present = min(max(held - before, 0) // per_point, points)
-        raise InputError(f"{path}: truncated: header declares {points} points, "
+        raise InputError(f"{path}: truncated: header declares {points} "
+                         f"{plural(points, 'point')}, "
                          f"the file holds {present}")
     return points
 

@@ -11,10 +11,9 @@ from pathlib import Path
 import numpy as np
 
 from pcmapq.core.errors import InputError
+from pcmapq.core.words import plural
 from pcmapq.io.writers import one_line
 
-#: Survey cloud formats.
-LAS_SUFFIXES, E57_SUFFIXES = (".las", ".laz"), (".e57",)
 #: Points read from a LAS file at a time (a record is up to 64 kB: a few MB a chunk).
 LAS_CHUNK = 100_000
 
@@ -41,8 +40,8 @@ def read_las(path: Path, memory_limit: int | None = None) -> np.ndarray:
     except Exception as exc:  # noqa: BLE001 - laspy and lazrs raise many kinds on a bad file
         raise InputError(f"{path}: not a readable LAS/LAZ file: {one_line(exc)}") from None
     if done != count:
-        raise InputError(f"{path}: truncated: {done:,} of the {count:,} points its header "
-                         "declares")
+        raise InputError(f"{path}: truncated: {done:,} of the {count:,} "
+                         f"{plural(count, 'point')} its header declares")
     return points
 
 

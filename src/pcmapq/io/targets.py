@@ -10,8 +10,8 @@ from collections.abc import Iterable
 from pathlib import Path
 
 from pcmapq.core.errors import InputError
-from pcmapq.io.map_yaml import YAML_SUFFIXES, read_yaml
-from pcmapq.io.occupancy import IMAGE_SUFFIXES
+from pcmapq.io.formats import IMAGE_SUFFIXES, YAML_SUFFIXES
+from pcmapq.io.map_yaml import read_yaml
 from pcmapq.io.writers import same_file
 
 #: What each output option writes, by extension (``--aligned``: see :func:`output_suffixes`).

@@ -9,7 +9,6 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import BinaryIO
 
-import cv2
 import numpy as np
 
 from pcmapq.core.errors import InputError
@@ -105,6 +104,8 @@ def write_ros_map(path: Path, image: np.ndarray, resolution: float,
     metres per pixel, ``origin`` (x, y) metres of the image's lower-left corner, yaw 0, ROS's
     default thresholds. Both are written whole (:func:`write_atomic`; with ``outputs``, when
     that set is committed). Returns ``path``."""
+    import cv2  # here: the command line's help reads this module's one_line, not OpenCV
+
     path = Path(path)
     ok, encoded = cv2.imencode(path.suffix or ".png", np.asarray(image, dtype=np.uint8))
     if not ok:

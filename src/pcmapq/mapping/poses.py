@@ -32,6 +32,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from pcmapq.core.errors import InputError
+from pcmapq.core.words import count
 from pcmapq.io.writers import OutputSet, one_line, write_atomic
 
 __all__ = [
@@ -105,7 +106,8 @@ def write_tum_poses(path: str | Path, poses: np.ndarray, timestamps: np.ndarray 
     stamps = (np.arange(len(poses), dtype=np.float64) if timestamps is None
               else np.asarray(timestamps, dtype=np.float64).reshape(-1))
     if len(stamps) != len(poses):
-        raise InputError(f"{path}: {len(stamps)} timestamps for {len(poses)} poses")
+        raise InputError(f"{path}: {count(len(stamps), 'timestamp')} for "
+                         f"{count(len(poses), 'pose')}")
     quats = Rotation.from_matrix(poses[:, :3, :3]).as_quat()  # x, y, z, w
     quats *= np.where(quats[:, 3:4] < 0, -1.0, 1.0)
     rows = np.column_stack([stamps, poses[:, :3, 3], quats])
@@ -120,7 +122,7 @@ def read_pose_matrix(path: str | Path) -> np.ndarray:
     if len(rows) == 3:
         rows = np.vstack([rows, [0.0, 0.0, 0.0, 1.0]])
     if len(rows) != 4:
-        raise InputError(f"{path}: {len(rows)} rows, expected a 4x4 pose")
+        raise InputError(f"{path}: {count(len(rows), 'row')}, expected a 4x4 pose")
     return _check_poses(rows[None], path)[0]
 
 
@@ -155,7 +157,8 @@ def read_calib(path: str | Path) -> np.ndarray:
             if key in keyed:
                 values = _numbers(keyed[key], path, f"'{key}:'")
                 if len(values) != 12:
-                    raise InputError(f"{path}: '{key}:' has {len(values)} numbers, expected 12")
+                    raise InputError(f"{path}: '{key}:' has {count(len(values), 'number')}, "
+                                     "expected 12")
                 return _homogeneous(values.reshape(1, 3, 4))[0]
         raise InputError(f"{path}: no 'Tr:' line (keys: {', '.join(sorted(keyed))})")
     body = " ".join(line for line in text.splitlines() if not line.lstrip().startswith("#"))
@@ -164,7 +167,7 @@ def read_calib(path: str | Path) -> np.ndarray:
         return _homogeneous(values.reshape(1, 3, 4))[0]
     if len(values) == 16:
         return _check_poses(values.reshape(1, 4, 4), path)[0]
-    raise InputError(f"{path}: {len(values)} numbers, expected 12 (3x4) or 16 (4x4) "
+    raise InputError(f"{path}: {count(len(values), 'number')}, expected 12 (3x4) or 16 (4x4) "
                      "or a KITTI calib.txt with a 'Tr:' line")
 
 
@@ -252,7 +255,7 @@ def _read_table(path: Path, columns: int, expected: str) -> np.ndarray:
             continue
         values = _numbers(line, path, f"line {number}")
         if len(values) != columns:
-            raise InputError(f"{path}: line {number} has {len(values)} numbers, "
+            raise InputError(f"{path}: line {number} has {count(len(values), 'number')}, "
                              f"expected {expected}")
         rows.append(values)
     if not rows:

@@ -20,6 +20,7 @@ import numpy as np
 from pcmapq.core.errors import InputError
 from pcmapq.core.transform import affine
 from pcmapq.core.voxels import VoxelMap
+from pcmapq.core.words import count
 from pcmapq.mapping.scans import ScanSequence, open_scans
 from pcmapq.metrics.posed import place
 
@@ -36,14 +37,16 @@ def scans_for_poses(source: str | Path | ScanSequence, pose_count: int, *,
     name = "poses" if poses_path is None else str(poses_path)
     if max_scans is None:
         if pose_count != len(scans):
-            raise InputError(f"{name}: {pose_count} poses for {len(scans)} scans in "
+            raise InputError(f"{name}: {count(pose_count, 'pose')} for "
+                             f"{count(len(scans), 'scan')} in "
                              f"{scans.path} (one pose per scan); --max-scans "
                              f"{min(pose_count, len(scans))} maps the first "
                              f"{min(pose_count, len(scans))}")
         return scans
     wanted = min(max_scans, len(scans))
     if pose_count < wanted:
-        raise InputError(f"{name}: {pose_count} poses for the first {wanted} scans of "
+        raise InputError(f"{name}: {count(pose_count, 'pose')} for the first "
+                         f"{count(wanted, 'scan')} of "
                          f"{scans.path}")
     return replace(scans, count=wanted, files=scans.files[:wanted])
 

@@ -31,12 +31,11 @@ from pcmapq.io.bag_scans import scan_topic
 from pcmapq.io.bag_scans import scans as bag_scans
 from pcmapq.io.bags import is_bag
 from pcmapq.io.clouds import XYZ, read_kitti_bin, read_npy, with_z
+from pcmapq.io.formats import SCAN_SUFFIXES
 from pcmapq.io.writers import one_line
 
 __all__ = ["SCAN_SUFFIXES", "ScanSequence", "open_scans"]
 
-#: Scan file formats of a scan folder.
-SCAN_SUFFIXES = (".bin", ".ply", ".pcd", ".npy")
 
 #: Per-point time fields of PLY/PCD scans, in the order KISS-ICP's generic loader tries them.
 TIME_FIELDS = ("t", "timestamp", "timestamps", "time", "stamps")

@@ -14,8 +14,9 @@ strong-strong pair beats a strong-weak one.
 quality = matched strong truth / strong truth features (the paper's q = RMF / GTF);
 precision = matched strong map / strong map features; f1 = their harmonic mean. A ratio with
 nothing to count (no strong feature on that side) is undefined, None, not 0: a round room has no
-corner, and its perfect map must not score 0 for missing none. f1 is None when either is None,
-0 when both are 0.
+corner, and its perfect map must not score 0 for missing none. So are all three when the truth
+has fewer features than the detector needs to have anything to find (rooms: a place of one room
+has no rooms to tell apart). f1 is None when either is None, 0 when both are 0.
 """
 
 from __future__ import annotations
@@ -28,6 +29,7 @@ from scipy import sparse
 from scipy.optimize import linear_sum_assignment
 from scipy.sparse.csgraph import connected_components
 
+from pcmapq.core.words import count
 from pcmapq.features import Features, detector
 
 
@@ -49,6 +51,8 @@ class Matching:
     matched_map: number of strong map features matched (precision's numerator).
     missing: indices of strong truth features left unmatched.
     extra: indices of strong map features left unmatched.
+    unscored: why the detector had nothing to find (the truth has fewer features than it
+        needs, :attr:`~pcmapq.features.base.Detector.min_truth`): its three scores are None.
     """
 
     truth_idx: np.ndarray
@@ -64,10 +68,13 @@ class Matching:
     matched_map: int
     missing: np.ndarray
     extra: np.ndarray
+    unscored: str | None = None
 
     def note(self, truth_scope: str = "") -> str | None:
         """Why a score is undefined, one line (None when all three are defined);
         ``truth_scope`` qualifies the truth's features, e.g. "inside the footprint"."""
+        if self.unscored is not None:
+            return self.unscored
         scope = f" {truth_scope}" if truth_scope else ""
         reasons = ([f"no strong truth feature{scope}"] if self.quality is None else []) + \
                   (["no strong map feature"] if self.precision is None else [])
@@ -167,6 +174,11 @@ def match(name: str, truth: Features, map_: Features, threshold: float = 0.5,
     matched_map = int(map_.strong[mj].sum())
     quality = _ratio(matched, len(t_strong))
     precision = _ratio(matched_map, len(m_strong))
+    unscored = None
+    if len(truth) < found.min_truth:  # nothing to find: undefined, not 0
+        unscored = (f"the truth has {count(len(truth), found.noun)}, fewer than "
+                    f"{found.min_truth}: nothing to find")
+        quality = precision = None
     return Matching(
         truth_idx=ti,
         map_idx=mj,
@@ -181,4 +193,5 @@ def match(name: str, truth: Features, map_: Features, threshold: float = 0.5,
         matched_map=matched_map,
         missing=np.setdiff1d(t_strong, ti),
         extra=np.setdiff1d(m_strong, mj),
+        unscored=unscored,
     )

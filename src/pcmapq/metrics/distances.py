@@ -12,9 +12,7 @@ import numpy as np
 from pcmapq.core.grid import MetricGrid
 from pcmapq.core.morphology import distance_to
 from pcmapq.core.stats import Stats
-
-#: Default distance thresholds of the F-score, metres.
-DEFAULT_TAUS = (0.05, 0.1, 0.2, 0.5)
+from pcmapq.metrics.defaults import DEFAULT_TAUS
 
 
 @dataclass(frozen=True)

@@ -27,11 +27,11 @@ from scipy.spatial import cKDTree
 from pcmapq.core.bounds import bounds
 from pcmapq.metrics.ballsums import CHUNK_POINTS, ball_sums, moments
 
-#: map-metrics' presets (metres, neighbour counts): ``LidarConfig`` and ``DepthConfig``.
-LIDAR_RADIUS = 1.0
-DEPTH_RADIUS = 0.2
-MIN_KNN = 5
-MAX_NN = 30
+# the presets, re-exported: their home is apart from this module (which loads SciPy and Numba)
+from pcmapq.metrics.defaults import DEPTH_RADIUS as DEPTH_RADIUS
+from pcmapq.metrics.defaults import LIDAR_RADIUS, MIN_KNN
+from pcmapq.metrics.defaults import MAX_NN as MAX_NN
+
 #: MOM keeps an orthogonal-subset point whose neighbourhood holds more than this many map
 #: points (hard-coded in map-metrics, independent of ``min_knn``).
 MOM_MIN_NEIGHBOURS = 3

@@ -24,16 +24,13 @@ import numpy as np
 from scipy.cluster.hierarchy import fcluster
 
 from pcmapq.core.errors import EvaluationError
+from pcmapq.metrics.defaults import MAX_WARD_POINTS
 from pcmapq.metrics.noref import MAX_NN, flat, neighbourhood_sums
 
 #: map-metrics' constants: Ward cut distance, near-orthogonality |cos|, smallest cluster.
 WARD_CUT = 0.1
 ORTHOGONAL_COS = 0.1
 MIN_CLUSTER = 5
-#: Ward clustering takes N^2 time: more planar points than this are
-#: clustered through an evenly spaced sample of this many. One scan stays below it (7,336 in
-#: KITTI 00's first scan at 0.3 m), so an extraction from a scan is map-metrics' own.
-MAX_WARD_POINTS = 10_000
 
 
 def planar_points(cloud: np.ndarray, radius: float) -> np.ndarray:

@@ -17,12 +17,13 @@ from numpy.lib import format as npy
 
 from pcmapq.core.errors import InputError
 from pcmapq.core.transform import affine
+from pcmapq.core.words import count
 
 
 def place(clouds: Sequence[np.ndarray], poses: Sequence[np.ndarray]) -> np.ndarray:
     """Stack (N_i, 3) clouds, each moved by ``inv(poses[0]) @ poses[i]`` -> (sum N_i, 3) metres."""
     if len(clouds) != len(poses):
-        raise ValueError(f"{len(clouds)} clouds but {len(poses)} poses")
+        raise ValueError(f"{count(len(clouds), 'cloud')} but {count(len(poses), 'pose')}")
     if not clouds:
         return np.zeros((0, 3))
     first = np.linalg.inv(np.asarray(poses[0], dtype=np.float64))

@@ -16,6 +16,7 @@ from scipy.spatial.transform import Rotation
 
 from pcmapq.core.errors import EvaluationError
 from pcmapq.core.stats import Stats
+from pcmapq.core.words import count
 
 Relation = Literal["translation_part", "rotation_angle_deg", "full"]
 DeltaUnit = Literal["frames", "metres"]
@@ -77,7 +78,7 @@ def _poses(poses: np.ndarray, name: str) -> np.ndarray:
 def _pair(est: np.ndarray, ref: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     est, ref = _poses(est, "estimate"), _poses(ref, "reference")
     if len(est) != len(ref):
-        raise ValueError(f"estimate has {len(est)} poses, reference {len(ref)}: "
+        raise ValueError(f"estimate has {count(len(est), 'pose')}, reference {len(ref)}: "
                          "they are compared by index and must be as many")
     return est, ref
 
@@ -111,7 +112,7 @@ def align_umeyama(est_xyz: np.ndarray, ref_xyz: np.ndarray,
     cov = yc.T @ xc / n
     u, d, vt = np.linalg.svd(cov)
     if np.count_nonzero(d > np.finfo(d.dtype).eps) < m - 1:
-        raise EvaluationError(f"degenerate trajectory (its {n} positions span less than a "
+        raise EvaluationError(f"degenerate trajectory (its {count(n, 'position')} span less than a "
                               "plane): Umeyama alignment is not possible")
     sign = np.ones(m)
     if np.linalg.det(u) * np.linalg.det(vt) < 0.0:

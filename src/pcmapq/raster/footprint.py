@@ -34,9 +34,8 @@ from scipy import ndimage
 from pcmapq.core.grid import MetricGrid
 from pcmapq.core.morphology import disc, distance_to
 from pcmapq.raster.draw import polygon_cells
+from pcmapq.raster.rules import FOOTPRINT_RULES
 
-#: The footprint rules, ``auto`` first (the default).
-FOOTPRINT_RULES = ("auto", "known", "walls", "seen", "all")
 #: Unknown cells count as an unknown region when they are part of a patch at least this wide,
 #: metres: an opening by a disc of this diameter.
 UNKNOWN_WIDTH = 0.5

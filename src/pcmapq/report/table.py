@@ -10,6 +10,7 @@ from rich.console import Console
 from rich.table import Table
 
 from pcmapq.core.stats import FIELDS, Stats
+from pcmapq.core.words import count, length
 from pcmapq.report.text import LEGEND, metres, number, score, verdict, words, wrap
 from pcmapq.results.result import DetectorResult, Result
 
@@ -82,7 +83,7 @@ def _summary(result: Result) -> list[tuple[str, list[str]]]:
         lines.append(("regions", [f"largest offset {c.offset_m[k]:.3f} m",
                                   f"turn {abs(c.turn_deg[k]):.2f} deg",
                                   f"at ({x:.1f}, {y:.1f}) m",
-                                  f"{len(c.points)} regions of {c.tile_m:g} m",
+                                  f"{count(len(c.points), 'region')} of {length(c.tile_m)}",
                                   f"fitness {c.global_fitness():.3f} as placed",
                                   f"{c.local_fitness():.3f} each fitted alone"]))
     if result.registration_3d is not None:
@@ -123,12 +124,12 @@ def _noref_parts(figures: dict) -> list[str]:
         return [f"MME {_g(cloud['mme'])} nats", f"MPV {_g(cloud['mpv'])} m²",
                 f"MOM {_g(cloud['mom'])}" + (" m²" if cloud["mom"] is not None else ""),
                 f"within {cloud['radius_m']:g} m"]
-    parts = [f"{grid['occupied_cells']:,} occupied cells of {grid['resolution_m']:g} m"]
+    parts = [f"{count(grid['occupied_cells'], 'occupied cell')} of {grid['resolution_m']:g} m"]
     if grid["occupied_free_ratio"] is not None:
         parts.append(f"occupied/free {grid['occupied_free_ratio']:.4f}")
-    parts.append(f"{grid['corners']:,} corners")
+    parts.append(count(grid["corners"], "corner"))
     if grid["enclosed_areas"] is not None:
-        parts.append(f"{grid['enclosed_areas']:,} enclosed areas")
+        parts.append(count(grid["enclosed_areas"], "enclosed area"))
     return parts
 
 
@@ -165,7 +166,7 @@ def _displacements(console: Console, result: Result) -> None:
         "displacement from truth feature to map feature over the matched pairs (every pair, "
         "whichever of its features are counted), metres",
         "displacement of the matched pairs",
-        {name: [f"{pairs} pairs"] + [f"{k} {v}" + (" m" if v != "-" else "")
+        {name: [count(int(pairs), "pair")] + [f"{k} {v}" + (" m" if v != "-" else "")
                                      for k, v in zip(FIELDS[1:], values, strict=True)]
          for name, (pairs, *values) in rows.items()})
 

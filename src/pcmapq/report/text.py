@@ -6,6 +6,7 @@ from __future__ import annotations
 import re
 from collections.abc import Sequence
 
+from pcmapq.core.words import count
 from pcmapq.results.result import INCONSISTENT, LOW, OTHER, Result
 
 #: What the terms of the table mean, in one short paragraph (their definitions:
@@ -58,7 +59,8 @@ def alignment_words(result: Result) -> str:
         from pcmapq.evaluation.same_place import MIN_AGREEING
 
         agree = sum(p.agrees for p in cover.parts)
-        why = f"{agree} of its {len(cover.parts)} parts placed on their own land near its pose"
+        why = (f"{agree} of its {count(len(cover.parts), 'part')} placed on their own land near "
+               "its pose")
         if agree < MIN_AGREEING:  # the pose stands out: see same_place.verdict
             why = (f"its pose stands out in the search by "
                    f"{result.alignment.distinctiveness:.2f}; {why}")
@@ -91,17 +93,15 @@ def breaks(result: Result) -> str:
 
 def verdict(result: Result) -> str:
     """How good the map is and why, in one sentence built from the result only: how it was
-    aligned, how much of the truth it covers, each detector's quality (or why it is
-    undefined), and how far its walls are from the truth's, metres."""
+    aligned, how much of the truth it covers, each detector's quality and precision (a map
+    full of features the truth lacks reads low; 'n/a' with why when undefined), and how far
+    its walls are from the truth's, metres."""
     covered = f"{100 * result.overlap.coverage:.0f} % of the truth's walls covered"
     if result.full:
         covered += " (scored against the whole truth)"
-    features = []
-    for name, det in result.detectors.items():
-        note = result.note(name)
-        quality = det.matching.quality
-        features.append(f"{name} {score(quality, 2)}" if quality is not None
-                        else f"{name} n/a ({note})")
+    features = [_quality_precision(name, det.matching.quality, det.matching.precision,
+                                   result.note(name))
+                for name, det in result.detectors.items()]
     d = result.distances
     walls = (f"map walls {metres(d.accuracy.mean)} from the truth's on average, "
              f"truth walls {metres(d.completeness.mean)} from the map's")
@@ -109,8 +109,18 @@ def verdict(result: Result) -> str:
         walls += " ('-': nothing to measure)"
     parts = [alignment_words(result), covered]
     if features:
-        parts.append("feature quality " + ", ".join(features))
+        parts.append("feature quality/precision " + ", ".join(features))
     return f"{result.map_path.name}: " + "; ".join(parts + [walls]) + "."
+
+
+def _quality_precision(name: str, quality: float | None, precision: float | None,
+                       note: str | None) -> str:
+    """A detector in the verdict: ``harris 0.97/0.82`` (quality/precision), ``n/a`` for an
+    undefined one and why (``rooms n/a (the truth has 1 room ...)``)."""
+    if quality is None and precision is None:
+        return f"{name} n/a ({note})"
+    pair = f"{name} {score(quality, 2)}/{score(precision, 2)}"
+    return f"{pair} ({note})" if note else pair
 
 
 def wrap(parts: Sequence[str], width: int, sep: str = ", ", indent: str = "") -> list[str]:

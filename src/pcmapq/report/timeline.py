@@ -10,6 +10,7 @@ import html
 import numpy as np
 from matplotlib.figure import Figure
 
+from pcmapq.core.words import count
 from pcmapq.report.html import STYLE, _img, _table
 from pcmapq.report.plot import WIDTH_IN, png_bytes, vectorial_figure
 from pcmapq.report.style import DETECTOR_COLOURS, OTHER_COLOURS
@@ -98,7 +99,7 @@ def timeline_figure(rows: list[dict], drop: dict | None, title: str = "") -> Fig
     panels = [(t, cols) for t, cols in panels if cols]
     if not panels:
         fig = Figure(figsize=(WIDTH_IN, 1.5))
-        fig.text(0.5, 0.5, f"no step could be scored ({len(rows)} steps)", ha="center",
+        fig.text(0.5, 0.5, f"no step could be scored ({count(len(rows), 'step')})", ha="center",
                  va="center")
         return fig
     fig = Figure(figsize=(WIDTH_IN, 2.0 * len(panels) + 0.6), layout="constrained")
@@ -158,12 +159,12 @@ def timeline_html(rows: list[dict], drop: dict | None, shown: int, result: Resul
     was not scored; ``asked``: chosen with ``--step``) and a table of every step."""
     step = rows[shown]
     scored = sum(bool(r["scored"]) for r in rows)
-    unit = "maps published" if recorded(rows) else "scans"
+    unit = ("map", " published") if recorded(rows) else ("scan", "")
     facts = "".join(f"<tr><td>{html.escape(k)}</td><td>{html.escape(v)}</td></tr>"
                     for k, v in inputs.items())
     parts = [f"<h1>pcmapq track</h1><p class='sub'>{html.escape(inputs.get('run', ''))}"
-             f" against {html.escape(inputs.get('truth', ''))}: {len(rows)} steps, {scored} "
-             f"scored, of {rows[-1]['scans']} {unit}</p>",
+             f" against {html.escape(inputs.get('truth', ''))}: {count(len(rows), 'step')}, "
+             f"{scored} scored, of {count(rows[-1]['scans'], unit[0])}{unit[1]}</p>",
              f"<table class='facts'>{facts}</table>",
              f"<p>command: <code>{html.escape(command or '(called from Python)')}</code></p>",
              "<h2>Quality over the run</h2>",
@@ -173,7 +174,8 @@ def timeline_html(rows: list[dict], drop: dict | None, shown: int, result: Resul
             if drop is not None and drop["start"] == shown else "the last step; no drop")
     parts.append(f"<h2>Step {shown} ({what}): map {step['scans']} of {rows[-1]['scans']}, "
                  f"published at {where(step)}</h2>" if recorded(rows) else
-                 f"<h2>Step {shown} ({what}): {step['scans']} of {rows[-1]['scans']} scans, "
+                 f"<h2>Step {shown} ({what}): {step['scans']} of "
+                 f"{count(rows[-1]['scans'], 'scan')}, "
                  f"{step['distance_m']:.0f} m travelled</h2>")
     if result is not None and path_xy is not None:
         parts.append(_img(png_bytes(path_figure(result, path_xy)),

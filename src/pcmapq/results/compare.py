@@ -13,6 +13,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from pcmapq.core.errors import InputError
+from pcmapq.core.words import count
 from pcmapq.io.writers import one_line
 from pcmapq.results.figures import table_row
 
@@ -35,7 +36,8 @@ def read_results(paths: Sequence[Path], names: Sequence[str] | None = None) -> l
     without the suffix when two stems are alike). A file that cannot be read, is not JSON or
     is not a pcmapq eval result is an InputError naming it."""
     if names is not None and len(names) != len(paths):
-        raise InputError(f"--names gives {len(names)} names for {len(paths)} result(s)")
+        raise InputError(f"--names gives {count(len(names), 'name')} for "
+                         f"{count(len(paths), 'result')}")
     if names is None:
         stems = [p.stem for p in paths]
         names = [s if stems.count(s) == 1 else str(p.with_suffix(""))
@@ -67,7 +69,7 @@ def check_same_truth(results: Sequence[Saved], allow_different: bool) -> str | N
     differ = truth_differences(results)
     if not differ:
         return None
-    line = (f"{len(differ)} of {len(results)} results have another truth than "
+    line = (f"{len(differ)} of {count(len(results), 'result')} have another truth than "
             f"{results[0].path} ({results[0].doc['truth']['path']}): {'; '.join(differ)}")
     if not allow_different:
         raise InputError(line + " (--allow-different-truths to compare them anyway)")

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from pcmapq.core.errors import InputError
+from pcmapq.core.words import count
 from pcmapq.results.figures import BY_NAME, FIGURES
 
 #: The exit code of a run whose figures fail a gate (0 scored, 1 evaluation failed, 2 usage).
@@ -205,7 +206,8 @@ def _tau_index(key: str, text: str | None, block: dict | None) -> int:
     if text is None:
         if len(taus) == 1:
             return 0
-        raise GateError(f"{key}: this result has an F-score at each of {len(taus)} taus; name "
+        raise GateError(f"{key}: this result has an F-score at each of "
+                        f"{count(len(taus), 'tau')}; name "
                         f"one: {listed}")
     tau = _tau(text)
     hit = [i for i, t in enumerate(taus) if tau is not None and math.isclose(t, tau,

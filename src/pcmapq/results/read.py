@@ -32,6 +32,12 @@ def _xy(rows: list[dict], key: str) -> np.ndarray:
     return np.array([r[key] for r in rows], dtype=np.float64).reshape(-1, 2)
 
 
+def _unscored(doc: dict) -> str | None:
+    """A detector's saved note when none of its scores is defined (it may have had nothing to
+    find, which its counts alone do not tell); else None, the note follows from the counts."""
+    return doc.get("note") if doc["quality"] is None and doc["precision"] is None else None
+
+
 def _detector_of(doc: dict, matches: list[dict], missing: list[dict],
                  extra: list[dict]) -> DetectorResult:
     """One detector read back: the truth's features are the matched ones then the missing
@@ -47,7 +53,8 @@ def _detector_of(doc: dict, matches: list[dict], missing: list[dict],
         cost=np.full(n, np.nan), quality=doc["quality"], precision=doc["precision"],
         f1=doc["f1"], truth_features=doc["truth_features"], map_features=doc["map_features"],
         matched=doc["matched"], matched_map=doc["matched_map"],
-        missing=np.arange(n, n + k), extra=np.arange(n, n + e))
+        missing=np.arange(n, n + k), extra=np.arange(n, n + e),
+        unscored=_unscored(doc))
     return DetectorResult(Features(truth_xy, np.full(n + k, np.nan), t_strong),
                           Features(map_xy, np.full(n + e, np.nan), m_strong), matching)
 

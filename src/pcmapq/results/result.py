@@ -238,12 +238,16 @@ class Result:
         return json.dumps(self.to_dict(), indent=2, allow_nan=False) + "\n"
 
     @classmethod
-    def from_json(cls, text: str) -> Result:
+    def from_json(cls, source: str | Path) -> Result:
         """The Result that :meth:`to_json` wrote: ``from_json(r.to_json()).to_json() ==
-        r.to_json()``. What the JSON does not hold is absent: the rasters are None, feature
-        strengths and pair costs NaN, descriptors and segments None."""
+        r.to_json()``. ``source`` is the JSON text (a str starting with ``{``) or the path of
+        a file holding it (a Path, or any other str), as ``--json FILE`` writes it. What the
+        JSON does not hold is absent: the rasters are None, feature strengths and pair costs
+        NaN, descriptors and segments None."""
         from pcmapq.results.read import result_of
 
+        is_text = isinstance(source, str) and source.lstrip().startswith("{")
+        text = source if is_text else Path(source).read_text(encoding="utf-8")
         return result_of(json.loads(text))
 
     def figures(self) -> dict[str, float | str | None]:

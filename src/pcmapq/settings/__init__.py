@@ -1,5 +1,7 @@
 """Settings: every option of a run in one object, nested by pipeline stage, every length in
-metres. Each default is defined here once; the command line reads it from here."""
+metres. Each default is defined here once; the command line reads it from here. Light: the
+defaults come from modules that load no pipeline (the detectors' names, the metrics' defaults),
+so that the command line's help, which shows them, loads none of it."""
 
 from __future__ import annotations
 
@@ -7,16 +9,24 @@ from dataclasses import dataclass, field, fields, is_dataclass
 from typing import Any
 
 from pcmapq.align.params import AlignParams
+from pcmapq.core.bounds import Box
 from pcmapq.core.transform import Similarity2D
-from pcmapq.features import DEFAULT_DETECTORS, DETECTORS, default_params
-from pcmapq.io.extent import Box
+from pcmapq.features.names import DEFAULT_DETECTORS, DETECTOR_NAMES
 from pcmapq.io.map_yaml import Thresholds
-from pcmapq.metrics.distances import DEFAULT_TAUS
-from pcmapq.metrics.noref import LIDAR_RADIUS, MAX_NN, MIN_KNN
-from pcmapq.metrics.orthogonal import MAX_WARD_POINTS
+from pcmapq.metrics.defaults import DEFAULT_TAUS, LIDAR_RADIUS, MAX_NN, MAX_WARD_POINTS, MIN_KNN
 
-#: Every registered detector (a module of :mod:`pcmapq.features` that defines ``DETECTOR``).
-DETECTOR_NAMES = tuple(DETECTORS)
+__all__ = ["DEFAULT_DETECTORS", "DETECTOR_NAMES", "EVAL_MAX_WARD", "EVAL_NOREF_SAMPLE",
+           "EVAL_NOREF_VOXEL", "AlignmentConfig", "DistancesConfig", "FootprintConfig",
+           "MatchingConfig", "NoRefConfig", "RasterConfig", "Settings", "SourceConfig",
+           "default_params", "plain"]
+
+
+def default_params() -> dict[str, Any]:
+    """The default parameters of the detectors run by default, by name
+    (:func:`pcmapq.features.registry.default_params`; loads the detectors)."""
+    from pcmapq.features.registry import default_params as of_detectors
+
+    return of_detectors()
 
 
 @dataclass(frozen=True)
@@ -184,11 +194,13 @@ class Settings:
     def to_dict(self) -> dict:
         """Every option as plain JSON types, one object per stage, in metres and degrees:
         ``init`` as ``{"x_m", "y_m", "yaw_deg", "scale"}``, tuples as lists."""
-        return _plain(self)
+        return plain(self)
 
     @classmethod
     def from_dict(cls, doc: dict) -> Settings:
         """The inverse of :meth:`to_dict` (e.g. the ``settings`` of a saved result)."""
+        from pcmapq.features.registry import detector
+
         def source(d: dict) -> SourceConfig:
             t = d["thresholds"]
             crop = d.get("crop")
@@ -207,20 +219,20 @@ class Settings:
                     a["params"]["scale_range"])})}),
             footprint=FootprintConfig(**doc["footprint"]),
             matching=MatchingConfig(tuple(m["detectors"]), m["threshold"],
-                                    {name: DETECTORS[name].params(**p)
+                                    {name: detector(name).params(**p)
                                      for name, p in m["params"].items()}),
             distances=DistancesConfig(tuple(doc["distances"]["taus"])),
             noref=NoRefConfig(**doc.get("noref", {"enabled": False})))  # saved before noref
 
 
-def _plain(value):
+def plain(value):
     """A settings value as plain JSON types (see :meth:`Settings.to_dict`)."""
     if isinstance(value, Similarity2D):
         return value.to_dict()
     if is_dataclass(value):
-        return {f.name: _plain(getattr(value, f.name)) for f in fields(value)}
+        return {f.name: plain(getattr(value, f.name)) for f in fields(value)}
     if isinstance(value, dict):
-        return {k: _plain(v) for k, v in value.items()}
+        return {k: plain(v) for k, v in value.items()}
     if isinstance(value, tuple):
-        return [_plain(v) for v in value]
+        return [plain(v) for v in value]
     return value

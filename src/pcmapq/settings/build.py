@@ -5,7 +5,7 @@ options that cannot work together."""
 from __future__ import annotations
 
 import typing
-from dataclasses import is_dataclass, replace
+from dataclasses import MISSING, fields, is_dataclass, replace
 from typing import Any
 
 from pcmapq.core.errors import InputError
@@ -17,6 +17,31 @@ def base_settings(command: str) -> Settings:
     """A command's defaults: eval's, but ``inspect``'s no-reference figures of a cloud as it
     is (no voxel), as map-metrics computes them."""
     return Settings(noref=NoRefConfig()) if command == "inspect" else Settings()
+
+
+def default_of(command: str, path: str) -> Any:
+    """The setting at a dotted ``path`` as :func:`base_settings` holds it for ``command``, read
+    from the dataclasses' field defaults (:func:`field_default`): the defaults the help shows
+    load no detector."""
+    if command == "inspect" and path.startswith("noref."):
+        return field_default(NoRefConfig, path.partition(".")[2])
+    return field_default(Settings, path)
+
+
+def field_default(owner: type, path: str) -> Any:
+    """The default of the field at a dotted ``path`` of the dataclass ``owner``; a group whose
+    factory is its class is not made (``MatchingConfig()`` would load every detector for its
+    ``params``), its fields are read instead."""
+    step, _, rest = path.partition(".")
+    found = {f.name: f for f in fields(owner)}[step]
+    factory = found.default_factory
+    if found.default is not MISSING:
+        value = found.default
+    elif rest and isinstance(factory, type) and is_dataclass(factory):
+        return field_default(factory, rest)
+    else:
+        value = factory()  # type: ignore[misc]
+    return get_path(value, rest) if rest else value
 
 
 def get_path(settings: Any, path: str) -> Any:

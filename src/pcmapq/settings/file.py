@@ -5,6 +5,7 @@ file leaves out keeps its default; options on the command line override the file
 
 from __future__ import annotations
 
+import copy
 import difflib
 import math
 from pathlib import Path
@@ -16,7 +17,7 @@ from pcmapq.core.errors import InputError
 from pcmapq.core.transform import Similarity2D
 from pcmapq.io.map_yaml import Thresholds
 from pcmapq.io.writers import one_line
-from pcmapq.settings import Settings
+from pcmapq.settings import Settings, plain
 from pcmapq.settings.build import check
 from pcmapq.settings.table import FLOAT, INT, OPTIONS, SWITCH, TEXT, OptionError
 
@@ -30,10 +31,29 @@ def dump_settings(settings: Settings) -> str:
     return yaml.safe_dump(settings.to_dict(), sort_keys=False)
 
 
-def read_settings(path: Path, base: Settings) -> Settings:
-    """``base`` with the settings of the YAML file at ``path`` over it. An unreadable file,
-    an unknown key, a value of the wrong kind or out of its option's bounds: InputError naming
-    the file and the key."""
+def changed_settings(settings: Settings, base: Settings) -> dict:
+    """The settings of ``settings`` that differ from ``base``'s, as :meth:`Settings.to_dict`
+    nests them (a list whole); empty when none do."""
+    def diff(new: dict, old: dict) -> dict:
+        out = {}
+        for key, value in new.items():
+            if isinstance(value, dict) and isinstance(old.get(key), dict):
+                inner = diff(value, old[key])
+                if inner:
+                    out[key] = inner
+            elif value != old.get(key):
+                out[key] = value
+        return out
+
+    return diff(settings.to_dict(), base.to_dict())
+
+
+def read_settings(path: str | Path, base: Settings | None = None) -> Settings:
+    """``base`` (default: ``Settings()``) with the settings of the YAML file at ``path`` over
+    it (``pcmapq.read_settings``). A word option takes its command line's text
+    (``alignment: {scale: auto}``). An unreadable file, an unknown key, a value of the wrong
+    kind or out of its option's bounds: InputError naming the file and the key."""
+    base = Settings() if base is None else base
     try:
         doc = yaml.safe_load(Path(path).read_text(encoding="utf-8"))
     except (OSError, UnicodeDecodeError) as exc:
@@ -46,7 +66,7 @@ def read_settings(path: Path, base: Settings) -> Settings:
     if not isinstance(doc, dict):
         raise InputError(f"{path}: expected a mapping of settings groups (map, truth, raster, "
                          "alignment, footprint, matching, distances, noref)")
-    merged = _merge(base.to_dict(), doc, path, "")
+    merged = _merge(base.to_dict(), _read_words(doc, path), path, "")
     for option in OPTIONS:
         _check_option(merged, option, path)
     try:
@@ -58,6 +78,45 @@ def read_settings(path: Path, base: Settings) -> Settings:
     except InputError as exc:
         raise InputError(f"{path}: {exc}") from None
     return settings
+
+
+def _read_words(doc: dict, path: str | Path) -> dict:
+    """``doc`` with each word option given as text (``scale: auto``, ``resolution: auto``,
+    ``init: "1,2,30"``, ``detectors: harris,hough``) read by its option's parser, as the
+    command line reads it, and the settings that value implies (``also``) set too."""
+    out = copy.deepcopy(doc)
+    seen: set[str] = set()
+    for option in OPTIONS:
+        if option.kind != TEXT or option.path in seen:
+            continue
+        seen.add(option.path)
+        *groups, key = option.path.split(".")
+        group = _group(out, groups)
+        if group is None or not isinstance(group.get(key), str):
+            continue
+        try:
+            setting = option.read(group[key])
+        except OptionError as exc:
+            raise InputError(f"{path}: {option.path}: {exc.message}") from None
+        group[key] = plain(setting)
+        for also, value in option.also(setting).items():
+            *also_groups, also_key = also.split(".")
+            target = _group(out, also_groups, make=True)
+            if target is not None:
+                target[also_key] = plain(value)
+    return out
+
+
+def _group(doc: dict, steps: list[str], make: bool = False) -> dict | None:
+    """The group of ``doc`` at ``steps`` (made empty when absent and ``make``); None when a
+    step is absent or not a group."""
+    for step in steps:
+        if make and step not in doc:
+            doc[step] = {}
+        doc = doc.get(step)
+        if not isinstance(doc, dict):
+            return None
+    return doc
 
 
 def _merge(into: dict, doc: dict, path: Path, where: str) -> dict:

@@ -15,7 +15,7 @@ import numpy as np
 
 from pcmapq.core.errors import InputError
 from pcmapq.core.transform import Similarity2D
-from pcmapq.raster.footprint import FOOTPRINT_RULES
+from pcmapq.raster.rules import FOOTPRINT_RULES
 from pcmapq.settings import DETECTOR_NAMES
 
 #: Kinds of option: a number, an integer, text read by the option's parser, or a switch

@@ -17,6 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
+from pcmapq.core.words import count, plural
 from pcmapq.evaluation.inputs import TRUTH_CROP, load_input
 from pcmapq.evaluation.truth import PreparedTruth, prepare_truth
 from pcmapq.io.writers import OutputSet, write_atomic
@@ -137,8 +138,8 @@ def inputs_of(tracked: Tracked, every: dict) -> dict[str, str]:
                (False, True): "scale corrected, not aligned",
                (False, False): "not aligned"}[options.align, options.correct_scale]
         words["reference poses"] = (f"{tracked.reference}; {how}, RPE over {options.delta} "
-                                    f"scan{'s' * (options.delta > 1)}")
-    words["steps"] = (f"every {every['every_scans']} scans" if every.get("every_scans")
+                                    f"{plural(options.delta, 'scan')}")
+    words["steps"] = (f"every {count(every['every_scans'], 'scan')}" if every.get("every_scans")
                       else f"every {every['every_m']:g} m travelled" if every.get("every_m")
                       else f"every map published, at most one per {every['every_s']:g} s"
                       if every.get("every_s") else "every map published") + ", and the last"

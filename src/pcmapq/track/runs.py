@@ -28,6 +28,7 @@ import numpy as np
 
 from pcmapq.core.errors import InputError
 from pcmapq.core.transform import affine
+from pcmapq.core.words import plural
 from pcmapq.features.walls import CLOSING
 from pcmapq.io import PointMap
 from pcmapq.io.carmen import DEFAULT_MAX_RANGE, LaserScans, endpoints, is_carmen, read_laser_scans
@@ -181,8 +182,9 @@ def open_run(source: Path, poses: Path | None = None, *,
         if estimate is None:
             estimate = planar_poses(scans.poses)
         elif len(estimate) != len(scans.poses):
-            raise InputError(f"{poses}: {len(estimate)} poses for the {len(scans.poses)} "
-                             f"scans of {source} (one pose per scan)")
+            raise InputError(f"{poses}: {len(estimate)} {plural(len(estimate), 'pose')} for the "
+                             f"{len(scans.poses)} {plural(len(scans.poses), 'scan')} of {source} "
+                             "(one pose per scan)")
         return LaserRun(source, scans, estimate, scans.stamps,
                         **({} if poses is None else {"poses_source": str(poses)}))
     sequence = open_scans(source, topic=scan_topic)
@@ -201,6 +203,6 @@ def reference_poses_of(path: Path, count: int, calib: Path | None = None) -> np.
     poses = (planar_poses(read_laser_scans(path).poses) if is_carmen(path)
              else scanner_poses(path, calib))
     if len(poses) != count:
-        raise InputError(f"{path}: {len(poses)} reference poses for {count} scans (one per "
-                         "scan)")
+        raise InputError(f"{path}: {len(poses)} reference {plural(len(poses), 'pose')} for "
+                         f"{count} {plural(count, 'scan')} (one per scan)")
     return poses

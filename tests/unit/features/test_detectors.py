@@ -173,8 +173,9 @@ def test_no_more_detectors_run_at_once_than_the_process_allows(monkeypatch):
     from dataclasses import replace
 
     import pcmapq.features as features
+    from pcmapq.features import registry
 
-    monkeypatch.setattr(features, "_DETECTING", threading.BoundedSemaphore(1))
+    monkeypatch.setattr(registry, "_DETECTING", threading.BoundedSemaphore(1))
     running, most, count = 0, 0, threading.Lock()
     real = {name: features.detector(name) for name in ("harris", "hough")}
 
@@ -190,7 +191,7 @@ def test_no_more_detectors_run_at_once_than_the_process_allows(monkeypatch):
             return real[name].detect(walls, params)
         return replace(real[name], detect=detect)
 
-    monkeypatch.setattr(features, "detector", lambda name: slow(name))
+    monkeypatch.setattr(registry, "detector", lambda name: slow(name))
     occupied = np.zeros((40, 40), bool)
     occupied[10, 5:35] = occupied[5:35, 10] = True
     grid = MetricGrid(0.05, (0.0, 0.0, 0.0), occupied.shape)

@@ -245,6 +245,18 @@ def test_a_map_without_rooms_leaves_every_truth_room_missing():
     assert room_table(truth, none)["counts"]["truth missing"] == 3
 
 
+@pytest.mark.parametrize("map_rooms", [1, 3])
+def test_a_truth_of_one_room_has_nothing_to_find(map_rooms):
+    """One room in the truth (an outdoor place, a single hall): the rooms' quality, precision
+    and f1 are undefined, with why, whatever the map's rooms; the counts stay."""
+    hall = plan(walls=(False, False))
+    t, m, found = scored(hall, hall if map_rooms == 1 else plan())
+    assert (len(t), len(m)) == (1, map_rooms)
+    assert (found.quality, found.precision, found.f1) == (None, None, None)
+    assert found.note() == "the truth has 1 room, fewer than 2: nothing to find"
+    assert (found.truth_features, found.map_features) == (1, map_rooms)
+
+
 def test_a_closet_smaller_than_a_room_joins_the_room_behind_its_gap():
     """A 0.3 x 0.3 m closet behind a gap in the wall is part of the room: no door to it."""
     free = plan(rooms=1)

@@ -316,11 +316,11 @@ def test_bad_input_is_one_line_naming_the_file(tmp_path: Path, name: str) -> Non
     ("missing.png", "missing.png: not found"),
     ("garbage.png", "garbage.png: cannot be read as an image"),
     ("nores.yaml", "nores.yaml: no 'resolution' key"),
-    ("lonely.png", "lonely.png: no resolution: give --map-resolution/--truth-resolution "
-                   "or a YAML beside it"),
+    ("lonely.png", "lonely.png: no resolution: give --map-resolution or a YAML beside it"),
     ("empty.xyz", "empty.xyz: no points"),
-    ("foo.abc", "foo.abc: unsupported format '.abc' (expected .png, .pgm, .yaml, .ply, .pcd, "
-                ".xyz, .txt, .npy, .bin, .las, .laz, .e57, .bag, .db3, .mcap)"),
+    ("foo.abc", "foo.abc: unsupported format '.abc' (expected .png, .pgm, .jpg, .jpeg, .bmp, "
+                ".yaml, .yml, .ply, .pcd, .xyz, .txt, .npy, .bin, .las, .laz, .e57, .log, "
+                ".log.gz, .bag, .db3, .mcap, or a ROS 2 bag folder)"),
 ])
 def test_bad_input_messages(tmp_path: Path, name: str, expected: str) -> None:
     BAD_INPUTS[name](tmp_path)

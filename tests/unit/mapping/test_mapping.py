@@ -164,7 +164,7 @@ def test_build_map_from_poses_places_scans(tmp_path: Path) -> None:
     expected = np.array([[0, 2, 1], [1, 0, 1], [10, 2, 1], [11, 0, 1]], dtype=np.float64)
     assert np.allclose(points, expected)
     assert calls == [(1, 2), (2, 2)]
-    with pytest.raises(InputError, match="2 poses for 1 scans"):
+    with pytest.raises(InputError, match="2 poses for 1 scan in"):
         build_map_from_poses(write_scans(tmp_path / "one", [scan]), poses)
 
 

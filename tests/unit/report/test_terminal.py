@@ -102,7 +102,7 @@ def test_the_first_line_says_how_good_the_map_is_and_why():
     assert first.startswith("scan.ply: aligned with confidence 1.00; ")
     assert f"{100 * doc['coverage']:.0f} % of the truth's walls covered" in first
     for name, det in doc["detectors"].items():
-        assert f"{name} {det['quality']:.2f}" in first
+        assert f"{name} {det['quality']:.2f}/{det['precision']:.2f}" in first
     assert f"map walls {doc['distances']['accuracy_m']['mean']:.3f} m from the truth's" in first
     assert (f"truth walls {doc['distances']['completeness_m']['mean']:.3f} m from the map's"
             in first)
@@ -135,10 +135,47 @@ def test_the_verdict_says_plainly_when_a_score_is_undefined():
     doc["alignment"]["confidence"] = 0.3
     doc["alignment"]["verdict"] = "another place"
     line = verdict(sample_result(doc))
-    assert "harris n/a (no strong truth feature inside the footprint)" in line
+    precision = doc["detectors"]["harris"]["precision"]
+    assert f"harris n/a/{precision:.2f} (no strong truth feature inside the footprint)" in line
     assert "it may show another place (confidence 0.30 < 0.5, scored because of --force)" in line
     assert "harris: n/a: no strong truth feature inside the footprint" in shown(
         sample_result(doc), 80)
+
+
+def test_the_first_line_gives_the_precision_of_a_map_full_of_extra_features():
+    """A map that finds a sixth of the truth's corners among 200 of its own (a SLAM map of a
+    Gazebo world, precision 0.005) reads low on the first line, not 'harris 0.17' alone."""
+    doc = copy.deepcopy(SAMPLE_DOC)
+    doc["detectors"]["harris"].update(quality=1 / 6, precision=0.005, f1=0.0097,
+                                      map_features=200, matched_map=1)
+    line = verdict(sample_result(doc))
+    assert "feature quality/precision harris 0.17/0.01," in line
+
+
+def test_a_detector_with_nothing_to_find_reads_n_a_with_why():
+    """One room each side (an outdoor pair): 'rooms n/a (...)', not 'rooms 0.00'; the why
+    comes back from the saved JSON."""
+    doc = copy.deepcopy(SAMPLE_DOC)
+    why = "the truth has 1 room, fewer than 2: nothing to find"
+    doc["detectors"]["rooms"].update(quality=None, precision=None, f1=None, note=why,
+                                     truth_features=1, map_features=1, matched=0,
+                                     matched_map=0)
+    result = sample_result(doc)
+    assert f"rooms n/a ({why})" in verdict(result)
+    assert result.to_dict()["detectors"]["rooms"]["note"] == why
+
+
+def test_the_regions_line_counts_in_words_and_rounds_the_tile_as_metres():
+    """'44 regions of 6.6 m', not '6.64829 m'; one region is 'a region', not '1 regions'."""
+    doc = copy.deepcopy(SAMPLE_DOC)
+    doc["consistency"]["tile_m"] = 6.64829
+    text = " ".join(shown(sample_result(doc), 132).split())
+    regions = len(doc["consistency"]["regions"])
+    assert f"{regions} regions of 6.6 m" in text and "6.64829" not in text
+    doc["consistency"]["regions"] = doc["consistency"]["regions"][:1]
+    doc["consistency"]["largest_at_m"] = 0
+    text = " ".join(shown(sample_result(doc), 132).split())
+    assert "1 region of 6.6 m" in text
 
 
 def test_lines_break_between_values_only():

@@ -127,3 +127,15 @@ def test_older_results_read_back_without_noref():
     doc = Settings().to_dict()
     del doc["noref"]
     assert Settings.from_dict(doc).noref.enabled is False
+
+
+def test_from_json_reads_a_path_or_the_text(result: Result, tmp_path):
+    """A path (str or Path) is read; text starting with '{' is parsed: the same Result."""
+    path = tmp_path / "full.json"
+    path.write_text(result.to_json())
+    text = Result.from_json(result.to_json()).to_json()
+    assert Result.from_json(path).to_json() == text
+    assert Result.from_json(str(path)).to_json() == text
+    assert Result.from_json("\n  " + result.to_json()).to_json() == text
+    with pytest.raises(FileNotFoundError):
+        Result.from_json(str(tmp_path / "absent.json"))

@@ -1,4 +1,5 @@
-"""One source of truth: the command line's defaults are Settings', and a detector is one file."""
+"""One source of truth: the command line's defaults are Settings', a detector is one file (and
+its name), and the names the help reads without loading a detector are the registry's."""
 
 from __future__ import annotations
 
@@ -12,6 +13,7 @@ import pcmapq.features as features
 from pcmapq.cli import app
 from pcmapq.core.errors import InputError
 from pcmapq.core.grid import MetricGrid
+from pcmapq.features import registry
 from pcmapq.match import match
 from pcmapq.settings import DETECTOR_NAMES, Settings
 from pcmapq.testing import synth
@@ -44,7 +46,7 @@ def test_a_detector_is_one_file(tmp_path, monkeypatch):
         "    radius: float = 0.6\n"
         "DETECTOR = Detector('corners_again', harris.detect, harris.candidates, Params)\n")
     monkeypatch.setattr(features, "__path__", [*features.__path__, str(tmp_path)])
-    found = features._discover()
+    found = registry._discover()
     assert "corners_again" in found and set(DETECTOR_NAMES) <= set(found)
     monkeypatch.setitem(features.DETECTORS, "corners_again", found["corners_again"])
     assert features.default_params()["corners_again"].radius == 0.6
@@ -56,6 +58,14 @@ def test_a_detector_is_one_file(tmp_path, monkeypatch):
     assert f.strong.sum() >= 10 and m.quality == 1.0
     wide = features.detect("harris", occ, grid, features.harris.Params(radius=0.6))
     np.testing.assert_array_equal(f.xy, wide.xy)
+
+
+def test_the_names_read_without_the_detectors_are_the_registrys():
+    """pcmapq.features.names (read by the settings and the help) lists the registry's
+    detectors in its order, and those run by default."""
+    assert features.DETECTOR_NAMES == tuple(registry.DETECTORS)
+    assert features.DEFAULT_DETECTORS == tuple(
+        name for name, d in registry.DETECTORS.items() if d.by_default)
 
 
 def test_parameters_are_data():

@@ -1,0 +1,19 @@
+"""The metrics' defaults, apart from the code that uses them (which loads SciPy, Numba and
+fastcluster), so the settings and the command line's help read them without it. Each metric's
+module re-exports its own."""
+
+from __future__ import annotations
+
+#: Default distance thresholds of the F-score, metres.
+DEFAULT_TAUS = (0.05, 0.1, 0.2, 0.5)
+
+#: map-metrics' presets (metres, neighbour counts): ``LidarConfig`` and ``DepthConfig``.
+LIDAR_RADIUS = 1.0
+DEPTH_RADIUS = 0.2
+MIN_KNN = 5
+MAX_NN = 30
+
+#: Ward clustering takes N^2 time: more planar points than this are
+#: clustered through an evenly spaced sample of this many. One scan stays below it (7,336 in
+#: KITTI 00's first scan at 0.3 m), so an extraction from a scan is map-metrics' own.
+MAX_WARD_POINTS = 10_000
