@@ -1,11 +1,14 @@
 """Fuzzing of every map and pose loader: valid small seed files of each format, mutated (byte
 flips, insertions, deletions, truncation, header fields and YAML values replaced by absurd ones),
-each read by :func:`pcmapq.io.load_map` or a pose reader. The only outcomes allowed are a load
-whose result holds the documented invariants or an :class:`InputError` of one line starting with
-the file's path; anything else (another exception, a slow read, a large allocation, output on
-stdout or stderr, a warning) is a finding.
+each read by :func:`pcmapq.io.load_map` or a pose reader; a ROS recording (ROS 1 bag, ROS 2
+bag of SQLite or MCAP storage, a zstd-compressed MCAP) by every reader of recordings: its map,
+its scans and the odometry placing them (:func:`read_recording`). The only outcomes allowed are
+a load whose result holds the documented invariants or an :class:`InputError` of one line
+starting with the file's path; anything else (another exception, a slow read, a large
+allocation, output on stdout or stderr, a warning other than pcmapq's own about a recording) is
+a finding.
 
-``tests/e2e/test_fuzz_loaders.py`` runs this for about ten seconds in CI; from the command line
+``tests/e2e/test_fuzz_loaders.py`` runs this for about a minute in CI; from the command line
 it runs longer and prints the examples run and the outcomes per format::
 
     python tools/fuzz_loaders.py [--minutes 10] [--seed 0] [--formats ply_binary,pcd_ascii]
@@ -28,7 +31,7 @@ import zlib
 from collections import Counter
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -198,6 +201,38 @@ def _mcap_bytes() -> bytes:
                                                               "mcap"))
 
 
+def _recording_files(layout: str, name: str) -> dict[str, bytes]:
+    """A small recording of every message pcmapq reads (a 12 x 16 map, three 20-beam laser
+    scans, the odometry and transforms placing them) written by rosbags in ``layout``, as
+    its files by name (a ROS 2 bag: ``name/metadata.yaml`` and its storage file)."""
+    from pcmapq.core.grid import MetricGrid
+    from pcmapq.testing.recordings import Scan, write_recording
+
+    state = np.full((12, 16), FREE, dtype=np.int8)
+    state[0, :], state[:, 0], state[5:7, 5:9] = OCCUPIED, OCCUPIED, UNKNOWN
+    grid = MetricGrid(0.05, (0.0, 0.0, 0.0), state.shape)
+    ranges = np.random.default_rng(8).uniform(0.5, 6.0, (3, 20))
+    ranges[:, 3] = np.nan
+    poses = []
+    for k in range(3):
+        pose = np.eye(4)
+        pose[:2, 3] = 0.3 * k, 0.1 * k
+        poses.append((1.0 + 0.25 * k, pose))
+    with tempfile.TemporaryDirectory() as folder:
+        path = write_recording(Path(folder) / name, [(1.0, state, grid)], layout,
+                               scans=[Scan(t, r, -1.0, 0.1) for (t, _), r in zip(
+                                   poses, ranges, strict=True)], poses=poses,
+                               transforms=[(t, "odom", "laser", p) for t, p in poses])
+        files = [path] if path.is_file() else sorted(path.iterdir())
+        return {str(f.relative_to(folder)): f.read_bytes() for f in files}
+
+
+def _zstd(data: bytes) -> bytes:
+    from pcmapq.io.bag_files import zstd_module
+
+    return zstd_module().compress(data)
+
+
 def _after(marker: bytes) -> Callable[[bytes], int]:
     """The header ends after the line holding ``marker``."""
     def end(data: bytes) -> int:
@@ -206,8 +241,24 @@ def _after(marker: bytes) -> Callable[[bytes], int]:
     return end
 
 
-def make_seeds() -> dict[str, Seed]:
-    """The seed inputs, by name; deterministic."""
+def recording_seeds() -> dict[str, Seed]:
+    """The seed recordings, by name (each read by :func:`read_recording`); deterministic."""
+    ros1, sqlite = _recording_files("ros1", "r.bag"), _recording_files("ros2-sqlite", "r")
+    mcap, solo = _recording_files("ros2-mcap", "r"), _recording_files("mcap", "r.mcap")
+    seeds = [
+        Seed("ros1_bag", ros1, "r.bag", "r.bag", reader="recording", header=lambda d: 0),
+        Seed("ros2_sqlite", sqlite, "r/r.db3", "r", reader="recording", header=lambda d: 0),
+        Seed("ros2_mcap", mcap, "r/r.mcap", "r", reader="recording", header=lambda d: 0),
+        Seed("ros2_metadata", mcap, "r/metadata.yaml", "r", reader="recording"),
+        Seed("mcap_zstd", {"r.mcap.zstd": _zstd(solo["r.mcap"])}, "r.mcap.zstd",
+             "r.mcap.zstd", reader="recording", header=lambda d: 0, encode=_zstd),
+    ]
+    return {s.name: s for s in seeds}
+
+
+def make_seeds(recordings: bool = True) -> dict[str, Seed]:
+    """The seed inputs, by name (with ``recordings``, :func:`recording_seeds` too: a few
+    seconds to write); deterministic."""
     ply_head, pcd_head = _after(b"end_header"), _after(b"DATA")
     kitti_points = np.random.default_rng(5).uniform(-4, 4, (40, 4)).astype("<f4")
     text_cloud = "".join(f"{x:.4f} {y:.4f} {z:.4f}\n" for x, y, z in
@@ -246,12 +297,17 @@ def make_seeds() -> dict[str, Seed]:
         Seed("calib", {"c.txt": b"P0: 1 0 0 0 0 1 0 0 0 0 1 0\nTr: 0 -1 0 0 0 0 -1 0 1 0 0 0\n"},
              "c.txt", "c.txt", reader="calib"),
     ]
-    return {s.name: s for s in seeds}
+    return {s.name: s for s in seeds} | (recording_seeds() if recordings else {})
 
 
 def original(seed: Seed) -> bytes:
-    """The bytes mutations apply to: the target's contents, decoded (gunzipped) if encoded."""
+    """The bytes mutations apply to: the target's contents, decoded (gunzipped, or
+    decompressed by zstd) if encoded."""
     data = seed.files[seed.target]
+    if seed.encode is _zstd:
+        from pcmapq.io.bag_files import zstd_module
+
+        return zstd_module().decompress(data)
     return gzip.decompress(data) if seed.encode else data
 
 
@@ -352,6 +408,7 @@ def time_limit(seconds: float) -> Iterator[None]:
 def write_example(seed: Seed, ops: list[Op], folder: Path) -> Path:
     """Write the seed's files into ``folder``, the target mutated; the entry's path."""
     for name, data in seed.files.items():
+        (folder / name).parent.mkdir(parents=True, exist_ok=True)
         (folder / name).write_bytes(data)
     data = mutate(original(seed), ops, seed.header)
     (folder / seed.target).write_bytes(seed.encode(data) if seed.encode else data)
@@ -364,7 +421,44 @@ def load(seed: Seed, path: Path) -> object:
         return read_poses(path)
     if seed.reader == "calib":
         return read_calib(path)
+    if seed.reader == "recording":
+        return read_recording(path)
     return load_map(path)
+
+
+@dataclass(frozen=True)
+class RecordingRead:
+    """What each reader of a recording gave (None: it refused, with ``errors``' line)."""
+
+    map: OccupancyMap | None
+    poses: np.ndarray | None
+    scans: list[np.ndarray] | None
+    errors: tuple[InputError, ...]
+
+
+def read_recording(path: Path) -> RecordingRead:
+    """Read a recording as pcmapq's commands do: its map (``load_map``), the odometry at its
+    scans' times (``recorded_poses``, /odom) and its scans (``open_scans``), each on its own;
+    InputError (the first) when every one refuses it; :class:`Finding` for a refusal not one
+    line naming the file."""
+    from pcmapq.mapping import open_scans, recorded_poses
+
+    readers = (lambda: load_map(path), lambda: recorded_poses(path, None, "/odom"),
+               lambda: [points for points, _ in open_scans(path)])
+    got: list[object] = []
+    errors: list[InputError] = []
+    for reader in readers:
+        try:
+            got.append(reader())
+        except InputError as error:
+            if "\n" in str(error) or not str(error).startswith(str(path)):
+                raise Finding(f"InputError not one line naming the file: {str(error)!r}"
+                              ) from None
+            got.append(None)
+            errors.append(error)
+    if len(errors) == len(readers):
+        raise errors[0]
+    return RecordingRead(*got, tuple(errors))
 
 
 def run_example(seed: Seed, ops: list[Op], folder: Path) -> str:
@@ -395,6 +489,8 @@ def run_example(seed: Seed, ops: list[Op], folder: Path) -> str:
         outcome = "loaded"
     elapsed = time.perf_counter() - start
     grown = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024 - before
+    if seed.reader == "recording":  # pcmapq's own warnings (poses far from the scans) are said
+        caught = [w for w in caught if not _own_warning(w)]
     if caught:
         w = caught[0]
         raise Finding(f"warning at {Path(w.filename).name}:{w.lineno}: "
@@ -408,8 +504,24 @@ def run_example(seed: Seed, ops: list[Op], folder: Path) -> str:
     return outcome
 
 
+def _own_warning(w: warnings.WarningMessage) -> bool:
+    """A warning pcmapq gives in words (``pcmapq: warning: ...`` on the command line)."""
+    import pcmapq
+
+    return w.category is UserWarning and w.filename.startswith(str(Path(pcmapq.__file__).parent))
+
+
 def check_result(seed: Seed, result: object) -> None:
     """Raise :class:`Finding` unless a loaded result holds its documented invariants."""
+    if isinstance(result, RecordingRead):
+        for part in (result.map, result.poses):
+            if part is not None:
+                check_result(replace(seed, reader="poses" if part is result.poses else "map"),
+                             part)
+        for points in result.scans or []:
+            _require(points.ndim == 2 and points.shape[1] == 3, f"scan of shape {points.shape}")
+            _require(bool(np.isfinite(points).all()), "non-finite scan point")
+        return
     if seed.reader == "poses":
         poses = result  # type: ignore[assignment]
         _require(poses.ndim == 3 and poses.shape[1:] == (4, 4) and len(poses) > 0,

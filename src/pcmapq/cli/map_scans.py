@@ -99,6 +99,9 @@ def map_command(
                               highlight=False, soft_wrap=True)
                 trajectory = trajectory[:len(scans)]
                 points = build_map_from_poses(scans, trajectory, voxel=voxel, progress=tick)
+        if not len(points):
+            raise InputError(f"{source}: the scans hold no point to map (no return within "
+                             "their range limits)")
         with OutputSet() as outputs:  # the map and its poses: all or none
             write_cloud(out, points, outputs)
             wrote = [f"wrote {out}: {count(len(points), 'point')} from "

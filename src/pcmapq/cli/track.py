@@ -102,15 +102,17 @@ def track_command(
                               inputs=(*paths, poses, reference_poses, calib,
                                       settings_values.get("config")))
         limit = memory_limit(max_memory)
-        if has_grids(run_path, map_topic):
-            given = [o for o, v in (("--poses", poses), ("--reference-poses", reference_poses),
-                                    ("--calib", calib), ("--every", every),
-                                    ("--every-m", every_m), ("--scan-topic", scan_topic),
-                                    ("--pose-topic", pose_topic)) if v is not None]
-            if given:
-                raise InputError(f"{run_path}: a recording's published maps are scored on its "
-                                 f"time axis: {', '.join(given)} apply to a run's scans "
-                                 "(--every-s thins the maps)")
+        scan_options = [o for o, v in (
+            ("--poses", poses), ("--reference-poses", reference_poses), ("--calib", calib),
+            ("--every", every), ("--every-m", every_m), ("--scan-topic", scan_topic),
+            ("--pose-topic", pose_topic), ("--frame", frame)) if v is not None]
+        map_options = [o for o, v in (("--map-topic", map_topic), ("--every-s", every_s))
+                       if v is not None]
+        if scan_options and map_options:
+            raise InputError(f"{run_path}: {', '.join(map_options)} score a recording's "
+                             f"published maps, {', '.join(scan_options)} a run's scans: give "
+                             "the options of one")
+        if not scan_options and has_grids(run_path, map_topic):
             tracked = track_recording(Recording(run_path, map_topic, every_s), truth_path,
                                       settings, show=step, progress=progress,
                                       memory_limit=limit)
@@ -118,8 +120,8 @@ def track_command(
             rule: dict = {"every_s": every_s, "map_topic": map_topic}
             total = f"{count(tracked.steps[-1].scans, 'map')} published"
         else:
-            if every_s is not None or map_topic is not None:
-                raise InputError(f"{run_path}: --every-s and --map-topic apply to a ROS "
+            if map_options:
+                raise InputError(f"{run_path}: {', '.join(map_options)} apply to a ROS "
                                  "recording of published maps (nav_msgs/OccupancyGrid)")
             tracked, rule = _track_scans(run_path, truth_path, settings, poses=poses,
                                          reference_poses=reference_poses, calib=calib,

@@ -93,7 +93,9 @@ def score(placed: Placed, prepared: PreparedTruth, settings: Settings,
                   threshold=threshold, full=full, detectors=detectors,
                   footprint_rule=rule, frames=frames, settings=settings.to_dict(),
                   truth_occupied=prepared.occupied, map_occupied=side.occupied, noref=noref,
-                  consistency=consistency, rooms=rooms)
+                  consistency=consistency, rooms=rooms,
+                  map_message=None if getattr(loaded, "message", None) is None
+                  else loaded.message.to_dict())
 
 
 def inside(features: Features, area: np.ndarray, grid: MetricGrid,

@@ -1,12 +1,14 @@
 """The ``nav_msgs/OccupancyGrid`` messages of a ROS recording (:mod:`pcmapq.io.bags`) as
 occupancy maps, read as map_server reads a saved map: a cell of -1 is unknown, else
 ``p = value / 100`` is occupied above ``occupied_thresh`` and free below ``free_thresh``.
-Times are seconds of the recording's clock."""
+Times are seconds from the recording's start (:func:`pcmapq.io.bags.seconds`); each map names
+its message (:class:`~pcmapq.io.bags.Message`)."""
 
 from __future__ import annotations
 
 import hashlib
 from collections.abc import Iterator
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -16,7 +18,19 @@ from pcmapq.core import memory
 from pcmapq.core.cells import FREE, OCCUPIED, UNKNOWN
 from pcmapq.core.errors import InputError
 from pcmapq.core.grid import MetricGrid
-from pcmapq.io.bags import DEFAULT_MAP_TOPIC, GRID, topic_messages
+from pcmapq.io.bags import (
+    DEFAULT_MAP_TOPIC,
+    GRID,
+    Message,
+    deserialised,
+    messages,
+    opened,
+    pick,
+    seconds,
+    stamp_of,
+    topic_messages,
+    topics,
+)
 from pcmapq.io.map_yaml import MapMeta, Thresholds
 from pcmapq.io.occupancy import OccupancyMap
 from pcmapq.io.writers import one_line
@@ -25,37 +39,57 @@ from pcmapq.io.writers import one_line
 def grids(path: Path, topic: str | None = None, thresholds: Thresholds | None = None,
           option: str = "--map-topic", memory_limit: int | None = None
           ) -> Iterator[tuple[float, OccupancyMap]]:
-    """Every OccupancyGrid of the recording's map topic, in time order: (seconds, map). A grid
-    the same as the one before (same cells, resolution and origin) is left out; one larger
-    than ``memory_limit`` bytes allow (None: the default) is refused before it is drawn."""
+    """Every OccupancyGrid of the recording's map topic, in time order: (seconds from the
+    recording's start, map naming its message). A grid the same as the one before (same
+    cells, resolution and origin) is left out; one larger than ``memory_limit`` bytes allow
+    (None: the default) is refused before it is drawn."""
     last = None
-    for chosen, seconds, msg in topic_messages(path, (GRID,), topic, DEFAULT_MAP_TOPIC, option):
-        try:
-            key = _digest(msg)
-            if key == last:
-                continue
-            last = key
-            grid = grid_map(msg, path, chosen.name, thresholds, memory_limit)
-        except (AttributeError, TypeError, ValueError) as exc:  # a message of another shape
-            raise InputError(f"{path}: {chosen.name}: not an OccupancyGrid as nav_msgs "
-                             f"defines it: {one_line(exc)}") from None
-        yield seconds, grid
+    for index, (chosen, at, msg) in enumerate(
+            topic_messages(path, (GRID,), topic, DEFAULT_MAP_TOPIC, option)):
+        key = _checked(path, chosen.name, _digest, msg)
+        if key == last:
+            continue
+        last = key
+        grid = _checked(path, chosen.name, grid_map, msg, path, chosen.name, thresholds,
+                        memory_limit)
+        yield at, replace(grid, message=Message(chosen.name, index, at, stamp_of(msg)))
 
 
 def grid_at(path: Path, topic: str | None = None, at: float | None = None,
             thresholds: Thresholds | None = None, option: str = "--map-topic",
             memory_limit: int | None = None) -> OccupancyMap:
-    """The OccupancyGrid of the map topic at ``at`` seconds of the bag's clock (the last one
-    published at or before it), or the last one; InputError when there is none."""
-    chosen = None
-    for stamp, grid in grids(path, topic, thresholds, option, memory_limit):
-        if at is not None and stamp > at:
-            break
-        chosen = grid
-    if chosen is None:
-        raise InputError(f"{path}: no OccupancyGrid at or before {at:g} s" if at is not None
-                         else f"{path}: the map topic holds no message")
-    return chosen
+    """The OccupancyGrid of the map topic at ``at`` seconds from the recording's start (the
+    last one recorded at or before it), or the last one; InputError when there is none. Only
+    that message is decoded."""
+    with opened(path) as reader:
+        chosen = pick(path, topics(reader), (GRID,), topic, DEFAULT_MAP_TOPIC, option)
+        connections = [c for c in reader.connections if c.topic == chosen.name]
+        found = None
+        for index, (connection, stamp, raw) in enumerate(
+                messages(reader, connections, path)):
+            t = seconds(reader, stamp)
+            if at is not None and t > at:
+                break
+            found = (index, t, connection, raw)
+        if found is None:
+            raise InputError(f"{path}: no OccupancyGrid at or before {at:g} s from the "
+                             "recording's start" if at is not None
+                             else f"{path}: the map topic holds no message")
+        index, t, connection, raw = found
+        msg = deserialised(reader, raw, connection, path)
+    grid = _checked(path, chosen.name, grid_map, msg, path, chosen.name, thresholds,
+                    memory_limit)
+    return replace(grid, message=Message(chosen.name, index, t, stamp_of(msg)))
+
+
+def _checked(path: Path, topic: str, function, *args):
+    """``function(*args)`` on a message, InputError naming the topic when the message is of
+    another shape."""
+    try:
+        return function(*args)
+    except (AttributeError, TypeError, ValueError) as exc:
+        raise InputError(f"{path}: {topic}: not an OccupancyGrid as nav_msgs defines it: "
+                         f"{one_line(exc)}") from None
 
 
 def grid_map(msg: Any, path: Path, topic: str, thresholds: Thresholds | None = None,

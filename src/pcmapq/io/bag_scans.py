@@ -1,10 +1,12 @@
 """The scans and poses of a ROS recording (:mod:`pcmapq.io.bags`): ``sensor_msgs/PointCloud2``
 and ``sensor_msgs/LaserScan`` messages as points in the sensor's frame, ``nav_msgs/Odometry``
-and ``geometry_msgs/PoseStamped`` messages as a pose track, and poses interpolated along it.
-Times are seconds of the recording's clock; metres."""
+and ``geometry_msgs/PoseStamped`` messages as a pose track, and poses interpolated along it:
+a scan farther in time from the nearest pose than :data:`GAP_WARN_S` gets a warning, than
+:data:`GAP_MAX_S` is refused. Times are seconds from the recording's start; metres."""
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Iterator
 from contextlib import closing
 from pathlib import Path
@@ -32,6 +34,11 @@ FIELD_TYPES = {1: "i1", 2: "u1", 3: "i2", 4: "u2", 5: "i4", 6: "u4", 7: "f4", 8:
 TIME_FIELDS = ("t", "timestamp", "timestamps", "time", "stamps")
 #: The message types of scans.
 SCANS = (CLOUD, LASER)
+#: Scans farther than this from the nearest pose of their track, seconds, are placed with a
+#: warning (their pose is held or interpolated across that gap: 0.5 m at a walking pace).
+GAP_WARN_S = 0.5
+#: Scans farther than this from the nearest pose of their track, seconds, are refused.
+GAP_MAX_S = 5.0
 
 
 def scan_topic(path: Path, topic: str | None = None) -> Topic:
@@ -99,7 +106,7 @@ def scan_frame(path: Path, topic: str | None = None) -> str:
 
 
 def scan_times(path: Path, topic: str | None = None) -> np.ndarray:
-    """The times of the recording's scans (seconds of its clock), without reading their
+    """The times of the recording's scans (seconds from its start), without reading their
     points' data into arrays."""
     return np.array([seconds for _, seconds, _ in
                      topic_messages(path, SCANS, topic, None, "--scan-topic", decode=False)],
@@ -108,7 +115,7 @@ def scan_times(path: Path, topic: str | None = None) -> np.ndarray:
 
 def pose_track(path: Path, topic: str) -> tuple[np.ndarray, np.ndarray]:
     """A recording's nav_msgs/Odometry or geometry_msgs/PoseStamped topic: times (K,) seconds
-    of its clock and poses (K, 4, 4), the frame the messages name -> world."""
+    from its start and poses (K, 4, 4), the frame the messages name -> world."""
     times, poses = [], []
     for chosen, seconds, msg in topic_messages(path, (ODOMETRY, POSE), topic, None,
                                                "--pose-topic"):
@@ -138,6 +145,34 @@ def poses_at(times: np.ndarray, track_times: np.ndarray, track: np.ndarray) -> n
     slerp = Slerp(unique, Rotation.from_matrix(track[first, :3, :3]))
     out[:, :3, :3] = slerp(t).as_matrix()
     return out
+
+
+def pose_gaps(times: np.ndarray, track_times: np.ndarray) -> np.ndarray:
+    """(N,) seconds from each of ``times`` to the nearest of ``track_times`` (K >= 1)."""
+    track = np.sort(np.asarray(track_times, dtype=np.float64))
+    times = np.asarray(times, dtype=np.float64)
+    after = np.clip(np.searchsorted(track, times), 0, len(track) - 1)
+    before = np.clip(after - 1, 0, len(track) - 1)
+    return np.minimum(np.abs(times - track[before]), np.abs(track[after] - times))
+
+
+def check_gaps(path: Path, source: str, times: np.ndarray, gaps: np.ndarray) -> None:
+    """Refuse (InputError) scans at ``times`` (seconds from the recording's start) farther
+    than :data:`GAP_MAX_S` from the nearest pose of ``source`` (``gaps``, seconds, from
+    :func:`pose_gaps`); warn, with the gap, about those farther than :data:`GAP_WARN_S`."""
+    far = gaps > GAP_WARN_S
+    if not far.any():
+        return
+    worst = float(gaps.max())
+    which = (f"{np.count_nonzero(far)} of {len(gaps)} scans (recorded {times[far].min():.1f} "
+             f"to {times[far].max():.1f} s from its start) lie up to {worst:.1f} s from the "
+             f"nearest pose of {source}")
+    if worst > GAP_MAX_S:
+        raise InputError(f"{path}: {which}, more than {GAP_MAX_S:g} s: their poses would be "
+                         "guesses; give poses that cover the scans' time, or cut the "
+                         "recording to the poses' time")
+    warnings.warn(f"{path}: {which}, more than {GAP_WARN_S:g} s: they are placed at poses "
+                  "held or interpolated across that gap", stacklevel=2)
 
 
 def pose_matrix(position: Any, q: Any) -> np.ndarray:

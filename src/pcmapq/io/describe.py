@@ -1,6 +1,7 @@
 """What pcmapq sees in an input (``pcmapq info``): a recording's topics with their types,
-counts and time span; a cloud's points, bounds and fields; an image's size, resolution, origin,
-thresholds and the share of its cells occupied, free and unknown. Metres, degrees, seconds."""
+counts and time span (its start on its own clock: time 0 of every command's times); a cloud's
+points, bounds and fields; an image's size, resolution, origin, thresholds and the share of its
+cells occupied, free and unknown. Metres, degrees, seconds."""
 
 from __future__ import annotations
 
@@ -30,9 +31,10 @@ def describe(path: Path, memory_limit: int | None = None) -> dict[str, Any]:
         raise InputError(f"{path}: not found")
     if is_bag(path):
         with opened(path) as reader:
-            found, (start, end) = topics(reader), span(reader)
+            found, times = topics(reader), span(reader)
+        start, end = times or (None, None)
         return {"file": str(path), "kind": "recording", "start_s": start, "end_s": end,
-                "duration_s": end - start,
+                "duration_s": 0.0 if times is None else end - start,
                 "topics": [{"name": t.name, "type": t.msgtype, "count": t.count}
                            for t in found]}
     resolution_given = True
@@ -51,8 +53,10 @@ def describe(path: Path, memory_limit: int | None = None) -> dict[str, Any]:
 def lines(record: dict[str, Any]) -> list[str]:
     """The record as the terminal shows it."""
     if record["kind"] == "recording":
-        out = [f"{record['file']}: a ROS recording, {record['duration_s']:.1f} s "
-               f"({record['start_s']:.3f} to {record['end_s']:.3f} s)"]
+        out = [f"{record['file']}: a ROS recording holding no message" if record["start_s"]
+               is None else f"{record['file']}: a ROS recording of {record['duration_s']:.1f} "
+               f"s, starting at {record['start_s']:.3f} s of its clock (time 0 of --at and "
+               "track)"]
         out += [f"  {t['name']}: {t['type']}, {count(t['count'], 'message')}"
                 for t in record["topics"]]
         return out

@@ -18,6 +18,10 @@ CLOUD_SUFFIXES = POINT_SUFFIXES + LAS_SUFFIXES + E57_SUFFIXES
 CARMEN_SUFFIXES = (".log", ".log.gz")
 #: ROS recordings: ROS 1 bags, ROS 2 storage files (alone or in their bag folder), MCAP.
 BAG_SUFFIXES = (".bag", ".db3", ".mcap")
+#: ROS 2 storage files compressed whole with zstd (rosbag2's file compression, or ``zstd
+#: FILE``), read from a decompressed copy (:mod:`pcmapq.io.bag_files`).
+COMPRESSED_SUFFIXES = tuple(f"{storage}{zstd}" for storage in (".mcap", ".db3")
+                            for zstd in (".zstd", ".zst"))
 #: The scan files of a scan folder (``--scans``, ``pcmapq map``).
 SCAN_SUFFIXES = (".bin", ".ply", ".pcd", ".npy")
 
@@ -29,7 +33,7 @@ MAP_KINDS: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("LAS/LAZ", LAS_SUFFIXES),
     ("E57", E57_SUFFIXES),
     ("CARMEN log", CARMEN_SUFFIXES),
-    ("ROS recording", BAG_SUFFIXES),
+    ("ROS recording", BAG_SUFFIXES + COMPRESSED_SUFFIXES),
 )
 #: Every suffix ``load_map`` reads, in :data:`MAP_KINDS`' order.
 MAP_SUFFIXES = tuple(s for _, suffixes in MAP_KINDS for s in suffixes)
@@ -40,7 +44,7 @@ BAG_FOLDER = "a ROS 2 bag folder"
 def map_formats() -> str:
     """Every map format, for help and messages: ``image (.png/.pgm/...), ..., ROS recording
     (.bag/.db3/.mcap, or a ROS 2 bag folder)``."""
-    parts = [f"{kind} ({'/'.join(suffixes)}" + (f", or {BAG_FOLDER})" if suffixes is BAG_SUFFIXES
+    parts = [f"{kind} ({'/'.join(suffixes)}" + (f", or {BAG_FOLDER})" if kind == "ROS recording"
                                                 else ")")
              for kind, suffixes in MAP_KINDS]
     return ", ".join(parts)

@@ -17,6 +17,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import cv2
 import numpy as np
@@ -38,6 +39,9 @@ from pcmapq.io.map_yaml import (
 )
 from pcmapq.io.stderr import stderr_captured, stderr_uncaptured
 from pcmapq.io.writers import same_file
+
+if TYPE_CHECKING:
+    from pcmapq.io.bags import Message
 
 #: The problem of an image read without a resolution.
 NO_RESOLUTION = "no resolution"
@@ -61,6 +65,7 @@ class OccupancyMap:
     grid: cell size and pose of the image in the map's metric frame.
     state: (rows, cols) int8, OCCUPIED (1), FREE (0) or UNKNOWN (-1); row 0 is the image's top.
     empty: why no cell is occupied, and what would read its walls (empty when some are).
+    message: the recording's message it was read from (None: a file).
     """
 
     path: Path
@@ -68,6 +73,7 @@ class OccupancyMap:
     state: np.ndarray
     kind: str = "image"
     empty: str = ""
+    message: Message | None = None
 
 
 def load_occupancy(path: Path, resolution: float | None = None,

@@ -217,9 +217,17 @@ def recorded_poses(source: str | Path, scan_topic: str | None, pose_topic: str,
     """One pose per scan of a recording (K, 4, 4): its pose topic interpolated at the scans'
     times, or with ``pose_topic`` a tf topic (``/tf``), the pose of ``frame`` (default: the
     scans' own frame) in the transform tree's root; with ``calib`` (T, scanner -> pose
-    frame) the scanner's, ``P_k @ T``."""
-    from pcmapq.io.bag_scans import pose_track, poses_at, scan_frame, scan_times
-    from pcmapq.io.bag_tf import TF, frame_poses
+    frame) the scanner's, ``P_k @ T``. Scans far in time from the poses are warned about or
+    refused (:func:`pcmapq.io.bag_scans.check_gaps`)."""
+    from pcmapq.io.bag_scans import (
+        check_gaps,
+        pose_gaps,
+        pose_track,
+        poses_at,
+        scan_frame,
+        scan_times,
+    )
+    from pcmapq.io.bag_tf import TF_TYPES, frame_poses
     from pcmapq.io.bags import is_bag, opened, topics
 
     source, calib = Path(source), None if calib is None else Path(calib)
@@ -228,10 +236,12 @@ def recorded_poses(source: str | Path, scan_topic: str | None, pose_topic: str,
     times = scan_times(source, scan_topic)
     with opened(source) as reader:
         kinds = {t.name: t.msgtype for t in topics(reader)}
-    if kinds.get(pose_topic) == TF:
+    if kinds.get(pose_topic) in TF_TYPES:
         trajectory = frame_poses(source, frame or scan_frame(source, scan_topic), times)
     else:
-        trajectory = poses_at(times, *pose_track(source, pose_topic))
+        track_times, track = pose_track(source, pose_topic)
+        check_gaps(source, pose_topic, times, pose_gaps(times, track_times))
+        trajectory = poses_at(times, track_times, track)
     return trajectory if calib is None else trajectory @ read_calib(calib)
 
 

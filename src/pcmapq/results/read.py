@@ -100,6 +100,7 @@ def result_of(doc: dict) -> Result:
         truth_occupied=None, map_occupied=None, frames=frames,
         footprint_rule=doc["footprint"], settings=doc["settings"],
         command=doc["pcmapq"]["command"], noref=doc.get("noref"), truth_sha256=t.get("sha256"),
+        map_message={k: v for k, v in doc["map"].items() if k not in ("path", "kind")} or None,
         consistency=_consistency_of(doc.get("consistency"), a["tolerance_m"]),
         rooms=doc.get("rooms"))
 

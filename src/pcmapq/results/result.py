@@ -109,7 +109,8 @@ class Result:
     truth_sha256: the truth file's SHA-256 (hex; None for a result made without its file), so
     that results of one truth are known as such however its path was written. rooms: the
     rooms detector's rooms, each with its status (:func:`pcmapq.match.rooms.room_table`), None
-    when it did not run.
+    when it did not run. map_message: the recording's message the map was read from (topic,
+    index, ``time_s`` from the recording's start, header ``stamp_s``), None for a file.
     truth_occupied, map_occupied (and the overlap's footprint): the rasters on ``grid``; None
     in a result read back by :meth:`from_json`, which holds everything the JSON holds and no
     more.
@@ -138,6 +139,7 @@ class Result:
     consistency: Consistency | None = None
     truth_sha256: str | None = None
     rooms: dict | None = None
+    map_message: dict | None = None
 
     @property
     def transform(self) -> Similarity2D:
@@ -165,7 +167,8 @@ class Result:
         doc = {
             "pcmapq": {"version": __version__, "command": self.command},
             "settings": self.settings,
-            "map": {"path": str(self.map_path), "kind": self.map_kind},
+            "map": {"path": str(self.map_path), "kind": self.map_kind,
+                    **(self.map_message or {})},
             "truth": {"path": str(self.truth_path), "kind": self.truth_kind,
                       "resolution_m": self.grid.resolution,
                       "origin": {"x_m": x0, "y_m": y0, "yaw_deg": float(np.degrees(yaw0))},

@@ -41,8 +41,8 @@ class SourceConfig:
         frame (``--map-crop``, ``--truth-crop``; see :mod:`pcmapq.io.extent`).
     topic: a ROS recording's OccupancyGrid topic (``--map-topic``, ``--truth-topic``; None:
         its only one, or ``/map``).
-    at: the recording's map at this time, seconds of its clock (the last published at or
-        before it; ``--at`` for the map); None: its last.
+    at: the recording's map at this time, seconds from the recording's start (the last
+        recorded at or before it; ``--at`` for the map); None: its last.
     """
 
     resolution: float | None = None

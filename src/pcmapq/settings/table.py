@@ -207,8 +207,8 @@ OPTIONS: tuple[Option, ...] = (
            "A ROS recording map: its OccupancyGrid topic (default: the only one, or /map).",
            metavar="<topic>"),
     Option("at", "map.at", FLOAT,
-           "A ROS recording map: the map published at this time, seconds of the recording's "
-           "clock (the last one at or before it; default: the last)."),
+           "A ROS recording map: the map recorded at this time, seconds from the recording's "
+           "start (its first message; the last map at or before it; default: the last)."),
     Option("truth_topic", "truth.topic", TEXT,
            "A ROS recording truth: its OccupancyGrid topic (default: the only one, or /map).",
            metavar="<topic>"),

@@ -56,30 +56,35 @@ def write_recording(path: Path, maps: Sequence[tuple[float, np.ndarray, MetricGr
                     map_topic: str = "/map", scan_topic: str = "/scan",
                     poses: Sequence[tuple[float, np.ndarray]] = (),
                     pose_topic: str = "/odom", compress: bool = False,
-                    transforms: Sequence[tuple[float, str, str, np.ndarray]] = ()) -> Path:
+                    transforms: Sequence[tuple[float, str, str, np.ndarray]] = (),
+                    tf_type: str = "tf2_msgs/msg/TFMessage") -> Path:
     """Write ``maps`` ((seconds, state, grid) each) on ``map_topic`` and ``scans`` on
     ``scan_topic`` and ``poses`` ((seconds, 4 x 4 pose) each) as nav_msgs/Odometry on
     ``pose_topic`` as a recording of ``layout`` (:data:`LAYOUTS`; ``mcap``: the ROS 2 MCAP
     file alone) at ``path`` (a ``.bag`` file, a ROS 2 bag folder, or an ``.mcap`` file). The
     path written. ``compress``: a ROS 2 recording's messages zstd-compressed. ``transforms``:
-    (seconds, parent, child, 4 x 4 pose of the child in the parent) each, on ``/tf``; scans
-    are in the frame ``laser``."""
-    from rosbags.typesys import Stores, get_typestore
+    (seconds, parent, child, 4 x 4 pose of the child in the parent) each, on ``/tf`` as
+    ``tf_type`` (ROS 1's older ``tf/msg/tfMessage`` has tf2's layout); scans are in the frame
+    ``laser``."""
+    from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 
     ros1 = layout == "ros1"
     store = get_typestore(Stores.ROS1_NOETIC if ros1 else Stores.ROS2_HUMBLE)
+    if tf_type not in store.types:
+        store.register(get_types_from_msg("geometry_msgs/TransformStamped[] transforms",
+                                          tf_type))
     folder = path.with_suffix("") if layout == "mcap" else path
     messages = sorted([(t, map_topic, _grid(store, t, state, grid, ros1))
                        for t, state, grid in maps] +
                       [(s.time_s, scan_topic, _scan(store, s, ros1) if isinstance(s, Scan)
                         else _cloud(store, s, ros1)) for s in scans] +
                       [(t, pose_topic, _odometry(store, t, pose, ros1)) for t, pose in poses] +
-                      [(t, "/tf", _tf(store, t, parent, child, pose, ros1))
+                      [(t, "/tf", _tf(store, t, parent, child, pose, ros1, tf_type))
                        for t, parent, child, pose in transforms],
                       key=lambda m: (m[0], m[1]))
     clouds = any(isinstance(s, Cloud) for s in scans)
     kinds = {map_topic: "nav_msgs/msg/OccupancyGrid", pose_topic: "nav_msgs/msg/Odometry",
-             "/tf": "tf2_msgs/msg/TFMessage",
+             "/tf": tf_type,
              scan_topic: "sensor_msgs/msg/PointCloud2" if clouds else "sensor_msgs/msg/LaserScan"}
     used = {topic for _, topic, _ in messages}
     if ros1:
@@ -184,7 +189,8 @@ def _odometry(store, t: float, pose: np.ndarray, ros1: bool):
         twist=types["geometry_msgs/msg/TwistWithCovariance"](twist=twist, covariance=covariance))
 
 
-def _tf(store, t: float, parent: str, child: str, pose: np.ndarray, ros1: bool):
+def _tf(store, t: float, parent: str, child: str, pose: np.ndarray, ros1: bool,
+        tf_type: str):
     from scipy.spatial.transform import Rotation
 
     types = store.types
@@ -197,4 +203,4 @@ def _tf(store, t: float, parent: str, child: str, pose: np.ndarray, ros1: bool):
                                                        w=float(w)))
     stamped = types["geometry_msgs/msg/TransformStamped"](header=header, child_frame_id=child,
                                                           transform=transform)
-    return types["tf2_msgs/msg/TFMessage"](transforms=[stamped])
+    return types[tf_type](transforms=[stamped])

@@ -1,7 +1,8 @@
 """Quality over time from a recording: every ``nav_msgs/OccupancyGrid`` a SLAM system
 published (slam_toolbox's, Cartographer's ``/map``) scored against the truth, on the
-recording's time axis. A grid the same as the one before is not scored again; ``every_s``
-thins the grids to one per that many seconds (the last one always kept). Each grid's ICP
+recording's time axis (seconds from its start, as ``eval --at`` takes them). A grid the same
+as the one before is not scored again; ``every_s`` thins the grids to one per that many
+seconds (the last one always kept). Each grid's ICP
 starts from the pose the grid before found (a global search when that start is refused), as
 :func:`pcmapq.track.timeline.track` does for a growing map."""
 
@@ -15,7 +16,6 @@ from pcmapq.core.errors import EvaluationError, InputError
 from pcmapq.evaluation.scoring import score
 from pcmapq.evaluation.truth import PreparedTruth
 from pcmapq.io.bag_grids import grids
-from pcmapq.io.bags import opened, span
 from pcmapq.io.occupancy import OccupancyMap
 from pcmapq.results.result import Result
 from pcmapq.settings import Settings
@@ -36,15 +36,12 @@ class Recording:
         return f"none: the OccupancyGrid messages of {self.topic or 'its map topic'}"
 
     def grids(self, settings: Settings) -> Iterator[tuple[int, float, OccupancyMap]]:
-        """(index among the distinct grids, seconds since the recording's start, grid) of the
+        """(index among the distinct grids, seconds from the recording's start, grid) of the
         grids scored: one per ``every_s`` seconds at most, and the last."""
-        with opened(self.path) as reader:
-            first = span(reader)[0]
         pending = None
         last_kept = None
-        for index, (stamp, grid) in enumerate(grids(self.path, self.topic,
-                                                    settings.map.thresholds)):
-            t = stamp - first
+        for index, (t, grid) in enumerate(grids(self.path, self.topic,
+                                               settings.map.thresholds)):
             if self.every_s is None or last_kept is None or t - last_kept >= self.every_s:
                 last_kept, pending = t, None
                 yield index, t, grid

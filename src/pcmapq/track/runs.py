@@ -31,6 +31,8 @@ from pcmapq.core.transform import affine
 from pcmapq.core.words import plural
 from pcmapq.features.walls import CLOSING
 from pcmapq.io import PointMap
+from pcmapq.io.bag_scans import scan_times
+from pcmapq.io.bags import is_bag
 from pcmapq.io.carmen import DEFAULT_MAX_RANGE, LaserScans, endpoints, is_carmen, read_laser_scans
 from pcmapq.io.clouds import flat
 from pcmapq.mapping import (
@@ -70,8 +72,8 @@ def planar_of(poses: np.ndarray) -> np.ndarray:
 @dataclass(frozen=True)
 class LaserRun:
     """A CARMEN log's scans at ``poses`` (K, 4, 4; the log's own or a file's), readings up to
-    ``max_range`` metres; ``stamps`` (K,) seconds; ``poses_source``: where the poses come
-    from, in words."""
+    ``max_range`` metres; ``stamps`` (K,) seconds of the log's clock; ``poses_source``: where
+    the poses come from, in words."""
 
     path: Path
     scans: LaserScans
@@ -82,6 +84,11 @@ class LaserRun:
 
     def __len__(self) -> int:
         return len(self.poses)
+
+    @property
+    def time_origin(self) -> float:
+        """Time 0 of the run's steps, seconds of the log's clock: its first scan's."""
+        return 0.0 if self.stamps is None else float(self.stamps[0])
 
     def maps(self, ends: Sequence[int],
              tick: Callable[[int], None] = lambda done: None) -> Iterator[PointMap]:
@@ -115,7 +122,8 @@ class LaserRun:
 @dataclass(frozen=True)
 class ScanRun:
     """A scan sequence at ``poses`` (K, 4, 4), grown into a voxel map of ``voxel`` metres;
-    ``poses_source``: where the poses come from, in words."""
+    ``stamps`` (K,): a recording's scan times, seconds from its start (None: a folder's
+    scans); ``poses_source``: where the poses come from, in words."""
 
     path: Path
     sequence: ScanSequence
@@ -126,6 +134,11 @@ class ScanRun:
 
     def __len__(self) -> int:
         return len(self.poses)
+
+    @property
+    def time_origin(self) -> float:
+        """Time 0 of the run's steps: the recording's start (its stamps are seconds from it)."""
+        return 0.0
 
     def maps(self, ends: Sequence[int],
              tick: Callable[[int], None] = lambda done: None) -> Iterator[PointMap]:
@@ -172,7 +185,8 @@ def open_run(source: Path, poses: Path | None = None, *,
     TUM file, one pose per scan, the scanner's: a warning when they move as a camera's, see
     :func:`~pcmapq.mapping.scanner_poses`), or of a recording's ``pose_topic`` at its scans'
     times, else the log's own, else KISS-ICP's (``progress(done, total)`` while it runs); a
-    recording's scans are its ``scan_topic``'s. InputError, one line, when the counts differ."""
+    recording's scans are its ``scan_topic``'s, timed from its start. InputError, one line,
+    when the counts differ."""
     estimate = (scanner_poses(poses) if poses is not None else
                 recorded_poses(source, scan_topic, pose_topic, frame=frame)
                 if pose_topic is not None
@@ -191,7 +205,8 @@ def open_run(source: Path, poses: Path | None = None, *,
     if estimate is None:
         _, estimate = build_map_kiss(source, progress=progress, topic=scan_topic)
     sequence = scans_for_poses(sequence, len(estimate), poses_path=poses or pose_topic)
-    return ScanRun(source, sequence, estimate,
+    stamps = scan_times(source, scan_topic)[:len(sequence)] if is_bag(source) else None
+    return ScanRun(source, sequence, estimate, stamps,
                    poses_source=str(poses) if poses is not None else
                    f"{pose_topic} of {source}" if pose_topic is not None else "KISS-ICP's poses")
 

@@ -32,6 +32,7 @@ from pcmapq.core.voxels import evenly, voxel_centroids
 from pcmapq.evaluation.placing import Placed, place
 from pcmapq.evaluation.scoring import score
 from pcmapq.evaluation.truth import PreparedTruth
+from pcmapq.io import PointMap
 from pcmapq.metrics.trajectory import ape, rpe
 from pcmapq.results.figures import table_row
 from pcmapq.results.result import Result
@@ -71,11 +72,12 @@ class PoseOptions:
 
 @dataclass(frozen=True)
 class Step:
-    """One step: the map of the first ``scans`` scans; ``time_s`` since the first scan (None
-    without timestamps) and ``distance_m`` travelled at its last scan; ``figures`` the flat
-    columns of :func:`~pcmapq.results.figures.table_row` plus ``slide_m``,
-    ``local_offset_m`` and the trajectory errors (None when undefined); ``note`` why a step
-    was not scored ("" when it was);
+    """One step: the map of the first ``scans`` scans; ``time_s`` at its last scan, seconds
+    from a recording's start or from a log's first scan (None without timestamps), and
+    ``distance_m`` travelled by then; ``figures`` the flat columns of
+    :func:`~pcmapq.results.figures.table_row` plus ``slide_m``, ``local_offset_m`` and the
+    trajectory errors (None when undefined); ``note`` why a step was not scored ("" when it
+    was);
     ``start`` the pose its ICP started from (None: the global search); ``frames`` the frames
     its result put the map and truth in (None when not scored); ``result`` its full result,
     while the steps' rasters fit in :data:`KEEP_BYTES` (None otherwise: :func:`result_at`
@@ -137,7 +139,11 @@ def place_step(source, prepared: PreparedTruth, settings: Settings,
                start: Similarity2D | None) -> tuple[Placed, Similarity2D | None]:
     """Align and draw one step's map (:func:`~pcmapq.evaluation.placing.place`), ICP from
     ``start`` (None: the global search); a start whose pose is refused is followed by a global
-    search. The placed map and the start it used."""
+    search. The placed map and the start it used; EvaluationError for a map of no point yet
+    (scans with no return within their range limits)."""
+    if isinstance(source, PointMap) and not len(source.points):
+        raise EvaluationError(f"{source.path}: the scans so far hold no point (no return "
+                              "within their range limits)")
     option = settings.alignment
     if start is None or not option.enabled:
         return place(source, prepared, settings), option.init
@@ -197,7 +203,7 @@ def track(run: Run, prepared: PreparedTruth, settings: Settings, ends: np.ndarra
         for index, (end, (source, recent)) in enumerate(zip(ends, run.steps(ends, tick),
                                                             strict=True)):
             end = int(end)
-            time_s = None if stamps is None else float(stamps[end - 1] - stamps[0])
+            time_s = None if stamps is None else float(stamps[end - 1] - run.time_origin)
             extra = {} if reference is None else pose_errors(run.poses[:end], reference[:end],
                                                              pose_options)
             at = (index, end, time_s, float(distance[end - 1]))

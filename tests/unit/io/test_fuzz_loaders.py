@@ -1,6 +1,7 @@
-"""The loaders' fuzzing seeds (``tools/fuzz_loaders.py``) load as they are, and one regression
-test for each crash or noise the fuzzer found (the fuzzing itself, mutated seeds of every
-format: tests/e2e/test_fuzz_loaders.py)."""
+"""The loaders' fuzzing seeds (``tools/fuzz_loaders.py``; its recordings, slower to write: in
+tests/e2e/test_fuzz_bags.py) load as they are, and one regression test for each crash or noise
+the fuzzer found (the fuzzing itself, mutated seeds of every format:
+tests/e2e/test_fuzz_loaders.py)."""
 
 from __future__ import annotations
 
@@ -16,7 +17,7 @@ from pcmapq.core.errors import InputError
 from pcmapq.io import PointMap, load_map
 from tools.fuzz_loaders import make_seeds, run_example
 
-SEEDS = make_seeds()
+SEEDS = make_seeds(recordings=False)  # the recordings': tests/e2e/test_fuzz_bags.py
 
 
 @pytest.mark.parametrize("name", sorted(SEEDS))

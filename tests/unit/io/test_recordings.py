@@ -14,6 +14,7 @@ from pcmapq.core.errors import InputError
 from pcmapq.core.grid import MetricGrid
 from pcmapq.io import load_map
 from pcmapq.io.bag_scans import poses_at
+from pcmapq.io.bags import Message
 from pcmapq.mapping import build_map_from_poses, open_scans, recorded_poses, scanner_poses
 from pcmapq.testing.paths import SAMPLE
 from pcmapq.testing.recordings import LAYOUTS, Cloud, Scan, write_recording
@@ -39,14 +40,20 @@ def test_a_grid_reads_back_as_the_map_it_was_made_from(layout, truth, tmp_path):
 
 
 def test_the_last_grid_or_the_one_at_a_time_is_read(truth, tmp_path):
+    """Recorded at 1 and 2 s of the bag's clock: 0 and 1 s from its start, the time axis of
+    ``at``; each map names its message."""
     empty = np.full_like(truth.state, UNKNOWN)
     empty[:10, :10] = truth.state[:10, :10]
     path = write_recording(tmp_path / "run.mcap", [(1.0, empty, truth.grid),
                                                   (2.0, truth.state, truth.grid)], "mcap")
-    assert np.array_equal(load_map(path).state, truth.state)
-    assert np.array_equal(load_map(path, at=1.5).state, empty)
-    with pytest.raises(InputError, match="no OccupancyGrid at or before 0.5 s"):
-        load_map(path, at=0.5)
+    last = load_map(path)
+    assert np.array_equal(last.state, truth.state)
+    assert last.message == Message("/map", 1, 1.0, 2.0)
+    first = load_map(path, at=0.5)
+    assert np.array_equal(first.state, empty) and first.message == Message("/map", 0, 0.0, 1.0)
+    with pytest.raises(InputError, match="no OccupancyGrid at or before -0.5 s from the "
+                                         "recording's start"):
+        load_map(path, at=-0.5)
 
 
 def test_a_missing_or_wrong_topic_lists_the_recordings_topics(truth, tmp_path):
