@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 
 from pcmapq.core.errors import InputError
-from pcmapq.core.words import plural
+from pcmapq.core.words import count, plural
 from pcmapq.io.bags import (
     CLOUD,
     LASER,
@@ -164,7 +164,8 @@ def check_gaps(path: Path, source: str, times: np.ndarray, gaps: np.ndarray) -> 
     if not far.any():
         return
     worst = float(gaps.max())
-    which = (f"{np.count_nonzero(far)} of {len(gaps)} scans (recorded {times[far].min():.1f} "
+    which = (f"{np.count_nonzero(far)} of {count(len(gaps), 'scan')} (recorded "
+             f"{times[far].min():.1f} "
              f"to {times[far].max():.1f} s from its start) lie up to {worst:.1f} s from the "
              f"nearest pose of {source}")
     if worst > GAP_MAX_S:

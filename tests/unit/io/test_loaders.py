@@ -320,7 +320,8 @@ def test_bad_input_is_one_line_naming_the_file(tmp_path: Path, name: str) -> Non
     ("empty.xyz", "empty.xyz: no points"),
     ("foo.abc", "foo.abc: unsupported format '.abc' (expected .png, .pgm, .jpg, .jpeg, .bmp, "
                 ".yaml, .yml, .ply, .pcd, .xyz, .txt, .npy, .bin, .las, .laz, .e57, .log, "
-                ".log.gz, .bag, .db3, .mcap, or a ROS 2 bag folder)"),
+                ".log.gz, .bag, .db3, .mcap, .mcap.zstd, .mcap.zst, .db3.zstd, .db3.zst, or a "
+                "ROS 2 bag folder)"),
 ])
 def test_bad_input_messages(tmp_path: Path, name: str, expected: str) -> None:
     BAD_INPUTS[name](tmp_path)
