@@ -51,18 +51,20 @@ class LasLayout:
     items: tuple[tuple[int, int], ...] = ()
 
 
-def read_layout(path: Path, f: BinaryIO) -> LasLayout:
-    """The layout the header of the LAS/LAZ file ``f`` (named ``path``) declares; InputError
-    when it has no LAS header, or a LAZ file has no readable LASzip VLR."""
+def read_layout(path: Path, f: BinaryIO, size: int) -> LasLayout:
+    """The layout the header of the LAS/LAZ file ``f`` (named ``path``, ``size`` bytes long)
+    declares; InputError when it has no LAS header, more variable-length records than fit
+    before its points, or its points are compressed without a LASzip VLR."""
     head = f.read(375)
     if len(head) < _HEADER.size or head[:4] != b"LASF":
         raise _unreadable(path, "no LAS header")
     _, minor, header_size, offset, vlrs, fmt, record, points = _HEADER.unpack_from(head)
     if minor >= 4 and len(head) >= _COUNT_14[0] + 8:
         points = struct.unpack_from(_COUNT_14[1], head, _COUNT_14[0])[0]
-    if vlrs * VLR_HEADER > max(offset - header_size, 0):
+    room = max(min(offset, size) - header_size, 0)  # the records lie before the points
+    if vlrs * VLR_HEADER > room:
         raise _unreadable(path, f"its header declares {vlrs:,} variable-length records in "
-                          f"{max(offset - header_size, 0):,} bytes")
+                          f"{room:,} bytes")
     compressed = bool(fmt & 0x80) and not fmt & 0x40  # laspy's test
     if not compressed:
         return LasLayout(points, record, offset, False)
@@ -97,7 +99,7 @@ def check_layout(path: Path) -> LasLayout:
     declares more chunks than fit, or whose layered chunks declare layers past its end."""
     size = path.stat().st_size
     with open(path, "rb") as f:
-        layout = read_layout(path, f)
+        layout = read_layout(path, f, size)
         if not layout.compressed:
             held = max(size - layout.offset, 0) // max(layout.record, 1)
             if held < layout.points:

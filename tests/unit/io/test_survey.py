@@ -175,3 +175,12 @@ def test_extended_records_are_not_read(tmp_path):
     struct.pack_into("<QI", data, 235, 0, 2**23)
     (tmp_path / "evlrs.laz").write_bytes(data)
     assert load_map(tmp_path / "evlrs.laz").points.shape == (400, 3)
+
+
+def test_more_records_than_the_file_holds_are_refused_before_laspy_reads_them(tmp_path, capfd):
+    """65,536 VLRs declared before points said to start past the file's end: laspy would
+    parse each from nothing (seconds)."""
+    data = small_laz(tmp_path / "a.laz")
+    struct.pack_into("<II", data, 96, 2**31, 65536)  # offset to the points, VLRs
+    message = refused(tmp_path / "vlrs.laz", data, capfd)
+    assert "its header declares 65,536 variable-length records in" in message
