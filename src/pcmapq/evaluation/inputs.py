@@ -11,6 +11,7 @@ occupied (not walls: a picture read inverted).
 from __future__ import annotations
 
 from concurrent.futures import Future, ThreadPoolExecutor
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -23,7 +24,7 @@ from pcmapq.core.grid import MetricGrid
 from pcmapq.core.morphology import outline
 from pcmapq.io import OccupancyMap, PointMap, load_map
 from pcmapq.io.extent import crop
-from pcmapq.io.occupancy import NO_RESOLUTION
+from pcmapq.io.occupancy import NO_RESOLUTION, open_outside
 from pcmapq.raster.draw import OCCUPIED, points_to_grid
 from pcmapq.raster.slice import wall_band
 from pcmapq.settings import Settings, SourceConfig
@@ -54,10 +55,14 @@ def load_input(path: str | Path, config: SourceConfig, option: str,
                fallback: float | None = None,
                memory_limit: int | None = None) -> OccupancyMap | PointMap:
     """An input read as ``config`` says (resolution, thresholds; ``fallback``: the resolution of
-    an image that has none) and cut to its crop box; see :func:`pcmapq.io.load_map`."""
-    return cropped(load_map(path, config.resolution, fallback, config.thresholds, memory_limit,
-                            config.topic, config.at, option.replace("crop", "topic")),
-                   config, option)
+    an image that has none) and cut to its crop box; see :func:`pcmapq.io.load_map`. An
+    image's outside drawn solid is read as its face (:func:`pcmapq.io.occupancy.open_outside`)
+    before the crop."""
+    source = load_map(path, config.resolution, fallback, config.thresholds, memory_limit,
+                      config.topic, config.at, option.replace("crop", "topic"))
+    if isinstance(source, OccupancyMap) and source.kind == "image":
+        source = replace(source, state=open_outside(source.state, source.grid.resolution))
+    return cropped(source, config, option)
 
 
 def load_pair(map_path: str | Path | PointMap, truth_path: str | Path, settings: Settings,
