@@ -20,9 +20,11 @@ letters (:func:`open3d_readable`).
 
 from __future__ import annotations
 
+import itertools
 import shutil
 import struct
 import tempfile
+import warnings
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass, field
@@ -138,17 +140,20 @@ def coordinate_names(path: Path, header: PcdHeader) -> tuple[str, str, str]:
 
 def read_ascii(path: Path, header: PcdHeader, names: Sequence[str]) -> np.ndarray:
     """The fields ``names`` of the ``DATA ascii`` PCD ``path``, (points, len(names)) float64:
-    the first ``header.points`` lines of its data, values separated by spaces, tabs or commas;
-    InputError when a line lacks a value or holds one that is not a number."""
+    the first ``header.points`` lines of its data (blank lines skipped, as PCL does), values
+    separated by spaces, tabs or commas; InputError when a line lacks a value or holds one
+    that is not a number, or the lines are fewer than the points."""
     if header.points == 0:
         return np.empty((0, len(names)))
     columns = [header.fields[n].column for n in names]
     try:
-        with path.open("rb") as f:
+        with path.open("rb") as f, warnings.catch_warnings():
+            warnings.simplefilter("ignore", UserWarning)  # "input contained no data"
             f.seek(header.offset)
-            lines = (line.decode("ascii", errors="replace").replace(",", " ") for line in f)
-            table = np.loadtxt(lines, dtype=np.float64, comments=None, usecols=columns,
-                               max_rows=header.points, ndmin=2)
+            lines = (line.decode("ascii", errors="replace").replace(",", " ") for line in f
+                     if line.strip())  # PCL skips blank lines
+            table = np.loadtxt(itertools.islice(lines, header.points), dtype=np.float64,
+                               comments=None, usecols=columns, ndmin=2)
     except ValueError as exc:
         raise InputError(f"{path}: bad ASCII PCD data: {one_line(exc)}") from None
     if len(table) < header.points:

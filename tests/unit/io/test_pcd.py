@@ -5,6 +5,7 @@ naming the fields it has."""
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -203,3 +204,18 @@ def test_an_ascii_value_that_is_no_number_is_refused_in_one_line(tmp_path: Path)
     with pytest.raises(InputError, match=r"map.pcd: bad ASCII PCD data: ") as raised:
         load_map(path)
     assert "\n" not in str(raised.value)
+
+
+@pytest.mark.unit
+def test_blank_ascii_lines_are_skipped_as_pcl_skips_them(tmp_path: Path) -> None:
+    """Found by the fuzzer: NumPy warned of blank lines. They are skipped, silently; lines
+    fewer than the points declared are a truncated file."""
+    path = pdal_style(tmp_path / "map.pcd", "ascii")
+    head, body = path.read_text().split("DATA ascii\n")
+    path.write_text(head + "DATA ascii\n" + body.replace("\n", "\n\n", 2))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        np.testing.assert_array_equal(load_map(path).points, XYZ[:4])
+    path.write_text(head + "DATA ascii\n\n\n" + "".join(body.splitlines(True)[:3]))
+    with pytest.raises(InputError, match="truncated: header declares 4 points, the file holds 3"):
+        load_map(path)
