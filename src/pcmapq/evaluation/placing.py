@@ -168,8 +168,9 @@ def align_clouds_3d(source: OccupancyMap | PointMap, truth: OccupancyMap | Point
     try:
         reg = align_3d(source.points, truth.points, voxel=option.voxel_3d)
     except EvaluationError as error:
-        raise EvaluationError(f"{source.path} against {truth.path}: {error} at --voxel-3d "
-                              f"{option.voxel_3d:g} m{_unit_hint(source, truth)}") from None
+        voxel = "" if "voxel" in str(error) else f" at --voxel-3d {option.voxel_3d:g} m"
+        raise EvaluationError(f"{source.path} against {truth.path}: {error}{voxel}"
+                              f"{_unit_hint(source, truth)}") from None
     return replace(source, points=apply(reg.transform, source.points)), reg
 
 
