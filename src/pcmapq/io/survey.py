@@ -129,6 +129,8 @@ def read_e57(path: Path, memory_limit: int | None = None) -> np.ndarray:
 
     from pcmapq.io.clouds import check_points
 
+    if path.stat().st_size == 0:  # libE57Format: "an unrecoverable inconsistent internal state"
+        raise InputError(f"{path}: not a readable E57 file: empty")
     try:
         e57 = pye57.E57(str(path))
     except Exception as exc:  # noqa: BLE001 - libE57Format's errors

@@ -59,6 +59,7 @@ def test_an_e57_file_reads_every_scan_placed_by_its_pose(tmp_path):
     ("short.las", b"LASF" + bytes(50), "not a readable LAS/LAZ file"),
     ("empty.laz", b"", "not a readable LAS/LAZ file"),
     ("bad.e57", b"ASTM-E57" + bytes(60), "not a readable E57 file"),
+    ("empty.e57", b"", "not a readable E57 file: empty"),
 ])
 def test_a_broken_survey_file_is_refused_naming_it(name, data, message, tmp_path):
     path = tmp_path / name
