@@ -65,8 +65,9 @@ ODD_VALUES = (
 class Seed:
     """A valid input: ``files`` written into a folder; ``target`` is the file mutated,
     ``entry`` the file given to ``reader``; ``header`` gives the end of the target's text header
-    (the region whose tokens field edits replace); ``encode`` turns the mutated bytes into the
-    file's contents (gzip)."""
+    (the region whose tokens field edits replace); ``decode`` turns the target's contents into
+    the bytes mutated (gunzip), ``encode`` the mutated bytes into the file's contents (gzip;
+    an E57's page checksums made right again, so that mutations reach its parser)."""
 
     name: str
     files: dict[str, bytes]
@@ -75,6 +76,7 @@ class Seed:
     reader: str = "map"
     header: Callable[[bytes], int] = len
     encode: Callable[[bytes], bytes] | None = None
+    decode: Callable[[bytes], bytes] | None = None
 
 
 @dataclass
@@ -175,19 +177,68 @@ def _file_bytes(name: str, write: Callable[[Path], object]) -> bytes:
         return path.read_bytes()
 
 
-def _las_bytes(suffix: str) -> bytes:
+def _las_bytes(suffix: str, point_format: int = 3, version: str = "1.2") -> bytes:
+    """A LAS or LAZ file (by ``suffix``) of 40 points written by laspy: point format 3 is
+    compressed in point-wise chunks, 6 (LAS 1.4) in layered ones."""
     import laspy
 
     def write(path: Path) -> None:
         points = np.random.default_rng(7).uniform(-4, 4, (40, 3))
-        las = laspy.LasData(laspy.LasHeader(point_format=3, version="1.2"))
+        las = laspy.LasData(laspy.LasHeader(point_format=point_format, version=version))
         las.x, las.y, las.z = points.T
         las.write(path)
     return _file_bytes(f"m{suffix}", write)
 
 
-# LAZ and E57 are not fuzzed: lazrs (Rust) and libE57Format (C++) end the process on some
-# corrupt files, which no Python code can catch.
+def _e57_bytes() -> bytes:
+    """An E57 file of two scans of 20 points, the second placed by a pose, written by pye57."""
+    import pye57
+
+    def write(path: Path) -> None:
+        points = np.random.default_rng(8).uniform(-4, 4, (40, 3))
+        e57 = pye57.E57(str(path), mode="w")
+        for k, part in enumerate((points[:20], points[20:])):
+            e57.write_scan_raw({"cartesianX": part[:, 0], "cartesianY": part[:, 1],
+                                "cartesianZ": part[:, 2]}, translation=np.array([k, 0.0, 0.0]),
+                               rotation=np.array([1.0, 0.0, 0.0, 0.0]))
+        e57.close()
+    return _file_bytes("m.e57", write)
+
+
+#: An E57 file's physical pages: 1020 bytes of data, then their CRC-32C (big-endian).
+E57_PAGE, E57_DATA = 1024, 1020
+
+
+def _crc_table(polynomial: int = 0x82F63B78) -> list[int]:
+    """The byte table of a reflected CRC-32 (Castagnoli's polynomial by default)."""
+    table = []
+    for byte in range(256):
+        crc = byte
+        for _ in range(8):
+            crc = (crc >> 1) ^ (polynomial & -(crc & 1))
+        table.append(crc)
+    return table
+
+
+_CRC32C = _crc_table()
+
+
+def _crc32c(data: bytes) -> int:
+    """CRC-32C (Castagnoli) of ``data``, as E57 pages carry it."""
+    crc = 0xFFFFFFFF
+    for byte in data:
+        crc = _CRC32C[(crc ^ byte) & 0xFF] ^ (crc >> 8)
+    return crc ^ 0xFFFFFFFF
+
+
+def e57_checksummed(data: bytes) -> bytes:
+    """``data`` with the checksum of each whole E57 page set to its data's (a short last page
+    left as it is)."""
+    out = bytearray(data)
+    for start in range(0, len(out) - E57_PAGE + 1, E57_PAGE):
+        crc = _crc32c(bytes(out[start:start + E57_DATA]))
+        out[start + E57_DATA:start + E57_PAGE] = crc.to_bytes(4, "big")
+    return bytes(out)
 
 
 def _mcap_bytes() -> bytes:
@@ -233,6 +284,12 @@ def _zstd(data: bytes) -> bytes:
     return zstd_module().compress(data)
 
 
+def _unzstd(data: bytes) -> bytes:
+    from pcmapq.io.bag_files import zstd_module
+
+    return zstd_module().decompress(data)
+
+
 def _after(marker: bytes) -> Callable[[bytes], int]:
     """The header ends after the line holding ``marker``."""
     def end(data: bytes) -> int:
@@ -251,7 +308,8 @@ def recording_seeds() -> dict[str, Seed]:
         Seed("ros2_mcap", mcap, "r/r.mcap", "r", reader="recording", header=lambda d: 0),
         Seed("ros2_metadata", mcap, "r/metadata.yaml", "r", reader="recording"),
         Seed("mcap_zstd", {"r.mcap.zstd": _zstd(solo["r.mcap"])}, "r.mcap.zstd",
-             "r.mcap.zstd", reader="recording", header=lambda d: 0, encode=_zstd),
+             "r.mcap.zstd", reader="recording", header=lambda d: 0, encode=_zstd,
+             decode=_unzstd),
     ]
     return {s.name: s for s in seeds}
 
@@ -281,7 +339,7 @@ def make_seeds(recordings: bool = True) -> dict[str, Seed]:
         Seed("kitti_bin", {"m.bin": kitti_points.tobytes()}, "m.bin", "m.bin", header=lambda d: 0),
         Seed("carmen", {"m.log": carmen}, "m.log", "m.log"),
         Seed("carmen_gz", {"m.log.gz": gzip.compress(carmen, mtime=0)}, "m.log.gz", "m.log.gz",
-             encode=lambda data: gzip.compress(data, mtime=0)),
+             encode=lambda data: gzip.compress(data, mtime=0), decode=gzip.decompress),
         Seed("png_image", {"m.png": _png_bytes(), "m.yaml": YAML.format(image="m.png").encode()},
              "m.png", "m.yaml", header=lambda d: 0),
         Seed("png_yaml", {"m.png": _png_bytes(), "m.yaml": YAML.format(image="m.png").encode()},
@@ -289,6 +347,11 @@ def make_seeds(recordings: bool = True) -> dict[str, Seed]:
         Seed("pgm_image", {"m.pgm": _pgm_bytes(), "m.yaml": YAML.format(image="m.pgm").encode()},
              "m.pgm", "m.pgm", header=_after(b"255")),
         Seed("las", {"m.las": _las_bytes(".las")}, "m.las", "m.las", header=lambda d: 0),
+        Seed("laz", {"m.laz": _las_bytes(".laz")}, "m.laz", "m.laz", header=lambda d: 0),
+        Seed("laz_layered", {"m.laz": _las_bytes(".laz", 6, "1.4")}, "m.laz", "m.laz",
+             header=lambda d: 0),
+        Seed("e57", {"m.e57": _e57_bytes()}, "m.e57", "m.e57", header=lambda d: 0,
+             encode=e57_checksummed),
         Seed("mcap_grid", {"m.mcap": _mcap_bytes()}, "m.mcap", "m.mcap", header=lambda d: 0),
         Seed("kitti_poses", {"p.txt": _poses_text("kitti").encode()}, "p.txt", "p.txt",
              reader="poses"),
@@ -301,14 +364,9 @@ def make_seeds(recordings: bool = True) -> dict[str, Seed]:
 
 
 def original(seed: Seed) -> bytes:
-    """The bytes mutations apply to: the target's contents, decoded (gunzipped, or
-    decompressed by zstd) if encoded."""
+    """The bytes mutations apply to: the target's contents, decoded (gunzipped) if need be."""
     data = seed.files[seed.target]
-    if seed.encode is _zstd:
-        from pcmapq.io.bag_files import zstd_module
-
-        return zstd_module().decompress(data)
-    return gzip.decompress(data) if seed.encode else data
+    return seed.decode(data) if seed.decode else data
 
 
 # ---- mutations -----------------------------------------------------------------------------
@@ -483,7 +541,9 @@ def run_example(seed: Seed, ops: list[Op], folder: Path) -> str:
             raise Finding(f"InputError not one line naming the file: {message!r}") from None
     except _Slow:
         raise Finding(f"load took more than {TIME_LIMIT} s") from None
-    except Exception as error:  # noqa: BLE001 - the finding is any other exception
+    except KeyboardInterrupt:
+        raise
+    except BaseException as error:  # noqa: BLE001 - any other, a Rust panic's among them
         raise Finding(f"{type(error).__name__}: {error}") from error
     else:
         outcome = "loaded"

@@ -32,7 +32,13 @@ class OneLineUsageErrors(TyperGroup):
     def main(self, args: Sequence[str] | None = None, prog_name: str | None = None,
              complete_var: str | None = None, standalone_mode: bool = True,
              **extra: Any) -> Any:
-        """Click's main; in standalone mode, a usage error becomes one line on stderr."""
+        """Click's main, every command's warnings shown as pcmapq's (:func:`show_warnings`);
+        in standalone mode, a usage error becomes one line on stderr."""
+        with show_warnings(Console(stderr=True)):
+            return self._main(args, prog_name, complete_var, standalone_mode, **extra)
+
+    def _main(self, args: Sequence[str] | None, prog_name: str | None,
+              complete_var: str | None, standalone_mode: bool, **extra: Any) -> Any:
         if not standalone_mode:
             return super().main(args, prog_name, complete_var, standalone_mode, **extra)
         try:

@@ -42,9 +42,27 @@ def needed_bytes(image_cells: int, grid_cells: int, extent_m2: float, points: in
     """Estimated peak memory of a run, bytes: ``image_cells`` cells of input images,
     ``grid_cells`` cells of the truth's grid covering ``extent_m2`` square metres, ``points``
     cloud points."""
-    working = extent_m2 / WORKING_CELL**2
-    return int(BASE + PER_IMAGE_CELL * image_cells + PER_GRID_CELL * grid_cells
-               + PER_WORKING_CELL * working + PER_POINT * points)
+    return int(BASE + sum(parts(image_cells, grid_cells, extent_m2, points).values()))
+
+
+def parts(image_cells: int, grid_cells: int, extent_m2: float, points: int) -> dict[str, float]:
+    """The parts of :func:`needed_bytes` beyond :data:`BASE`, bytes: ``images``, ``grid`` (the
+    truth's), ``working`` (the detectors' cells of :data:`WORKING_CELL` over ``extent_m2``,
+    whatever the grid's cell size) and ``points``."""
+    return {"images": float(PER_IMAGE_CELL * image_cells),
+            "grid": float(PER_GRID_CELL * grid_cells),
+            "working": PER_WORKING_CELL * extent_m2 / WORKING_CELL**2,
+            "points": float(PER_POINT * points)}
+
+
+def more_memory(need: int) -> str:
+    """The general advice for ``need`` bytes over the limit: a higher --max-memory when this
+    machine has that much, else a smaller input."""
+    machine = machine_bytes()
+    if need < machine:
+        return (f"a --max-memory of {need / 1e9:.1f} GB or more runs it, if this machine's "
+                f"{machine / 1e9:.1f} GB can spare that; else a smaller input")
+    return f"more than this machine's {machine / 1e9:.1f} GB: a smaller input"
 
 
 def guard(need: int, limit: int | None, what: str,
@@ -58,7 +76,6 @@ def guard(need: int, limit: int | None, what: str,
         default = f", {DEFAULT_SHARE:.0%} of this machine's {machine_bytes() / 1e9:.1f} GB"
     if need <= limit:
         return
-    fix = advice() or ("a coarser --truth-resolution, a larger --voxel-3d or inputs cropped to "
-                       "the region of interest (--map-crop, --truth-crop) need less")
+    fix = advice() or more_memory(need)
     raise InputError(f"{what}: needs about {need / 1e9:,.1f} GB of memory, more than the limit "
                      f"of {limit / 1e9:.1f} GB (--max-memory{default}); {fix}")

@@ -26,7 +26,7 @@ from pcmapq.features.walls import CLOSING
 from pcmapq.io import OccupancyMap, PointMap, load_map
 from pcmapq.io.carmen import read_laser_scans
 from pcmapq.io.extent import crop
-from pcmapq.io.occupancy import NO_RESOLUTION
+from pcmapq.io.occupancy import NO_RESOLUTION, open_outside
 from pcmapq.raster.draw import OCCUPIED, points_to_grid
 from pcmapq.raster.seen import seen_of_scans
 from pcmapq.raster.slice import wall_band
@@ -58,11 +58,15 @@ def load_input(path: str | Path, config: SourceConfig, option: str,
                fallback: float | None = None,
                memory_limit: int | None = None) -> OccupancyMap | PointMap:
     """An input read as ``config`` says (resolution, thresholds; ``fallback``: the resolution of
-    an image that has none) and cut to its crop box; see :func:`pcmapq.io.load_map`. A CARMEN
-    log given as the map, uncropped, carries the area its scans saw (:func:`with_seen`)."""
+    an image that has none) and cut to its crop box; see :func:`pcmapq.io.load_map`. An
+    image's outside drawn solid is read as its face (:func:`pcmapq.io.occupancy.open_outside`)
+    before the crop; a CARMEN log given as the map, uncropped, carries the area its scans saw
+    (:func:`with_seen`)."""
     source = load_map(path, config.resolution, fallback, config.thresholds, memory_limit,
                       config.topic, config.at, option.replace("crop", "topic"),
                       option.replace("crop", "resolution"))
+    if isinstance(source, OccupancyMap) and source.kind == "image":
+        source = replace(source, state=open_outside(source.state, source.grid.resolution))
     if option == MAP_CROP and config.crop is None:
         source = with_seen(source)
     return cropped(source, config, option)

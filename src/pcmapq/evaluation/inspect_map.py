@@ -55,10 +55,8 @@ def summary_lines(record: dict[str, Any]) -> list[str]:
         among = "" if drawn is None else f" of {drawn:,} drawn at random"
         lines += [f"points    {noref['points']:,} ({noref['mpv_points']:,}{among} with "
                   f"neighbours {near})",
-                  f"MME       {_num(noref['mme'])}{_se(noref.get('mme_se'))} nats "
-                  "(lower: crisper)",
-                  f"MPV       {_num(noref['mpv'])}{_se(noref.get('mpv_se'))} m² "
-                  "(lower: thinner surfaces)",
+                  f"MME       {_mean(noref, 'mme', 'nats (lower: crisper)')}",
+                  f"MPV       {_mean(noref, 'mpv', 'm² (lower: thinner surfaces)')}",
                   f"MOM       {_num(noref['mom'])}"
                   + (f" ({noref['mom_note']})" if noref["mom"] is None else
                      f" m² (orthogonal planes {noref['orth_subset']})")]
@@ -73,6 +71,14 @@ def summary_lines(record: dict[str, Any]) -> list[str]:
                                   f"{count(grid['enclosed_areas'], 'area')}, "
                                   f"{grid['enclosed_area_m2']:.2f} m²")]
     return lines
+
+
+def _mean(noref: dict[str, Any], name: str, unit: str) -> str:
+    """MME or MPV with its standard error and unit, or ``n/a (why)``."""
+    value = noref[name]
+    if value is None:
+        return f"n/a ({noref.get(f'{name}_note') or 'not finite'})"
+    return f"{_num(value)}{_se(noref.get(f'{name}_se'))} {unit}"
 
 
 def _num(value: float | None) -> str:

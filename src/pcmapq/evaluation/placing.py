@@ -21,7 +21,7 @@ from pcmapq.core.errors import EvaluationError, InputError, Refused
 from pcmapq.core.frames import Levelling
 from pcmapq.core.grid import MetricGrid
 from pcmapq.core.transform import Similarity2D
-from pcmapq.evaluation.inputs import MAP_CROP, min_hits, plan_points
+from pcmapq.evaluation.inputs import MAP_CROP, TRUTH_CROP, min_hits, plan_points
 from pcmapq.evaluation.same_place import OVERSIZE, overlap, refusal, verdict
 from pcmapq.evaluation.truth import PreparedTruth
 from pcmapq.features import Features
@@ -165,8 +165,24 @@ def align_clouds_3d(source: OccupancyMap | PointMap, truth: OccupancyMap | Point
     option = settings.alignment
     if not (both_3d and option.enabled and option.init is None and not option.scale):
         return source, None
-    reg = align_3d(source.points, truth.points, voxel=option.voxel_3d)
+    try:
+        reg = align_3d(source.points, truth.points, voxel=option.voxel_3d)
+    except EvaluationError as error:
+        voxel = "" if "voxel" in str(error) else f" at --voxel-3d {option.voxel_3d:g} m"
+        raise EvaluationError(f"{source.path} against {truth.path}: {error}{voxel}"
+                              f"{_unit_hint(source, truth)}") from None
     return replace(source, points=apply(reg.transform, source.points)), reg
+
+
+def _unit_hint(source: PointMap, truth: PointMap) -> str:
+    """What looks wrong with either cloud (:func:`~pcmapq.io.extent.hint`, the rule the
+    truth's side and a map too large for its truth are refused by: a span of another unit,
+    points far from the rest), as a clause naming it; empty when nothing does."""
+    for side, option in ((source, MAP_CROP), (truth, TRUTH_CROP)):
+        why = hint(side, option)
+        if why:
+            return f"; {side.path}: {why}"
+    return ""
 
 
 def check_size(source: OccupancyMap | PointMap, map_xy: np.ndarray, truth_xy: np.ndarray,

@@ -82,7 +82,8 @@ def prepare_truth(truth: OccupancyMap | PointMap, settings: Settings,
             f"{truth.path} with {least} map{'s' * (least > 1)} scored on its grid")
     memory.guard(need[fits[0] if fits else least], memory_limit, what,
                  lambda: hint(truth, TRUTH_CROP, grid.resolution)
-                 or next((h for s in loaded if (h := hint(s, MAP_CROP))), None))
+                 or next((h for s in loaded if (h := hint(s, MAP_CROP))), None)
+                 or memory_advice((*loaded, truth), grid, least, limit))
     occupied = truth_cells(truth, xy, grid, settings)
     sides = SideBySide(settings.matching.detectors, settings.matching.params)
     if background:
@@ -97,14 +98,63 @@ def prepare_truth(truth: OccupancyMap | PointMap, settings: Settings,
                          aligner, fits[0] if fits else least, sides)
 
 
+def _sizes(inputs: Sequence[OccupancyMap | PointMap],
+           grid: MetricGrid) -> tuple[int, int, float, int]:
+    """Image cells, grid cells, the grid's area (m^2) and cloud points of scoring on ``grid``."""
+    images = sum(int(np.prod(s.grid.shape)) for s in inputs if isinstance(s, OccupancyMap))
+    points = sum(len(s.points) for s in inputs if isinstance(s, PointMap))
+    cells = int(np.prod(grid.shape))
+    return images, cells, cells * grid.resolution**2, points
+
+
 def needed_memory(inputs: Sequence[OccupancyMap | PointMap], grid: MetricGrid,
                   more_maps: int = 0) -> int:
     """Estimated peak memory, bytes, of scoring a map against a truth (``inputs``: both, or
     the truth alone for what it needs whatever the map) on the truth's ``grid``, with
     ``more_maps`` maps more scored on it at once: see :mod:`pcmapq.core.memory`."""
-    images = sum(int(np.prod(s.grid.shape)) for s in inputs if isinstance(s, OccupancyMap))
-    points = sum(len(s.points) for s in inputs if isinstance(s, PointMap))
-    cells = int(np.prod(grid.shape))
-    extent = cells * grid.resolution**2
+    images, cells, extent, points = _sizes(inputs, grid)
     one_map = memory.needed_bytes(0, cells, extent, 0) - memory.BASE
     return memory.needed_bytes(images, cells, extent, points) + more_maps * one_map
+
+
+#: Cell sizes, metres, a cloud truth's grid may be made coarser to (``--truth-resolution``).
+COARSER = (0.05, 0.1, 0.2, 0.5, 1.0)
+
+
+def memory_advice(inputs: Sequence[OccupancyMap | PointMap], grid: MetricGrid,
+                  more_maps: int, limit: int) -> str:
+    """What most of the memory a run needs on ``grid`` is for, and only what would help within
+    ``limit`` bytes, one clause: a cloud truth's grid at a coarser ``--truth-resolution`` when
+    that would fit (the detectors' working cells, :data:`memory.WORKING_CELL` over the grid's
+    area, are the same whatever it is), a crop (unless the libraries alone exceed the limit),
+    a higher ``--max-memory`` when this machine has that much. ``--voxel-3d`` changes no part
+    of the estimate, and is not named."""
+    need = needed_memory(inputs, grid, more_maps)
+    images, cells, extent, points = _sizes(inputs, grid)
+    maps = 1 + more_maps
+    part = memory.parts(images, cells * maps, extent * maps, points)
+    largest = max(part, key=part.__getitem__)
+    width, height = grid.size_m
+    what = {"images": f"the images' {images:,} pixels",
+            "grid": f"the truth's grid of {cells:,} cells of {grid.resolution:g} m",
+            "working": f"the detectors' {memory.WORKING_CELL:g} m cells over the truth's "
+                       f"{width:,.0f} x {height:,.0f} m, whatever --truth-resolution",
+            "points": f"the clouds' {points:,} points"}[largest]
+    fixes = []
+    truth = inputs[-1]
+    if isinstance(truth, PointMap):
+        for cell in (c for c in COARSER if c > grid.resolution):
+            coarse = MetricGrid(cell, grid.origin, (max(1, round(height / cell)),
+                                                    max(1, round(width / cell))))
+            fits = needed_memory(inputs, coarse, more_maps)
+            if fits <= limit:
+                fixes.append(f"--truth-resolution {cell:g} needs about {fits / 1e9:,.1f} GB")
+                break
+    if memory.BASE < limit:
+        fixes.append("inputs cropped to the region of interest (--map-crop, --truth-crop) "
+                     "need less")
+    machine = memory.machine_bytes()
+    if need < machine:
+        fixes.append(f"a --max-memory of {need / 1e9:,.1f} GB or more runs it, if this "
+                     f"machine's {machine / 1e9:.1f} GB can spare that")
+    return f"{part[largest] / 1e9:,.1f} GB of it for {what}: {'; or '.join(fixes)}"

@@ -8,7 +8,8 @@ copies); a large one (more than ``MAP_POINTS`` vertices, 3D, every coordinate fi
 read at all here but mapped: its points are a read-only array onto the file, in the file's own
 coordinate type, that the steps using them read chunk by chunk. Binary PCD is read by
 :mod:`pcmapq.io.pcd`, its coordinates as stored (float ones as Open3D's reader gives them; it
-reads double ones as zeros). ASCII PLY, and ASCII or compressed PCD, go through Open3D.
+reads double ones as zeros), an ASCII PCD by it too. ASCII PLY and compressed PCD go through
+Open3D.
 """
 
 from __future__ import annotations
@@ -31,7 +32,7 @@ from pcmapq.io.stderr import stderr_captured
 from pcmapq.io.survey import read_e57, read_las
 from pcmapq.io.writers import one_line
 
-#: A PCD's coordinate fields.
+#: A PCD's coordinate fields (PCL's names).
 XYZ = ("x", "y", "z")
 
 #: z range (metres) above which a cloud counts as 3D.
@@ -155,40 +156,48 @@ def check_points(path: Path, count: int, memory_limit: int | None = None) -> Non
 
 
 def read_pcd(path: Path, memory_limit: int | None = None) -> np.ndarray:
-    """A PCD's x, y, z (N, 3): a binary one's as stored, read by
-    :func:`pcmapq.io.pcd.read_fields`, any other's by Open3D (:func:`read_open3d`), once its
-    header is checked against the data the file holds and the points it declares against
-    ``memory_limit`` bytes."""
+    """A PCD's x, y, z (N, 3) (fields ``x y z``, or ``X Y Z``: :func:`pcmapq.io.pcd.
+    coordinate_names`), once its header is checked against the data the file holds and the
+    points it declares against ``memory_limit`` bytes: a binary one's as stored, read by
+    :func:`pcmapq.io.pcd.read_fields`, an ASCII one's by :func:`pcmapq.io.pcd.read_ascii`, a
+    compressed one's by Open3D (:func:`read_open3d`)."""
     header = pcd.check_size(path)
     check_points(path, header.points, memory_limit)
-    table = pcd.read_fields(path, XYZ, header)
-    if table is None or len(table) < len(XYZ):
-        return read_open3d(path, memory_limit)
-    return np.column_stack([table[axis] for axis in XYZ])
+    names = pcd.coordinate_names(path, header)
+    if header.data == "ascii":
+        return pcd.read_ascii(path, header, names)
+    table = pcd.read_fields(path, names, header)
+    if table is None:
+        with pcd.open3d_readable(path, header, names) as readable:
+            return read_open3d(readable, memory_limit, shown=path)
+    return np.column_stack([table[axis] for axis in names])
 
 
-def read_open3d(path: Path, memory_limit: int | None = None) -> np.ndarray:
+def read_open3d(path: Path, memory_limit: int | None = None,
+                shown: Path | None = None) -> np.ndarray:
     """PLY or PCD via Open3D, once its header is checked against the data the file holds
     (InputError for a truncated file). Open3D reports unreadable files by returning no
     points, and a PLY that RPly cannot parse by RPly's message on stderr (the points after it
     zeros): that message, captured, is the InputError's. The points declared are checked
-    against ``memory_limit`` bytes first (:func:`check_points`)."""
+    against ``memory_limit`` bytes first (:func:`check_points`). ``shown``: the path messages
+    name (a copy of it is read), default ``path``."""
     import open3d as o3d  # heavy: loaded when a PLY or PCD is read
 
+    shown = path if shown is None else shown
     if path.suffix.lower() == ".ply":  # Open3D pads a short file with zeros, printing RPly errors
-        check_points(path, ply.check_size(path), memory_limit)
+        check_points(shown, ply.check_size(path), memory_limit)
     else:
-        check_points(path, pcd.check_size(path).points, memory_limit)
+        check_points(shown, pcd.check_size(path).points, memory_limit)
     with (o3d.utility.VerbosityContextManager(o3d.utility.VerbosityLevel.Error),
           stderr_captured() as printed):
         cloud = o3d.io.read_point_cloud(str(path))
     rply = [line[6:] for line in printed if line.startswith("RPly: ")]
     if rply:  # Open3D gives the points read before the error, padded with zeros
-        raise InputError(f"{path}: corrupt PLY: {rply[0].strip()}")
+        raise InputError(f"{shown}: corrupt PLY: {rply[0].strip()}")
     if printed:  # not RPly's: passed on
         print("\n".join(printed), file=sys.stderr)
     if not cloud.has_points():
-        raise InputError(f"{path}: no points (empty or unreadable)")
+        raise InputError(f"{shown}: no points (empty or unreadable)")
     return np.asarray(cloud.points, dtype=np.float64)
 
 

@@ -120,9 +120,13 @@ def _meta(path: Path) -> MapMeta:
 
 
 def _fields(path: Path) -> list[str]:
-    """The per-point fields a PLY or LAS file declares (others: none known)."""
+    """The per-point fields a PLY, PCD or LAS file declares (others: none known)."""
     suffix = path.suffix.lower()
     try:
+        if suffix == ".pcd":
+            from pcmapq.io.pcd import read_header
+
+            return list(read_header(path).fields)
         if suffix == ".ply":
             from pcmapq.io.ply import _header
 
@@ -132,7 +136,7 @@ def _fields(path: Path) -> list[str]:
         if suffix in (".las", ".laz"):
             import laspy
 
-            with laspy.open(path) as reader:
+            with laspy.open(path, read_evlrs=False) as reader:
                 return list(reader.header.point_format.dimension_names)
     except (InputError, OSError, ValueError):
         return []

@@ -5,9 +5,11 @@ A pixel's grey value ``v`` (colour: mean of the colour channels; 16-bit images s
 gives ``p = (255 - v) / 255`` (``v / 255`` when ``negate``); the cell is occupied if
 ``p > occupied_thresh``, free if ``p < free_thresh`` and unknown otherwise. A transparent pixel
 (alpha 0) is unknown. The grid's frame is the map_server one: ``origin`` is the pose of the
-image's lower-left corner (see :mod:`pcmapq.core.grid`). One reading goes beyond map_server's: the
-outside of a building drawn solid, reaching the image's border, is read as its face
-(:func:`open_outside`), as a laser sees it.
+image's lower-left corner (see :mod:`pcmapq.core.grid`). The cells read are map_server's, on
+every map (one documented departure: map_saver's unknown grey beside a Nav2 YAML whose
+``free_thresh`` reads it as free, :func:`saver_unknown`). The evaluation reads one thing
+further, on an image fine enough to draw it: the outside of a building drawn solid, reaching
+the image's border, as its face (:func:`open_outside`), as a laser sees it.
 """
 
 from __future__ import annotations
@@ -109,7 +111,6 @@ def load_occupancy(path: Path, resolution: float | None = None,
         state = saver_unknown(state, levels, channels, scale, meta, path)
     empty = "" if (state == OCCUPIED).any() else _darkest(levels, channels, scale, transparent,
                                                           meta)
-    state = open_outside(state, meta.resolution)
     return OccupancyMap(path, MetricGrid(meta.resolution, meta.origin, state.shape), state,
                         empty=empty)
 
@@ -124,7 +125,7 @@ def _darkest(levels: np.ndarray, channels: int, scale: float, transparent: np.nd
     value = np.unique(shown) / channels * scale
     p = occupancy_of(value, meta)
     if meta.mode == "raw":
-        p = p[value <= 100.0]
+        p = p[raw_value(value) <= 100.0]
     top = float(p.max(initial=0.0))
     return (f"its darkest pixels read p = {top:.2f}, not above occupied_thresh "
             f"{meta.occupied_thresh:g}; walls drawn grey need a lower --map-occupied-thresh "
@@ -156,14 +157,17 @@ def saver_unknown(state: np.ndarray, levels: np.ndarray, channels: int, scale: f
 
 
 def open_outside(state: np.ndarray, resolution: float) -> np.ndarray:
-    """``state`` (int8 cells) with the outside of a building drawn solid read as its face: in
-    occupied regions that reach the image's border, the cells of parts thicker than
-    OUTSIDE_M (an opening by a disc of half that) and deeper than FACE_M metres inside the
-    region are UNKNOWN. The image goes on beyond its border as it is there, so a wall drawn
-    along the border keeps every cell, and so do walls and furniture joined to the border (none
-    that thick) and a region with no face (an all-black image). The state itself when no
-    border cell is occupied."""
+    """``state`` (int8 cells of ``resolution`` metres) with the outside of a building drawn
+    solid read as its face: in occupied regions that reach the image's border, the cells of
+    parts thicker than OUTSIDE_M (an opening by a disc of half that) and deeper than FACE_M
+    metres inside the region are UNKNOWN. The image goes on beyond its border as it is there,
+    so a wall drawn along the border keeps every cell, and so do walls and furniture joined to
+    the border (none that thick) and a region with no face (an all-black image). The state
+    itself when no border cell is occupied, or when a cell is wider than FACE_M (a face
+    thinner than a cell cannot be drawn: every cell is kept)."""
     occupied = state == OCCUPIED
+    if resolution > FACE_M:
+        return state
     if not (occupied[0].any() or occupied[-1].any() or occupied[:, 0].any()
             or occupied[:, -1].any()):
         return state
@@ -255,26 +259,36 @@ def _opencv_quiet() -> Iterator[None]:
 
 
 def occupancy_of(value: np.ndarray, meta: MapMeta) -> np.ndarray:
-    """map_server's occupancy probability p of grey values (0..255): ``(255 - v) / 255``,
-    ``v / 255`` when ``negate``; in ``raw`` mode the value itself in percent."""
+    """map_server's occupancy probability p of grey values v (0..255), computed as its
+    image_loader does: ``(255 - v) / 255``, with v first replaced by ``255 - v`` when
+    ``negate``; in ``raw`` mode v rounded to a whole number (half up, as nav2_map_server
+    does), in percent."""
     if meta.mode == "raw":
-        return value / 100.0
-    return value / 255.0 if meta.negate else (255.0 - value) / 255.0
+        return raw_value(value) / 100.0
+    if meta.negate:
+        value = 255.0 - value
+    return (255.0 - value) / 255.0
+
+
+def raw_value(value: np.ndarray) -> np.ndarray:
+    """The cell value a ``raw`` map_server map publishes for grey values v: v rounded half up
+    (unknown above 100)."""
+    return np.floor(np.asarray(value, dtype=np.float64) + 0.5)
 
 
 def classify(levels: np.ndarray, channels: int, scale: float, transparent: np.ndarray,
              meta: MapMeta) -> np.ndarray:
     """Cell states (int8 OCCUPIED/FREE/UNKNOWN) of :func:`read_levels`' pixels by map_server's
     rule, on their grey values ``level / channels * scale`` (0..255). ``raw`` mode reads the
-    value itself as occupancy in percent (above 100: unknown) and ignores ``negate``. The rule
-    is applied once per possible level, and the pixels look their state up."""
+    value itself, rounded, as occupancy in percent (above 100: unknown) and ignores ``negate``.
+    The rule is applied once per possible level, and the pixels look their state up."""
     value = np.arange(int(levels.max(initial=0)) + 1) / channels * scale
     p = occupancy_of(value, meta)
     state = np.full(value.shape, UNKNOWN, dtype=np.int8)
     state[p < meta.free_thresh] = FREE
     state[p > meta.occupied_thresh] = OCCUPIED
     if meta.mode == "raw":
-        state[value > 100.0] = UNKNOWN
+        state[raw_value(value) > 100.0] = UNKNOWN
     state = state[levels]
     state[transparent] = UNKNOWN
     return state

@@ -9,13 +9,24 @@ its size word announces and the uncompressed size against the points declared.
 The fields of a ``DATA binary`` file, fixed-size records at a known offset, are read here too
 (:func:`read_fields`), with their stored values, without importing Open3D (0.8 s): the values
 Open3D's tensor reader gives, which its legacy reader gives too but for double coordinates
-(zeros). ASCII and compressed files are left to Open3D.
+(zeros). So are the coordinates of a ``DATA ascii`` file (:func:`read_ascii`), whose values
+may be separated by commas as well as spaces and tabs. Compressed files are left to Open3D.
+
+The coordinates are the fields ``x``, ``y`` and ``z`` (PCL's names), else ``X``, ``Y`` and
+``Z`` (PDAL's): :func:`coordinate_names`. Open3D reads only the former: a file of the latter
+that it reads (compressed) is given to it as a copy whose ``FIELDS`` line names them in small
+letters (:func:`open3d_readable`).
 """
 
 from __future__ import annotations
 
+import itertools
+import shutil
 import struct
-from collections.abc import Sequence
+import tempfile
+import warnings
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -24,8 +35,10 @@ import numpy as np
 from pcmapq.core.errors import InputError
 from pcmapq.core.words import plural
 from pcmapq.io.ply import count_lines
+from pcmapq.io.writers import one_line
 
-__all__ = ["PcdField", "PcdHeader", "check_size", "read_fields", "read_header"]
+__all__ = ["PcdField", "PcdHeader", "check_size", "coordinate_names", "open3d_readable",
+           "read_ascii", "read_fields", "read_header"]
 
 #: The longest header read, bytes (comments included).
 MAX_HEADER = 1 << 20
@@ -38,11 +51,12 @@ KINDS = {"F": ("f", (4, 8)), "I": ("i", (1, 2, 4, 8)), "U": ("u", (1, 2, 4, 8))}
 @dataclass(frozen=True)
 class PcdField:
     """One field of a PCD record: its NumPy ``type`` (little-endian, as PCD stores it; None
-    when NumPy does not hold its TYPE and SIZE, or it has several values, COUNT > 1) and its
-    ``offset`` in the record, bytes."""
+    when NumPy does not hold its TYPE and SIZE, or it has several values, COUNT > 1), its
+    ``offset`` in the record, bytes, and the ``column`` of its first value on an ASCII line."""
 
     type: str | None
     offset: int
+    column: int = field(default=0, compare=False)
 
 
 @dataclass(frozen=True)
@@ -99,13 +113,78 @@ def _fields(names: list[str], types: list[str], sizes: list[int],
     if not len(names) == len(types) == len(sizes):
         return {}
     out: dict[str, PcdField] = {}
-    offset = 0
+    offset = column = 0
     for name, letter, size, count in zip(names, types, sizes, counts, strict=True):
         kind, held = KINDS.get(letter.upper(), ("", ()))
         numpy_type = f"<{kind}{size}" if size in held and count == 1 else None
-        out.setdefault(name, PcdField(numpy_type, offset))
+        out.setdefault(name, PcdField(numpy_type, offset, column))
         offset += size * count
+        column += count
     return out
+
+
+#: The coordinates' field names: PCL's, then PDAL's.
+COORDINATES = (("x", "y", "z"), ("X", "Y", "Z"))
+
+
+def coordinate_names(path: Path, header: PcdHeader) -> tuple[str, str, str]:
+    """The names of the fields that hold x, y and z (:data:`COORDINATES`); InputError, naming
+    the fields the file has, when it has neither set."""
+    for names in COORDINATES:
+        if all(n in header.fields for n in names):
+            return names
+    if not header.fields:
+        raise InputError(f"{path}: bad PCD header: FIELDS, SIZE and TYPE list different "
+                         "numbers of fields")
+    raise InputError(f"{path}: no x, y, z fields; its fields: {', '.join(header.fields)}")
+
+
+def read_ascii(path: Path, header: PcdHeader, names: Sequence[str]) -> np.ndarray:
+    """The fields ``names`` of the ``DATA ascii`` PCD ``path``, (points, len(names)) float64:
+    the first ``header.points`` lines of its data (blank lines skipped, as PCL does), values
+    separated by spaces, tabs or commas; InputError when a line lacks a value or holds one
+    that is not a number, or the lines are fewer than the points."""
+    if header.points == 0:
+        return np.empty((0, len(names)))
+    columns = [header.fields[n].column for n in names]
+    try:
+        with path.open("rb") as f, warnings.catch_warnings():
+            warnings.simplefilter("ignore", UserWarning)  # "input contained no data"
+            f.seek(header.offset)
+            lines = (line.decode("ascii", errors="replace").replace(",", " ") for line in f
+                     if line.strip())  # PCL skips blank lines
+            table = np.loadtxt(itertools.islice(lines, header.points), dtype=np.float64,
+                               comments=None, usecols=columns, ndmin=2)
+    except ValueError as exc:
+        raise InputError(f"{path}: bad ASCII PCD data: {one_line(exc)}") from None
+    if len(table) < header.points:
+        raise InputError(f"{path}: truncated: header declares {header.points} points, the "
+                         f"file holds {len(table)}")
+    return table
+
+
+@contextmanager
+def open3d_readable(path: Path, header: PcdHeader, names: Sequence[str]) -> Iterator[Path]:
+    """``path`` itself when its coordinates are named ``x y z``; else a temporary copy whose
+    ``FIELDS`` line names them so (the file itself is not changed), removed after the block."""
+    if tuple(names) == COORDINATES[0]:
+        yield path
+        return
+    with path.open("rb") as f:
+        head = f.read(header.offset)
+        lines = head.split(b"\n")
+        for k, line in enumerate(lines):
+            words = line.split()
+            if words and words[0].upper() == b"FIELDS":
+                renamed = {n.encode(): n.lower().encode() for n in names}
+                lines[k] = b" ".join(renamed.get(w, w) for w in words)
+                break
+        with tempfile.TemporaryDirectory() as folder:
+            copy = Path(folder) / "cloud.pcd"
+            with copy.open("wb") as out:
+                out.write(b"\n".join(lines))
+                shutil.copyfileobj(f, out)
+            yield copy
 
 
 def read_fields(path: Path, names: Sequence[str],

@@ -23,6 +23,19 @@ def _finite(value: float | None) -> float | None:
     return value if value is not None and math.isfinite(value) else None
 
 
+def _mean_note(over: int, neighboured: int, radius: float, min_knn: int) -> str | None:
+    """Why a mean over ``over`` points is no figure (None when it is one): no point has more
+    than ``min_knn`` neighbours within ``radius`` metres, or (MME) none of those that have
+    has a neighbourhood of positive volume (its points on a plane or a line)."""
+    if over:
+        return None
+    if neighboured:
+        return (f"no point's neighbourhood within {radius:g} m has volume (all flat or "
+                "straight: their entropy is not defined)")
+    return (f"no point has more than {min_knn} neighbours within {radius:g} m (a larger "
+            "radius, or a denser cloud)")
+
+
 def noref_figures(points: np.ndarray, radius: float = LIDAR_RADIUS, min_knn: int = MIN_KNN,
                   max_nn: int = MAX_NN, orth_subset: Sequence[np.ndarray] | None = None,
                   mom_source: np.ndarray | None = None,
@@ -36,7 +49,8 @@ def noref_figures(points: np.ndarray, radius: float = LIDAR_RADIUS, min_knn: int
     over that many points drawn at random, with their standard errors, and MOM's planes
     extracted from the map reduced to one point per cell of ``SAMPLED_MOM_VOXEL`` times the
     radius (when neither planes nor a source are given; 0: every point, as map-metrics). Figures
-    that are not finite are None.
+    that are not finite are None; ``mme_note`` and ``mpv_note`` say why MME or MPV is (no point
+    with enough neighbours).
     """
     coarse = 0 < sample < len(points) and orth_subset is None and mom_source is None
     if coarse:
@@ -55,7 +69,11 @@ def noref_figures(points: np.ndarray, radius: float = LIDAR_RADIUS, min_knn: int
             note, source = str(exc), None
     value = None if planes is None else _finite(mom(points, planes, radius))
     return {
-        "mme": _finite(s.mme), "mpv": _finite(s.mpv), "mom": value, "mom_note": note,
+        "mme": _finite(s.mme),
+        "mme_note": _mean_note(s.mme_points, s.mpv_points, radius, min_knn),
+        "mpv": _finite(s.mpv),
+        "mpv_note": _mean_note(s.mpv_points, s.mpv_points, radius, min_knn),
+        "mom": value, "mom_note": note,
         "points": s.total_points, "mme_points": s.mme_points, "mpv_points": s.mpv_points,
         "sampled_points": s.sampled_points, "mme_se": _finite(s.mme_se),
         "mpv_se": _finite(s.mpv_se),

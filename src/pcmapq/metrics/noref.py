@@ -45,7 +45,8 @@ LN_2PIE = math.log(2.0 * math.pi * math.e)
 
 @dataclass(frozen=True)
 class NoRefScores:
-    """MME (nats) and MPV (m^2) of one map, with the number of points each mean is over.
+    """MME (nats) and MPV (m^2) of one map, with the number of points each mean is over (NaN
+    when that number is 0: a mean over no point is no figure).
 
     mme_points: points with more than ``min_knn`` neighbours and a positive determinant;
     mpv_points: points with more than ``min_knn`` neighbours; total_points: the map's size.
@@ -186,7 +187,8 @@ def scores(points: np.ndarray, radius: float = LIDAR_RADIUS, min_knn: int = MIN_
     """MME and MPV of a map (N, 3 metres) in one pass: the means, over the points with more than
     ``min_knn`` neighbours (itself included) closer than ``radius`` metres, of the entropy
     0.5 ln det(2 pi e Sigma) (points with det <= 0 skipped) and of Sigma's smallest
-    eigenvalue. 0.0 when no point qualifies, as map-metrics. ``with_flat``: also which points'
+    eigenvalue. NaN when no point qualifies (map-metrics gives 0.0, a figure better than any
+    map's: pcmapq reports none). ``with_flat``: also which points'
     neighbourhoods are flat (:func:`flat`), from the same pass (MOM's subset extraction needs
     them). ``sample``: the means over that many points drawn at random (:func:`sample_of`),
     each with its whole neighbourhood in the map, and their standard errors (0: every point).
@@ -211,8 +213,8 @@ def scores(points: np.ndarray, radius: float = LIDAR_RADIUS, min_knn: int = MIN_
     se = (None, None) if sampled is None else (
         _standard_error(np.concatenate(entropy), len(points)),
         _standard_error(np.concatenate(variance), len(points)))
-    return NoRefScores(mme=ent_sum / ent_n if ent_n else 0.0,
-                       mpv=var_sum / var_n if var_n else 0.0,
+    return NoRefScores(mme=ent_sum / ent_n if ent_n else math.nan,
+                       mpv=var_sum / var_n if var_n else math.nan,
                        mme_points=ent_n, mpv_points=var_n, total_points=len(points),
                        flat=flat_points, sampled_points=sampled, mme_se=se[0], mpv_se=se[1])
 

@@ -121,7 +121,8 @@ def _noref(result: Result) -> list[tuple[str, list[str]]]:
 def _noref_parts(figures: dict) -> list[str]:
     cloud, grid = figures["cloud"], figures["grid"]
     if cloud is not None:
-        return [f"MME {_g(cloud['mme'])} nats", f"MPV {_g(cloud['mpv'])} m²",
+        return [f"MME {_g(cloud['mme'])}" + (" nats" if cloud["mme"] is not None else ""),
+                f"MPV {_g(cloud['mpv'])}" + (" m²" if cloud["mpv"] is not None else ""),
                 f"MOM {_g(cloud['mom'])}" + (" m²" if cloud["mom"] is not None else ""),
                 f"within {cloud['radius_m']:g} m"]
     parts = [f"{count(grid['occupied_cells'], 'occupied cell')} of {grid['resolution_m']:g} m"]

@@ -195,9 +195,10 @@ def test_a_filled_area_is_drawn_along_its_outline():
 @pytest.mark.parametrize("seed", [0, 3])
 def test_a_plan_drawn_with_its_outside_solid_scores_like_one_drawn_with_walls(seed, tmp_path):
     """The plan's outside drawn black to the image's border (as the IPA room-segmentation plans
-    draw it) is read as its face, a wall FACE_M thick: every detector finds what it finds on
-    the usual drawing, both ways, and nothing along the image's border."""
-    from pcmapq.io.occupancy import load_occupancy
+    draw it) is read by the evaluation as its face, a wall FACE_M thick: every detector finds
+    what it finds on the usual drawing, both ways, and nothing along the image's border."""
+    from pcmapq.evaluation.inputs import MAP_CROP, load_input
+    from pcmapq.settings import SourceConfig
 
     plan = synth.building_plan(seed)
     grid = synth.plan_grid(plan, 0.05, margin=3.0)
@@ -205,7 +206,7 @@ def test_a_plan_drawn_with_its_outside_solid_scores_like_one_drawn_with_walls(se
     usual = {n: detect(n, image == synth.OCCUPIED, grid) for n in NAMES}
     solid = np.where(image == synth.UNKNOWN, synth.OCCUPIED, image).astype(np.uint8)
     cv2.imwrite(str(tmp_path / "solid.png"), solid)
-    read = load_occupancy(tmp_path / "solid.png", 0.05)
+    read = load_input(tmp_path / "solid.png", SourceConfig(resolution=0.05), MAP_CROP)
     occupied = read.state == 1
     assert occupied.mean() < 0.2 and not occupied[:5].any() and not occupied[:, :5].any()
     for name in NAMES:

@@ -117,10 +117,38 @@ def test_sums_equal_a_kd_tree_count_and_np_cov_per_point():
         np.testing.assert_allclose(got_cov[i], np.cov(near.T), rtol=1e-9, atol=1e-15)
 
 
-def test_sparse_points_score_zero_as_map_metrics():
+def test_sparse_points_have_no_figure():
+    """No point with more than min_knn neighbours: map-metrics gives 0.0 (a figure better than
+    any real map's); here MME and MPV are not a number, null in the JSON with the reason, n/a
+    on the terminal."""
+    from pcmapq.evaluation.inspect_map import summary_lines
+    from pcmapq.metrics.inspection import noref_figures
+
     points = np.arange(30, dtype=float).reshape(10, 3) * 10.0
     got = noref.scores(points, 0.5, 5)
-    assert (got.mme, got.mpv, got.mpv_points, got.total_points) == (0.0, 0.0, 0, 10)
+    assert math.isnan(got.mme) and math.isnan(got.mpv)
+    assert (got.mme_points, got.mpv_points, got.total_points) == (0, 0, 10)
+    record = noref_figures(points, radius=0.5)
+    assert record["mme"] is None and record["mpv"] is None
+    assert record["mme_note"] == record["mpv_note"] == (
+        "no point has more than 5 neighbours within 0.5 m (a larger radius, or a denser cloud)")
+    lines = summary_lines({"map": {"path": "m.ply", "kind": "cloud"}, "cloud": record,
+                           "grid": None})
+    assert "MME       n/a (no point has more than 5 neighbours within 0.5 m" in lines[2]
+    assert lines[3].startswith("MPV       n/a (no point has more than 5")
+    from pcmapq.report.table import _noref_parts  # eval's table of both sides' figures
+
+    assert _noref_parts({"cloud": record, "grid": None})[:2] == ["MME n/a", "MPV n/a"]
+
+
+def test_flat_neighbourhoods_have_no_entropy():
+    """Points on a plane: MPV is 0 m^2 over every point, MME has no point (det = 0)."""
+    from pcmapq.metrics.inspection import noref_figures
+
+    grid = np.stack(np.meshgrid(np.arange(10.0), np.arange(10.0)), axis=-1).reshape(-1, 2)
+    record = noref_figures(np.column_stack([grid * 0.1, np.zeros(100)]), radius=0.5)
+    assert record["mpv"] == 0.0 and record["mpv_note"] is None
+    assert record["mme"] is None and "has volume" in record["mme_note"]
 
 
 def test_mom_sums_the_median_plane_variance_of_each_plane():
