@@ -15,6 +15,7 @@ from . import (
     consistency,
     corpus,
     drawings,
+    drawings_eval,
     floorplans,
     fr79,
     gazebo,
@@ -37,7 +38,8 @@ DOC = ROOT / "docs" / "validation.md"
 COMMAND = "python -m bench.validation --write"
 #: Every section of the document, in its order: a module with ``cases`` and ``section``.
 SECTIONS: dict[str, ModuleType] = {
-    "drawings": drawings, "fr79": fr79, "lidar": lidar, "kitti": kitti, "gazebo": gazebo,
+    "drawings": drawings, "drawings_eval": drawings_eval, "fr79": fr79, "lidar": lidar,
+    "kitti": kitti, "gazebo": gazebo,
     "halmstad": halmstad, "floorplans": floorplans, "carmen": carmen, "noref": noref,
     "same_place": same_place, "house": house,
     "corpus": corpus, "consistency": consistency, "track": track,
@@ -101,15 +103,20 @@ def write_one(name: str, section: Section, path: Path = DOC) -> None:
         write_atomic(path.parent / rel, data)
     head, *blocks = path.read_text().rstrip("\n").split("\n\n## ")
     blocks = ["## " + b for b in blocks]
-    order = list(SECTIONS)
-    present = [n for n in order if n != name] if len(blocks) < len(order) else order
-    if len(present) != len(blocks):
-        raise ValueError(f"{path}: {len(blocks)} sections, expected {len(present)}")
-    placed = dict(zip(present, blocks, strict=True))
-    placed[name] = section.text.rstrip("\n")
+    title = section.text.split("\n", 1)[0]
+    if title in (b.split("\n", 1)[0] for b in blocks):  # measured again: in its place
+        body = [section.text.rstrip("\n") if b.split("\n", 1)[0] == title else b
+                for b in blocks]
+    else:  # new to the document: where the order of SECTIONS puts it
+        order = list(SECTIONS)
+        present = [n for n in order if n != name] if len(blocks) < len(order) else order
+        if len(present) != len(blocks):
+            raise ValueError(f"{path}: {len(blocks)} sections, expected {len(present)}")
+        placed = dict(zip(present, blocks, strict=True))
+        placed[name] = section.text.rstrip("\n")
+        body = [placed[n] for n in order if n in placed]
     opening_text, _, again = head.partition("\n\n" + AGAIN)
     notes = [n for n in again.rstrip(".").split("; ") if n and not n.startswith(f"`{name}` ")]
     notes.append(f"`{name}` on {datetime.date.today().isoformat()} ({commit()})")
-    text = "\n\n".join([opening_text, AGAIN + "; ".join(notes) + ".",
-                         *(placed[n] for n in order if n in placed)])
+    text = "\n\n".join([opening_text, AGAIN + "; ".join(notes) + ".", *body])
     write_atomic(path, text + "\n")
