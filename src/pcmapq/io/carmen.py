@@ -131,6 +131,18 @@ def read_laser_scans(path: str | Path) -> LaserScans:
     return LaserScans(poses, ranges, angles, stamps)
 
 
+def _kept(poses: np.ndarray, ranges: np.ndarray, angles: np.ndarray,
+          max_range: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The poses (K, 3), the world headings of the beams (K, B) and which readings give a
+    point (K, B): positive, at most ``max_range`` metres, finite heading."""
+    poses = np.asarray(poses, dtype=np.float64).reshape(-1, 3)
+    ranges = np.asarray(ranges, dtype=np.float64).reshape(len(poses), -1)
+    heading = poses[:, 2:3] + np.broadcast_to(angles, ranges.shape)
+    with np.errstate(invalid="ignore"):
+        keep = (ranges > 0) & (ranges <= max_range) & np.isfinite(heading)
+    return poses, heading, keep
+
+
 def endpoints(poses: np.ndarray, ranges: np.ndarray, angles: np.ndarray,
               max_range: float = DEFAULT_MAX_RANGE) -> np.ndarray:
     """Beam endpoints in the world frame, (M, 2) metres, scan by scan in beam order.
@@ -139,24 +151,17 @@ def endpoints(poses: np.ndarray, ranges: np.ndarray, angles: np.ndarray,
     ranges: (K, B) metres; NaN, non-positive and above-``max_range`` readings give no point.
     angles: (K, B) or (B,) beam angles in the laser frame, radians.
     """
-    poses = np.asarray(poses, dtype=np.float64).reshape(-1, 3)
-    ranges = np.asarray(ranges, dtype=np.float64).reshape(len(poses), -1)
-    heading = poses[:, 2:3] + np.broadcast_to(angles, ranges.shape)
-    with np.errstate(invalid="ignore"):
-        keep = (ranges > 0) & (ranges <= max_range) & np.isfinite(heading)
-    r, a = ranges[keep], heading[keep]
-    k = np.broadcast_to(np.arange(len(poses))[:, None], ranges.shape)[keep]
+    poses, heading, keep = _kept(poses, ranges, angles, max_range)
+    r = np.asarray(ranges, dtype=np.float64).reshape(heading.shape)[keep]
+    a = heading[keep]
+    k = np.broadcast_to(np.arange(len(poses))[:, None], keep.shape)[keep]
     return np.column_stack([poses[k, 0] + r * np.cos(a), poses[k, 1] + r * np.sin(a)])
 
 
 def endpoint_scans(poses: np.ndarray, ranges: np.ndarray, angles: np.ndarray,
                    max_range: float = DEFAULT_MAX_RANGE) -> np.ndarray:
     """(M,) the scan index of each of :func:`endpoints`' points (same arguments)."""
-    poses = np.asarray(poses, dtype=np.float64).reshape(-1, 3)
-    ranges = np.asarray(ranges, dtype=np.float64).reshape(len(poses), -1)
-    heading = poses[:, 2:3] + np.broadcast_to(angles, ranges.shape)
-    with np.errstate(invalid="ignore"):
-        keep = (ranges > 0) & (ranges <= max_range) & np.isfinite(heading)
+    poses, _, keep = _kept(poses, ranges, angles, max_range)
     return np.repeat(np.arange(len(poses)), np.count_nonzero(keep, axis=1))
 
 

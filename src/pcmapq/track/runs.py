@@ -33,7 +33,14 @@ from pcmapq.features.walls import CLOSING
 from pcmapq.io import PointMap
 from pcmapq.io.bag_scans import scan_times
 from pcmapq.io.bags import is_bag
-from pcmapq.io.carmen import DEFAULT_MAX_RANGE, LaserScans, endpoints, is_carmen, read_laser_scans
+from pcmapq.io.carmen import (
+    DEFAULT_MAX_RANGE,
+    LaserScans,
+    endpoint_scans,
+    endpoints,
+    is_carmen,
+    read_laser_scans,
+)
 from pcmapq.io.clouds import flat
 from pcmapq.mapping import (
     ScanSequence,
@@ -102,12 +109,9 @@ class LaserRun:
         once, and each map is a prefix of them."""
         xy = endpoints(planar_of(self.poses), self.scans.ranges, self.scans.angles,
                        self.max_range)
-        with np.errstate(invalid="ignore"):
-            kept = (self.scans.ranges > 0) & (self.scans.ranges <= self.max_range) & \
-                np.isfinite(self.scans.angles)
-        counts = np.count_nonzero(kept, axis=1)
-        offsets = np.concatenate([[0], np.cumsum(counts)])
-        scan = np.repeat(np.arange(len(self)), counts)
+        scan = endpoint_scans(planar_of(self.poses), self.scans.ranges, self.scans.angles,
+                              self.max_range)
+        offsets = np.concatenate([[0], np.cumsum(np.bincount(scan, minlength=len(self)))])
         views = scan_views(self.poses[:, :2, 3], xy, scan, 2 * CLOSING)
         points = np.column_stack([xy, np.zeros(len(xy))])
         before, seen = 0, NO_VIEW
