@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import re
 
-from pcmapq.results.figures import F_SCORE_COLUMN, FIGURES
+from pcmapq.results.figures import ALIASES, AT_TAU_COLUMN, FIGURES, MEAN_PRECISION, TAU_FIELDS
 from pcmapq.settings.build import base_settings, get_path
 from pcmapq.settings.table import FLOAT, INT, SWITCH, Option, options_of
 
@@ -53,9 +53,15 @@ def _default(value: object) -> str:
 def figures_table() -> str:
     """Every named figure as a markdown table (name, JSON path, table column), as
     docs/ci.md lists the gates' keys."""
-    rows = ["| name (gate key) | JSON path | table column |", "| --- | --- | --- |"]
-    rows += [f"| `{f.name}` | `{'.'.join(f.path)}` | {f'`{f.column}`' if f.column else '-'} |"
+    rows = ["| name (gate key) | JSON path | table column | header |",
+            "| --- | --- | --- | --- |"]
+    rows += [f"| `{f.name}` | `{'.'.join(f.path)}` | "
+             f"{f'`{f.column_name}`' if f.column else '-'} | {f.header} |"
              for f in FIGURES if f.number]
-    rows.append(f"| `f_score@TAU`, `f_score_3d@TAU` | `distances.f_score.<i>.f` | "
-                f"`{F_SCORE_COLUMN.format(tau=0.05).replace('0.05', 'TAU')}` |")
+    rows += [f"| `{name}@TAU`, `{name}_3d@TAU` | `distances.f_score.<i>.{key}` | "
+             f"`{AT_TAU_COLUMN.format(name=name, tau=0.05).replace('0.05', 'TAU')}` | "
+             f"{name.replace('_', ' ')} at TAU |" for name, key in TAU_FIELDS.items()]
+    rows.append(f"| - | mean of `detectors.<name>.precision`, rooms aside | "
+                f"`{MEAN_PRECISION}` (track) | precision |")
+    rows += [f"| `{alias}` (other name of `{name}`) | | | |" for alias, name in ALIASES.items()]
     return "\n".join(rows) + "\n"

@@ -4,10 +4,15 @@
 from __future__ import annotations
 
 import io
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from pcmapq.results.result import DECIMALS, REGION_COLUMNS, Result, consistency_dict
+from pcmapq.results.blocks import DECIMALS
+from pcmapq.results.document import REGION_COLUMNS, consistency_block
+
+if TYPE_CHECKING:
+    from pcmapq.results.result import Result
 
 
 def vectors_csv(result: Result) -> str:
@@ -35,7 +40,8 @@ def regions_csv(result: Result) -> str:
     points and its fitness before and after, truth frame, metres and degrees."""
     out = io.StringIO()
     out.write(",".join(REGION_COLUMNS) + "\n")
-    for row in consistency_dict(result.consistency)["regions"]:
+    for region in consistency_block(result.consistency).regions:
+        row = region.model_dump()
         out.write(",".join(str(int(v)) if isinstance(v, bool | int) else f"{v:.{DECIMALS}f}"
                            for v in (row[k] for k in REGION_COLUMNS)) + "\n")
     return out.getvalue()

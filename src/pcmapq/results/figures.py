@@ -9,6 +9,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import numpy as np
+
 from pcmapq.core.stats import FIELDS as STAT_FIELDS
 from pcmapq.settings import DETECTOR_NAMES
 
@@ -20,71 +22,120 @@ ALIGNMENT_FIELDS = ("confidence", "fitness", "rmse_m", "truth_recall", "seen_thr
                     "y_m", "yaw_deg", "scale")
 
 
+#: Units a figure's JSON key ends with, and how a header writes them.
+UNITS = {"_m": "m", "_deg": "deg"}
+
+
 @dataclass(frozen=True)
 class Figure:
-    """One figure: its ``name`` (gates, :meth:`Result.figures`), its ``path`` in the result's
-    JSON, its table ``column`` and markdown ``header`` (None: not a table column). ``optional``:
-    a result without it reads None (a detector not run, a result without a consistency map);
-    otherwise a document without it is not a result. ``number``: False for a word (the
-    verdict), which no gate reads."""
+    """One figure: its ``name`` (gates, :meth:`Result.figures`, track) and its ``path`` in the
+    result's JSON. ``column``: whether it is a column of the batch, compare and track tables;
+    the column's name and markdown header follow from the path (:attr:`column_name`,
+    :attr:`header`; ``label`` overrides the header's words). ``optional``: a result without
+    it reads None (a detector not run, a result without a consistency map); otherwise a
+    document without it is not a result. ``number``: False for a word (the verdict), which
+    no gate reads."""
 
     name: str
     path: tuple[str, ...]
-    column: str | None = None
-    header: str | None = None
+    column: bool = False
+    label: str | None = None
     optional: bool = False
     number: bool = True
+
+    @property
+    def unit(self) -> str:
+        """The figure's unit, "m", "deg" or "" (a share, a count, a word), from its path."""
+        return next((u for key in self.path for end, u in UNITS.items() if key.endswith(end)),
+                    "")
+
+    @property
+    def words(self) -> tuple[str, ...]:
+        """The path below its group (``detectors``, ``distances``, ``alignment``, ...) with
+        the unit left out: ``("accuracy", "mean")``."""
+        keys = self.path[1:] if len(self.path) > 1 else self.path
+        return tuple(next((k[:-len(e)] for e in UNITS if k.endswith(e)), k) for k in keys)
+
+    @property
+    def column_name(self) -> str | None:
+        """Its table column (``harris_quality``, ``accuracy_mean_m``, ``yaw_deg``), None when
+        it is not a column."""
+        if not self.column:
+            return None
+        return "_".join(self.words) + (f"_{self.unit}" if self.unit else "")
+
+    @property
+    def header(self) -> str:
+        """Its markdown header, the unit in brackets: ``accuracy mean (m)``."""
+        words = self.label or " ".join(self.words)
+        return f"{words} ({self.unit})" if self.unit else words
 
 
 def _stats(side: str, block: str, suffix: str) -> list[Figure]:
     """``accuracy.mean`` ...: every statistic of one side's distances (mean and median are
     table columns of the 2D distances)."""
     return [Figure(f"{side}{suffix}.{s}", (block, f"{side}_m", s),
-                   f"{side}_{s}_m" if not suffix and s in ("mean", "median") else None,
-                   f"{side} {s} (m)", optional=bool(suffix) or s not in ("mean", "median"))
+                   column=not suffix and s in ("mean", "median"),
+                   optional=bool(suffix) or s not in ("mean", "median"))
             for s in STAT_FIELDS]
 
 
 #: Every named figure, table columns in table order first.
 FIGURES: tuple[Figure, ...] = (
-    *(Figure(f"{d}.{s}", ("detectors", d, s), f"{d}_{s}", f"{d} {s}", optional=True)
+    *(Figure(f"{d}.{s}", ("detectors", d, s), column=True, optional=True)
       for s in SCORES for d in DETECTOR_NAMES),
-    Figure("coverage", ("coverage",), "coverage", "coverage"),
-    Figure("alignment.fitness", ("alignment", "fitness"), "fitness", "fitness"),
-    Figure("alignment.confidence", ("alignment", "confidence"), "confidence", "confidence"),
-    Figure("alignment.verdict", ("alignment", "verdict"), "verdict", "verdict", optional=True,
+    Figure("coverage", ("coverage",), column=True),
+    Figure("alignment.fitness", ("alignment", "fitness"), column=True),
+    Figure("alignment.confidence", ("alignment", "confidence"), column=True),
+    Figure("alignment.verdict", ("alignment", "verdict"), column=True, optional=True,
            number=False),
-    Figure("alignment.x_m", ("alignment", "x_m"), "x_m", "x (m)"),
-    Figure("alignment.y_m", ("alignment", "y_m"), "y_m", "y (m)"),
-    Figure("alignment.yaw_deg", ("alignment", "yaw_deg"), "yaw_deg", "yaw (deg)"),
-    Figure("alignment.scale", ("alignment", "scale"), "scale", "scale"),
-    Figure("consistency.largest_offset_m", ("consistency", "largest_offset_m"),
-           "largest_offset_m", "largest region offset (m)", optional=True),
+    Figure("alignment.x_m", ("alignment", "x_m"), column=True),
+    Figure("alignment.y_m", ("alignment", "y_m"), column=True),
+    Figure("alignment.yaw_deg", ("alignment", "yaw_deg"), column=True),
+    Figure("alignment.scale", ("alignment", "scale"), column=True),
+    Figure("consistency.largest_offset_m", ("consistency", "largest_offset_m"), column=True,
+           label="largest region offset", optional=True),
     *(f for f in _stats("accuracy", "distances", "") if f.column),
     *(f for f in _stats("completeness", "distances", "") if f.column),
-    Figure("chamfer", ("distances", "chamfer_m"), "chamfer_m", "Chamfer (m)"),
+    Figure("chamfer", ("distances", "chamfer_m"), column=True, label="Chamfer"),
     *(f for f in _stats("accuracy", "distances", "") if not f.column),
     *(f for f in _stats("completeness", "distances", "") if not f.column),
     *(Figure(f"alignment.{a}", ("alignment", a), optional=True) for a in ALIGNMENT_FIELDS
       if a not in ("confidence", "fitness", "x_m", "y_m", "yaw_deg", "scale")),
     *_stats("accuracy", "distances_3d", "_3d"), *_stats("completeness", "distances_3d", "_3d"),
-    Figure("chamfer_3d", ("distances_3d", "chamfer_m"), optional=True),
+    Figure("chamfer_3d", ("distances_3d", "chamfer_m"), optional=True, label="Chamfer 3D"),
 )
 BY_NAME = {f.name: f for f in FIGURES}
+#: Other names of figures that gates have always read: the one list of aliases.
+ALIASES = {"chamfer.mean": "chamfer", "chamfer_3d.mean": "chamfer_3d"}
+#: The figures measured at each tau of the result, by name, and their key in an F-score's
+#: block: the F-score, and the wall precision (share of the map's walls within tau of a
+#: truth wall). ``f_score@0.05``, ``wall_precision_3d@0.1`` ...
+TAU_FIELDS = {"f_score": "f", "wall_precision": "precision"}
+#: The figure that dates a fault over a run (``pcmapq track``): the detectors' mean precision,
+#: is what the map shows right?
+MEAN_PRECISION = "precision"
+#: Detectors whose precision :data:`MEAN_PRECISION` leaves out. A room of a growing map is
+#: right only once the robot has drawn its walls whole: until then it leaks into the next
+#: room or stops at the map's edge, so the rooms' precision falls with exploration alone and
+#: would date a fault where there is none. Their own columns stay in every step.
+NOT_IN_PRECISION = ("rooms",)
 #: The groups every result has (a document without one is not a result).
 REQUIRED = ("map", "truth", "detectors", "alignment", "distances")
-#: An F-score's name and column, one per tau of the result (``f_score@0.05``,
-#: ``f_score@0.05m``); ``f_score_3d@TAU`` for two 3D clouds.
-F_SCORE, F_SCORE_COLUMN = "f_score{dim}@{tau:g}", "f_score@{tau:g}m"
+#: A figure at one tau: its name and its column (``f_score@0.05``, ``f_score@0.05m``);
+#: ``f_score_3d@TAU`` for two 3D clouds.
+AT_TAU, AT_TAU_COLUMN = "{name}{dim}@{tau:g}", "{name}@{tau:g}m"
+F_SCORE = AT_TAU.replace("{name}", "f_score")
+F_SCORE_COLUMN = AT_TAU_COLUMN.replace("{name}", "f_score")
 #: Columns before the F-scores: the name, its rank among the table's rows (:func:`ranked`)
 #: and inputs, then every figure that has a column.
-HEAD = ("name", "rank", "map", "truth", *(f.column for f in FIGURES if f.column))
+HEAD = ("name", "rank", "map", "truth", *(f.column_name for f in FIGURES if f.column))
 #: Columns after the F-scores: the gates' verdict ("" without gates, "pass", or "fail: " and
 #: the failing keys) and how the evaluation ended (0 and "" when it finished).
 TAIL = ("gates", "exit_code", "error")
 #: Markdown headers of the columns (units in brackets); an F-score's is ``F@0.05 m``.
 HEADERS = {"name": "name", "rank": "rank", "map": "map", "truth": "truth",
-           **{f.column: f.header for f in FIGURES if f.column},
+           **{f.column_name: f.header for f in FIGURES if f.column},
            "gates": "gates", "exit_code": "exit code", "error": "error"}
 
 
@@ -103,8 +154,24 @@ def figures(doc: dict) -> dict[str, float | str | None]:
         if block == "distances" or block in doc:
             for f in _get(doc, block, "f_score"):
                 tau = _number(f, "tau_m", "f_score")
-                values[F_SCORE.format(dim=dim, tau=tau)] = _number(f, "f", "f_score")
+                for name, key in TAU_FIELDS.items():
+                    values[AT_TAU.format(name=name, dim=dim, tau=tau)] = _number(f, key,
+                                                                                "f_score")
     return values
+
+
+def step_columns(doc: dict, precisions: dict[str, float | None]) -> dict[str, float | None]:
+    """The columns a step of ``pcmapq track`` adds to :func:`table_row`'s: the detectors'
+    mean precision (:data:`MEAN_PRECISION`, of ``precisions`` by detector, unrounded) and the
+    wall precision at each tau (``wall_precision@0.1m``)."""
+    values = figures(doc)
+    kept = [p for d, p in precisions.items() if p is not None and d not in NOT_IN_PRECISION]
+    columns: dict[str, float | None] = {
+        MEAN_PRECISION: float(np.mean(kept)) if kept else None}
+    for f in _get(doc, "distances", "f_score"):
+        name = AT_TAU.format(name="wall_precision", dim="", tau=f["tau_m"])
+        columns[AT_TAU_COLUMN.format(name="wall_precision", tau=f["tau_m"])] = values[name]
+    return columns
 
 
 def table_row(name: str, doc: dict) -> dict[str, object]:
@@ -115,7 +182,7 @@ def table_row(name: str, doc: dict) -> dict[str, object]:
     values = figures(doc)
     row: dict[str, object] = {"name": name, "rank": None, "map": _get(doc, "map", "path"),
                               "truth": _get(doc, "truth", "path")}
-    row.update((f.column, values[f.name]) for f in FIGURES if f.column)
+    row.update((f.column_name, values[f.name]) for f in FIGURES if f.column)
     for f in _get(doc, "distances", "f_score"):
         tau = f["tau_m"]
         row[F_SCORE_COLUMN.format(tau=tau)] = values[F_SCORE.format(dim="", tau=tau)]

@@ -19,21 +19,19 @@ from typing import Any
 
 from pcmapq.core.errors import InputError
 from pcmapq.core.words import count
-from pcmapq.results.figures import BY_NAME, FIGURES
+from pcmapq.results.figures import ALIASES, BY_NAME, FIGURES, TAU_FIELDS
 
 #: The exit code of a run whose figures fail a gate (0 scored, 1 evaluation failed, 2 usage).
 EXIT_CODE = 3
 #: The two directions and the option of each.
 UNDER, OVER = "under", "over"
 OPTIONS = {UNDER: "--fail-under", OVER: "--fail-over"}
-#: Other names of figures that gates have always read.
-ALIASES = {"chamfer.mean": "chamfer", "chamfer_3d.mean": "chamfer_3d"}
 #: The top-level keys of the result's JSON (``alignment_3d``, ``distances_3d``: two 3D clouds;
 #: ``rooms``: the rooms detector ran).
 TOP_LEVEL = ("pcmapq", "settings", "map", "truth", "alignment", "consistency", "frames",
              "coverage", "footprint", "scored_against", "distances", "noref", "detectors",
              "matches", "missing", "extra", "alignment_3d", "distances_3d", "rooms")
-_F_SCORE = re.compile(r"^(f_score(?:_3d)?)(?:@(.*))?$")
+_F_SCORE = re.compile(r"^(f_score|wall_precision)(_3d)?(?:@(.*))?$")
 
 
 class GateError(InputError):
@@ -121,8 +119,8 @@ def parse_rules(under: str | None, over: str | None) -> list[Gate]:
 def short_names() -> list[str]:
     """Every short key: each named figure (:data:`~pcmapq.results.figures.FIGURES`), the
     aliases, and the F-score forms (``f_score@TAU`` stands for any tau)."""
-    return [f.name for f in FIGURES if f.number] + list(ALIASES) + ["f_score", "f_score@TAU",
-                                                         "f_score_3d@TAU"]
+    return [f.name for f in FIGURES if f.number] + list(ALIASES) + [
+        form for name in TAU_FIELDS for form in (name, f"{name}@TAU", f"{name}_3d@TAU")]
 
 
 def json_path(key: str, doc: dict) -> tuple[str | int, ...]:
@@ -130,8 +128,8 @@ def json_path(key: str, doc: dict) -> tuple[str | int, ...]:
     dotted path split (digits index lists). ``f_score@TAU`` names the F-score at tau metres;
     ``f_score`` alone, the only one (an error when the result has several)."""
     if (m := _F_SCORE.match(key)) is not None:
-        block = "distances_3d" if m[1].endswith("_3d") else "distances"
-        return (block, "f_score", _tau_index(key, m[2], doc.get(block)), "f")
+        block = "distances_3d" if m[2] else "distances"
+        return (block, "f_score", _tau_index(key, m[3], doc.get(block)), TAU_FIELDS[m[1]])
     name = ALIASES.get(key, key)
     if name in BY_NAME:
         return BY_NAME[name].path
@@ -173,9 +171,9 @@ def to_json(doc: dict) -> str:
 def _check_key(key: str, option: str) -> None:
     """Refuse a key that is neither a short name nor a dotted path from a top-level key."""
     if (m := _F_SCORE.match(key)) is not None:
-        if m[2] is not None and _tau(m[2]) is None:
-            raise GateError(f"{option} {key}: expected f_score@TAU with TAU in metres, e.g. "
-                            "f_score@0.1")
+        if m[3] is not None and _tau(m[3]) is None:
+            raise GateError(f"{option} {key}: expected {m[1]}@TAU with TAU in metres, e.g. "
+                            f"{m[1]}@0.1")
         return
     if "" not in key.split(".") and json_path(key, {})[0] in TOP_LEVEL:
         return

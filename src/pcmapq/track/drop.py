@@ -6,6 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from pcmapq.results.figures import MEAN_PRECISION
 from pcmapq.track.timeline import Step
 
 #: A fall smaller than this is no drop (the band a good run's curves stay within): a value
@@ -29,7 +30,7 @@ class Drop:
     lasting: float
 
 
-def worst_drop(steps: list[Step], figure: str = "precision") -> Drop | None:
+def worst_drop(steps: list[Step], figure: str = MEAN_PRECISION) -> Drop | None:
     """The largest fall of ``figure`` from its highest value so far that no later step makes
     up (the maximum drawdown of the later steps' best), over the scored steps; None with fewer
     than two, or when it is less than :data:`MIN_DROP`. A map keeps every scan it took, so a

@@ -34,7 +34,7 @@ from pcmapq.evaluation.scoring import score
 from pcmapq.evaluation.truth import PreparedTruth
 from pcmapq.io import PointMap
 from pcmapq.metrics.trajectory import ape, rpe
-from pcmapq.results.figures import table_row
+from pcmapq.results.figures import step_columns, table_row
 from pcmapq.results.result import Result
 from pcmapq.settings import Settings
 from pcmapq.track.runs import Run
@@ -42,12 +42,6 @@ from pcmapq.track.steps import travelled
 
 #: The summary columns a step does not repeat (they name the inputs or a batch's outcome).
 NOT_PER_STEP = ("name", "map", "truth", "gates", "exit_code", "error")
-#: Detectors whose precision the step's ``precision`` leaves out. A room of a growing map is
-#: right only once the robot has drawn its walls whole: until then it leaks into the next room
-#: or stops at the map's edge, so the rooms' precision falls with exploration alone (FHW's
-#: recording at its corrected poses: 1.00 at 60 scans, 0.18 at 200) and would date a fault
-#: where there is none. Their own columns stay in every step.
-NOT_IN_PRECISION = ("rooms",)
 #: Positions of the first scored step that measure the slide (an even sample of them).
 SLIDE_POINTS = 2000
 #: The newest readings are aligned through this many of their voxel centroids at most (evenly
@@ -121,18 +115,13 @@ def pose_errors(estimate: np.ndarray, reference: np.ndarray,
 
 def figures_of(result: Result) -> dict[str, float | None]:
     """A result's flat figures: :func:`~pcmapq.results.figures.table_row` without the inputs and
-    outcome, the detectors' mean precision, rooms aside (``precision``: is what the map shows
-    right? the figure whose fall dates a fault; see NOT_IN_PRECISION) and the wall precision at
-    each tau (``wall_precision@0.1m``: share of the map's wall cells within tau of a truth
-    wall)."""
-    row = table_row("", result.to_dict(features=False))
+    outcome, then :func:`~pcmapq.results.figures.step_columns` (the detectors' mean precision,
+    the wall precision at each tau)."""
+    doc = result.to_dict(features=False)
+    row = table_row("", doc)
     figures = {k: v for k, v in row.items() if k not in NOT_PER_STEP}
-    precisions = [d.matching.precision for name, d in result.detectors.items()
-                  if d.matching.precision is not None and name not in NOT_IN_PRECISION]
-    figures["precision"] = float(np.mean(precisions)) if precisions else None
-    for f in result.distances.fscores:
-        figures[f"wall_precision@{f.tau_m:g}m"] = f.precision
-    return figures
+    return {**figures, **step_columns(doc, {name: d.matching.precision
+                                            for name, d in result.detectors.items()})}
 
 
 def place_step(source, prepared: PreparedTruth, settings: Settings,
