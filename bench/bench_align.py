@@ -15,7 +15,7 @@ import numpy as np
 
 from pcmapq.align import align
 from pcmapq.core.transform import Similarity2D
-from pcmapq.testing import synth
+from testkit import synth
 
 W, H = 24.0, 16.0
 

@@ -50,7 +50,7 @@ import numpy as np
 
 from pcmapq.core.transform import Similarity2D
 from pcmapq.io.writers import write_ros_map
-from pcmapq.testing import synth
+from testkit import synth
 
 #: The truth's plan (metres) and the resolution of every image, metres per pixel.
 WIDTH, HEIGHT, RESOLUTION = 24.0, 16.0, 0.05

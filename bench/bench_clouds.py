@@ -44,7 +44,7 @@ import numpy as np
 
 from pcmapq.core.transform import Similarity2D
 from pcmapq.io.writers import write_ros_map
-from pcmapq.testing import synth
+from testkit import synth
 
 #: Point spacing of the generated buildings, metres (about 3.4 M points per building).
 SPACING = 0.018

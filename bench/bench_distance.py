@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from pcmapq.core.grid import MetricGrid
-from pcmapq.testing import synth
+from testkit import synth
 
 RESOLUTION = 0.05
 

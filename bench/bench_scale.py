@@ -20,7 +20,7 @@ import numpy as np
 from pcmapq.align import AlignParams, align
 from pcmapq.align.similarity_icp import fit_similarity
 from pcmapq.core.transform import Similarity2D
-from pcmapq.testing.realdata.halmstad import BROKEN_ANNOTATIONS, keypoint_pairs
+from testkit.realdata.halmstad import BROKEN_ANNOTATIONS, keypoint_pairs
 
 DATA = Path(__file__).resolve().parents[2] / "shared" / "data" / "halmstad"
 TARGET_PX = 20.0

@@ -18,7 +18,7 @@ from pcmapq.core.grid import MetricGrid
 from pcmapq.core.transform import Similarity2D
 from pcmapq.io.writers import write_ros_map
 from pcmapq.raster.draw import points_to_grid, polygon_cells
-from pcmapq.testing import synth
+from testkit import synth
 
 RESOLUTION = 0.05
 #: The map's pose in the truth frame (p_truth = R(yaw) p_map + t), as the issue tried it.

@@ -19,7 +19,7 @@ from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.io.writers import write_ros_map
 from pcmapq.report.text import score
 from pcmapq.settings import AlignmentConfig, FootprintConfig, Settings
-from pcmapq.testing import synth
+from testkit import synth
 
 #: Parts of the 24 m x 16 m plan (x0, y0, x1, y1, metres), 25-60 % of its walls; no cut runs
 #: along a wall (the map would keep a sliver of it that the share counts).

@@ -24,8 +24,8 @@ from pcmapq.core.cells import UNKNOWN
 from pcmapq.core.grid import MetricGrid
 from pcmapq.core.transform import Similarity2D
 from pcmapq.io import load_map
-from pcmapq.testing import synth
-from pcmapq.testing.recordings import write_recording
+from testkit import synth
+from testkit.recordings import write_recording
 
 #: The scan frame's pose in the truth frame: x, y metres, yaw degrees.
 SCAN_POSE = (6.0, 8.0, 37.0)

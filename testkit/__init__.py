@@ -1,5 +1,5 @@
 """What tests and benchmarks share, never imported by the pipeline: synthetic plans and maps
-with known answers (:mod:`~pcmapq.testing.synth`), written as files (:mod:`.files`), CARMEN logs
+with known answers (:mod:`~testkit.synth`), written as files (:mod:`.files`), CARMEN logs
 (:mod:`.carmen`) and ROS recordings (:mod:`.recordings`); the command line as a test runs it
 (:mod:`.command`); known poses (:mod:`.poses`); the checkout's sample, references and real data
 (:mod:`.paths`), the real data sets' cases (:mod:`.realdata`) and KITTI's calibration
