@@ -1,6 +1,6 @@
 """Time and memory of `pcmapq eval` end to end, per stage, on the sample and on larger plans.
 
-    python bench/bench_pipeline.py        prints a markdown table (copied into docs/benchmarks.md)
+    python -m bench.bench_pipeline        prints a markdown table (copied into docs/benchmarks.md)
 
 Each case runs in a fresh process so its peak memory (max RSS) is its own.
 """

@@ -2,7 +2,7 @@
 table and the share of maps whose annotated keypoints land within 20 px (median) of their layout
 partners.
 
-Run: ``python bench/bench_scale.py [DATA]`` (DATA defaults to ``../shared/data/halmstad``).
+Run: ``python -m bench.bench_scale [DATA]`` (DATA defaults to ``../shared/data/halmstad``).
 Both images are read in pixels (x = column, y = rows - 1 - row, the annotations' frame); the
 reference is the least-squares similarity fitted to the annotated keypoint pairs. E5_08 is
 skipped: its annotation is broken (reference median residual 34 px).

@@ -2,7 +2,7 @@
 the same campus seen by a robot as the map image: turned, shifted, its walls drawn from points
 with Gaussian noise. Both are ``size`` x ``size`` cells of 0.05 m with their map_server YAML.
 
-    python bench/large_grid.py OUT [--size 8000]   writes OUT/truth.png, OUT/map.png (+ YAML)
+    python -m bench.large_grid OUT [--size 8000]   writes OUT/truth.png, OUT/map.png (+ YAML)
 
 ``write_case`` returns the known map -> truth transform, for benchmarks and checks.
 """

@@ -2,7 +2,7 @@
 plan, at random poses, scored under each footprint rule: coverage against the true share, and
 the three qualities. Prints a markdown table and a summary per rule.
 
-    python tools/binary_partial_sweep.py [--poses 3] [--rules auto,known]
+    python -m tools.binary_partial_sweep [--poses 3] [--rules auto,known]
 """
 
 from __future__ import annotations

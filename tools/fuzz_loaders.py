@@ -11,7 +11,7 @@ a finding.
 ``tests/e2e/test_fuzz_loaders.py`` runs this for about a minute in CI; from the command line
 it runs longer and prints the examples run and the outcomes per format::
 
-    python tools/fuzz_loaders.py [--minutes 10] [--seed 0] [--formats ply_binary,pcd_ascii]
+    python -m tools.fuzz_loaders [--minutes 10] [--seed 0] [--formats ply_binary,pcd_ascii]
 """
 
 from __future__ import annotations

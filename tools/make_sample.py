@@ -8,7 +8,7 @@ is moved by 0.3 m, furniture-like boxes stand in the rooms, and it has noise and
 recording's /map grows from west to east every 10 s in a frame of its own (RUN_ORIGIN); from
 DRIFT_AT seconds on, what it adds lies DRIFT_PX cells north of where it should.
 
-    python tools/make_sample.py [OUT_DIR]     (default: data/sample)
+    python -m tools.make_sample [OUT_DIR]     (default: data/sample)
 """
 
 from __future__ import annotations
