@@ -1,6 +1,6 @@
 """Time and score pcmapq.align.align on synthetic cases; prints a markdown table.
 
-Run: ``python bench/bench_align.py``. Truth: wall points of ``building_plan(0)`` (24 m x 16 m)
+Run: ``python -m bench.bench_align``. Truth: wall points of ``building_plan(0)`` (24 m x 16 m)
 every 0.05 m; maps: the same walls resampled with 1.5 cm noise, cut, bent or replaced, then
 turned and shifted into a map frame by a known transform. For the bent map the error is against
 that transform, which no rigid fit can fully recover; the other building has no right answer.
@@ -15,7 +15,7 @@ import numpy as np
 
 from pcmapq.align import align
 from pcmapq.core.transform import Similarity2D
-from pcmapq.testing import synth
+from testkit import synth
 
 W, H = 24.0, 16.0
 

@@ -1,7 +1,7 @@
 """Throughput of ``pcmapq batch`` on local processes and on Dask clusters, as ratios to 2 local
 processes measured in the same run.
 
-    python bench/bench_batch.py [N] [--repeat R]
+    python -m bench.bench_batch [N] [--repeat R]
 
 N small generated maps (default 50) against one truth, every row recomputed (``--force``), each
 batch a fresh ``pcmapq batch`` process, one at a time, ``R`` rounds (default 2) of the same runs
@@ -50,7 +50,7 @@ import numpy as np
 
 from pcmapq.core.transform import Similarity2D
 from pcmapq.io.writers import write_ros_map
-from pcmapq.testing import synth
+from testkit import synth
 
 #: The truth's plan (metres) and the resolution of every image, metres per pixel.
 WIDTH, HEIGHT, RESOLUTION = 24.0, 16.0, 0.05

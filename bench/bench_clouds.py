@@ -2,7 +2,7 @@
 5 and 6), each beside its floor: Open3D's ``read_point_cloud`` + ``voxel_down_sample(0.05)`` of
 the same file, measured in the same run.
 
-    python bench/bench_clouds.py [--sizes 1,3,10,30] [--distances 3,10] [--tmp DIR]
+    python -m bench.bench_clouds [--sizes 1,3,10,30] [--distances 3,10] [--tmp DIR]
 
 Sizes are millions of points. Each cloud is a campus of distinct synthetic buildings
 (``synth.building_plan(seed=k)`` on a lattice with 4 m gaps; walls 2.6 m high, floor and
@@ -44,7 +44,7 @@ import numpy as np
 
 from pcmapq.core.transform import Similarity2D
 from pcmapq.io.writers import write_ros_map
-from pcmapq.testing import synth
+from testkit import synth
 
 #: Point spacing of the generated buildings, metres (about 3.4 M points per building).
 SPACING = 0.018

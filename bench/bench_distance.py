@@ -3,7 +3,7 @@ pcmapq's ``nearest_distance`` (OpenCV's exact transform, kept in float32 cells a
 float64 metres where it is indexed) against SciPy's ``distance_transform_edt`` in metres, and
 the float32 transform alone (:func:`pcmapq.core.morphology.distance_to`).
 
-    python bench/bench_distance.py [--size 8000] [--repeat 3]   prints a markdown table
+    python -m bench.bench_distance [--size 8000] [--repeat 3]   prints a markdown table
 
 The grid is a synthetic building plan's walls, ``size`` x ``size`` cells of 0.05 m. Each case
 runs in a fresh process on the same saved raster, so its peak memory is its own: "extra MB" is
@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from pcmapq.core.grid import MetricGrid
-from pcmapq.testing import synth
+from testkit import synth
 
 RESOLUTION = 0.05
 

@@ -1,6 +1,6 @@
 """Time and memory of `pcmapq eval` end to end, per stage, on the sample and on larger plans.
 
-    python bench/bench_pipeline.py        prints a markdown table (copied into docs/benchmarks.md)
+    python -m bench.bench_pipeline        prints a markdown table (copied into docs/benchmarks.md)
 
 Each case runs in a fresh process so its peak memory (max RSS) is its own.
 """
@@ -21,11 +21,11 @@ CHILD = r"""
 import json, resource, sys, time
 from pathlib import Path
 import numpy as np
-from pcmapq.testing import synth
 from pcmapq.core.transform import Similarity2D
 from pcmapq.evaluation.pipeline import evaluate
 sys.path.insert(0, sys.argv[1])
-from pcmapq.testing.files import in_map_frame, write_cloud_map, write_image_map
+from testkit import synth
+from testkit.files import in_map_frame, write_cloud_map, write_image_map
 
 case, out = sys.argv[2], Path(sys.argv[3])
 if case == "sample":

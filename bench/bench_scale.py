@@ -2,7 +2,7 @@
 table and the share of maps whose annotated keypoints land within 20 px (median) of their layout
 partners.
 
-Run: ``python bench/bench_scale.py [DATA]`` (DATA defaults to ``../shared/data/halmstad``).
+Run: ``python -m bench.bench_scale [DATA]`` (DATA defaults to ``../shared/data/halmstad``).
 Both images are read in pixels (x = column, y = rows - 1 - row, the annotations' frame); the
 reference is the least-squares similarity fitted to the annotated keypoint pairs. E5_08 is
 skipped: its annotation is broken (reference median residual 34 px).
@@ -20,7 +20,7 @@ import numpy as np
 from pcmapq.align import AlignParams, align
 from pcmapq.align.similarity_icp import fit_similarity
 from pcmapq.core.transform import Similarity2D
-from pcmapq.testing.realdata.halmstad import BROKEN_ANNOTATIONS, keypoint_pairs
+from testkit.realdata.halmstad import BROKEN_ANNOTATIONS, keypoint_pairs
 
 DATA = Path(__file__).resolve().parents[2] / "shared" / "data" / "halmstad"
 TARGET_PX = 20.0

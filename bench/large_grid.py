@@ -2,7 +2,7 @@
 the same campus seen by a robot as the map image: turned, shifted, its walls drawn from points
 with Gaussian noise. Both are ``size`` x ``size`` cells of 0.05 m with their map_server YAML.
 
-    python bench/large_grid.py OUT [--size 8000]   writes OUT/truth.png, OUT/map.png (+ YAML)
+    python -m bench.large_grid OUT [--size 8000]   writes OUT/truth.png, OUT/map.png (+ YAML)
 
 ``write_case`` returns the known map -> truth transform, for benchmarks and checks.
 """
@@ -18,7 +18,7 @@ from pcmapq.core.grid import MetricGrid
 from pcmapq.core.transform import Similarity2D
 from pcmapq.io.writers import write_ros_map
 from pcmapq.raster.draw import points_to_grid, polygon_cells
-from pcmapq.testing import synth
+from testkit import synth
 
 RESOLUTION = 0.05
 #: The map's pose in the truth frame (p_truth = R(yaw) p_map + t), as the issue tried it.

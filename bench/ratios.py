@@ -35,9 +35,9 @@ from bench.bench_clouds import FLOOR_CHILD as CLOUD_FLOOR
 from bench.bench_clouds import measured, write_case
 from bench.bench_grids import FLOOR_CHILD as GRID_FLOOR
 from pcmapq.features import DEFAULT_DETECTORS
-from pcmapq.testing.paths import SAMPLE, SHARED_DATA
-from pcmapq.testing.realdata.halmstad import PLAN_RESOLUTION, halmstad_truth
-from pcmapq.testing.realdata.halmstad import paths as halmstad_paths
+from testkit.paths import SAMPLE, SHARED_DATA
+from testkit.realdata.halmstad import PLAN_RESOLUTION, halmstad_truth
+from testkit.realdata.halmstad import paths as halmstad_paths
 
 #: A ratio worse than its stored value by more than this share fails ``--check``.
 TOLERANCE = 0.20

@@ -1,6 +1,6 @@
 """Soak test (issue 12): many evaluations of varied inputs in one process through the Python
 API (``pcmapq.evaluation.pipeline.evaluate``), cycled round-robin (the loop and its checks:
-:mod:`pcmapq.testing.soak`). Checks that every run's outcome equals the first run of its input
+:mod:`testkit.soak`). Checks that every run's outcome equals the first run of its input
 (the JSON the CLI writes, byte for byte; for an input that fails by design, the same exception
 type and message), that the resident memory after the last round is within 10 % of that after
 the first, and that threads and open file descriptors do not grow.
@@ -25,8 +25,8 @@ import numpy as np
 from pcmapq.core.errors import EvaluationError
 from pcmapq.io.carmen import DEFAULT_MAX_RANGE, endpoints, read_flaser
 from pcmapq.settings import AlignmentConfig, Settings, SourceConfig
-from pcmapq.testing.drift import drifted, save_cloud
-from pcmapq.testing.soak import MAX_GROWTH, Input, Soak, rss_mb, soak, synthetic_inputs
+from testkit.drift import drifted, save_cloud
+from testkit.soak import MAX_GROWTH, Input, Soak, rss_mb, soak, synthetic_inputs
 
 ROOT = Path(__file__).resolve().parents[1]
 DATA = ROOT.parent / "shared" / "data"

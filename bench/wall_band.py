@@ -11,7 +11,7 @@ from pathlib import Path
 
 from bench.validation.drawings import plan_variants
 from pcmapq.features import detect, walls_of
-from pcmapq.testing import synth
+from testkit import synth
 
 #: The drawings shown, by title and variant name.
 SHOWN = {"1 cell at 0.025 m": "1 cell at 0.025 m", "6 cells (0.3 m) at 0.05 m": "6 cells at 0.05 m",

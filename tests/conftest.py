@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 
 from pcmapq.core.transform import Similarity2D
-from pcmapq.testing import synth
-from pcmapq.testing.files import write_image_map
-from pcmapq.testing.paths import SAMPLE
+from testkit import synth
+from testkit.files import write_image_map
+from testkit.paths import SAMPLE
 
 
 @pytest.fixture(autouse=True)

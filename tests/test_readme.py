@@ -15,7 +15,7 @@ from typer.testing import CliRunner
 
 from pcmapq.cli import app
 from pcmapq.settings import MatchingConfig
-from pcmapq.testing.paths import REPO, SHARED_DATA
+from testkit.paths import REPO, SHARED_DATA
 
 README = (REPO / "README.md").read_text()
 #: The pages whose examples run: the README, getting started and one page per command.

@@ -8,8 +8,8 @@ import json
 from pathlib import Path
 
 from pcmapq.evaluation.pipeline import evaluate
-from pcmapq.testing.paths import REPO
-from pcmapq.testing.reference import differences
+from testkit.paths import REPO
+from testkit.reference import differences
 
 REFERENCE = REPO / "tests" / "reference" / "sample.json"
 

@@ -2,7 +2,7 @@
 plan, at random poses, scored under each footprint rule: coverage against the true share, and
 the three qualities. Prints a markdown table and a summary per rule.
 
-    python tools/binary_partial_sweep.py [--poses 3] [--rules auto,known]
+    python -m tools.binary_partial_sweep [--poses 3] [--rules auto,known]
 """
 
 from __future__ import annotations
@@ -19,7 +19,7 @@ from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.io.writers import write_ros_map
 from pcmapq.report.text import score
 from pcmapq.settings import AlignmentConfig, FootprintConfig, Settings
-from pcmapq.testing import synth
+from testkit import synth
 
 #: Parts of the 24 m x 16 m plan (x0, y0, x1, y1, metres), 25-60 % of its walls; no cut runs
 #: along a wall (the map would keep a sliver of it that the share counts).

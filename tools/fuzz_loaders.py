@@ -11,7 +11,7 @@ a finding.
 ``tests/e2e/test_fuzz_loaders.py`` runs this for about a minute in CI; from the command line
 it runs longer and prints the examples run and the outcomes per format::
 
-    python tools/fuzz_loaders.py [--minutes 10] [--seed 0] [--formats ply_binary,pcd_ascii]
+    python -m tools.fuzz_loaders [--minutes 10] [--seed 0] [--formats ply_binary,pcd_ascii]
 """
 
 from __future__ import annotations
@@ -243,7 +243,7 @@ def e57_checksummed(data: bytes) -> bytes:
 
 def _mcap_bytes() -> bytes:
     from pcmapq.core.grid import MetricGrid
-    from pcmapq.testing.recordings import write_recording
+    from testkit.recordings import write_recording
 
     state = np.full((12, 16), FREE, dtype=np.int8)
     state[0, :], state[:, 0], state[5:7, 5:9] = OCCUPIED, OCCUPIED, UNKNOWN
@@ -257,7 +257,7 @@ def _recording_files(layout: str, name: str) -> dict[str, bytes]:
     scans, the odometry and transforms placing them) written by rosbags in ``layout``, as
     its files by name (a ROS 2 bag: ``name/metadata.yaml`` and its storage file)."""
     from pcmapq.core.grid import MetricGrid
-    from pcmapq.testing.recordings import Scan, write_recording
+    from testkit.recordings import Scan, write_recording
 
     state = np.full((12, 16), FREE, dtype=np.int8)
     state[0, :], state[:, 0], state[5:7, 5:9] = OCCUPIED, OCCUPIED, UNKNOWN

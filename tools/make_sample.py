@@ -8,7 +8,7 @@ is moved by 0.3 m, furniture-like boxes stand in the rooms, and it has noise and
 recording's /map grows from west to east every 10 s in a frame of its own (RUN_ORIGIN); from
 DRIFT_AT seconds on, what it adds lies DRIFT_PX cells north of where it should.
 
-    python tools/make_sample.py [OUT_DIR]     (default: data/sample)
+    python -m tools.make_sample [OUT_DIR]     (default: data/sample)
 """
 
 from __future__ import annotations
@@ -24,8 +24,8 @@ from pcmapq.core.cells import UNKNOWN
 from pcmapq.core.grid import MetricGrid
 from pcmapq.core.transform import Similarity2D
 from pcmapq.io import load_map
-from pcmapq.testing import synth
-from pcmapq.testing.recordings import write_recording
+from testkit import synth
+from testkit.recordings import write_recording
 
 #: The scan frame's pose in the truth frame: x, y metres, yaw degrees.
 SCAN_POSE = (6.0, 8.0, 37.0)

@@ -12,7 +12,7 @@ import sys
 import time
 from pathlib import Path
 
-from pcmapq.testing import reference
+from testkit import reference
 
 from .common import DATA, Record
 from .document import DOC, SECTIONS, write, write_one

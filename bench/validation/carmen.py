@@ -1,4 +1,4 @@
-"""CARMEN: the drift ladder (:mod:`pcmapq.testing.drift`) on the Intel and FHW logs: does
+"""CARMEN: the drift ladder (:mod:`testkit.drift`) on the Intel and FHW logs: does
 pcmapq rank maps by how much their poses drifted?"""
 
 from __future__ import annotations
@@ -7,7 +7,7 @@ from pathlib import Path
 
 from pcmapq.io.carmen import DEFAULT_MAX_RANGE
 from pcmapq.settings import Settings
-from pcmapq.testing import drift
+from testkit import drift
 
 from .common import Case, Record, Section, span
 

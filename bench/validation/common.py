@@ -1,5 +1,5 @@
 """What the sections share: the data folder, cases and the record of their figures, and how
-figures are written (timed runs of the pipeline: :mod:`pcmapq.testing.runs`)."""
+figures are written (timed runs of the pipeline: :mod:`testkit.runs`)."""
 
 from __future__ import annotations
 

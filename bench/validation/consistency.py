@@ -1,7 +1,7 @@
 """Where a map breaks: does the consistency map (each region of the map aligned on its own,
 :mod:`pcmapq.align.regions`) report the displacement a known distortion put there?
 
-- Plans bent like odometry drift (:func:`pcmapq.testing.synth.bend`) and plans whose eastern
+- Plans bent like odometry drift (:func:`testkit.synth.bend`) and plans whose eastern
   half was turned about the plan's middle: the displacement that undoes the distortion is known
   at every map point, so each region's expected offset is the mean of its points'.
 - CARMEN logs whose poses drift from a known scan k on (every increment after it scaled by
@@ -30,8 +30,8 @@ from pcmapq.io import PointMap
 from pcmapq.io.carmen import endpoints, read_flaser
 from pcmapq.report.plot import figure_bytes, vectorial_figure
 from pcmapq.settings import AlignmentConfig, MatchingConfig, Settings
-from pcmapq.testing import synth
-from pcmapq.testing.drift import increments, integrate
+from testkit import synth
+from testkit.drift import increments, integrate
 
 from .common import Case, Record, Section
 

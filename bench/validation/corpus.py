@@ -1,5 +1,5 @@
 """Scoring the labelled corpus of "same place, another place" (its pairs and their analysis:
-:mod:`pcmapq.testing.corpus`) and its section of docs/validation.md.
+:mod:`testkit.corpus`) and its section of docs/validation.md.
 
     python -m bench.validation.corpus --out bench/results/corpus.jsonl [--data DIR]
         [--only TEXT] [--fields confidence,truth_recall] [--records FILE] [--list]
@@ -33,7 +33,7 @@ from pcmapq.evaluation.same_place import (
 )
 from pcmapq.report.text import number
 from pcmapq.results.result import INCONSISTENT, LOW, OTHER, SAME
-from pcmapq.testing.corpus import (
+from testkit.corpus import (
     CURRENT,
     DRIFT_LOGS,
     DRIFT_SCANS,
@@ -62,7 +62,7 @@ from pcmapq.testing.corpus import (
     value,
     verdict_groups,
 )
-from pcmapq.testing.corpus.records import _kind_key
+from testkit.corpus.records import _kind_key
 
 from .common import DATA, ROOT, Case, Section, header, row, stand_out_rule
 from .common import Record as Figures

@@ -1,7 +1,7 @@
 """Drawing invariance: does a score depend on how the walls are drawn? The same geometry drawn
 otherwise, scored against the usual drawing in both directions (no alignment: same frame).
 
-- synthetic: the plan of ``pcmapq.testing.synth.building_plan`` drawn with walls 1, 2, 3 and 6 cells
+- synthetic: the plan of ``testkit.synth.building_plan`` drawn with walls 1, 2, 3 and 6 cells
   thick and as double outlines at 0.05 m and 0.025 m cells, against the usual drawing;
 - real: the Freiburg 079 SLAM map thickened and thinned to its skeleton, a Halmstad layout
   against its skeleton;
@@ -25,7 +25,7 @@ from pcmapq.io import OccupancyMap, load_map
 from pcmapq.match import match
 from pcmapq.raster.draw import OCCUPIED
 from pcmapq.settings import Settings
-from pcmapq.testing import synth
+from testkit import synth
 
 from .common import Case, Record, Section, header, row
 

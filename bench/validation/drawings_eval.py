@@ -6,7 +6,7 @@ Each synthetic plan (``synth.building_plan``, the layouts of :mod:`.drawings`) i
 binary image with walls 0.2 and 0.3 m thick and as double outlines (the faces of a 0.15 m wall,
 and outlines 0.25 m apart), and scored against its usual drawing (0.15 m walls) both ways: the
 variant as the map, then as the truth. The map side is drawn in the corpus's frame of its
-layout (:func:`pcmapq.testing.corpus.frame`), so the pose found is compared with a known one.
+layout (:func:`testkit.corpus.frame`), so the pose found is compared with a known one.
 """
 
 from __future__ import annotations
@@ -21,8 +21,8 @@ from pcmapq.core.transform import Similarity2D
 from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.io.writers import write_ros_map
 from pcmapq.settings import Settings
-from pcmapq.testing import synth
-from pcmapq.testing.corpus import frame
+from testkit import synth
+from testkit.corpus import frame
 
 from .common import Case, Record, Section, header, row
 from .drawings import BAR, LAYOUTS, NAMES, USUAL_RESOLUTION, USUAL_THICKNESS, WIDE_OUTLINES

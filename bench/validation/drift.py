@@ -1,4 +1,4 @@
-"""A drift ladder on real CARMEN logs (:mod:`pcmapq.testing.drift`): does pcmapq rank maps by
+"""A drift ladder on real CARMEN logs (:mod:`testkit.drift`): does pcmapq rank maps by
 how much their poses drifted?
 
     python -m bench.validation.drift LOG [LOG ...] [--levels 0,0.0005,...] [--seed 0]
@@ -15,7 +15,7 @@ import sys
 from pathlib import Path
 
 from pcmapq.io.carmen import DEFAULT_MAX_RANGE
-from pcmapq.testing.drift import DEFAULT_LEVELS, falls_text, ladder, markdown
+from testkit.drift import DEFAULT_LEVELS, falls_text, ladder, markdown
 
 
 def main(argv: list[str] | None = None) -> int:

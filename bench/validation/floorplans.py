@@ -7,7 +7,7 @@ from pathlib import Path
 
 from pcmapq.report.text import number
 from pcmapq.results.result import Result
-from pcmapq.testing.realdata.floorplans import (
+from testkit.realdata.floorplans import (
     FLOORPLANS,
     PLAN_RESOLUTION,
     SCALE_TOLERANCE,
@@ -15,7 +15,7 @@ from pcmapq.testing.realdata.floorplans import (
     floorplan_run,
     recovered,
 )
-from pcmapq.testing.runs import Run
+from testkit.runs import Run
 
 from .common import ROS, Case, Record, Section, commonest_greys, header, occupancy, q_p, row
 

@@ -10,8 +10,8 @@ from __future__ import annotations
 from pathlib import Path
 
 from pcmapq.report.text import score
-from pcmapq.testing.realdata.fr79 import RESOLUTION, SHIFT, TURNS, turn
-from pcmapq.testing.runs import Run
+from testkit.realdata.fr79 import RESOLUTION, SHIFT, TURNS, turn
+from testkit.runs import Run
 
 from .common import Case, Record, Section, header, row, span
 

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import cv2
 
-from pcmapq.testing.realdata.gazebo import BOUND_M, MAP, RESOLUTION, SETTINGS, TRUTH, run
+from testkit.realdata.gazebo import BOUND_M, MAP, RESOLUTION, SETTINGS, TRUTH, run
 
 from .common import Case, Record, Section, cm, qualities
 

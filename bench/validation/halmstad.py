@@ -14,7 +14,7 @@ from pcmapq.core.transform import Similarity2D
 from pcmapq.io.occupancy import classify
 from pcmapq.raster.draw import OCCUPIED
 from pcmapq.report.text import number
-from pcmapq.testing.realdata.halmstad import (
+from testkit.realdata.halmstad import (
     BROKEN_ANNOTATIONS,
     DARK,
     MAPS,
@@ -24,7 +24,7 @@ from pcmapq.testing.realdata.halmstad import (
     pipeline,
     walls_read_occupied,
 )
-from pcmapq.testing.runs import Run, f_at, yaw_error
+from testkit.runs import Run, f_at, yaw_error
 
 from .common import ROS, Case, Record, Section, commonest_greys, header, q_p, row
 

@@ -24,7 +24,7 @@ from pcmapq.io import load_map
 from pcmapq.raster.draw import OCCUPIED
 from pcmapq.results.result import LOW, OTHER
 from pcmapq.settings import AlignmentConfig, MatchingConfig, Settings
-from pcmapq.testing import reference
+from testkit import reference
 
 from .common import Case, Record, Section, header, row
 

@@ -17,7 +17,7 @@ from pcmapq.mapping import (
     lidar_poses_from_camera,
     read_kitti_poses,
 )
-from pcmapq.testing.runs import Run, f_at, timed_evaluate
+from testkit.runs import Run, f_at, timed_evaluate
 
 from .common import Case, Record, Section, q_p
 

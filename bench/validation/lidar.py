@@ -8,8 +8,8 @@ import numpy as np
 
 from pcmapq.core.transform import Similarity2D
 from pcmapq.settings import Settings
-from pcmapq.testing.realdata.lidar import pair
-from pcmapq.testing.runs import Run, f_at
+from testkit.realdata.lidar import pair
+from testkit.runs import Run, f_at
 
 from .common import Case, Record, Section, header, q_p, row
 

@@ -1,6 +1,6 @@
 """No-reference figures against the truth: do they rank maps by drift as the ground truth does?
 
-2D, on the CARMEN drift ladders (:mod:`pcmapq.testing.drift`): each rung's scans along their
+2D, on the CARMEN drift ladders (:mod:`testkit.drift`): each rung's scans along their
 drifted poses are ray-cast into an occupancy grid (:func:`raycast_state`) and scored by
 :func:`pcmapq.metrics.noref2d.grid_scores`, beside the rung's figures against the corrected map.
 3D, on the first KITTI 00 scans: maps from KITTI's reference poses, from KISS-ICP's poses and
@@ -39,8 +39,8 @@ from pcmapq.metrics.noref2d import grid_scores
 from pcmapq.metrics.orthogonal import extract_orthogonal_subset
 from pcmapq.raster.draw import hit_counts
 from pcmapq.settings import AlignmentConfig, MatchingConfig, Settings
-from pcmapq.testing import drift
-from pcmapq.testing.runs import Run, f_at, timed_evaluate
+from testkit import drift
+from testkit.runs import Run, f_at, timed_evaluate
 
 from . import carmen, noref_grids
 from .common import Case, Record, Section, header, row
@@ -142,7 +142,7 @@ def yaw_drifted(poses: np.ndarray, deg_per_m: float, seed: int = SEED) -> np.nda
     pose with a yaw error after each step: each relative motion inv(P_k) P_k+1 is followed by a
     turn about the sensor's z of ``deg_per_m * (1 + z_k)`` degrees per metre of the step
     (z ~ N(0, 1), seeded: a systematic rate plus a random one of the same size, as
-    :func:`pcmapq.testing.drift.drifted`). 0 gives ``poses`` back (up to rounding)."""
+    :func:`testkit.drift.drifted`). 0 gives ``poses`` back (up to rounding)."""
     rel = np.linalg.inv(poses[:-1]) @ poses[1:]
     step = np.linalg.norm(rel[:, :3, 3], axis=1)
     z = np.random.default_rng(seed).standard_normal(len(rel))

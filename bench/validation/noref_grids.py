@@ -11,8 +11,8 @@ import numpy as np
 from scipy.stats import spearmanr
 
 from pcmapq.report.text import number, score
-from pcmapq.testing.realdata import halmstad
-from pcmapq.testing.realdata.noref_grids import Scored, pairs, score_pair
+from testkit.realdata import halmstad
+from testkit.realdata.noref_grids import Scored, pairs, score_pair
 
 from .common import Case, header, row
 

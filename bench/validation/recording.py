@@ -5,7 +5,7 @@ after the middle scan. Does the worst drop start when the drift does?
 
 The grids: the endpoints so far as occupied cells (0.05 m), the area the scans saw (their
 views, as pcmapq track draws them) as free, the rest unknown. Written as a ROS 2 MCAP bag with
-rosbags' own writer (pcmapq.testing.recordings), then scored as a user's recording is:
+rosbags' own writer (testkit.recordings), then scored as a user's recording is:
 ``pcmapq track RUN.mcap LOG`` against the map of the log's corrected poses.
 
     python -m bench.validation --only recording
@@ -29,10 +29,10 @@ from pcmapq.io.bag_scans import scans as bag_scans
 from pcmapq.raster.draw import points_to_grid
 from pcmapq.raster.seen import seen_on
 from pcmapq.settings import Settings
-from pcmapq.testing.recordings import Scan, write_recording
 from pcmapq.track import Recording, open_run, step_ends, track_recording, travelled
 from pcmapq.track.drop import MIN_DROP
 from pcmapq.track.timeline import Step
+from testkit.recordings import Scan, write_recording
 
 from .common import Case, Record, Section
 from .track import LEVEL, START_SHARE, drifted_poses

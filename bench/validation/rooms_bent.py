@@ -1,5 +1,5 @@
 """Rooms of bent real maps: a Halmstad map per building bent more and more (the slow turn that
-odometry drift gives a map, :func:`pcmapq.testing.synth.bend_image`), each way and from each
+odometry drift gives a map, :func:`testkit.synth.bend_image`), each way and from each
 side, and scored against its building's layout: does the rooms' quality fall with the bend, as
 on the CARMEN ladders?"""
 
@@ -16,8 +16,8 @@ from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.evaluation.same_place import RECALL_NONE, STANDS_OUT
 from pcmapq.report.text import score
 from pcmapq.results.result import INCONSISTENT, OTHER
-from pcmapq.testing import synth
-from pcmapq.testing.realdata.halmstad import halmstad_truth, paths
+from testkit import synth
+from testkit.realdata.halmstad import halmstad_truth, paths
 
 from .common import Case, Record, Section, header, row
 from .rooms_drift import RHO, rho, rho_cell

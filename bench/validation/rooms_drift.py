@@ -1,4 +1,4 @@
-"""Rooms under drift: the CARMEN drift ladder (:mod:`pcmapq.testing.drift`) on six logs, each
+"""Rooms under drift: the CARMEN drift ladder (:mod:`testkit.drift`) on six logs, each
 with several drift draws (seeds), scored by the rooms detector alone: does its quality fall as
 the poses drift?"""
 
@@ -11,7 +11,7 @@ from scipy.stats import spearmanr
 
 from pcmapq.report.text import score
 from pcmapq.settings import AlignmentConfig, MatchingConfig, Settings
-from pcmapq.testing import drift
+from testkit import drift
 
 from .common import Case, Record, Section, header, row
 

@@ -11,7 +11,7 @@ from pathlib import Path
 
 from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.report.text import score
-from pcmapq.testing.realdata.halmstad import (
+from testkit.realdata.halmstad import (
     BROKEN_ANNOTATIONS,
     SETTINGS,
     fit_residual,

@@ -24,15 +24,15 @@ from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.evaluation.same_place import MIN_AGREEING, RECALL_NONE, STANDS_OUT
 from pcmapq.report.text import number
 from pcmapq.results.result import INCONSISTENT, OTHER, SAME
-from pcmapq.testing.realdata.floorplans import FLOORPLANS
-from pcmapq.testing.realdata.same_place import (
+from testkit.realdata.floorplans import FLOORPLANS
+from testkit.realdata.same_place import (
     NEW_MIN_CONFIDENCE,
     PLAN,
     Pair,
     matrix_pairs,
     pairs,
 )
-from pcmapq.testing.reference import summary
+from testkit.reference import summary
 
 from .common import Case, Record, Section, header, row, stand_out_rule
 

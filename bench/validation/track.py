@@ -4,7 +4,7 @@ before it, fall after it, and does the worst drop land on it?
 For each log the run is tracked twice against the map of its corrected poses (the truth):
 once at the corrected poses, once at poses integrated again with a gain error of ``LEVEL``
 on every rotation and translation increment after scan ``k`` (the middle scan; see
-:mod:`pcmapq.testing.drift`), so both runs' maps are the same up to scan k.
+:mod:`testkit.drift`), so both runs' maps are the same up to scan k.
 
     python -m bench.validation --only track
 """
@@ -19,10 +19,10 @@ from pathlib import Path
 import numpy as np
 
 from pcmapq.settings import Settings
-from pcmapq.testing.drift import increments, integrate
 from pcmapq.track import open_run, planar_of, planar_poses, step_ends, track_run, travelled
 from pcmapq.track.drop import Drop
 from pcmapq.track.timeline import Step
+from testkit.drift import increments, integrate
 
 from .common import Case, Record, Section
 

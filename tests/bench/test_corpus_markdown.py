@@ -9,9 +9,9 @@ import subprocess
 import sys
 from pathlib import Path
 
-from pcmapq.testing.corpus import Record
-from pcmapq.testing.corpus.examples import RECORDS, VERDICTS
-from pcmapq.testing.paths import REPO
+from testkit.corpus import Record
+from testkit.corpus.examples import RECORDS, VERDICTS
+from testkit.paths import REPO
 
 
 def markdown(records: list[Record], folder: Path, fields: tuple[str, ...] = ("confidence",)

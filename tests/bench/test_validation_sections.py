@@ -13,8 +13,8 @@ import sys
 
 import pytest
 
-from pcmapq.testing import reference
-from pcmapq.testing.paths import REPO, SHARED_DATA, shared
+from testkit import reference
+from testkit.paths import REPO, SHARED_DATA, shared
 
 #: They read ../shared/data (and skip, saying why, where it is absent).
 pytestmark = pytest.mark.realdata

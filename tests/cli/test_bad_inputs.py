@@ -19,8 +19,8 @@ from numpy.lib import format as npy
 from typer.testing import CliRunner
 
 from pcmapq.cli import app
-from pcmapq.testing.carmen import flaser_log
-from pcmapq.testing.paths import SAMPLE
+from testkit.carmen import flaser_log
+from testkit.paths import SAMPLE
 
 POINTS = np.random.default_rng(0).uniform(0.0, 5.0, (200, 3))
 

@@ -22,7 +22,7 @@ from pcmapq.batch.run import run_local as pool_run
 from pcmapq.cli import app
 from pcmapq.core.errors import InputError
 from pcmapq.settings import Settings
-from pcmapq.testing.batch import MAPS, write_inputs
+from testkit.batch import MAPS, write_inputs
 
 
 def cli_run(*args: str):
@@ -36,7 +36,7 @@ def cli_run(*args: str):
 @pytest.fixture(scope="module")
 def inputs(tmp_path_factory) -> Path:
     """A small truth, three maps of it seen from other poses and a map file that is not an
-    image, with a manifest naming them (:func:`pcmapq.testing.batch.write_inputs`)."""
+    image, with a manifest naming them (:func:`testkit.batch.write_inputs`)."""
     return write_inputs(tmp_path_factory.mktemp("batch"))
 
 
@@ -288,8 +288,8 @@ def test_cli_failed_row_and_missing_dask(inputs, tmp_path, monkeypatch):
 def test_refused_row_keeps_its_verdict_and_ranks_last(inputs, tmp_path):
     """A map of another place (three round rooms) refused in a batch: its row says "another
     place", and it ranks below the scored map and above a row that failed otherwise."""
-    from pcmapq.testing import synth
-    from pcmapq.testing.files import write_image_map
+    from testkit import synth
+    from testkit.files import write_image_map
 
     rooms = write_image_map(synth.round_rooms(), tmp_path / "rooms.png")
     truth = inputs / "truth.png"

@@ -19,7 +19,7 @@ from typer.testing import CliRunner
 
 from pcmapq.batch import read_rows, run_batch
 from pcmapq.cli import app
-from pcmapq.testing.batch import write_inputs
+from testkit.batch import write_inputs
 
 distributed = pytest.importorskip("dask.distributed")
 pytestmark = pytest.mark.skipif(os.name != "posix", reason="process groups (os.killpg): POSIX")
@@ -48,7 +48,7 @@ def batch(*args: str) -> tuple[int, list[tuple[str, str]], str]:
 @pytest.fixture(scope="module")
 def inputs(tmp_path_factory) -> Path:
     """A small truth, three maps of it and a broken map file, with their manifest
-    (:func:`pcmapq.testing.batch.write_inputs`)."""
+    (:func:`testkit.batch.write_inputs`)."""
     return write_inputs(tmp_path_factory.mktemp("cluster"))
 
 

@@ -11,10 +11,10 @@ from pathlib import Path
 
 import pytest
 
-from pcmapq.testing import synth
-from pcmapq.testing.command import run
-from pcmapq.testing.files import write_image_map
-from pcmapq.testing.paths import SAMPLE
+from testkit import synth
+from testkit.command import run
+from testkit.files import write_image_map
+from testkit.paths import SAMPLE
 
 
 @pytest.fixture(scope="module")

@@ -6,8 +6,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from pcmapq.testing.command import run
-from pcmapq.testing.paths import SAMPLE
+from testkit.command import run
+from testkit.paths import SAMPLE
 
 
 def one_line(proc) -> str:

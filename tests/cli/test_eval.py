@@ -11,9 +11,9 @@ import pytest
 
 import pcmapq
 from pcmapq.settings import Settings
-from pcmapq.testing.command import run, run_process
-from pcmapq.testing.files import write_image_map
-from pcmapq.testing.paths import SAMPLE
+from testkit.command import run, run_process
+from testkit.files import write_image_map
+from testkit.paths import SAMPLE
 
 
 @pytest.fixture(scope="module")

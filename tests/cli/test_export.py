@@ -12,10 +12,10 @@ from scipy.spatial.distance import cdist
 from pcmapq.core.transform import Similarity2D
 from pcmapq.io import load_map
 from pcmapq.io.export import DISTANCE_FIELD
-from pcmapq.testing import synth
-from pcmapq.testing.command import run
-from pcmapq.testing.files import in_map_frame, read_cloud, write_image_map
-from pcmapq.testing.poses import rotation_about
+from testkit import synth
+from testkit.command import run
+from testkit.files import in_map_frame, read_cloud, write_image_map
+from testkit.poses import rotation_about
 
 #: The known map -> truth transform of these tests: p_truth = R(25 deg) p_map + (3, -2).
 #: The plan of the exports' maps.

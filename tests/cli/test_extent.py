@@ -12,7 +12,7 @@ import pytest
 from typer.testing import CliRunner
 
 from pcmapq.cli import app
-from pcmapq.testing.paths import SAMPLE
+from testkit.paths import SAMPLE
 
 
 def _eval(*args: str) -> tuple[int, str, str]:

@@ -9,7 +9,7 @@ from pathlib import Path
 import laspy
 import numpy as np
 
-from pcmapq.testing.command import run, run_process
+from testkit.command import run, run_process
 
 
 def test_info_shows_a_warning_as_pcmapq_s(tmp_path: Path) -> None:

@@ -16,7 +16,7 @@ from pcmapq.cli import app
 from pcmapq.core.errors import InputError
 from pcmapq.io import load_map
 from pcmapq.io.formats import MAP_SUFFIXES, SCAN_SUFFIXES
-from pcmapq.testing.paths import REPO, SAMPLE
+from testkit.paths import REPO, SAMPLE
 
 #: Each stops at its parsing or at its first input: milliseconds.
 pytestmark = pytest.mark.unit

@@ -17,7 +17,7 @@ from pcmapq.results.gates import (
     check,
 )
 from pcmapq.settings import DETECTOR_NAMES
-from pcmapq.testing.paths import SAMPLE
+from testkit.paths import SAMPLE
 
 MAP, TRUTH = str(SAMPLE / "scan.ply"), str(SAMPLE / "truth.yaml")
 

@@ -14,7 +14,7 @@ from pcmapq.cli import app
 from pcmapq.io import load_map
 from pcmapq.metrics import noref
 from pcmapq.raster.draw import FREE, OCCUPIED
-from pcmapq.testing.paths import SAMPLE
+from testkit.paths import SAMPLE
 
 
 def _inspect(*args: str) -> tuple[int, str, str]:

@@ -15,8 +15,8 @@ from typer.testing import CliRunner
 
 from pcmapq import cli
 from pcmapq.evaluation.inputs import MAX_OCCUPIED_SHARE
-from pcmapq.testing.command import foreign_lines
-from pcmapq.testing.paths import SAMPLE
+from testkit.command import foreign_lines
+from testkit.paths import SAMPLE
 
 TRUTH = SAMPLE / "truth.yaml"
 

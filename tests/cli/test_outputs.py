@@ -14,7 +14,7 @@ from typer.testing import CliRunner
 
 from pcmapq.cli import app
 from pcmapq.core.errors import InputError
-from pcmapq.testing.paths import SAMPLE
+from testkit.paths import SAMPLE
 
 
 def _cli(*args: str | Path) -> tuple[int, str, str]:

@@ -13,9 +13,9 @@ import pytest
 from pcmapq.core.cells import UNKNOWN
 from pcmapq.io import load_map
 from pcmapq.results.figures import figures
-from pcmapq.testing.command import run
-from pcmapq.testing.paths import SAMPLE
-from pcmapq.testing.recordings import Scan, write_recording
+from testkit.command import run
+from testkit.paths import SAMPLE
+from testkit.recordings import Scan, write_recording
 
 
 @pytest.fixture(scope="module")
@@ -192,7 +192,7 @@ def corridor_scans(start_s: float, period_s: float) -> tuple[list[Scan], list, n
     """A robot driving 8 m east along the corridor of synth.building_plan(0), a 181-beam laser
     scan (ray-cast against the plan's walls, -90 to 90 degrees) and an odometry pose every 0.2
     m, ``period_s`` apart from ``start_s`` (seconds of the bag's clock); the plan's walls."""
-    from pcmapq.testing import synth
+    from testkit import synth
 
     walls = synth.building_plan(0)
     xy = np.column_stack([1.0 + 0.2 * np.arange(41), np.full(41, 7.8)])
@@ -220,7 +220,7 @@ def test_track_builds_a_recordings_scans_when_asked_with_their_times(tmp_path):
     scans; each step's time_s is its last scan's, seconds from the recording's start (its
     map, 0.5 s before the first scan)."""
     from pcmapq.io.writers import write_ros_map
-    from pcmapq.testing import synth
+    from testkit import synth
 
     scans, poses, walls = corridor_scans(100.5, 0.25)
     grid = synth.plan_grid(walls, 0.05)

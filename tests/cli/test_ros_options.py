@@ -15,9 +15,9 @@ import pytest
 from typer.testing import CliRunner
 
 from pcmapq.cli import app
-from pcmapq.testing.command import run
-from pcmapq.testing.files import sample_yaml, write_png
-from pcmapq.testing.paths import SAMPLE
+from testkit.command import run
+from testkit.files import sample_yaml, write_png
+from testkit.paths import SAMPLE
 
 RESULTS_YAML = "quality: 0.93\nprecision: 0.88\nnote: scored by hand\n"
 

@@ -7,10 +7,10 @@ import json
 
 import pytest
 
-from pcmapq.testing import synth
-from pcmapq.testing.command import run_process as run
-from pcmapq.testing.files import write_image_map
-from pcmapq.testing.paths import SAMPLE
+from testkit import synth
+from testkit.command import run_process as run
+from testkit.files import write_image_map
+from testkit.paths import SAMPLE
 
 
 def test_cli_exit_codes_and_refusal_messages(tmp_path):

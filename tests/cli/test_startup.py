@@ -17,7 +17,7 @@ from typer.testing import CliRunner
 
 from pcmapq.cli import app
 from pcmapq.cli.base import listing_app
-from pcmapq.testing.paths import SAMPLE
+from testkit.paths import SAMPLE
 
 #: Libraries the pipeline needs and a listing must not import.
 HEAVY = ("open3d", "cv2", "kiss_icp", "numpy", "scipy", "skimage", "matplotlib")

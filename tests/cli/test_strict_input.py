@@ -12,7 +12,7 @@ from typer.testing import CliRunner
 
 from pcmapq.cli import app
 from pcmapq.results.result import Result
-from pcmapq.testing.paths import SAMPLE
+from testkit.paths import SAMPLE
 
 TRUTH = str(SAMPLE / "truth.png")
 

@@ -14,7 +14,7 @@ from typer.testing import CliRunner
 
 import pcmapq
 from pcmapq.cli import app
-from pcmapq.testing.paths import SAMPLE
+from testkit.paths import SAMPLE
 
 
 def test_version():

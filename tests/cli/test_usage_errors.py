@@ -9,7 +9,7 @@ import pytest
 from typer.testing import CliRunner
 
 from pcmapq.cli import app
-from pcmapq.testing.paths import SAMPLE
+from testkit.paths import SAMPLE
 
 MAP, TRUTH = str(SAMPLE / "scan.ply"), str(SAMPLE / "truth.yaml")
 

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from pcmapq.align import AlignParams, align
-from pcmapq.testing.poses import pose_error
+from testkit.poses import pose_error
 
 
 def test_pyramid_finds_a_repeated_campus(campus):

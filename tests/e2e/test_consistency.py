@@ -16,9 +16,9 @@ from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.io import PointMap
 from pcmapq.results.result import INCONSISTENT, Result
 from pcmapq.settings import MatchingConfig, Settings
-from pcmapq.testing import synth
-from pcmapq.testing.files import write_image_map
-from pcmapq.testing.paths import SAMPLE
+from testkit import synth
+from testkit.files import write_image_map
+from testkit.paths import SAMPLE
 
 TRUE = Similarity2D(3.0, -2.0, np.radians(37.0))
 FAST = Settings(matching=MatchingConfig(detectors=()))

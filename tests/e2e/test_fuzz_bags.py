@@ -14,7 +14,7 @@ import pytest
 from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
-from pcmapq.testing.command import run
+from testkit.command import run
 from tools.fuzz_loaders import read_recording, recording_seeds, run_example, write_example
 
 SEEDS = recording_seeds()

@@ -13,8 +13,8 @@ from pcmapq.core.transform import Similarity2D
 from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.io import clouds, load_map
 from pcmapq.raster import slice as slice_module
-from pcmapq.testing import synth
-from pcmapq.testing.files import in_map_frame, write_image_map
+from testkit import synth
+from testkit.files import in_map_frame, write_image_map
 
 #: The scan's pose in the truth frame, as the shipped sample's.
 POSE = Similarity2D(6.0, 8.0, float(np.radians(37.0)))

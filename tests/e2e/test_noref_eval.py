@@ -23,8 +23,8 @@ from pcmapq.settings import (
     Settings,
     SourceConfig,
 )
-from pcmapq.testing.files import write_image_map
-from pcmapq.testing.paths import SAMPLE
+from testkit.files import write_image_map
+from testkit.paths import SAMPLE
 
 
 def test_eval_reports_the_figures_inspect_gives_for_map_and_truth():

@@ -16,8 +16,8 @@ from pcmapq.io import PointMap
 from pcmapq.io.writers import write_ros_map
 from pcmapq.raster.seen import NO_VIEW, add_views
 from pcmapq.settings import AlignmentConfig, FootprintConfig, MatchingConfig, Settings
-from pcmapq.testing import synth
-from pcmapq.testing.files import in_map_frame, write_cloud_map, write_image_map
+from testkit import synth
+from testkit.files import in_map_frame, write_cloud_map, write_image_map
 
 #: Sub-rectangles of the 24 m x 16 m plan (x0, y0, x1, y1, metres) and map poses.
 CUTS = [((-1, -1, 12.5, 17), Similarity2D(4.0, -6.0, np.radians(63.0))),      # west half

@@ -8,8 +8,8 @@ import pytest
 from pcmapq.core.transform import Similarity2D
 from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.settings import AlignmentConfig, MatchingConfig, Settings
-from pcmapq.testing import synth
-from pcmapq.testing.files import in_map_frame, write_cloud_map, write_image_map
+from testkit import synth
+from testkit.files import in_map_frame, write_cloud_map, write_image_map
 
 DETECTORS = ("harris", "hough", "sift")
 

@@ -15,7 +15,7 @@ from pcmapq.io import PointMap
 from pcmapq.io.writers import write_ros_map
 from pcmapq.raster.draw import OCCUPIED, polygon_cells
 from pcmapq.settings import AlignmentConfig, MatchingConfig, Settings
-from pcmapq.testing import synth
+from testkit import synth
 
 TRUE = Similarity2D(3.0, -2.0, np.radians(37.0))
 

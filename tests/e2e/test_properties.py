@@ -29,8 +29,8 @@ from pcmapq.core.transform import Similarity2D
 from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.io.writers import write_ros_map
 from pcmapq.results.result import Result
-from pcmapq.testing import synth
-from pcmapq.testing.paths import REPO, SAMPLE
+from testkit import synth
+from testkit.paths import REPO, SAMPLE
 
 #: Deterministic and bounded: the same examples on every run, no database, no deadline (an
 #: evaluation takes about a second); the examples' count is set per property.

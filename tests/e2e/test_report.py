@@ -23,9 +23,9 @@ from pcmapq.report.style import DPI, FIGURE_WIDTH_PX, MAP_LIGHT
 from pcmapq.report.text import number
 from pcmapq.report.viewer import viewer_html
 from pcmapq.settings import MatchingConfig, Settings
-from pcmapq.testing import synth
-from pcmapq.testing.files import write_image_map
-from pcmapq.testing.viewer import chromium
+from testkit import synth
+from testkit.files import write_image_map
+from testkit.viewer import chromium
 
 #: The colour of the truth's walls where no map wall is under them.
 TRUTH_ON_WHITE = tuple(overlay(np.ones((1, 1)), np.zeros((1, 1)))[0, 0])

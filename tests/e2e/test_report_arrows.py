@@ -16,9 +16,9 @@ from pcmapq.report.html import report_html
 from pcmapq.report.plot import vectorial_figure
 from pcmapq.report.style import ARROW_SHARE, MAX_ARROW_SCALE
 from pcmapq.settings import MatchingConfig, Settings
-from pcmapq.testing import synth
-from pcmapq.testing.files import write_image_map
-from pcmapq.testing.paths import SAMPLE
+from testkit import synth
+from testkit.files import write_image_map
+from testkit.paths import SAMPLE
 
 #: Where the sample's moved wall's arrows start (truth frame, metres: x0, x1, y0, y1): its
 #: features on the plan's wall at x = 8.0 m (SIFT's a little either side), and the regions of

@@ -12,9 +12,9 @@ import pytest
 from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.report.html import report_html
 from pcmapq.settings import MatchingConfig, Settings
-from pcmapq.testing import synth
-from pcmapq.testing.files import write_image_map
-from pcmapq.testing.viewer import check_view, circles, probed, selector
+from testkit import synth
+from testkit.files import write_image_map
+from testkit.viewer import check_view, circles, probed, selector
 
 CHROMIUM = pytest.mark.skipif(shutil.which("chromium") is None,
                               reason="Debian's chromium is not installed")

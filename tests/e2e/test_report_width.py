@@ -10,10 +10,10 @@ import pytest
 
 from pcmapq.report.plot import png_bytes
 from pcmapq.report.timeline import TABLE, timeline_figure, timeline_html
-from pcmapq.testing.viewer import chromium, probe_of
 from pcmapq.track.drop import worst_drop
 from pcmapq.track.outputs import step_rows
 from pcmapq.track.timeline import Step
+from testkit.viewer import chromium, probe_of
 
 #: A path with no place to break: longer than the window.
 LONG = "/data/" + "run_" * 60 + "final.log.gz"

@@ -11,8 +11,8 @@ import pytest
 from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.results.result import Result
 from pcmapq.settings import Settings
-from pcmapq.testing.paths import SAMPLE
-from pcmapq.testing.reference import same_document
+from testkit.paths import SAMPLE
+from testkit.reference import same_document
 
 
 def test_a_3d_registration_in_the_chain_and_back(tmp_path: Path):
@@ -20,7 +20,7 @@ def test_a_3d_registration_in_the_chain_and_back(tmp_path: Path):
     map -> truth transform is that pose, and the 3D registration and both levellings survive
     the round trip."""
     from pcmapq.io.writers import write_cloud
-    from pcmapq.testing import synth
+    from testkit import synth
 
     cloud = synth.lidar_cloud(synth.building_plan(0))
     yaw, t = np.radians(30.0), np.array([3.0, -2.0, 0.0])

@@ -11,8 +11,8 @@ import pytest
 from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.results.result import Result
 from pcmapq.settings import AlignmentConfig, MatchingConfig, Settings
-from pcmapq.testing import synth
-from pcmapq.testing.files import write_image_map
+from testkit import synth
+from testkit.files import write_image_map
 
 PLAN = synth.building_plan(0)
 #: The wall between the two rooms of the lower row at x = 8.03 m.
@@ -116,7 +116,7 @@ def test_hovering_a_room_in_chromium_tells_its_fit(result, tmp_path):
     number, area, status, IoU, area error and offset as the rooms' table has them; unticking
     the matched rooms hides them and nothing else."""
     from pcmapq.report.html import report_html
-    from pcmapq.testing.viewer import probed, selector
+    from testkit.viewer import probed, selector
 
     det = result.detectors["rooms"]
     k = int(det.matching.truth_idx[0])

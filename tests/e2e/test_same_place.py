@@ -11,8 +11,8 @@ from pcmapq.core.errors import EvaluationError
 from pcmapq.core.transform import Similarity2D
 from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.settings import AlignmentConfig, MatchingConfig, Settings
-from pcmapq.testing import synth
-from pcmapq.testing.files import in_map_frame, write_image_map
+from testkit import synth
+from testkit.files import in_map_frame, write_image_map
 
 FAST = Settings(matching=MatchingConfig(detectors=()))
 

@@ -1,4 +1,4 @@
-"""The soak (pcmapq.testing.soak; ``python -m bench.soak`` runs it long) in small: a few
+"""The soak (testkit.soak; ``python -m bench.soak`` runs it long) in small: a few
 evaluations in one process leave no thread or file behind and repeat their first result byte
 for byte, which is also a fresh process's."""
 
@@ -9,8 +9,8 @@ import subprocess
 import sys
 from pathlib import Path
 
-from pcmapq.testing import soak
-from pcmapq.testing.paths import REPO
+from testkit import soak
+from testkit.paths import REPO
 
 SINGLE_RUN = """
 import sys

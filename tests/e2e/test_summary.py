@@ -18,9 +18,9 @@ from pcmapq.report import summary
 from pcmapq.report.summary import summary_figure, table_csv, table_md, write_summary
 from pcmapq.results.figures import HEAD, failed_row, table_row
 from pcmapq.settings import DEFAULT_DETECTORS, DETECTOR_NAMES, MatchingConfig, Settings
-from pcmapq.testing import synth
-from pcmapq.testing.files import write_image_map
-from pcmapq.testing.paths import SAMPLE
+from testkit import synth
+from testkit.files import write_image_map
+from testkit.paths import SAMPLE
 
 
 @pytest.fixture(scope="module")

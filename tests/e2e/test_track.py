@@ -1,6 +1,6 @@
 """``pcmapq track`` end to end, on a CARMEN log generated here with a known answer.
 
-A robot drives along the corridor of :func:`pcmapq.testing.synth.building_plan` (east, 14 m), turns
+A robot drives along the corridor of :func:`testkit.synth.building_plan` (east, 14 m), turns
 left by 90 degrees into the hall at its end and drives north; at each of its 111 poses a
 180-beam FLASER scan is ray-cast exactly against the plan's walls. The corrected log holds
 those poses; the drifted log holds the same ranges at poses integrated again with a gain error
@@ -35,13 +35,13 @@ from pcmapq.evaluation.truth import prepare_truth
 from pcmapq.io.carmen import beam_angles, read_laser_scans
 from pcmapq.io.writers import write_ros_map
 from pcmapq.settings import Settings
-from pcmapq.testing import synth
-from pcmapq.testing.carmen import flaser_log
 from pcmapq.track import Tracked, open_run, step_ends, track_run, travelled
 from pcmapq.track.drop import MIN_DROP
 from pcmapq.track.outputs import HEAD
 from pcmapq.track.runs import reference_poses_of
 from pcmapq.track.timeline import figures_of, track
+from testkit import synth
+from testkit.carmen import flaser_log
 
 PLAN = synth.building_plan(0)
 #: The path: from the corridor's west end on its centre line (the corridor lies between

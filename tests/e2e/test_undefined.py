@@ -16,7 +16,7 @@ from pcmapq.report.html import report_html
 from pcmapq.report.plot import vectorial_figure
 from pcmapq.report.table import print_table
 from pcmapq.settings import AlignmentConfig, FootprintConfig, MatchingConfig, Settings
-from pcmapq.testing.files import write_image_map
+from testkit.files import write_image_map
 
 
 def polygon(corners: np.ndarray) -> np.ndarray:

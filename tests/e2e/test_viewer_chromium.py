@@ -13,8 +13,8 @@ import pytest
 from pcmapq.report.viewer import viewer_html
 from pcmapq.report.viewer_page import STYLE
 from pcmapq.results.result import Result
-from pcmapq.testing import synth
-from pcmapq.testing.viewer import (
+from testkit import synth
+from testkit.viewer import (
     TURNED,
     check_view,
     chromium,

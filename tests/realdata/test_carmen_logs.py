@@ -8,8 +8,8 @@ import numpy as np
 from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.io import load_map
 from pcmapq.settings import AlignmentConfig, Settings
-from pcmapq.testing import drift
-from pcmapq.testing.paths import shared
+from testkit import drift
+from testkit.paths import shared
 
 
 def test_intel_log() -> None:

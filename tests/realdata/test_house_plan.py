@@ -8,8 +8,8 @@ import json
 
 import numpy as np
 
-from pcmapq.testing.command import run_process as run
-from pcmapq.testing.paths import shared
+from testkit.command import run_process as run
+from testkit.paths import shared
 
 HOUSE = ("plans", "gopi5go_house")
 #: The README's reference placements (map -> plan: x m, y m, yaw deg), found by hand.

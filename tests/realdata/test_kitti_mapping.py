@@ -16,8 +16,8 @@ from pcmapq.mapping import (
     read_kitti_poses,
     write_kitti_poses,
 )
-from pcmapq.testing.kitti import tr_00
-from pcmapq.testing.paths import shared
+from testkit.kitti import tr_00
+from testkit.paths import shared
 
 
 def test_kitti_file_of_sequence_00_round_trips(tmp_path: Path) -> None:

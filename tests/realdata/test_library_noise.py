@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import pytest
 
-from pcmapq.testing.command import foreign_lines
-from pcmapq.testing.paths import shared
+from testkit.command import foreign_lines
+from testkit.paths import shared
 
 
 def test_a_carmen_log_prints_only_pcmapq_s_lines(capfd: pytest.CaptureFixture[str],

@@ -7,8 +7,8 @@ import json
 import numpy as np
 
 from pcmapq.mapping import read_kitti_poses, read_tum_poses
-from pcmapq.testing.command import run
-from pcmapq.testing.paths import SAMPLE, shared
+from testkit.command import run
+from testkit.paths import SAMPLE, shared
 
 TR = ("4.276802385584e-04 -9.999672484946e-01 -8.084491683471e-03 -1.198459927713e-02 "
       "-7.210626507497e-03 8.081198471645e-03 -9.999413164504e-01 -5.403984729748e-02 "

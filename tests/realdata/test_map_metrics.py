@@ -12,7 +12,7 @@ from pcmapq.cli import app
 from pcmapq.mapping.poses import read_pose_matrix, read_poses
 from pcmapq.mapping.reference import posed_map
 from pcmapq.metrics import noref, posed
-from pcmapq.testing.paths import shared
+from testkit.paths import shared
 
 #: map-metrics' own figures on its depth test data (radius 0.2 m, more than 5 neighbours),
 #: from running its code (Python 0.0.4, and its C++ rewrite's test_depth.cpp for MME and MPV).

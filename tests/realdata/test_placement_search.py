@@ -71,7 +71,7 @@ def test_the_search_scores_as_well_as_an_exhaustive_one(pair):
     (within 0.005)."""
     from pcmapq.align import align
     from pcmapq.align.coarse import auto_resolution
-    from pcmapq.testing.paths import shared
+    from testkit.paths import shared
 
     map_xy, truth_xy = (_plan_xy(shared(*p.split("/"))) for p in pair)
     found = align(map_xy, truth_xy)

@@ -19,7 +19,7 @@ from pcmapq.match import match
 from pcmapq.raster.draw import OCCUPIED
 from pcmapq.report.html import report_html
 from pcmapq.settings import AlignmentConfig, Settings
-from pcmapq.testing.paths import shared
+from testkit.paths import shared
 
 #: Freiburg building 079's SLAM map has no resolution; 0.05 m per pixel is assumed.
 FR79_RES = 0.05

@@ -8,8 +8,8 @@ import open3d as o3d
 import pytest
 
 from pcmapq.align.rigid3d import align_3d
-from pcmapq.testing.paths import shared
-from pcmapq.testing.poses import apply, errors, rigid
+from testkit.paths import shared
+from testkit.poses import apply, errors, rigid
 
 
 def read_ply(path) -> np.ndarray:

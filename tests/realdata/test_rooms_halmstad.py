@@ -8,8 +8,8 @@ from dataclasses import replace
 import pytest
 
 from pcmapq.evaluation.pipeline import evaluate
-from pcmapq.testing.paths import SHARED_DATA, shared
-from pcmapq.testing.realdata import halmstad
+from testkit.paths import SHARED_DATA, shared
+from testkit.realdata import halmstad
 
 ROOMS = replace(halmstad.SETTINGS,
                 matching=replace(halmstad.SETTINGS.matching, detectors=("rooms",)))

@@ -11,8 +11,8 @@ import pytest
 
 from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.settings import AlignmentConfig, MatchingConfig, Settings, SourceConfig
-from pcmapq.testing.command import run_process as run
-from pcmapq.testing.paths import shared
+from testkit.command import run_process as run
+from testkit.paths import shared
 
 
 def test_intel_map_against_its_plan_without_force():

@@ -12,9 +12,9 @@ from pcmapq.align import AlignParams, align
 from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.evaluation.same_place import MIN_AGREEING, STANDS_OUT
 from pcmapq.results.result import INCONSISTENT, SAME
-from pcmapq.testing import synth
-from pcmapq.testing.paths import SHARED_DATA, shared
-from pcmapq.testing.realdata import halmstad
+from testkit import synth
+from testkit.paths import SHARED_DATA, shared
+from testkit.realdata import halmstad
 
 
 def occupied_pixels(mask: np.ndarray) -> np.ndarray:

@@ -15,7 +15,7 @@ from typer.testing import CliRunner
 from pcmapq.cli import app
 from pcmapq.io.writers import write_cloud
 from pcmapq.mapping import build_map_from_poses, open_scans, read_poses, write_kitti_poses
-from pcmapq.testing.paths import shared
+from testkit.paths import shared
 
 #: KITTI odometry sequence 00's Tr (velodyne -> left camera), row-major 3x4
 #: (../shared/README.md).

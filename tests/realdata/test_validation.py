@@ -1,7 +1,7 @@
 """Real maps of ../shared/data (docs/validation.md): stated bounds, and the cheap cases' figures
 against their stored references (tests/reference/validation/: behaviour unchanged, numbers
-within 1e-6), each case run as the validation runs it (pcmapq.testing.realdata,
-pcmapq.testing.drift). ``python -m bench.validation --check`` compares every case;
+within 1e-6), each case run as the validation runs it (testkit.realdata,
+testkit.drift). ``python -m bench.validation --check`` compares every case;
 tests/bench/test_validation_sections.py runs the cheap sections through bench's command line.
 
 About 75 s in all on 2 cores, 30 s of it the Gazebo pair (62 M truth cells, about 3 GB peak).
@@ -19,9 +19,9 @@ import pytest
 
 from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.metrics.noref2d import enclosed_areas
-from pcmapq.testing import drift, reference
-from pcmapq.testing.paths import SHARED_DATA, shared
-from pcmapq.testing.realdata import (
+from testkit import drift, reference
+from testkit.paths import SHARED_DATA, shared
+from testkit.realdata import (
     floorplans,
     fr79,
     gazebo,
@@ -30,7 +30,7 @@ from pcmapq.testing.realdata import (
     noref_grids,
     same_place,
 )
-from pcmapq.testing.runs import Run
+from testkit.runs import Run
 
 
 class Measured(Protocol):

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from pcmapq.testing import synth
+from testkit import synth
 
 #: The plan of the alignment tests and its size, metres.
 PLAN = synth.building_plan(0)

@@ -10,8 +10,8 @@ from pcmapq.align.coarse import coarse_search
 from pcmapq.align.finalists import TIE_COVERAGE, TIE_FITNESS, refine_best
 from pcmapq.core.transform import Similarity2D
 from pcmapq.core.voxels import voxel_centroids
-from pcmapq.testing import synth
-from pcmapq.testing.poses import pose_error
+from testkit import synth
+from testkit.poses import pose_error
 
 from .conftest import HEIGHT, PLAN, WIDTH
 

@@ -14,7 +14,7 @@ from pcmapq.core.transform import Similarity2D
 from pcmapq.core.voxels import voxel_centroids
 from pcmapq.evaluation.same_place import verdict
 from pcmapq.results.result import INCONSISTENT, OTHER, SAME
-from pcmapq.testing import synth
+from testkit import synth
 
 TRUE = Similarity2D(3.0, -2.0, np.radians(37.0))
 

@@ -9,7 +9,7 @@ from pcmapq.align import refine3d
 from pcmapq.align.features3d import feature_matches, keypoints
 from pcmapq.align.rigid3d import align_3d
 from pcmapq.core.errors import EvaluationError, InputError
-from pcmapq.testing.poses import apply, errors, rigid
+from testkit.poses import apply, errors, rigid
 
 
 def room(seed: int = 0) -> np.ndarray:

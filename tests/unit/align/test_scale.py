@@ -10,7 +10,7 @@ from pcmapq.align.point_to_line import LineTarget, refine_point_to_line
 from pcmapq.align.similarity_icp import fit_similarity
 from pcmapq.core.transform import Similarity2D
 from pcmapq.core.voxels import voxel_centroids
-from pcmapq.testing import synth
+from testkit import synth
 
 from .conftest import HEIGHT, PLAN, WIDTH
 

@@ -13,13 +13,13 @@ from pcmapq.batch import Task, read_rows, run_row
 from pcmapq.batch.manifest import glob_rows, parse_assignments
 from pcmapq.core.errors import InputError
 from pcmapq.settings import MatchingConfig, Settings
-from pcmapq.testing.batch import write_inputs
+from testkit.batch import write_inputs
 
 
 @pytest.fixture(scope="module")
 def inputs(tmp_path_factory) -> Path:
     """A small truth, three maps of it seen from other poses and a map file that is not an
-    image, with a manifest naming them (:func:`pcmapq.testing.batch.write_inputs`)."""
+    image, with a manifest naming them (:func:`testkit.batch.write_inputs`)."""
     return write_inputs(tmp_path_factory.mktemp("batch"))
 
 

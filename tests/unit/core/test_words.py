@@ -8,7 +8,7 @@ import re
 import pytest
 
 from pcmapq.core.words import count, length, plural
-from pcmapq.testing.paths import REPO
+from testkit.paths import REPO
 
 
 @pytest.mark.parametrize(("n", "text"), [(0, "0 points"), (1, "1 point"), (2, "2 points"),

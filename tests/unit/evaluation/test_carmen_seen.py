@@ -10,7 +10,7 @@ from pcmapq.evaluation.inputs import MAP_CROP, TRUTH_CROP, load_input
 from pcmapq.io.carmen import beam_angles
 from pcmapq.io.clouds import SEEN_CELL
 from pcmapq.settings import SourceConfig
-from pcmapq.testing.carmen import flaser_log
+from testkit.carmen import flaser_log
 
 #: The room: walls at x, y = +-HALF metres.
 HALF = 4.0

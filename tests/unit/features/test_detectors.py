@@ -11,7 +11,7 @@ from pcmapq.core.transform import Similarity2D
 from pcmapq.features import DETECTORS, Features, detect
 from pcmapq.match import match
 from pcmapq.raster import draw
-from pcmapq.testing import synth
+from testkit import synth
 
 NAMES = ("harris", "hough", "sift")
 

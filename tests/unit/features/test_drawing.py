@@ -11,7 +11,7 @@ from pcmapq.core.grid import MetricGrid
 from pcmapq.features import detect
 from pcmapq.features.walls import prune, wall_image
 from pcmapq.match import match
-from pcmapq.testing import synth
+from testkit import synth
 
 NAMES = ("harris", "hough", "sift")
 PLAN = synth.building_plan(0)

@@ -12,7 +12,7 @@ from pcmapq.features import scale_space
 from pcmapq.features.scale_space import extrema, octave_count
 from pcmapq.features.sift import entropy
 from pcmapq.features.walls import wall_image
-from pcmapq.testing import synth
+from testkit import synth
 
 SIGMA, LAYERS = 1.6, 3
 

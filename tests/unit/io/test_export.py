@@ -8,8 +8,8 @@ import pytest
 
 from pcmapq.io.export import DISTANCE_FIELD, record_dtype, records, write_matrix, write_records
 from pcmapq.report.export import colours
-from pcmapq.testing.files import read_cloud
-from pcmapq.testing.poses import rotation_about
+from testkit.files import read_cloud
+from testkit.poses import rotation_about
 
 
 @pytest.mark.parametrize("suffix", [".ply", ".pcd"])

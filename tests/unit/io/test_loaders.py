@@ -16,7 +16,7 @@ from pcmapq.core.grid import MetricGrid
 from pcmapq.io import OccupancyMap, PointMap, load_map, writers
 from pcmapq.io.writers import write_atomic
 from pcmapq.raster.draw import FREE, OCCUPIED, UNKNOWN
-from pcmapq.testing.files import write_png
+from testkit.files import write_png
 
 
 def write_yaml(path: Path, image: str = "map.png", **keys: object) -> Path:

@@ -16,8 +16,8 @@ from pcmapq.io import Thresholds, load_map
 from pcmapq.io.map_yaml import read_yaml
 from pcmapq.io.occupancy import load_occupancy
 from pcmapq.raster.draw import FREE, OCCUPIED, UNKNOWN
-from pcmapq.testing.files import sample_yaml
-from pcmapq.testing.paths import SAMPLE
+from testkit.files import sample_yaml
+from testkit.paths import SAMPLE
 
 
 @pytest.mark.parametrize(("text", "value"), [("5e-2", 0.05), ("1e-2", 0.01),

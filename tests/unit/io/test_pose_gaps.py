@@ -13,7 +13,7 @@ import pytest
 from pcmapq.core.errors import InputError
 from pcmapq.io.bag_scans import GAP_MAX_S, GAP_WARN_S, pose_gaps
 from pcmapq.mapping import recorded_poses
-from pcmapq.testing.recordings import Cloud, write_recording
+from testkit.recordings import Cloud, write_recording
 
 #: Scans one a second from 10 s of the bag's clock (the recording's start: 0 s).
 SCAN_TIMES = [10.0 + k for k in range(6)]

@@ -15,8 +15,8 @@ from pcmapq.io import load_map
 from pcmapq.io.bag_files import zstd_module
 from pcmapq.io.bags import Message
 from pcmapq.mapping import recorded_poses
-from pcmapq.testing.paths import SAMPLE
-from pcmapq.testing.recordings import Cloud, write_recording
+from testkit.paths import SAMPLE
+from testkit.recordings import Cloud, write_recording
 
 
 @pytest.fixture(scope="module")

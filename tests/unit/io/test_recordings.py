@@ -16,8 +16,8 @@ from pcmapq.io import load_map
 from pcmapq.io.bag_scans import poses_at
 from pcmapq.io.bags import Message
 from pcmapq.mapping import build_map_from_poses, open_scans, recorded_poses, scanner_poses
-from pcmapq.testing.paths import SAMPLE
-from pcmapq.testing.recordings import LAYOUTS, Cloud, Scan, write_recording
+from testkit.paths import SAMPLE
+from testkit.recordings import LAYOUTS, Cloud, Scan, write_recording
 
 
 @pytest.fixture(scope="module")

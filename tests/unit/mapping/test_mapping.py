@@ -23,7 +23,7 @@ from pcmapq.mapping import (
     write_kitti_poses,
     write_tum_poses,
 )
-from pcmapq.testing.kitti import TR_00, tr_00
+from testkit.kitti import TR_00, tr_00
 
 
 def random_poses(count: int, seed: int = 0) -> np.ndarray:

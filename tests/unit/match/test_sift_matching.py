@@ -12,7 +12,7 @@ from pcmapq.features import Features, detect
 from pcmapq.features.sift import DESCRIPTOR_NORM, Params
 from pcmapq.match import match
 from pcmapq.raster import draw
-from pcmapq.testing import synth
+from testkit import synth
 
 
 def unit(*weights: float) -> np.ndarray:

@@ -14,7 +14,7 @@ from numpy.lib import format as npy
 from pcmapq.core.errors import EvaluationError, InputError
 from pcmapq.mapping.poses import read_poses
 from pcmapq.metrics import noref, orthogonal, posed
-from pcmapq.testing.synth import room_corner
+from testkit.synth import room_corner
 
 
 def _reference(points: np.ndarray, radius: float, min_knn: int) -> tuple[float, float, int]:

@@ -10,7 +10,7 @@ from pcmapq.core.transform import Similarity2D
 from pcmapq.raster import draw
 from pcmapq.raster.draw import FREE, OCCUPIED, UNKNOWN, hit_counts, points_to_grid, warp_state
 from pcmapq.raster.footprint import footprint_rule
-from pcmapq.testing import synth
+from testkit import synth
 
 
 def state_of(img: np.ndarray) -> np.ndarray:

@@ -8,7 +8,7 @@ from scipy.spatial import cKDTree
 
 from pcmapq.raster import slice as slice_module
 from pcmapq.raster.slice import floor_height, level_rotation, wall_band
-from pcmapq.testing import synth
+from testkit import synth
 
 FLOOR_Z = 1.7
 TILT_DEG = 5.0

@@ -10,7 +10,7 @@ from pcmapq.core.frames import Frames, Levelling
 from pcmapq.core.transform import Similarity2D
 from pcmapq.report.export import cloud_matrix
 from pcmapq.report.plot import figure_bytes
-from pcmapq.testing.poses import rotation_about
+from testkit.poses import rotation_about
 
 #: The known map -> truth transform of these tests: p_truth = R(25 deg) p_map + (3, -2).
 KNOWN = Similarity2D(3.0, -2.0, float(np.radians(25.0)))

@@ -16,7 +16,7 @@ import pcmapq
 from pcmapq.report.table import DISPLACEMENT_COLUMNS, print_table
 from pcmapq.report.text import verdict, words, wrap
 from pcmapq.results.result import Result
-from pcmapq.testing.paths import REPO
+from testkit.paths import REPO
 
 #: A stored result of the sample (tests/test_reference.py keeps it current).
 SAMPLE_DOC = json.loads((REPO / "tests" / "reference" / "sample.json").read_text())

@@ -11,7 +11,7 @@ import numpy as np
 
 from pcmapq.core.grid import MetricGrid
 from pcmapq.report.viewer import VIEWER_PX, viewer_html
-from pcmapq.testing.viewer import TURNED, circles, small_result
+from testkit.viewer import TURNED, circles, small_result
 
 
 def test_viewer_places_each_feature_where_the_grid_puts_it():

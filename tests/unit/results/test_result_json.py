@@ -14,8 +14,8 @@ from pcmapq.results.result import Result
 from pcmapq.settings import (
     Settings,
 )
-from pcmapq.testing.paths import SAMPLE
-from pcmapq.testing.reference import same_document
+from testkit.paths import SAMPLE
+from testkit.reference import same_document
 
 
 @pytest.fixture(scope="module")

@@ -27,7 +27,7 @@ from pcmapq.settings.table import (
     Option,
     options_of,
 )
-from pcmapq.testing.paths import REPO
+from testkit.paths import REPO
 
 #: A value other than the default for each text option, as typed.
 TEXTS = {"scale": "auto", "map_resolution": "0.1", "map_crop": "-5,-5,5,5",

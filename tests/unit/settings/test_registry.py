@@ -16,7 +16,7 @@ from pcmapq.core.grid import MetricGrid
 from pcmapq.features import registry
 from pcmapq.match import match
 from pcmapq.settings import DETECTOR_NAMES, Settings
-from pcmapq.testing import synth
+from testkit import synth
 
 
 def test_cli_defaults_are_the_settings_defaults():

@@ -35,7 +35,7 @@ PLAN = Settings(alignment=AlignmentConfig(scale=True, force=True),
 RIGID = Settings(alignment=AlignmentConfig(force=True), matching=MatchingConfig(detectors=()))
 BUILDINGS = ("E5", "F5", "HIH", "KPT4A")
 CARMEN = ("intel", "aces", "fhw", "csail", "orebro", "freiburg-079")
-#: (log, drift level) of the drifted CARMEN maps (see :mod:`pcmapq.testing.drift`), seed 0.
+#: (log, drift level) of the drifted CARMEN maps (see :mod:`testkit.drift`), seed 0.
 DRIFTS = (("intel", 0.001), ("intel", 0.005), ("fhw", 0.005))
 
 

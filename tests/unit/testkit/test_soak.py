@@ -1,10 +1,10 @@
-"""The soak's checks (pcmapq.testing.soak): each leak is named."""
+"""The soak's checks (testkit.soak): each leak is named."""
 
 from __future__ import annotations
 
 import pytest
 
-from pcmapq.testing import soak
+from testkit import soak
 
 
 def test_soak_failures_name_each_leak() -> None:

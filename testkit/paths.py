@@ -1,13 +1,14 @@
 """Where a source checkout keeps what tests and benchmarks read: the shipped sample, the stored
-references (``tests/reference``) and the real data of ``../shared/data``. pcmapq.testing is
-used from a checkout (by tests/ and bench/), so these are the checkout's folders."""
+references (``tests/reference``) and the real data of ``../shared/data``. testkit lives in the
+checkout, not in the installed package (tests/, bench/ and tools/ import it from the checkout's
+root), so these are the checkout's folders."""
 
 from __future__ import annotations
 
 from pathlib import Path
 
-#: The checkout: this file is src/pcmapq/testing/paths.py in it.
-REPO = Path(__file__).resolve().parents[3]
+#: The checkout: this file is testkit/paths.py in it.
+REPO = Path(__file__).resolve().parents[1]
 #: The shipped sample: scan.ply, truth.png and truth.yaml.
 SAMPLE = REPO / "data" / "sample"
 #: Stored references: the sample's result (sample.json) and the validation's cases.

@@ -1,8 +1,8 @@
-"""The drift ladder (pcmapq.testing.drift): the steps where a detector's f1 does not fall."""
+"""The drift ladder (testkit.drift): the steps where a detector's f1 does not fall."""
 
 from __future__ import annotations
 
-from pcmapq.testing import drift
+from testkit import drift
 
 
 def test_not_falling_lists_the_steps_where_f1_does_not_fall() -> None:

@@ -1,6 +1,6 @@
 """The corpus's pairs, each labelled: same place or not, a kind (clean, a degradation ladder,
 which other place) and a level on that ladder; the synthetic pairs, the real ones
-(:mod:`pcmapq.testing.realdata.same_place`) and the CARMEN drift ladders."""
+(:mod:`testkit.realdata.same_place`) and the CARMEN drift ladders."""
 
 from __future__ import annotations
 

@@ -1,7 +1,7 @@
 """A labelled corpus for "same place, another place": (map, truth) pairs, each labelled with
 whether the map shows the truth's place (``same``), a ``kind`` (clean, a degradation ladder, or
 which other place) and a ``level`` on that ladder, scored as the same-place pairs are
-(:mod:`pcmapq.testing.realdata.same_place`: ``force`` and no detectors); then how well a figure
+(:mod:`testkit.realdata.same_place`: ``force`` and no detectors); then how well a figure
 of the result (the confidence by default) tells the two labels apart.
 
 Same place:
@@ -23,7 +23,7 @@ Same place:
   the plan's middle (12, 8) m); a doubled half (those walls drawn again 0.5 / 1 / 2 m higher);
   a partial view (the walls in the left 0.6 / 0.45 / 0.3 of the plan's width).
 - CARMEN drift: the first :data:`DRIFT_SCANS` scans of the intel, fhw and aces logs placed along
-  their poses re-integrated with drift 1 / 2 / 3 / 4 % (the unit of :mod:`pcmapq.testing.drift`:
+  their poses re-integrated with drift 1 / 2 / 3 / 4 % (the unit of :mod:`testkit.drift`:
   relative gain errors of the rotation and translation increments, ``1 + e * (1 + z)``,
   z ~ N(0, 1), seed 0) against the same scans at their corrected poses (readings up to 30 m);
   and the full-log drifted maps of the same-place pairs (intel 0.1 and 0.5 %, fhw 0.5 %)

@@ -1,13 +1,13 @@
-"""Stored references (pcmapq.testing.reference): the comparison of two JSON documents sees a
+"""Stored references (testkit.reference): the comparison of two JSON documents sees a
 change, and a reference keeps the named fields only."""
 
 from __future__ import annotations
 
 import json
 
-from pcmapq.testing import reference
-from pcmapq.testing.paths import REPO
-from pcmapq.testing.reference import differences
+from testkit import reference
+from testkit.paths import REPO
+from testkit.reference import differences
 
 REFERENCE = REPO / "tests" / "reference" / "sample.json"
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from pcmapq.testing import synth
+from testkit import synth
 
 FILL = 127
 

@@ -1,4 +1,4 @@
-"""The labelled corpus (pcmapq.testing.corpus): the ROC, acceptance and verdict analysis on
+"""The labelled corpus (testkit.corpus): the ROC, acceptance and verdict analysis on
 hand-made records with known answers, the screening's shared walls, and the corpus's make-up
 (listed, not measured)."""
 
@@ -7,9 +7,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from pcmapq.testing import corpus, synth
-from pcmapq.testing.corpus.examples import RECORDS, VERDICTS, record
-from pcmapq.testing.paths import SHARED_DATA
+from testkit import corpus, synth
+from testkit.corpus.examples import RECORDS, VERDICTS, record
+from testkit.paths import SHARED_DATA
 
 
 def test_roc_shares() -> None:
