@@ -17,7 +17,7 @@ from pcmapq.results.blocks import rounded
 from pcmapq.results.figures import figures
 from pcmapq.results.gates import check, parse_rules, with_gates
 from pcmapq.results.result import Result
-from pcmapq.testing.paths import REPO, SAMPLE
+from testkit.paths import REPO, SAMPLE
 
 jsonschema = pytest.importorskip("jsonschema")
 
