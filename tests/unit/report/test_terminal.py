@@ -173,7 +173,8 @@ def test_the_regions_line_counts_in_words_and_rounds_the_tile_as_metres():
     regions = len(doc["consistency"]["regions"])
     assert f"{regions} regions of 6.6 m" in text and "6.64829" not in text
     doc["consistency"]["regions"] = doc["consistency"]["regions"][:1]
-    doc["consistency"]["largest_at_m"] = 0
+    first = doc["consistency"]["regions"][0]
+    doc["consistency"]["largest_at_m"] = [first["x_m"], first["y_m"]]
     text = " ".join(shown(sample_result(doc), 132).split())
     assert "1 region of 6.6 m" in text
 
