@@ -7,9 +7,9 @@ match. One optimal assignment is then solved over the candidate graph, per conne
 (scipy ``linear_sum_assignment``): it maximises the sum over chosen pairs of
 ``weight * (1 - cost)``, where weight is the pair's number of strong features (1 or 2) and cost
 the detector's normalised cost in [0, 1]. A pair is worth its closeness: the assignment never
-trades one close pair for two stretched ones just to match more features (maximising the count
-first did that, and reported displacements of 0.7 m around a wall moved by 0.5 m), and a
-strong-strong pair beats a strong-weak one.
+trades one close pair for two stretched ones just to match more features (which would report
+displacements larger than the walls' true offset), and a strong-strong pair beats a strong-weak
+one.
 
 quality = matched strong truth / strong truth features (the paper's q = RMF / GTF);
 precision = matched strong map / strong map features; f1 = their harmonic mean. A ratio with

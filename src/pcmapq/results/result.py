@@ -160,8 +160,8 @@ class Result:
     def to_dict(self, features: bool = True) -> dict:
         """The JSON document (docs/formats.md): plain types, floats rounded to DECIMALS.
         ``features=False``: the figures alone, with the lists of matched, missing and extra
-        features left empty (a figures row needs none of them; Intel's final map has about
-        3000, and rounding them was most of the work)."""
+        features left empty (a figures row needs none of them, and a large map's thousands of
+        features would be most of the work of rounding)."""
         tf = self.transform
         x0, y0, yaw0 = self.grid.origin
         doc = {
