@@ -5,7 +5,7 @@
 
 --check: exit 1 when a ratio is worse than its stored one (bench/ratios.json) by more
 than 20 %. --save: store the ratios measured. --doc: write them into docs/benchmarks.md's
-table (the rows of the ratios not measured now stay).
+table (the rows of ratios this run does not measure are kept).
 """
 
 from __future__ import annotations

@@ -14,8 +14,8 @@ temporary folder and deleted after. The truth is the campus's plan drawn at 0.05
 Every run is a fresh process (``python -m pcmapq eval ... --json``, or the floor's few lines),
 its peak GB the child's peak RSS (``os.wait4``). pcmapq s is the whole process's wall time
 (interpreter, imports, every step); floor s is Open3D's read + voxel alone, timed inside its
-process (its whole process, imports included, is "floor process s": importing Open3D takes
-about 3 s here). ratio = pcmapq s / floor s, the stricter of the two ratios. ``--before SRC``
+process (its whole process, imports included, is "floor process s": importing Open3D alone
+takes seconds). ratio = pcmapq s / floor s, the stricter of the two ratios. ``--before SRC``
 also runs another pcmapq (``PYTHONPATH=SRC``, e.g. a checkout of main) on the same files.
 
 ``--distances`` compares pcmapq's 3D distances (``metrics.distances.distances_3d``: both clouds

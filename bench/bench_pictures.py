@@ -7,8 +7,8 @@ Each run does what `pcmapq eval gazebo/SLAM_Gen_Map.png gazebo/Ground_Truth.png
 --truth-resolution 1/529 --scale auto [--plot P] [--report R]` does (as docs/validation.md runs
 this pair): ``evaluate``, then ``png_bytes(vectorial_figure(result))`` for the plot and
 ``report_html(result)`` for the report, in a fresh process, so its peak RSS is its own. The
-pictures are timed apart from the evaluation (on a shared machine a 20 s evaluation varies by
-more than the pictures cost), and their own peak is read apart too: the kernel's peak (VmHWM)
+pictures are timed apart from the evaluation (on a shared machine the evaluation's time varies
+by more than the pictures cost), and their own peak is read apart too: the kernel's peak (VmHWM)
 is reset between the two (``/proc/self/clear_refs``). The fastest of ``--repeat`` runs is kept.
 Skips, saying so, when ../shared/data/gazebo is absent.
 """

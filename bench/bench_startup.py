@@ -22,7 +22,7 @@ Every round runs each of them once, in turn, so that the load of other processes
 alike; the table gives the median wall time over ``--repeat`` rounds with its range, the peak
 RSS (the child's ``ru_maxrss``), and map-metrics' run divided by each (the median of the rounds'
 ratios). Numba's compiled loops are cached on disk, so one run of the inspect command before
-the rounds compiles them if the cache is cold (about 6 s, once per install). ``--baseline SRC``
+the rounds compiles them if the cache is cold (once per install). ``--baseline SRC``
 also times the pcmapq commands from another source tree (``git archive`` of another commit,
 say) in the same rounds, labelled "(baseline)".
 """

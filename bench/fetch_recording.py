@@ -14,7 +14,7 @@ Recordings (``--name``; default ``willow-stage``):
     http://download.ros.org/data/amcl/basic_localization_stage_indexed.bag; the MD5 comes from
     ros-planning/navigation amcl/CMakeLists.txt (catkin_download_test_data). It has a
     Hokuyo-like ``/base_scan`` (sensor_msgs/LaserScan, 1081 beams, 270 deg, 30 m) and ``/tf``
-    (odom -> base_link -> base_laser). Third-party code says so; this file was not opened here.
+    (odom -> base_link -> base_laser), as third-party code describes it (not checked here).
     It has no /map, and maybe no nav_msgs/Odometry topic.
     Ground truth: ``willow-full.pgm``, the bitmap Stage simulated the laser against
     (ros-simulation/stage_ros world/willow-full.pgm, BSD). It is 540 x 587 px; willow-erratic.world

@@ -21,7 +21,7 @@ from pcmapq.raster.draw import points_to_grid, polygon_cells
 from testkit import synth
 
 RESOLUTION = 0.05
-#: The map's pose in the truth frame (p_truth = R(yaw) p_map + t), as the issue tried it.
+#: The map's pose in the truth frame (p_truth = R(yaw) p_map + t).
 KNOWN = Similarity2D(31.0, -17.0, float(np.radians(-12.0)))
 NOISE = 0.03
 GAP = 4.0

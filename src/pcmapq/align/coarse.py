@@ -76,7 +76,7 @@ def distinctiveness(search: Search, tf: Similarity2D) -> float:
     pose scores as well); 1 when nothing elsewhere scores above zero. The scores are the
     walls' alone (``search.plain`` where the search weighed free space): the free space's
     cost falls on nearly every pose of a map laid over another place, so the one it spares
-    would stand out (maps of other offices at 0.33-0.51, docs/validation.md)."""
+    would stand out (docs/validation.md: maps of other offices)."""
     poses = search.poses if search.plain is None else search.plain
     if len(poses) == 0:
         return 0.0

@@ -23,8 +23,8 @@ SAME_POSE_M, SAME_POSE_DEG = 1.0, 5.0
 #: With the scale free, finalists whose fitness is within this of the best one's are told apart
 #: by the share of the truth's walls they cover: a map's fitness barely changes when it is
 #: shrunk into a part of the truth that looks like it, the walls it covers do (a bent map of a
-#: small building fits as well at half its scale in one half of it, covering 18 % of the truth's
-#: walls against 57 %; ``tests/realdata/test_scale_halmstad.py``).
+#: small building fits as well at half its scale in one half of it, covering far fewer of the
+#: truth's walls; ``tests/realdata/test_scale_halmstad.py``).
 TIE_FITNESS = 0.02
 #: ... when it covers at least this share of the truth more than the fittest finalist does.
 TIE_COVERAGE = 0.05

@@ -36,10 +36,9 @@ CLEAR_M = 0.25
 PENALTY = 20.0
 #: The cost of a free cell off the truth's known cells, against 1 for one on a truth wall,
 #: beyond the first OFF_ALLOWED of the map's free cells: the truth says nothing there, and a map
-#: of its place may see a little beyond it (6 % of their free cells for the real maps of
-#: docs/validation.md's free-space section at their right poses; 15 % for a synthetic part
-#: of a plan cut 1 m beyond its outer walls), but a map of another place placed to hang off
-#: the truth (63-85 % off) must not go free.
+#: of its place may see a little beyond it (through a door or window, or past a plan cut short
+#: of its outer walls), but a map of another place placed to hang off the truth, most of its
+#: free space off it, must not go free (docs/validation.md, the free-space section).
 OFF_TRUTH, OFF_ALLOWED = 0.3, 0.2
 #: Memory for the templates' spectra held at once, bytes.
 FFT_BYTES = 64e6

@@ -24,13 +24,13 @@ class AlignParams:
         ICP stages).
     finest: rigid search: a sweep coarser than this is refined through rasters of half the cell
         each down to at most this cell, metres (:func:`pcmapq.align.pyramid.descend`); maps up
-        to 80 m from their centroid are swept at this cell or finer and not refined (every
-        real map of docs/validation.md; a 400 m campus descends from 7 m to 1.75 m cells).
+        to 80 m from their centroid (a building's) are swept at this cell or finer and not
+        refined; a campus's is swept coarser and descends.
     beam: poses kept per level of that descent.
     top_k: candidate poses of the global search, each refined by a rough ICP stage.
     finalists: how many of those, by fitness, go through the fine stages and the point-to-line
-        finish; None: 2 rigid, 3 with the scale free (the rough stage ranks less surely there:
-        the Freiburg 079 map's right pose came third).
+        finish; None: 2 rigid, 3 with the scale free (the rough stage ranks less surely
+        there, so the right pose may come third).
     scale_range: (lowest, highest) scale of a map of unknown unit, truth units per map unit.
     """
 

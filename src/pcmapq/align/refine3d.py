@@ -9,7 +9,7 @@ The registration's sums run on one thread, so the result is the same bit for bit
 normals, each point's own, are built on every core: the same tree and normals, bit for bit.
 
 small_gicp over Open3D's ICP: repeatable without holding Open3D to one thread, and closer to
-the truth on the KITTI pairs (docs/benchmarks.md, "Choices behind the code").
+the reference poses (docs/benchmarks.md, "Choices behind the code").
 """
 
 from __future__ import annotations

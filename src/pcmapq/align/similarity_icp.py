@@ -47,7 +47,7 @@ class SimilarityTarget:
 
 # Hand-written, not Open3D's TransformationEstimationPointToPoint(with_scaling=True): the same
 # Umeyama fit, but Open3D's rule (fitness and RMSE changing by under 1e-6 in truth units) leaves
-# slow scale drifts unconverged (the Intel floor plan's scale 1.184, survey 1.168: refused),
+# slow scale drifts unconverged (their steps change both by less than that, the scale far off),
 # where this one, a move under 1e-4 of the stage's distance, is free of the unit.
 def refine_similarity(map_xy: np.ndarray, target: SimilarityTarget, init: Similarity2D,
                       max_iterations: int = 30) -> Similarity2D:

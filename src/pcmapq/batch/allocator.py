@@ -7,7 +7,7 @@ so, and leaves it there, so that a Python program that started a LocalCluster pa
 every process it starts afterwards, local batch workers included. Set, it turns off
 glibc's dynamic mmap threshold, so that every allocation of 128 KiB or more (most of a map's
 NumPy arrays and OpenCV images) is a fresh ``mmap`` whose pages fault in anew and go back to the
-system when freed: a batch then takes 1.5 times the CPU time, with 20 times the page faults
+system when freed: a batch then spends much of its CPU time faulting pages in
 (docs/benchmarks.md, Batches). :func:`glibc_thresholds` gives a row the thresholds
 glibc's dynamic rule rises to in a process started without it (mmap 32 MiB on 64-bit, trim
 twice that), then puts back the environment's and returns the free memory to the system

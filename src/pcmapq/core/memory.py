@@ -18,9 +18,8 @@ from pcmapq.core.errors import InputError
 #: Resident memory of the imported libraries, bytes.
 BASE = 450e6
 #: Bytes per input image cell, per truth grid cell, per working cell and per cloud point. A
-#: working cell's cost errs high (the 8000^2 campus pair peaks at under 40 B a working cell
-#: beyond its images and grid): which of the detectors' biggest temporaries coincide varies
-#: from run to run.
+#: working cell's cost errs high: which of the detectors' biggest temporaries coincide varies
+#: from run to run, and the estimate assumes the worst.
 PER_IMAGE_CELL, PER_GRID_CELL, PER_WORKING_CELL, PER_POINT = 10, 17, 100, 100
 #: The detectors' working cell, metres (:func:`pcmapq.features.walls.wall_image`).
 WORKING_CELL = 0.05

@@ -10,7 +10,7 @@ import numpy as np
 def affine(points: np.ndarray, matrix: np.ndarray) -> np.ndarray:
     """Points (N, d) through the homogeneous (d + 1, d + 1) ``matrix``: the same numbers as
     ``points @ matrix[:d, :d].T + matrix[:d, d]``, with the rotation made contiguous first
-    (NumPy multiplies by a strided view outside BLAS, 5 to 100 times slower)."""
+    (NumPy multiplies by a strided view outside BLAS, far more slowly)."""
     d = points.shape[1]
     return points @ np.ascontiguousarray(matrix[:d, :d].T) + matrix[:d, d]
 

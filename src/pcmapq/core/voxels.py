@@ -29,11 +29,9 @@ __all__ = ["VoxelMap", "evenly", "voxel_centroids", "voxel_count"]
 DENSE_PER_POINT = 4
 DENSE_CELLS = 1 << 27
 #: Clouds (2D or 3D) of more points than this are grouped by the compiled hash table
-#: (:mod:`pcmapq.core.voxel_table`): the same centroids in the same order, with a fraction of
-#: the sort's temporaries (0.58 M points at 0.1 m: 76 MB at its peak against 88 MB; at 2 m:
-#: 3 MB against 40 MB), and on a large plan's walls in a fraction of its time (52 M points at
-#: 0.15 m: 0.37 s against 2.7 s). Smaller ones are sorted, which spares a short run loading
-#: the table.
+#: (:mod:`pcmapq.core.voxel_table`): the same centroids in the same order, in memory that grows
+#: with the voxels rather than the points, and with only the voxels sorted. Smaller ones are
+#: sorted, which spares a short run loading the table.
 STREAM_FROM = 100_000
 
 

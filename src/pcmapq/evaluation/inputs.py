@@ -38,10 +38,9 @@ MAP_CROP, TRUTH_CROP = "--map-crop", "--truth-crop"
 #: be scored: fewer (one point, a few identical points, a 1x1 image) is refused, exit 1.
 MIN_CELLS = 10
 #: The largest share of an image's cells that may be occupied: a map of walls draws thin lines
-#: on free space (at most 15 % in every real map of ../shared/data, 5 % in data/sample/truth.png).
-#: More is a picture read inverted (``negate: 1`` on a black-walls image, free space read above
-#: occupied_thresh) or a filled area, not walls; it is refused (exit 1) before the alignment,
-#: whose cost grows with the occupied cells.
+#: on free space, a small share of its cells. More is a picture read inverted (``negate: 1`` on
+#: a black-walls image, free space read above occupied_thresh) or a filled area, not walls; it
+#: is refused (exit 1) before the alignment, whose cost grows with the occupied cells.
 MAX_OCCUPIED_SHARE = 0.5
 #: Walls narrower than this across their main direction, metres, are one straight line.
 LINE_WIDTH = 0.5

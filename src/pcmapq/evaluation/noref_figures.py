@@ -41,12 +41,12 @@ def input_figures(source: OccupancyMap | PointMap, config: NoRefConfig = NoRefCo
 
 
 #: A cloud of more than this many points is reduced in stripes of x, one pass over its points
-#: each, so that the voxel table holds one stripe's voxels at a time: the 97 M-point cloud's
-#: table of 9.7 M voxels took about 1 GB beside the evaluation (docs/benchmarks.md).
+#: each, so that the voxel table holds one stripe's voxels at a time, not a large cloud's whole
+#: table beside the evaluation (docs/benchmarks.md).
 STRIPE_POINTS = 25_000_000
 #: Such a cloud's stripes hold about this many points each: the table of one stripe's voxels and
-#: the centroids of the stripes before it stand beside the plan's global search (97 M points:
-#: 13 stripes peaked at 4.65-4.75 GB, 4 at 4.70-4.83 GB, three runs each).
+#: the centroids of the stripes before it stand beside the plan's global search, whose peak the
+#: stripes' width barely moves.
 STRIPE_WIDTH_POINTS = 8_000_000
 
 
@@ -88,10 +88,10 @@ BACKGROUND_NICE = 10
 #: A map cloud of more than this many points, reduced in one pass (at most STRIPE_POINTS), has
 #: its figures wait for its plan points (:meth:`EarlyFigures.walls_found`): its wall band is
 #: shorter than the reduction beside it, and the band's end is the evaluation's first peak in
-#: memory (a 10 M-point cloud: the figures' voxel table beside it raised the peak 9-13 %; after
-#: it, 1-3 %). A cloud reduced in stripes starts at once: its wall band is long enough for the
-#: reduction to end within it (11 s at 97 M points), and after it the table would stand beside
-#: the plan's global search, that run's peak (16-24 % measured; docs/benchmarks.md).
+#: memory, which the figures' voxel table would raise; after it the table stands beside less. A
+#: cloud reduced in stripes starts at once: its wall band is long enough for the reduction to
+#: end within it, and after it the table would stand beside the plan's global search, that
+#: run's peak (docs/benchmarks.md).
 DEFER_FROM = 2_000_000
 
 

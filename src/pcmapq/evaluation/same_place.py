@@ -38,8 +38,7 @@ MIN_AGREEING = 3
 #: much in the global search (no pose elsewhere scores within 70 % of it) and more than
 #: RECALL_NONE of the truth it covers lies near it: a map bent so far that half of it is off
 #: the truth, whose parts (an eighth of an office floor each) fit other offices as well as their
-#: own. Among the maps of other places in docs/validation.md (the corpus's 114 pairs and the
-#: Halmstad maps against the other layouts, 108) the most is 0.235.
+#: own. No map of another place in docs/validation.md stands out this much.
 STANDS_OUT = 0.3
 #: A map with free space is of another place only with evidence that it is: at its pose it
 #: saw through SEEN_THROUGH or more of the truth's walls it covers (they lie on its free cells:
@@ -47,11 +46,12 @@ STANDS_OUT = 0.3
 #: ON_TRUTH of its free cells lie on the truth's known cells, or RECALL_NONE or less of the
 #: truth it covers lies near its walls. Without such evidence it is scored and flagged as
 #: placed with low confidence: a cluttered room fits another room of its house, or of another
-#: building, and nothing it holds tells which. Real maps of their own place see through at most
-#: 0.045 of the truth's walls, with 0.94 or more of their free space on it; of other places
-#: 0.22 or more, but for a one-room map that fits a room of another office; a map under 800
-#: boxes of clutter sees through few walls anywhere, but a third or more of its free space
-#: lies off another layout at its best pose (docs/validation.md).
+#: building, and nothing it holds tells which. The bounds lie between what maps of their own
+#: place and maps of other places give (docs/validation.md): a map of its own place sees
+#: through few of the truth's walls, with nearly all its free space on it; one of another
+#: place sees through many, but for a one-room map that fits a room of another office; a map
+#: under heavy clutter sees through few walls anywhere, but much of its free space lies off
+#: another layout at its best pose.
 SEEN_THROUGH, ON_TRUTH = 0.1, 0.8
 
 

@@ -1,10 +1,10 @@
 """Feature detectors behind one registry: Harris corners, Hough wall segments, SIFT on entropy,
 rooms.
 
-Each detector is a module of this package that defines ``DETECTOR`` (a
-:class:`~pcmapq.features.base.Detector`) and its parameters ``Params`` (a frozen dataclass,
-lengths in metres), and is named in :mod:`pcmapq.features.names`: adding a detector is adding
-a file and its name. The names are read without loading a detector; the rest
+Each detector is a :class:`~pcmapq.features.base.Detector` (with its parameters ``Params``, a
+frozen dataclass, lengths in metres) defined by a module of this package and named in the
+registry, :data:`pcmapq.features.names.DETECTOR_SOURCES`: adding a detector is adding its module
+and one line there. The names are read without loading a detector; the rest
 (:mod:`pcmapq.features.registry`, :mod:`pcmapq.features.base`) loads on first use, so that the
 command line's help, which names the detectors, loads none of them.
 """
@@ -14,7 +14,7 @@ from __future__ import annotations
 import importlib
 from typing import TYPE_CHECKING, Any
 
-from pcmapq.features.names import DEFAULT_DETECTORS, DETECTOR_NAMES
+from pcmapq.features.names import DEFAULT_DETECTORS, DETECTOR_NAMES, DETECTOR_SOURCES
 
 if TYPE_CHECKING:
     from pcmapq.features.base import Candidates, Detector, Features
@@ -29,9 +29,9 @@ if TYPE_CHECKING:
     )
     from pcmapq.features.walls import WallImage
 
-__all__ = ["DEFAULT_DETECTORS", "DETECTORS", "DETECTOR_NAMES", "Candidates", "Detector",
-           "Features", "SideBySide", "WallImage", "default_params", "detect", "detect_in",
-           "detector", "walls_of"]
+__all__ = ["DEFAULT_DETECTORS", "DETECTORS", "DETECTOR_NAMES", "DETECTOR_SOURCES", "Candidates",
+           "Detector", "Features", "SideBySide", "WallImage", "default_params", "detect",
+           "detect_in", "detector", "walls_of"]
 
 #: The package's names defined by its modules, loaded on first use.
 _LAZY = {"Candidates": "base", "Detector": "base", "Features": "base", "WallImage": "walls",

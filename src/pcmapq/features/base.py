@@ -74,7 +74,6 @@ class Detector:
     params: the detector's parameters, a frozen dataclass whose field defaults are the
         documented ones (``params()``), lengths in metres.
     by_default: whether an evaluation runs it when no detectors are named.
-    from_paper: one of the paper's detectors (Harris, Hough, SIFT), listed before the others.
     min_truth: the fewest features (counted or not) the truth must have for the detector to
         have anything to find; with fewer its three scores are undefined (rooms: 2, since a
         place that is one room has no rooms to tell apart; 0: no such minimum).
@@ -86,7 +85,6 @@ class Detector:
     candidates: Callable[[Features, Features, float, Any], Candidates]
     params: type
     by_default: bool = True
-    from_paper: bool = True
     min_truth: int = 0
     noun: str = "feature"
 

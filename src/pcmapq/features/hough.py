@@ -19,8 +19,8 @@ Segments come from two sources:
   it never adds a second, differently cut copy of a wall the pieces already hold.
 
 Hough alone, on the one-pixel ridges of a real SLAM map (walls one or two cells thin, wavy,
-broken), gave fragments, chords across curves and jumps between nearby walls that changed with
-every re-rasterisation (a turned Freiburg 079 map scored 0.63); the pieces do not. Pieces and
+broken), gives fragments, chords across curves and jumps between nearby walls that change with
+every re-rasterisation; the pieces do not. Pieces and
 segments are then merged into maximal wall segments, so one straight wall (between doors) is one
 feature. ``xy`` is the segment midpoint, ``strength`` its length in
 metres; strong segments are at least ``min_length`` long, support-level ones at least

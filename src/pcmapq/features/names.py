@@ -1,12 +1,23 @@
-"""The detectors' names, apart from the detectors (which load OpenCV, SciPy and Numba), so the
-settings and the command line's help name them without loading any. A detector added as a
-module of :mod:`pcmapq.features` is named here too: a test holds these to the registry
-(:data:`pcmapq.features.registry.DETECTORS`: its order, and which run by default)."""
+"""The detectors' registry: each detector's name and where it is defined, apart from the
+detectors themselves (which load OpenCV, SciPy and Numba), so the settings and the command
+line's help name them without loading any. :mod:`pcmapq.features.registry` loads the detectors
+listed here, and only those."""
 
 from __future__ import annotations
 
-#: Every detector, the paper's first (Harris, Hough, SIFT), then the others, each group in
-#: alphabetical order.
-DETECTOR_NAMES: tuple[str, ...] = ("harris", "hough", "sift", "rooms")
-#: The detectors an evaluation runs when none are named.
-DEFAULT_DETECTORS: tuple[str, ...] = ("harris", "hough", "sift", "rooms")
+#: Every detector by name, in the order they are run, written and drawn: the paper's (Harris,
+#: Hough, SIFT), then the others. Each value names a
+#: :class:`~pcmapq.features.base.Detector` as ``module:attribute``. Adding a detector is one
+#: line here; a module of :mod:`pcmapq.features` not named here is never run.
+DETECTOR_SOURCES: dict[str, str] = {
+    "harris": "pcmapq.features.harris:DETECTOR",
+    "hough": "pcmapq.features.hough:DETECTOR",
+    "sift": "pcmapq.features.sift:DETECTOR",
+    "rooms": "pcmapq.features.rooms:DETECTOR",
+}
+
+#: Every detector's name, in the registry's order.
+DETECTOR_NAMES: tuple[str, ...] = tuple(DETECTOR_SOURCES)
+#: The detectors an evaluation runs when none are named: every one (a detector run only when
+#: named is left out here, and says ``by_default=False``).
+DEFAULT_DETECTORS: tuple[str, ...] = DETECTOR_NAMES

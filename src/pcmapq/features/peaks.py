@@ -4,7 +4,7 @@ its grayscale reconstruction done by the hybrid algorithm of Vincent (1993) in a
 ``skimage.morphology.reconstruction`` sorts every value of the seed and the mask (2N values) and
 then walks them in order; the reconstruction by dilation is one image whatever the algorithm
 (every value is one of the seed's or the mask's, found by maxima and minima alone), so two raster
-scans and a queue give it in linear time (0.014 s against 0.34 s on a 1230 x 1762 clearance).
+scans and a queue give it in linear time, with no sort.
 The arithmetic around it (the seed ``image - h - resolution``, the residue ``image - rec``) is
 scikit-image's, in the image's own float type, so the cells are the same.
 """

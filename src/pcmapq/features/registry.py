@@ -1,14 +1,13 @@
-"""The detectors' registry and running them: every module of :mod:`pcmapq.features` that
-defines ``DETECTOR`` (a :class:`~pcmapq.features.base.Detector`) and its ``Params`` (a frozen
-dataclass, lengths in metres), found on import; the walls every detector sees, and the two
-sides' detectors run side by side. Its names are re-exported by :mod:`pcmapq.features`.
+"""The detectors' registry and running them: the detectors named in
+:data:`pcmapq.features.names.DETECTOR_SOURCES`, each a :class:`~pcmapq.features.base.Detector`
+with its ``Params`` (a frozen dataclass, lengths in metres); the walls every detector sees, and
+the two sides' detectors run side by side. Its names are re-exported by :mod:`pcmapq.features`.
 """
 
 from __future__ import annotations
 
 import importlib
 import os
-import pkgutil
 from collections.abc import Mapping, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from threading import BoundedSemaphore, Event, Lock
@@ -19,29 +18,30 @@ import numpy as np
 from pcmapq.core.errors import InputError
 from pcmapq.core.grid import MetricGrid
 from pcmapq.features.base import Detector, Features
+from pcmapq.features.names import DETECTOR_SOURCES
 from pcmapq.features.walls import WallImage, wall_image
 
 __all__ = ["DETECTORS", "SideBySide", "default_params", "detect", "detect_in", "detector",
-           "walls_of"]
+           "load", "walls_of"]
 
 
-def _discover() -> dict[str, Detector]:
-    """Every ``DETECTOR`` defined by a module of :mod:`pcmapq.features`, by name: the paper's
-    first, each group in alphabetical order."""
-    import pcmapq.features as package
-
-    found = []
-    for info in pkgutil.iter_modules(package.__path__):
-        module = importlib.import_module(f"{package.__name__}.{info.name}")
-        detector = getattr(module, "DETECTOR", None)
-        if isinstance(detector, Detector):
-            found.append(detector)
-    return {d.name: d for d in sorted(found, key=lambda d: (not d.from_paper, d.name))}
+def _load(name: str, source: str) -> Detector:
+    """The detector ``name`` defined at ``source`` (``module:attribute``)."""
+    module, _, attribute = source.partition(":")
+    found = getattr(importlib.import_module(module), attribute)
+    if not isinstance(found, Detector) or found.name != name:
+        raise TypeError(f"{source} is not the Detector {name!r}")
+    return found
 
 
-#: The detectors by name: "harris", "hough", "sift" (the paper's), then "rooms"; the same
-#: names, in the same order, as :data:`pcmapq.features.names.DETECTOR_NAMES` (a test holds it).
-DETECTORS: dict[str, Detector] = _discover()
+def load(sources: Mapping[str, str]) -> dict[str, Detector]:
+    """The detectors of a registry (name -> ``module:attribute``), by name, in its order."""
+    return {name: _load(name, source) for name, source in sources.items()}
+
+
+#: The detectors by name, those of :data:`pcmapq.features.names.DETECTOR_SOURCES` in its order:
+#: "harris", "hough", "sift" (the paper's), then "rooms".
+DETECTORS: dict[str, Detector] = load(DETECTOR_SOURCES)
 
 
 def detector(name: str) -> Detector:

@@ -220,5 +220,4 @@ def candidates(truth: Features, map_: Features, threshold: float,
 #: A truth of one room (an outdoor place, a single hall) has no rooms to tell apart: its rooms'
 #: scores are undefined, not 0 or 1.
 MIN_ROOMS = 2
-DETECTOR = Detector("rooms", detect, candidates, Params, from_paper=False,
-                    min_truth=MIN_ROOMS, noun="room")
+DETECTOR = Detector("rooms", detect, candidates, Params, min_truth=MIN_ROOMS, noun="room")

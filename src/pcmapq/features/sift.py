@@ -19,8 +19,8 @@ that consecutive octaves share a searched DoG layer. Its response is the refined
 ``cv2.SIFT`` computes the descriptors of these keypoints, upright: features are detected on
 rasters in the truth's frame, after alignment, so rotation invariance buys nothing, and SIFT's
 dominant orientation flips between the walls of a corner (on a plan drawn half a cell shifted,
-a quarter of the keypoints turned by tens of degrees or more, and their descriptors were as
-unlike as those of unrelated keypoints).
+many keypoints turn by tens of degrees, and their descriptors become as unlike as those of
+unrelated keypoints).
 
 Hysteresis: a keypoint is kept at ``support * threshold`` response and an edge ratio under
 ``support_edge * edge``; it is strong at ``threshold`` and under ``edge``, if it is also the
@@ -33,8 +33,8 @@ an L2 distance at most ``descriptor_gate``, by default the descriptors' own leng
 angle of at most 60 degrees, cosine >= 0.5). The same keypoint on a re-drawn plan stays under
 about half of that; in a map built from drifted poses each wall is smeared over a band, and the
 keypoints of the smear that lie within the threshold of a truth keypoint no longer look like
-it. Without this gate any keypoint within the threshold matched, however unlike, and SIFT's
-quality stayed near 0.8 on maps whose poses were off by tens of metres. The cost is the mean of
+it. Without this gate any keypoint within the threshold would match, however unlike, and a map
+whose poses are off by tens of metres would keep a high SIFT quality. The cost is the mean of
 the distance over the threshold and the descriptor distance over the gate, so among nearby
 alike keypoints the most alike are paired.
 """

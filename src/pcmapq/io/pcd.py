@@ -7,7 +7,7 @@ record being the sum of ``SIZE`` x ``COUNT``), ``DATA binary_compressed`` the co
 its size word announces and the uncompressed size against the points declared.
 
 The fields of a ``DATA binary`` file, fixed-size records at a known offset, are read here too
-(:func:`read_fields`), with their stored values, without importing Open3D (0.8 s): the values
+(:func:`read_fields`), with their stored values, without importing Open3D (slow to load): the values
 Open3D's tensor reader gives, which its legacy reader gives too but for double coordinates
 (zeros). So are the coordinates of a ``DATA ascii`` file (:func:`read_ascii`), whose values
 may be separated by commas as well as spaces and tabs. Compressed files are left to Open3D.

@@ -45,8 +45,8 @@ class _Grid:
     columns in sorted order (empty where there are no points)."""
 
     def __init__(self, pts: np.ndarray, radius: float) -> None:
-        # Built an axis at a time, with no temporary of all the points beside those kept (a
-        # 9.7 M-point map: about 40 bytes a point less at the peak).
+        # Built an axis at a time, with no temporary of all the points beside those kept: a
+        # large map's peak holds its points once.
         self.axes = np.argsort(np.ptp(pts, axis=0), kind="stable")  # longest axis last
         self.low = pts.min(axis=0)[self.axes[:2]]
         i, j = (np.floor((pts[:, a] - low) / radius).astype(np.int64) + 1

@@ -14,6 +14,6 @@ MIN_KNN = 5
 MAX_NN = 30
 
 #: Ward clustering takes N^2 time: more planar points than this are
-#: clustered through an evenly spaced sample of this many. One scan stays below it (7,336 in
-#: KITTI 00's first scan at 0.3 m), so an extraction from a scan is map-metrics' own.
+#: clustered through an evenly spaced sample of this many. A single scan's planar points stay
+#: below it, so an extraction from a scan is map-metrics' own.
 MAX_WARD_POINTS = 10_000

@@ -43,7 +43,7 @@ class DistanceField:
     none), kept in cells as the transform gives them (float32) and read in metres:
     ``field[where]`` is the float64 metres of the cells ``where`` selects (any NumPy index),
     so that a distance of whole cells compares exactly with a threshold in metres. The same
-    values as a float64 field of metres, in half its memory (256 MB for an 8000^2 grid)."""
+    values as a float64 field of metres, in half its memory (4 bytes a cell)."""
 
     cells: np.ndarray
     resolution: float

@@ -73,8 +73,8 @@ def strict_radius(radius: float) -> float:
     d^2 <= r'^2 keeps the pairs with d^2 < radius^2 (Open3D's strict test). The two agree
     except for a squared distance between r'^2 and radius^2 when no double squares to the
     double just below radius^2: an interval of one or two units in the last place (a point at
-    exactly sqrt(2) from another with ``radius=math.sqrt(2)``, say); never met in measured
-    clouds."""
+    exactly sqrt(2) from another with ``radius=math.sqrt(2)``, say), which real clouds do not
+    meet."""
     if not radius > 0:
         raise ValueError(f"radius must be positive, got {radius}")
     target = np.nextafter(radius * radius, 0.0)

@@ -6,7 +6,7 @@
 3. their normals clustered by Ward linkage, cut at distance 0.1 (scikit-learn's
    ``AgglomerativeClustering(distance_threshold=0.1)``; here the same Ward tree built by
    fastcluster from the normals themselves, in memory linear in N, where SciPy's ``ward``
-   holds all N^2 / 2 distances twice: 0.77 GB for 9,900 normals). A Ward tree still costs
+   holds all N^2 / 2 distances twice, quadratic in memory). A Ward tree still costs
    N^2 in time: above ``max_ward`` planar points (default ``MAX_WARD_POINTS``; a whole map:
    map-metrics extracts from one scan) the tree is built on that many of them, evenly spaced
    in the cloud's order, and every planar point then joins the cluster whose mean normal is

@@ -6,8 +6,8 @@ blocks are partial when the shape is not a multiple of ``f``, so the pooled rast
 ``ceil(rows / f) x ceil(cols / f)`` cells and covers the source's cells and, past its bottom and
 right edges, less than one block more. Rows are reduced first, ``f`` at a time, on a reshaped
 view of the source (no padded copy of it: the partial last block is reduced on its own), then
-columns on that ``f`` times smaller result; no Python loop over cells, and several times
-cheaper than ``ufunc.reduceat`` over the same blocks.
+columns on that ``f`` times smaller result; no Python loop over cells, and cheaper than
+``ufunc.reduceat`` over the same blocks.
 """
 
 from __future__ import annotations

@@ -12,8 +12,7 @@ the HTML report shows it (style.py).
 Rasters are drawn at display resolution: a grid with more cells across or down than its panel
 has pixels at :data:`DPI` is pooled (:mod:`pcmapq.raster.pool`) to fit, so a map of any size
 costs a picture of the same size, and a wall one cell thin still shows, which matplotlib's
-nearest resampling of a larger image would skip (on a 2000-pixel raster of one-cell walls drawn
-into 600 pixels it showed 4 walls of 50). A grid that fits is drawn cell for cell. Two 3D
+nearest resampling of a larger image would skip. A grid that fits is drawn cell for cell. Two 3D
 clouds (LiDAR maps, outdoors as a rule: a scatter of points, not walls) are drawn as a bird's-eye
 density instead: each pixel's shade is the share of its cells that are occupied. Feature
 markers of one kind are thinned to one per :data:`~pcmapq.report.style.THIN_PX` pixels square

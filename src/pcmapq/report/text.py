@@ -24,7 +24,7 @@ LEGEND = ("quality: share of the truth's features the map has (the paper's q = m
 
 def score(value: float | None, digits: int = 3) -> str:
     """A quality, precision or f1 with ``digits`` decimals; 'n/a' when undefined (nothing to
-    count, see :mod:`pcmapq.match`)."""
+    count, see :mod:`pcmapq.match.one_to_one`)."""
     return "n/a" if value is None else f"{value:.{digits}f}"
 
 

@@ -1,5 +1,6 @@
-"""One source of truth: the command line's defaults are Settings', a detector is one file (and
-its name), and the names the help reads without loading a detector are the registry's."""
+"""One source of truth: the command line's defaults are Settings', and the names the help reads
+without loading a detector are the registry's (a detector is one line of it:
+tests/unit/features/test_registry.py)."""
 
 from __future__ import annotations
 
@@ -32,32 +33,6 @@ def test_cli_defaults_are_the_settings_defaults():
         ",".join(features.DEFAULT_DETECTORS)
     assert set(features.DEFAULT_DETECTORS) == set(DETECTOR_NAMES)
     assert tuple(float(t) for t in defaults["tau"].split(",")) == s.distances.taus
-
-
-def test_a_detector_is_one_file(tmp_path, monkeypatch):
-    """A module dropped beside the detectors is found, run with its own parameters and matched
-    by name."""
-    (tmp_path / "corners_again.py").write_text(
-        "from dataclasses import dataclass\n"
-        "from pcmapq.features import harris\n"
-        "from pcmapq.features.base import Detector\n"
-        "@dataclass(frozen=True)\n"
-        "class Params(harris.Params):\n"
-        "    radius: float = 0.6\n"
-        "DETECTOR = Detector('corners_again', harris.detect, harris.candidates, Params)\n")
-    monkeypatch.setattr(features, "__path__", [*features.__path__, str(tmp_path)])
-    found = registry._discover()
-    assert "corners_again" in found and set(DETECTOR_NAMES) <= set(found)
-    monkeypatch.setitem(features.DETECTORS, "corners_again", found["corners_again"])
-    assert features.default_params()["corners_again"].radius == 0.6
-    plan = synth.building_plan(0)
-    grid = synth.plan_grid(plan, 0.05)
-    occ = synth.render(plan, grid) == synth.OCCUPIED
-    f = features.detect("corners_again", occ, grid)
-    m = match("corners_again", f, f)
-    assert f.strong.sum() >= 10 and m.quality == 1.0
-    wide = features.detect("harris", occ, grid, features.harris.Params(radius=0.6))
-    np.testing.assert_array_equal(f.xy, wide.xy)
 
 
 def test_the_names_read_without_the_detectors_are_the_registrys():
