@@ -14,7 +14,7 @@ import pcmapq.features as features
 from pcmapq.features import registry
 from pcmapq.features.names import DEFAULT_DETECTORS, DETECTOR_NAMES, DETECTOR_SOURCES
 from pcmapq.match import match
-from pcmapq.testing import synth
+from testkit import synth
 
 DOCS = Path(__file__).resolve().parents[3] / "docs"
 
