@@ -33,6 +33,15 @@ def truth_png(plan, tmp_path_factory) -> Path:
     return write_image_map(plan, tmp_path_factory.mktemp("truth") / "truth.png")
 
 
+@pytest.fixture(scope="session")
+def sample_result():
+    """The shipped sample evaluated with the defaults (a Result), made once for every test
+    that reads it and must not change it."""
+    from pcmapq.evaluation.pipeline import evaluate
+
+    return evaluate(SAMPLE / "scan.ply", SAMPLE / "truth.png")
+
+
 @pytest.fixture(scope="module")
 def scan_points() -> np.ndarray:
     """The sample scan's points (N, 3), metres, in its own frame."""

@@ -18,18 +18,11 @@ from pcmapq.report.style import ARROW_SHARE, MAX_ARROW_SCALE
 from pcmapq.settings import MatchingConfig, Settings
 from testkit import synth
 from testkit.files import write_image_map
-from testkit.paths import SAMPLE
 
 #: Where the sample's moved wall's arrows start (truth frame, metres: x0, x1, y0, y1): its
 #: features on the plan's wall at x = 8.0 m (SIFT's a little either side), and the regions of
 #: the tiles holding it (x 8-12 m), whose arrows start where they fit the truth.
 SAMPLE_WALL = (7.3, 10.0, -0.5, 7.0)
-
-
-@pytest.fixture(scope="module")
-def sample_result():
-    """The shipped sample, as README's first command scores it."""
-    return evaluate(SAMPLE / "scan.ply", SAMPLE / "truth.png")
 
 
 @pytest.fixture(scope="module")

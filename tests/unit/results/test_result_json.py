@@ -9,18 +9,16 @@ import numpy as np
 import pytest
 
 from pcmapq.core.stats import FIELDS, Stats
-from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.results.result import Result
 from pcmapq.settings import (
     Settings,
 )
-from testkit.paths import SAMPLE
 from testkit.reference import same_document
 
 
 @pytest.fixture(scope="module")
-def result() -> Result:
-    return evaluate(SAMPLE / "scan.ply", SAMPLE / "truth.png")
+def result(sample_result) -> Result:
+    return sample_result
 
 
 def test_stats_of_known_lengths():

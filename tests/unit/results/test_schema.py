@@ -11,20 +11,19 @@ from pathlib import Path
 import pytest
 from pydantic import ValidationError
 
-from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.results import schema
 from pcmapq.results.blocks import rounded
 from pcmapq.results.figures import figures
 from pcmapq.results.gates import check, parse_rules, with_gates
 from pcmapq.results.result import Result
-from testkit.paths import REPO, SAMPLE
+from testkit.paths import REPO
 
 jsonschema = pytest.importorskip("jsonschema")
 
 
 @pytest.fixture(scope="module")
-def doc() -> dict:
-    return evaluate(SAMPLE / "scan.ply", SAMPLE / "truth.png").to_dict()
+def doc(sample_result) -> dict:
+    return sample_result.to_dict()
 
 
 def _text(doc: dict) -> str:
