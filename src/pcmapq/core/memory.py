@@ -78,3 +78,10 @@ def guard(need: int, limit: int | None, what: str,
     fix = advice() or more_memory(need)
     raise InputError(f"{what}: needs about {need / 1e9:,.1f} GB of memory, more than the limit "
                      f"of {limit / 1e9:.1f} GB (--max-memory{default}); {fix}")
+
+
+def check_points(path: object, count: int, memory_limit: int | None = None) -> None:
+    """InputError (one line) when ``count`` points, declared by the file ``path``, need more
+    memory than ``memory_limit`` bytes (None: the default limit)."""
+    guard(needed_bytes(0, 0, 0.0, int(count)), memory_limit,
+          f"{path} ({count:,} points declared)")

@@ -26,6 +26,7 @@ from numpy.lib import format as npy
 
 from pcmapq.core import memory
 from pcmapq.core.errors import InputError
+from pcmapq.core.memory import check_points
 from pcmapq.io import pcd, ply
 from pcmapq.io.ply import CHUNK, VertexBlock, vertex_block
 from pcmapq.io.stderr import stderr_captured
@@ -146,13 +147,6 @@ def with_z(path: Path, table: np.ndarray) -> np.ndarray:
     with np.errstate(invalid="ignore"):  # a float32 signalling NaN (the row is dropped later)
         out[:, :cols] = table[:, :cols]
     return out
-
-
-def check_points(path: Path, count: int, memory_limit: int | None = None) -> None:
-    """InputError (one line) when ``count`` points, declared by the file ``path``, need more
-    memory than ``memory_limit`` bytes (None: the default limit)."""
-    memory.guard(memory.needed_bytes(0, 0, 0.0, int(count)), memory_limit,
-                 f"{path} ({count:,} points declared)")
 
 
 def read_pcd(path: Path, memory_limit: int | None = None) -> np.ndarray:

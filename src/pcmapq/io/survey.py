@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 
 from pcmapq.core.errors import InputError
+from pcmapq.core.memory import check_points
 from pcmapq.core.words import plural
 from pcmapq.io.las_layout import check_layout
 from pcmapq.io.stderr import stderr_captured
@@ -31,7 +32,6 @@ def read_las(path: Path, memory_limit: int | None = None) -> np.ndarray:
     a Rust panic among them, are one InputError line."""
     import laspy
 
-    from pcmapq.io.clouds import check_points
 
     xyz = laspy.DecompressionSelection.XY_RETURNS_CHANNEL | laspy.DecompressionSelection.Z
     layout = check_layout(path)
@@ -126,7 +126,6 @@ def read_e57(path: Path, memory_limit: int | None = None) -> np.ndarray:
     common frame)."""
     import pye57
 
-    from pcmapq.io.clouds import check_points
 
     if path.stat().st_size == 0:  # libE57Format: "an unrecoverable inconsistent internal state"
         raise InputError(f"{path}: not a readable E57 file: empty")

@@ -4,18 +4,14 @@
 from __future__ import annotations
 
 import io
-from typing import TYPE_CHECKING
 
 import numpy as np
 
-from pcmapq.results.blocks import DECIMALS
+from pcmapq.results.blocks import DECIMALS, Findings
 from pcmapq.results.document import REGION_COLUMNS, consistency_block
 
-if TYPE_CHECKING:
-    from pcmapq.results.result import Result
 
-
-def vectors_csv(result: Result) -> str:
+def vectors_csv(result: Findings) -> str:
     """One row per matched pair (the JSON's ``matches``): its truth and map features'
     positions and the displacement between them, metres (truth frame), then which of its
     two features are counted (1) or support-level (0). A pair counts towards ``matched``
@@ -34,7 +30,7 @@ def vectors_csv(result: Result) -> str:
     return out.getvalue()
 
 
-def regions_csv(result: Result) -> str:
+def regions_csv(result: Findings) -> str:
     """One row per region of the consistency map (the JSON's ``consistency.regions``):
     where the region is, the offset and turn that fit it to the truth on its own, its
     points and its fitness before and after, truth frame, metres and degrees."""

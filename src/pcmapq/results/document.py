@@ -1,4 +1,4 @@
-"""A :class:`~pcmapq.results.result.Result` as its JSON document
+"""A result's findings (:class:`~pcmapq.results.blocks.Findings`) as its JSON document
 (:class:`~pcmapq.results.schema.ResultDocument`) and back. Writing and reading go through the
 one schema; what the document does not hold reads back absent (rasters None, feature strengths
 and pair costs NaN)."""
@@ -19,17 +19,16 @@ from pcmapq.features import Features
 from pcmapq.match import Matching
 from pcmapq.metrics.distances import Distances
 from pcmapq.results import schema as s
-from pcmapq.results.blocks import DetectorResult, Overlap
+from pcmapq.results.blocks import DetectorResult, Findings, Overlap
 
 if TYPE_CHECKING:
     from pcmapq.align.regions import Consistency
-    from pcmapq.results.result import Result
 
 #: The columns of a region, in the JSON and the regions CSV.
 REGION_COLUMNS = tuple(s.Region.model_fields)
 
 
-def document(r: Result, features: bool = True) -> s.ResultDocument:
+def document(r: Findings, features: bool = True) -> s.ResultDocument:
     """The result's document; ``features=False``: its figures alone, with the lists of
     matched, missing and extra features left empty."""
     tf = r.transform
@@ -72,7 +71,7 @@ def document(r: Result, features: bool = True) -> s.ResultDocument:
 
 
 def fields(doc: s.ResultDocument) -> dict[str, Any]:
-    """The keyword arguments of the :class:`Result` a document holds."""
+    """The keyword arguments of the result (its :class:`Findings`) a document holds."""
     from pcmapq.align import Alignment  # runtime imports: reading a 3D result loads Open3D
     from pcmapq.align.parts import Part
     from pcmapq.align.rigid3d import Registration3D
@@ -136,7 +135,7 @@ def _distances_of(doc: s.Distances) -> Distances:
                      doc.computed_on)
 
 
-def _detector(r: Result, name: str, det: DetectorResult) -> s.Detector:
+def _detector(r: Findings, name: str, det: DetectorResult) -> s.Detector:
     m = det.matching
     return s.Detector(quality=m.quality, precision=m.precision, f1=m.f1, note=r.note(name),
                       truth_features=m.truth_features, map_features=m.map_features,
@@ -144,7 +143,7 @@ def _detector(r: Result, name: str, det: DetectorResult) -> s.Detector:
                       displacement_m=det.displacement_stats())
 
 
-def _feature_rows(r: Result) -> tuple[list[s.Match], list[s.Missing], list[s.Extra]]:
+def _feature_rows(r: Findings) -> tuple[list[s.Match], list[s.Missing], list[s.Extra]]:
     """Every detector's matched pairs, missing truth features and extra map features."""
     matches: list[s.Match] = []
     missing: list[s.Missing] = []

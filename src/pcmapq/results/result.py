@@ -5,15 +5,8 @@ from __future__ import annotations
 import json
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING
 
-import numpy as np
-
-from pcmapq.core.frames import Frames
-from pcmapq.core.grid import MetricGrid
 from pcmapq.core.stats import significant
-from pcmapq.core.transform import Similarity2D
-from pcmapq.metrics.distances import Distances
 from pcmapq.results import csv_files, document
 from pcmapq.results import figures as figure_table
 from pcmapq.results.blocks import (  # noqa: F401  (the names every reader imports from here)
@@ -23,78 +16,18 @@ from pcmapq.results.blocks import (  # noqa: F401  (the names every reader impor
     OTHER,
     SAME,
     DetectorResult,
+    Findings,
     Overlap,
     rounded,
 )
 from pcmapq.results.document import REGION_COLUMNS  # noqa: F401
 from pcmapq.results.schema import ResultDocument
 
-if TYPE_CHECKING:  # the alignment modules load Open3D; a Result only holds their outputs
-    from pcmapq.align import Alignment
-    from pcmapq.align.regions import Consistency
-    from pcmapq.align.rigid3d import Registration3D
-
 
 @dataclass(frozen=True)
-class Result:
-    """A finished evaluation; all coordinates in the truth frame, metres.
-
-    frames: the chain from each input to the truth's plan (levelling, 3D registration, the 2D
-    alignment; :mod:`pcmapq.core.frames`). settings: the options it ran with
-    (``Settings.to_dict()``, metres and degrees); command: the command line that made it
-    (``pcmapq eval ...``, defaults left out), None from the library. noref: each input's
-    no-reference figures, ``{"map": ..., "truth": ...}``
-    (:func:`pcmapq.evaluation.noref_figures.input_figures`), None when not asked for.
-    truth_sha256: the truth file's SHA-256 (hex; None for a result made without its file), so
-    that results of one truth are known as such however its path was written. rooms: the
-    rooms detector's rooms, each with its status (:func:`pcmapq.match.rooms.room_table`), None
-    when it did not run. map_message: the recording's message the map was read from (topic,
-    index, ``time_s`` from the recording's start, header ``stamp_s``), None for a file.
-    truth_occupied, map_occupied (and the overlap's footprint): the rasters on ``grid``; None
-    in a result read back by :meth:`from_json`, which holds everything the JSON holds and no
-    more.
-    """
-
-    map_path: Path
-    map_kind: str
-    truth_path: Path
-    truth_kind: str
-    grid: MetricGrid
-    alignment: Alignment
-    overlap: Overlap
-    distances: Distances
-    registration_3d: Registration3D | None
-    distances_3d: Distances | None
-    threshold: float
-    full: bool
-    detectors: dict[str, DetectorResult]
-    truth_occupied: np.ndarray | None
-    map_occupied: np.ndarray | None
-    frames: Frames
-    footprint_rule: str = "known"
-    settings: dict | None = None
-    command: str | None = None
-    noref: dict | None = None
-    consistency: Consistency | None = None
-    truth_sha256: str | None = None
-    rooms: dict | None = None
-    map_message: dict | None = None
-
-    @property
-    def transform(self) -> Similarity2D:
-        """The map -> truth transform in the plane (``p_truth = s * R(yaw) * p_map + t``): the
-        2D alignment after the 3D registration's planar part, when there is one."""
-        return self.frames.map_to_truth()
-
-    def note(self, name: str) -> str | None:
-        """Why detector ``name``'s quality, precision or f1 is undefined (None if defined)."""
-        scope = "" if self.full else "inside the footprint"
-        return self.detectors[name].matching.note(scope)
-
-    def notes(self) -> list[str]:
-        """One line per detector with an undefined score: ``name: n/a: why``."""
-        return [f"{name}: n/a: {note}" for name in self.detectors
-                if (note := self.note(name)) is not None]
+class Result(Findings):
+    """A finished evaluation (:class:`~pcmapq.results.blocks.Findings`, whose fields it has)
+    and its views: the JSON document, the figures by name, the CSV files."""
 
     def to_dict(self, features: bool = True) -> dict:
         """The JSON document (:class:`~pcmapq.results.schema.ResultDocument`, docs/formats.md):
