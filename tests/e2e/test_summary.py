@@ -16,7 +16,7 @@ from pcmapq.core.errors import InputError
 from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.report import summary
 from pcmapq.report.summary import summary_figure, table_csv, table_md, write_summary
-from pcmapq.results.figures import HEAD, failed_row, table_row
+from pcmapq.results.figures import failed_row, head, table_row
 from pcmapq.settings import DEFAULT_DETECTORS, DETECTOR_NAMES, MatchingConfig, Settings
 from testkit import synth
 from testkit.files import write_image_map
@@ -46,7 +46,7 @@ def table_rows(summary_docs) -> list[dict[str, object]]:
 def test_a_row_holds_the_documents_figures(summary_docs):
     doc = summary_docs["sample"]
     row = table_row("sample", doc)
-    assert list(row)[:len(HEAD)] == list(HEAD)
+    assert list(row)[:len(head())] == list(head())
     assert row["map"] == doc["map"]["path"] and row["truth"] == doc["truth"]["path"]
     for det in DETECTOR_NAMES:  # a detector not run is null
         for score in ("quality", "precision", "f1"):

@@ -8,7 +8,8 @@ from __future__ import annotations
 
 import re
 
-from pcmapq.results.figures import ALIASES, AT_TAU_COLUMN, FIGURES, MEAN_PRECISION, TAU_FIELDS
+from pcmapq.results import figures as table
+from pcmapq.results.figures import ALIASES, AT_TAU_COLUMN, MEAN_PRECISION, TAU_FIELDS
 from pcmapq.settings.build import base_settings, get_path
 from pcmapq.settings.table import FLOAT, INT, SWITCH, Option, options_of
 
@@ -57,7 +58,7 @@ def figures_table() -> str:
             "| --- | --- | --- | --- |"]
     rows += [f"| `{f.name}` | `{'.'.join(f.path)}` | "
              f"{f'`{f.column_name}`' if f.column else '-'} | {f.header} |"
-             for f in FIGURES if f.number]
+             for f in table.FIGURES if f.number]
     rows += [f"| `{name}@TAU`, `{name}_3d@TAU` | `distances.f_score.<i>.{key}` | "
              f"`{AT_TAU_COLUMN.format(name=name, tau=0.05).replace('0.05', 'TAU')}` | "
              f"{name.replace('_', ' ')} at TAU |" for name, key in TAU_FIELDS.items()]

@@ -15,7 +15,7 @@ import numpy as np
 from pcmapq.core.errors import InputError
 from pcmapq.io.writers import OutputSet, one_line, write_atomic
 from pcmapq.report.style import DETECTOR_COLOURS
-from pcmapq.results.figures import HEADERS, SCORES, TAIL, columns, ranked
+from pcmapq.results.figures import SCORES, TAIL, by_name, columns, header, ranked
 from pcmapq.results.result import DECIMALS
 from pcmapq.settings import DEFAULT_DETECTORS, DETECTOR_NAMES
 
@@ -67,8 +67,10 @@ def shown_detectors(rows: Sequence[dict[str, object]]) -> list[str]:
 def terminal_columns(rows: Sequence[dict[str, object]]) -> dict[str, str]:
     """The columns of the terminal's table and their short headers: the comparison at a
     glance (the files hold every column)."""
-    return {**{f"{d}_quality": d for d in shown_detectors(rows)}, "coverage": "coverage",
-            "accuracy_mean_m": "accuracy\n(m)", "completeness_mean_m": "completeness\n(m)"}
+    names = [*(f"{d}.quality" for d in shown_detectors(rows)), "coverage", "accuracy.mean",
+             "completeness.mean"]
+    table = by_name()
+    return {table[n].column_name: table[n].short for n in names}
 
 
 def print_summary(rows: Sequence[dict[str, object]], console) -> None:
@@ -86,8 +88,8 @@ def print_summary(rows: Sequence[dict[str, object]], console) -> None:
     table.add_column("rank", justify="right", no_wrap=True)
     rows = ranked(list(rows))
     columns = terminal_columns(rows)
-    for header in columns.values():
-        table.add_column(header, justify="right", no_wrap=True)
+    for title in columns.values():
+        table.add_column(title, justify="right", no_wrap=True)
     table.add_column("status", no_wrap=True)
     for row in rows:
         failed = bool(row.get("exit_code"))
@@ -253,7 +255,7 @@ def _header(column: str) -> str:
     """A column's markdown header, units in brackets."""
     if column.startswith("f_score@"):
         return f"F@{column[len('f_score@'):-1]} m"
-    return HEADERS[column]
+    return header(column)
 
 
 def _md_cell(column: str, value: object, failed: bool) -> str:

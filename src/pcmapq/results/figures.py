@@ -65,6 +65,12 @@ class Figure:
         return "_".join(self.words) + (f"_{self.unit}" if self.unit else "")
 
     @property
+    def short(self) -> str:
+        """Its header in a narrow terminal table: the first word, the unit below it
+        (``accuracy`` over ``(m)``)."""
+        return self.words[0] + (f"\n({self.unit})" if self.unit else "")
+
+    @property
     def header(self) -> str:
         """Its markdown header, the unit in brackets: ``accuracy mean (m)``."""
         words = self.label or " ".join(self.words)
@@ -105,7 +111,6 @@ FIGURES: tuple[Figure, ...] = (
     *_stats("accuracy", "distances_3d", "_3d"), *_stats("completeness", "distances_3d", "_3d"),
     Figure("chamfer_3d", ("distances_3d", "chamfer_m"), optional=True, label="Chamfer 3D"),
 )
-BY_NAME = {f.name: f for f in FIGURES}
 #: Other names of figures that gates have always read: the one list of aliases.
 ALIASES = {"chamfer.mean": "chamfer", "chamfer_3d.mean": "chamfer_3d"}
 #: The figures measured at each tau of the result, by name, and their key in an F-score's
@@ -127,16 +132,32 @@ REQUIRED = ("map", "truth", "detectors", "alignment", "distances")
 AT_TAU, AT_TAU_COLUMN = "{name}{dim}@{tau:g}", "{name}@{tau:g}m"
 F_SCORE = AT_TAU.replace("{name}", "f_score")
 F_SCORE_COLUMN = AT_TAU_COLUMN.replace("{name}", "f_score")
-#: Columns before the F-scores: the name, its rank among the table's rows (:func:`ranked`)
-#: and inputs, then every figure that has a column.
-HEAD = ("name", "rank", "map", "truth", *(f.column_name for f in FIGURES if f.column))
+#: The columns before the figures: the name, its rank among the table's rows (:func:`ranked`)
+#: and the inputs.
+INPUTS = ("name", "rank", "map", "truth")
 #: Columns after the F-scores: the gates' verdict ("" without gates, "pass", or "fail: " and
 #: the failing keys) and how the evaluation ended (0 and "" when it finished).
 TAIL = ("gates", "exit_code", "error")
-#: Markdown headers of the columns (units in brackets); an F-score's is ``F@0.05 m``.
-HEADERS = {"name": "name", "rank": "rank", "map": "map", "truth": "truth",
-           **{f.column_name: f.header for f in FIGURES if f.column},
-           "gates": "gates", "exit_code": "exit code", "error": "error"}
+#: Markdown headers of the columns that are not figures.
+OTHER_HEADERS = {"name": "name", "rank": "rank", "map": "map", "truth": "truth",
+                 "gates": "gates", "exit_code": "exit code", "error": "error"}
+
+
+def by_name() -> dict[str, Figure]:
+    """Every figure of :data:`FIGURES` by its name. This and the tables below read the table
+    when called, so a figure added to it reaches every output."""
+    return {f.name: f for f in FIGURES}
+
+
+def head() -> tuple[str, ...]:
+    """Columns before the F-scores: :data:`INPUTS`, then every figure that has a column."""
+    return (*INPUTS, *(f.column_name for f in FIGURES if f.column))
+
+
+def header(column: str) -> str:
+    """A column's markdown header (units in brackets); an F-score's is its column."""
+    figure = next((f for f in FIGURES if f.column and f.column_name == column), None)
+    return figure.header if figure else OTHER_HEADERS.get(column, column)
 
 
 def figures(doc: dict) -> dict[str, float | str | None]:
@@ -176,7 +197,7 @@ def step_columns(doc: dict, precisions: dict[str, float | None]) -> dict[str, fl
 
 def table_row(name: str, doc: dict) -> dict[str, object]:
     """One flat row of a result JSON document (``pcmapq eval --json``): the inputs' paths,
-    every figure that has a column (:data:`HEAD`), the F-score at each tau and the verdict of
+    every figure that has a column (:func:`head`), the F-score at each tau and the verdict of
     its gates (:func:`gates_verdict`); exit_code 0, error ""; its rank None until the table's
     rows are ranked (:func:`ranked`). ValueError as :func:`figures`."""
     values = figures(doc)
@@ -193,7 +214,7 @@ def failed_row(name: str, map_path: str, truth_path: str, exit_code: int,
                error: str, verdict: str | None = None) -> dict[str, object]:
     """The row of an evaluation that failed: its inputs, exit code and one-line error, every
     figure None but the ``verdict`` of a map refused as another place."""
-    row: dict[str, object] = dict.fromkeys(HEAD)
+    row: dict[str, object] = dict.fromkeys(head())
     return {**row, "name": name, "map": str(map_path), "truth": str(truth_path),
             "verdict": verdict, "gates": "", "exit_code": int(exit_code),
             "error": " ".join(str(error).split())}
@@ -226,11 +247,11 @@ def gates_verdict(gates: list[dict] | None) -> str:
 
 
 def columns(rows: list[dict[str, object]]) -> list[str]:
-    """A table's columns: :data:`HEAD`, the F-score of every tau any row has (ascending),
+    """A table's columns: :func:`head`, the F-score of every tau any row has (ascending),
     :data:`TAIL`."""
     taus = sorted({float(k[len("f_score@"):-1]) for row in rows for k in row
                    if k.startswith("f_score@")})
-    return [*HEAD, *(F_SCORE_COLUMN.format(tau=t) for t in taus), *TAIL]
+    return [*head(), *(F_SCORE_COLUMN.format(tau=t) for t in taus), *TAIL]
 
 
 def _read(doc: dict, fig: Figure) -> float | str | None:

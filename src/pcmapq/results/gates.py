@@ -19,7 +19,7 @@ from typing import Any
 
 from pcmapq.core.errors import InputError
 from pcmapq.core.words import count
-from pcmapq.results.figures import ALIASES, BY_NAME, FIGURES, TAU_FIELDS
+from pcmapq.results import figures
 
 #: The exit code of a run whose figures fail a gate (0 scored, 1 evaluation failed, 2 usage).
 EXIT_CODE = 3
@@ -119,8 +119,8 @@ def parse_rules(under: str | None, over: str | None) -> list[Gate]:
 def short_names() -> list[str]:
     """Every short key: each named figure (:data:`~pcmapq.results.figures.FIGURES`), the
     aliases, and the F-score forms (``f_score@TAU`` stands for any tau)."""
-    return [f.name for f in FIGURES if f.number] + list(ALIASES) + [
-        form for name in TAU_FIELDS for form in (name, f"{name}@TAU", f"{name}_3d@TAU")]
+    return [f.name for f in figures.FIGURES if f.number] + list(figures.ALIASES) + [
+        form for name in figures.TAU_FIELDS for form in (name, f"{name}@TAU", f"{name}_3d@TAU")]
 
 
 def json_path(key: str, doc: dict) -> tuple[str | int, ...]:
@@ -129,10 +129,11 @@ def json_path(key: str, doc: dict) -> tuple[str | int, ...]:
     ``f_score`` alone, the only one (an error when the result has several)."""
     if (m := _F_SCORE.match(key)) is not None:
         block = "distances_3d" if m[2] else "distances"
-        return (block, "f_score", _tau_index(key, m[3], doc.get(block)), TAU_FIELDS[m[1]])
-    name = ALIASES.get(key, key)
-    if name in BY_NAME:
-        return BY_NAME[name].path
+        field = figures.TAU_FIELDS[m[1]]
+        return (block, "f_score", _tau_index(key, m[3], doc.get(block)), field)
+    name = figures.ALIASES.get(key, key)
+    if (figure := figures.by_name().get(name)) is not None:
+        return figure.path
     return tuple(int(s) if s.isdigit() else s for s in key.split("."))
 
 
