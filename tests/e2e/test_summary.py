@@ -166,7 +166,7 @@ def test_one_name_per_figure_reaches_the_same_value_everywhere(summary_docs):
         if fig.name not in values:
             continue
         if fig.column:
-            assert row[fig.column] == values[fig.name], fig.name
+            assert row[fig.column_name] == values[fig.name], fig.name
         if fig.number and values[fig.name] is not None:
             outcome, = gates.check([gates.Gate(fig.name, 0.0, gates.OVER)], doc)
             assert outcome.value == values[fig.name], fig.name
