@@ -124,7 +124,7 @@ def test_one_truth_written_two_ways_is_one_truth(saved, tmp_path, monkeypatch):
     ('{"pcmapq": ', "not a JSON file"),
     (b"\xff\xfe", "not a JSON file"),
     ("[1, 2]", "not a pcmapq eval result"),
-    ('{"pcmapq": {}, "map": {"path": "m"}}', "not a pcmapq eval result: no 'truth'"),
+    ('{"pcmapq": {}, "map": {"path": "m"}}', "not a pcmapq eval result: no 'settings'"),
 ])
 def test_a_file_that_is_not_a_result_is_one_line_exit_2(saved, tmp_path, content, says):
     bad = tmp_path / "bad.json"

@@ -12,10 +12,13 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
+from pydantic import ValidationError
+
 from pcmapq.core.errors import InputError
 from pcmapq.core.words import count
 from pcmapq.io.writers import one_line
 from pcmapq.results.figures import table_row
+from pcmapq.results.schema import ResultDocument, problem
 
 #: What makes two truths the same, beside their path: the truth grid's keys in the JSON.
 TRUTH_GRID = ("shape", "resolution_m", "origin")
@@ -87,8 +90,11 @@ def _read(path: Path, name: str) -> Saved:
     try:
         if not isinstance(doc, dict) or "pcmapq" not in doc:
             raise ValueError("no 'pcmapq' section")
+        ResultDocument.model_validate(doc)
         row = table_row(name, doc)
         _truth_key(doc)
+    except ValidationError as exc:
+        raise InputError(f"{path}: not a pcmapq eval result: {problem(exc)}") from None
     except (ValueError, TypeError, KeyError) as exc:
         raise InputError(f"{path}: not a pcmapq eval result: {one_line(exc)}") from None
     return Saved(Path(path), name, doc, row)

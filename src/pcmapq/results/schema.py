@@ -8,7 +8,7 @@ from __future__ import annotations
 import json
 from typing import Any
 
-from pydantic import BaseModel, ConfigDict
+from pydantic import BaseModel, ConfigDict, ValidationError
 
 from pcmapq.core.stats import Stats
 from pcmapq.metrics.distances import FScore
@@ -304,3 +304,13 @@ def _untitled(node: Any) -> Any:
 def schema_text() -> str:
     """:func:`json_schema` as docs/result.schema.json holds it."""
     return json.dumps(json_schema(), indent=2) + "\n"
+
+
+def problem(error: ValidationError) -> str:
+    """A document's departure from the schema in one line: the shallowest one (a missing
+    group before the keys inside it), where and what, and how many more there are."""
+    first = min(error.errors(), key=lambda e: len(e["loc"]))
+    where = ".".join(str(k) for k in first["loc"]) or "the document"
+    more = error.error_count() - 1
+    what = f"no '{where}'" if first["type"] == "missing" else f"{where}: {first['msg']}"
+    return what + (f" (and {more} more)" if more else "")
