@@ -1,13 +1,19 @@
-"""`pcmapq track`'s options checked before any work: --calib without reference poses is refused
-in one line."""
+"""`pcmapq track`'s options refused in one line: --calib without reference poses (before any
+work), a --footprint the run's maps cannot follow (as eval refuses it)."""
 
 from __future__ import annotations
+
+from pathlib import Path
 
 import numpy as np
 import pytest
 from typer.testing import CliRunner
 
 from pcmapq.cli import app
+from pcmapq.io import load_map
+from pcmapq.testing.carmen import flaser_log
+from pcmapq.testing.paths import SAMPLE
+from pcmapq.testing.recordings import write_recording
 
 #: KITTI odometry sequence 00's Tr (velodyne -> left camera), row-major 3x4
 #: (../shared/README.md).
@@ -25,3 +31,37 @@ def test_calib_without_reference_poses_is_refused(tmp_path) -> None:
                                    "--out", str(tmp_path / "o"), "--calib", str(calib)])
     assert got.exit_code == 2, got.stderr
     assert got.stderr.count("\n") == 1 and str(calib) in got.stderr, got.stderr
+
+
+def _log(tmp_path: Path) -> Path:
+    """A CARMEN log of three scans in the sample's hall (its map: a cloud of the scans' views;
+    ranges of 2 to 4 m, none the log's "no return" code)."""
+    poses = np.array([[6.0, 8.0, 0.0], [6.5, 8.0, 0.0], [7.0, 8.0, 0.0]])
+    ranges = np.tile(np.linspace(2.0, 4.0, 181), (3, 1))
+    return flaser_log(tmp_path / "run.log", ranges, poses)
+
+
+def _recording(tmp_path: Path) -> Path:
+    """A recording of one published map: the sample's truth (an image, no scans' views)."""
+    truth = load_map(SAMPLE / "truth.yaml")
+    return write_recording(tmp_path / "run.mcap", [(1.0, truth.state, truth.grid)], "mcap")
+
+
+@pytest.mark.parametrize(("make", "rule"), [(_log, "known"), (_recording, "seen")],
+                         ids=["cloud-known", "image-seen"])
+def test_a_footprint_rule_the_maps_cannot_follow_is_refused_as_eval_refuses_it(
+        tmp_path, make, rule) -> None:
+    """A run whose maps cannot follow ``--footprint`` (a cloud has no known cells, an image no
+    scans' views) is refused by track with eval's line and exit code, not scored into steps
+    that each note it."""
+    run_path, truth = make(tmp_path), str(SAMPLE / "truth.png")
+    runner = CliRunner()
+    evaluated = runner.invoke(app, ["eval", str(run_path), truth, "--footprint", rule])
+    tracked = runner.invoke(app, ["track", str(run_path), truth, "--footprint", rule,
+                                  "--out", str(tmp_path / "out")])
+    assert evaluated.exit_code == 2, evaluated.stderr
+    line, = evaluated.stderr.strip().splitlines()
+    assert line.startswith(f"pcmapq: error: {run_path}: ") and rule in line, line
+    assert tracked.exit_code == 2, tracked.stderr
+    assert tracked.stderr.strip() == line
+    assert not (tmp_path / "out").exists()

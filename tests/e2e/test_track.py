@@ -28,10 +28,7 @@ import pytest
 from typer.testing import CliRunner
 
 from pcmapq.cli import app
-from pcmapq.evaluation.inputs import TRUTH_CROP, load_input
-from pcmapq.evaluation.placing import place
-from pcmapq.evaluation.scoring import score
-from pcmapq.evaluation.truth import prepare_truth
+from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.io.carmen import beam_angles, read_laser_scans
 from pcmapq.io.writers import write_ros_map
 from pcmapq.settings import Settings
@@ -39,7 +36,7 @@ from pcmapq.track import Tracked, open_run, step_ends, track_run, travelled
 from pcmapq.track.drop import MIN_DROP
 from pcmapq.track.outputs import HEAD
 from pcmapq.track.runs import reference_poses_of
-from pcmapq.track.timeline import figures_of, track
+from pcmapq.track.timeline import figures_of, result_at, settings_from, track
 from testkit import synth
 from testkit.carmen import flaser_log
 
@@ -436,8 +433,8 @@ def test_every_m_steps_at_the_first_scan_reaching_each_multiple(runs: Runs) -> N
 def test_a_step_equals_a_from_scratch_evaluation(runs: Runs, which: str, tmp_path) -> None:
     """A step of the drifted run (the first, found by the global search; the first holding a
     drifted scan; the last) is the result of scoring the map of its first scans, read from
-    their own log, as :func:`pcmapq.evaluation.pipeline.evaluate` scores it (the truth
-    prepared for one map) with ICP from the step's start: the same figures, to 1e-9."""
+    their own log, with :func:`pcmapq.evaluation.pipeline.evaluate` (the truth prepared for
+    one map) with ICP from the step's start: the same figures, to 1e-9."""
     tracked = runs.track_run("drifted")
     step = tracked.steps[{"first": 0, "drifted": runs.k_step(), "last": -1}[which]]
     assert step.scored and (step.start is None) == (which == "first")
@@ -449,10 +446,7 @@ def test_a_step_equals_a_from_scratch_evaluation(runs: Runs, which: str, tmp_pat
     settings = replace(settings, noref=replace(settings.noref, enabled=False))
     if step.start is not None:
         settings = replace(settings, alignment=replace(settings.alignment, init=step.start))
-    prepared = prepare_truth(load_input(runs.data.corrected, settings.truth, TRUTH_CROP),
-                             settings, loaded=(source,), maps=(0,), background=True)
-    result = score(place(source, prepared, settings), prepared, settings)
-    got = figures_of(result)
+    got = figures_of(evaluate(source, runs.data.corrected, settings))
     want = {k: v for k, v in step.figures.items()
             if k not in ("slide_m", "local_offset_m") and k not in TRAJECTORY}
     assert list(got) == list(want)
@@ -464,6 +458,23 @@ def test_a_step_equals_a_from_scratch_evaluation(runs: Runs, which: str, tmp_pat
         else:
             assert math.isclose(got[key], value, rel_tol=0.0, abs_tol=1e-9), \
                 (key, got[key], value)
+
+
+@pytest.mark.parametrize("which", ["first", "drifted", "last"])
+def test_a_steps_result_is_evaluate_on_its_map(runs: Runs, which: str) -> None:
+    """A step's full result (the one the report draws) is
+    :func:`pcmapq.evaluation.pipeline.evaluate` of the step's map (the run's first scans) and
+    the truth file with the step's settings (the no-reference figures off, as track scores;
+    ICP from the step's start): the same JSON but for ``truth_sha256``, the truth file's
+    checksum that evaluate reads and a step does not."""
+    tracked = runs.track_run("drifted")
+    step = tracked.steps[{"first": 0, "drifted": runs.k_step(), "last": -1}[which]]
+    run = open_run(runs.data.drifted)
+    got = result_at(run, tracked.truth, tracked.settings, step)
+    want = evaluate(next(run.maps([step.scans])), runs.data.corrected,
+                    settings_from(tracked.settings, step.start))
+    assert want.truth_sha256 is not None and got.truth_sha256 is None
+    assert got.to_json() == replace(want, truth_sha256=None).to_json()
 
 
 # --- 4. trajectory errors ---------------------------------------------------------------------

@@ -10,8 +10,7 @@ from typing import Any
 from pcmapq.evaluation.inspect_map import inspect_map
 from pcmapq.io import OccupancyMap, PointMap, load_map
 from pcmapq.settings import NoRefConfig, Settings
-from pcmapq.track import Tracked, open_run, step_ends, track_run, travelled
-from pcmapq.track.runs import reference_poses_of
+from pcmapq.track import RunOptions, Tracked, plan_run, track_plan
 
 __all__ = ["inspect", "track_quality"]
 
@@ -32,11 +31,12 @@ def track_quality(run_path: str | Path, truth_path: str | Path, settings: Settin
     travelled) against the truth; ``poses``: the run's (default: a log's own, KISS-ICP's for
     scans); ``reference_poses`` (with ``calib``: their scanner -> pose-frame transform) add
     APE and RPE. ``Tracked.rows`` are the rows of ``track.csv``."""
-    run = open_run(Path(run_path), None if poses is None else Path(poses))
-    reference = (None if reference_poses is None else
-                 reference_poses_of(Path(reference_poses), len(run),
-                                    None if calib is None else Path(calib)))
-    ends = step_ends(len(run), every if every_m is None else None, every_m,
-                     travelled(run.poses))
-    return track_run(run, Path(truth_path), settings or Settings(), ends, reference=reference,
-                     reference_path=None if reference_poses is None else Path(reference_poses))
+    options = RunOptions(poses=_path(poses), reference_poses=_path(reference_poses),
+                         calib=_path(calib), every=every if every_m is None else None,
+                         every_m=every_m)
+    return track_plan(plan_run(Path(run_path), options), Path(truth_path),
+                      settings or Settings())
+
+
+def _path(path: str | Path | None) -> Path | None:
+    return None if path is None else Path(path)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import sys
 from dataclasses import asdict
 from pathlib import Path
-from typing import Annotated, Any
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 from rich.console import Console
@@ -22,6 +22,9 @@ from pcmapq.core.words import count
 from pcmapq.io import targets
 from pcmapq.io.formats import scan_formats
 from pcmapq.io.writers import OutputSet, write_atomic
+
+if TYPE_CHECKING:  # imported when the command runs: the command line starts without it
+    from pcmapq.track import RunOptions
 
 
 @app.command("track", help=HELP["track"])
@@ -81,9 +84,8 @@ def track_command(
 
     **settings_values: Any,
 ) -> None:
-    from pcmapq.io.bags import has_grids
     from pcmapq.report.timeline import drop_words
-    from pcmapq.track import PoseOptions, Recording, track_recording, write_track
+    from pcmapq.track import PoseOptions, RunOptions, plan_run, track_plan, write_track
 
     if len(paths) != 2:
         raise typer.BadParameter("give RUN and TRUTH", param_hint="RUN TRUTH")
@@ -102,42 +104,28 @@ def track_command(
                               inputs=(*paths, poses, reference_poses, calib,
                                       settings_values.get("config")))
         limit = memory_limit(max_memory)
-        scan_options = [o for o, v in (
-            ("--poses", poses), ("--reference-poses", reference_poses), ("--calib", calib),
-            ("--every", every), ("--every-m", every_m), ("--scan-topic", scan_topic),
-            ("--pose-topic", pose_topic), ("--frame", frame)) if v is not None]
-        map_options = [o for o, v in (("--map-topic", map_topic), ("--every-s", every_s))
-                       if v is not None]
-        if scan_options and map_options:
-            raise InputError(f"{run_path}: {', '.join(map_options)} score a recording's "
-                             f"published maps, {', '.join(scan_options)} a run's scans: give "
-                             "the options of one")
-        if not scan_options and has_grids(run_path, map_topic):
-            tracked = track_recording(Recording(run_path, map_topic, every_s), truth_path,
-                                      settings, show=step, progress=progress,
-                                      memory_limit=limit)
+        run_options = RunOptions(
+            poses=poses, reference_poses=reference_poses, calib=calib, every=every,
+            every_m=every_m, scan_topic=scan_topic, pose_topic=pose_topic, frame=frame,
+            pose_options=PoseOptions(align_poses, correct_scale, delta), map_topic=map_topic,
+            every_s=every_s)
+        _check_options(run_options, run_path)
+        with scan_bar(err, enabled=shown) as tick:
+            plan = plan_run(run_path, run_options, progress=tick)
+        if plan.ends is not None:
+            _check_step(step, len(plan.ends), "run")
+        tracked = track_plan(plan, truth_path, settings, show=step, progress=progress,
+                             memory_limit=limit)
+        if plan.ends is None:
             _check_step(step, len(tracked.steps), "recording")
-            rule: dict = {"every_s": every_s, "map_topic": map_topic}
-            total = f"{count(tracked.steps[-1].scans, 'map')} published"
-        else:
-            if map_options:
-                raise InputError(f"{run_path}: {', '.join(map_options)} apply to a ROS "
-                                 "recording of published maps (nav_msgs/OccupancyGrid)")
-            tracked, rule = _track_scans(run_path, truth_path, settings, poses=poses,
-                                         reference_poses=reference_poses, calib=calib,
-                                         every=every, every_m=every_m, step=step,
-                                         topics=(scan_topic, pose_topic, frame),
-                                         pose_options=PoseOptions(align_poses, correct_scale,
-                                                                  delta),
-                                         progress=progress, limit=limit,
-                                         bar=lambda: scan_bar(err, enabled=shown))
-            total = count(len(tracked.run), "scan")
-        wrote = write_track(tracked, out, rule, options.command_line(ctx))
+        wrote = write_track(tracked, out, options.command_line(ctx))
         if json_path not in (None, "-"):
             with OutputSet() as outputs:
                 write_atomic(Path(json_path), wrote[1].read_text(), outputs)
                 outputs.commit()
     scored = sum(s.scored for s in tracked.steps)
+    total = (f"{count(tracked.steps[-1].scans, 'map')} published" if plan.ends is None
+             else count(len(tracked.run), "scan"))
     if json_path == "-":
         sys.stdout.write(wrote[1].read_text())
     elif not quiet:
@@ -152,36 +140,33 @@ def track_command(
         raise typer.Exit(1)
 
 
-def _track_scans(run_path: Path, truth_path: Path, settings, *, poses: Path | None,
-                 reference_poses: Path | None, calib: Path | None, every: int | None,
-                 every_m: float | None, step: int | None, topics: tuple, pose_options,
-                 progress, limit: int | None, bar):
-    """A run's scans tracked (:func:`pcmapq.track.track_run`) and the rule of its steps."""
+def _check_options(given: RunOptions, run_path: Path) -> None:
+    """Refuse, before any work, options of a recording's published maps with those of a run's
+    scans or on a run that has none, --calib without a KITTI or TUM --reference-poses, and
+    --poses with --pose-topic."""
+    from pcmapq.io.bags import has_grids
     from pcmapq.io.carmen import is_carmen
-    from pcmapq.track import step_ends, track_run, travelled
-    from pcmapq.track.runs import open_run, reference_poses_of
 
-    if calib is not None and (reference_poses is None or is_carmen(reference_poses)):
-        raise InputError(f"{calib}: --calib moves the poses of a --reference-poses KITTI "
+    scan_options = [o for o, v in (
+        ("--poses", given.poses), ("--reference-poses", given.reference_poses),
+        ("--calib", given.calib), ("--every", given.every), ("--every-m", given.every_m),
+        ("--scan-topic", given.scan_topic), ("--pose-topic", given.pose_topic),
+        ("--frame", given.frame)) if v is not None]
+    map_options = [o for o, v in (("--map-topic", given.map_topic),
+                                  ("--every-s", given.every_s)) if v is not None]
+    if scan_options and map_options:
+        raise InputError(f"{run_path}: {', '.join(map_options)} score a recording's "
+                         f"published maps, {', '.join(scan_options)} a run's scans: give "
+                         "the options of one")
+    if map_options and not has_grids(run_path, given.map_topic):
+        raise InputError(f"{run_path}: {', '.join(map_options)} apply to a ROS "
+                         "recording of published maps (nav_msgs/OccupancyGrid)")
+    if given.calib is not None and (given.reference_poses is None
+                                    or is_carmen(given.reference_poses)):
+        raise InputError(f"{given.calib}: --calib moves the poses of a --reference-poses KITTI "
                          "or TUM file into the scanner's frame; none is given")
-    with bar() as tick:
-        if poses is not None and topics[1] is not None:
-            raise InputError("--poses and --pose-topic: give one of the two")
-        run = open_run(run_path, poses, progress=tick, scan_topic=topics[0],
-                       pose_topic=topics[1], frame=topics[2])
-    reference = (None if reference_poses is None
-                 else reference_poses_of(reference_poses, len(run), calib))
-    ends = step_ends(len(run), (every or 20) if every_m is None else None, every_m,
-                     travelled(run.poses))
-    _check_step(step, len(ends), "run")
-    tracked = track_run(run, truth_path, settings, ends, reference=reference,
-                        pose_options=pose_options, reference_path=reference_poses, show=step,
-                        progress=progress,
-                        tick=lambda done: progress(f"scoring: {done} of "
-                                                   f"{count(len(run), 'scan')}"),
-                        memory_limit=limit)
-    return tracked, {"every_scans": None if every_m is not None else (every or 20),
-                     "every_m": every_m}
+    if given.poses is not None and given.pose_topic is not None:
+        raise InputError("--poses and --pose-topic: give one of the two")
 
 
 def _check_step(step: int | None, steps: int, what: str) -> None:

@@ -1,5 +1,6 @@
-"""The two ways a run can fail, each with its exit code, and the refusal of a map of another
-place (an evaluation error whose verdict a table keeps)."""
+"""The two ways a run can fail, each with its exit code; the refusal of a map of another
+place (an evaluation error whose verdict a table keeps) and of settings a map of its kind
+cannot follow (bad input whatever the map holds)."""
 
 
 class InputError(Exception):
@@ -22,3 +23,10 @@ class Refused(EvaluationError):
     ``verdict`` ("another place") goes into a batch's row beside the one-line reason."""
 
     verdict = "another place"
+
+
+class SettingsRefused(InputError):
+    """Settings a map of its kind cannot follow (a footprint rule it has no cells or views
+    for), whatever the map holds: bad input, exit code 2. A run that scores many maps of one
+    kind (``pcmapq track``) stops at it, as ``pcmapq eval`` does, rather than noting it at
+    each."""

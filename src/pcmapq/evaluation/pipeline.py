@@ -1,17 +1,20 @@
-"""evaluate(): the method in one screen. load -> prepare the truth -> place the map (align,
-raster, same-place verdict) -> score (features, match, distances)."""
+"""evaluate(): the method in one screen. load -> prepare the truth -> :func:`evaluate_prepared`:
+check the map against the settings, place it (align, raster, same-place verdict), score it
+(features, match, distances). Every command scores a map through :func:`evaluate_prepared`;
+``pcmapq track`` calls its two halves (:func:`start_evaluation`, :func:`finish_evaluation`) on
+two threads, placing the next step's map while this one's features are found."""
 
 from __future__ import annotations
 
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 from pcmapq.evaluation.inputs import load_pair
 from pcmapq.evaluation.noref_figures import EarlyFigures
-from pcmapq.evaluation.placing import Progress, check_footprint_rule, place
+from pcmapq.evaluation.placing import Placed, Progress, check_footprint_rule, place
 from pcmapq.evaluation.scoring import score
-from pcmapq.evaluation.truth import prepare_truth
-from pcmapq.io import PointMap
+from pcmapq.evaluation.truth import PreparedTruth, prepare_truth
+from pcmapq.io import OccupancyMap, PointMap
 from pcmapq.io.digest import sha256_file
 from pcmapq.results.result import Result
 from pcmapq.settings import Settings
@@ -29,15 +32,58 @@ def evaluate(map_path: str | Path | PointMap, truth_path: str | Path,
     settings = Settings() if settings is None else settings
     progress("loading")
     source, truth = load_pair(map_path, truth_path, settings, memory_limit)
-    check_footprint_rule(source, settings)  # a rule the map cannot follow: before any work
+    check_footprint_rule(source, settings)  # before the truth is prepared: a refusal costs nothing
     prepared = prepare_truth(truth, settings, memory_limit, maps=(0,), loaded=(source,),
                              background=True)
-    early = EarlyFigures({"map": source, "truth": truth}, settings)
     try:
-        result = score(place(source, prepared, settings, progress, early.walls_found),
-                       prepared, settings, progress, early)
+        result = evaluate_prepared(source, prepared, settings, progress)
     except BaseException:
         prepared.cancel()
-        early.cancel()
         raise
     return replace(result, truth_sha256=truth_sha256 or sha256_file(truth_path))
+
+
+def evaluate_prepared(source: OccupancyMap | PointMap, prepared: PreparedTruth,
+                      settings: Settings, progress: Progress = lambda step: None) -> Result:
+    """Score a loaded map against a prepared truth: the footprint rule checked
+    (SettingsRefused), the no-reference figures of the 3D clouds and of an image map started on
+    a thread of their own when ``settings.noref.enabled``, the map placed
+    (:func:`~pcmapq.evaluation.placing.place`) and scored
+    (:func:`~pcmapq.evaluation.scoring.score`). The result has no ``truth_sha256``."""
+    return finish_evaluation(start_evaluation(source, prepared, settings, progress), progress)
+
+
+@dataclass(frozen=True)
+class Underway:
+    """An evaluation half done (:func:`start_evaluation`): its map ``placed`` on the
+    ``prepared`` truth with ``settings``, its ``early`` no-reference figures being found."""
+
+    placed: Placed
+    prepared: PreparedTruth
+    settings: Settings
+    early: EarlyFigures
+
+
+def start_evaluation(source: OccupancyMap | PointMap, prepared: PreparedTruth,
+                     settings: Settings, progress: Progress = lambda step: None) -> Underway:
+    """The first half of :func:`evaluate_prepared`: the rule checked, the early figures
+    started, the map placed (its errors raised, the figures' thread stopped)."""
+    check_footprint_rule(source, settings)
+    early = EarlyFigures({"map": source, "truth": prepared.source}, settings)
+    try:
+        placed = place(source, prepared, settings, progress, early.walls_found)
+    except BaseException:
+        early.cancel()
+        raise
+    return Underway(placed, prepared, settings, early)
+
+
+def finish_evaluation(underway: Underway, progress: Progress = lambda step: None) -> Result:
+    """The second half of :func:`evaluate_prepared`: the placed map scored with the settings it
+    was placed with (its errors raised, the figures' thread stopped)."""
+    try:
+        return score(underway.placed, underway.prepared, underway.settings, progress,
+                     underway.early)
+    except BaseException:
+        underway.early.cancel()
+        raise

@@ -17,7 +17,7 @@ from pcmapq.align.parts import place_parts
 from pcmapq.align.planar import RigidTarget
 from pcmapq.align.rigid3d import Registration3D, align_3d, apply
 from pcmapq.core.bounds import bounds, radius
-from pcmapq.core.errors import EvaluationError, InputError, Refused
+from pcmapq.core.errors import EvaluationError, Refused, SettingsRefused
 from pcmapq.core.frames import Levelling
 from pcmapq.core.grid import MetricGrid
 from pcmapq.core.transform import Similarity2D
@@ -105,13 +105,13 @@ def place(source: OccupancyMap | PointMap, prepared: PreparedTruth, settings: Se
 
 
 def check_footprint_rule(source: OccupancyMap | PointMap, settings: Settings) -> None:
-    """InputError (one line, naming the map) when the map cannot follow
+    """SettingsRefused (one line, naming the map) when the map cannot follow
     ``settings.footprint.rule``, found before any work (``auto`` is resolved later)."""
     try:
         check_rule(settings.footprint.rule, isinstance(source, OccupancyMap),
                    views=isinstance(source, PointMap) and source.seen is not None)
     except ValueError as err:
-        raise InputError(f"{source.path}: {err}") from None
+        raise SettingsRefused(f"{source.path}: {err}") from None
 
 
 def map_footprint_rule(source: OccupancyMap | PointMap, settings: Settings) -> str:
@@ -123,7 +123,7 @@ def map_footprint_rule(source: OccupancyMap | PointMap, settings: Settings) -> s
                               source.grid.resolution if image else 0.0,
                               views=not image and source.seen is not None)
     except ValueError as err:
-        raise InputError(f"{source.path}: {err}") from None
+        raise SettingsRefused(f"{source.path}: {err}") from None
 
 
 def map_raster(source: OccupancyMap | PointMap, map_xy: np.ndarray, transform: Similarity2D,

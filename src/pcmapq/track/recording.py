@@ -12,8 +12,8 @@ from collections.abc import Callable, Iterator
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-from pcmapq.core.errors import EvaluationError, InputError
-from pcmapq.evaluation.scoring import score
+from pcmapq.core.errors import EvaluationError, InputError, SettingsRefused
+from pcmapq.evaluation.pipeline import evaluate_prepared, finish_evaluation
 from pcmapq.evaluation.truth import PreparedTruth
 from pcmapq.io.bag_grids import grids
 from pcmapq.io.occupancy import OccupancyMap
@@ -65,13 +65,15 @@ def score_grids(recording: Recording, truth: PreparedTruth, settings: Settings,
         progress(f"scoring the map published at {t:.1f} s")
         at = (len(steps), index + 1, t, None)
         try:
-            side, used = place_step(grid, truth, settings, start)
-            result = score(side, truth, settings_from(settings, used))
+            underway, used = place_step(grid, truth, settings, start)
+            result = finish_evaluation(underway)
+        except SettingsRefused:
+            raise  # no grid can follow them: the recording is refused, as eval's map is
         except (EvaluationError, InputError) as err:
             steps.append(Step(*at, {"slide_m": None, "local_offset_m": None}, str(err), start))
             continue
         if settings.alignment.enabled:
-            start = side.alignment.transform
+            start = underway.placed.alignment.transform
         if held is not None:
             held += result.map_occupied.nbytes + result.overlap.footprint.nbytes
             held = held if held <= KEEP_BYTES else None
@@ -89,6 +91,4 @@ def grid_result(recording: Recording, truth: PreparedTruth, settings: Settings,
     if step.result is not None:
         return step.result
     grid = next(g for i, _, g in recording.grids(settings) if i + 1 == step.scans)
-    settings = settings_from(settings, step.start)
-    side, _ = place_step(grid, truth, settings, None)
-    return score(side, truth, settings)
+    return evaluate_prepared(grid, truth, settings_from(settings, step.start))

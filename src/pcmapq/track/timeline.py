@@ -25,12 +25,17 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from pcmapq.align import align
-from pcmapq.core.errors import EvaluationError, InputError
+from pcmapq.core.errors import EvaluationError, InputError, SettingsRefused
 from pcmapq.core.frames import Frames
 from pcmapq.core.transform import Similarity2D
 from pcmapq.core.voxels import evenly, voxel_centroids
-from pcmapq.evaluation.placing import Placed, place
-from pcmapq.evaluation.scoring import score
+from pcmapq.evaluation.pipeline import (
+    Underway,
+    evaluate_prepared,
+    finish_evaluation,
+    start_evaluation,
+)
+from pcmapq.evaluation.placing import Placed
 from pcmapq.evaluation.truth import PreparedTruth
 from pcmapq.io import PointMap
 from pcmapq.metrics.trajectory import ape, rpe
@@ -125,23 +130,25 @@ def figures_of(result: Result) -> dict[str, float | None]:
 
 
 def place_step(source, prepared: PreparedTruth, settings: Settings,
-               start: Similarity2D | None) -> tuple[Placed, Similarity2D | None]:
-    """Align and draw one step's map (:func:`~pcmapq.evaluation.placing.place`), ICP from
-    ``start`` (None: the global search); a start whose pose is refused is followed by a global
-    search. The placed map and the start it used; EvaluationError for a map of no point yet
-    (scans with no return within their range limits)."""
+               start: Similarity2D | None) -> tuple[Underway, Similarity2D | None]:
+    """One step's map checked, aligned and drawn, the first half of its evaluation
+    (:func:`~pcmapq.evaluation.pipeline.start_evaluation`), ICP from ``start`` (None: the
+    global search); a start whose pose is refused is followed by a global search. The
+    evaluation underway and the start it used; EvaluationError for a map of no point yet
+    (scans with no return within their range limits), SettingsRefused for settings no step's
+    map can follow."""
     if isinstance(source, PointMap) and not len(source.points):
         raise EvaluationError(f"{source.path}: the scans so far hold no point (no return "
                               "within their range limits)")
     option = settings.alignment
     if start is None or not option.enabled:
-        return place(source, prepared, settings), option.init
+        return start_evaluation(source, prepared, settings), option.init
     try:
-        return place(source, prepared, settings_from(settings, start)), start
+        return start_evaluation(source, prepared, settings_from(settings, start)), start
     except EvaluationError:
         if option.force:
             raise
-        return place(source, prepared, settings), None
+        return start_evaluation(source, prepared, settings), None
 
 
 def settings_from(settings: Settings, start: Similarity2D | None) -> Settings:
@@ -197,16 +204,16 @@ def track(run: Run, prepared: PreparedTruth, settings: Settings, ends: np.ndarra
                                                              pose_options)
             at = (index, end, time_s, float(distance[end - 1]))
             try:
-                side, used = place_step(source, prepared, settings, start)
+                underway, used = place_step(source, prepared, settings, start)
+            except SettingsRefused:
+                raise  # no step's map can follow them: the run is refused, as eval's map is
             except (EvaluationError, InputError) as err:
                 steps[index] = Step(*at, {"slide_m": None, "local_offset_m": None, **extra},
                                     str(err), start)
                 continue
             if settings.alignment.enabled:
-                start = side.alignment.transform
-            pending.append((index, scorers.submit(
-                _finish, at, recent, side, prepared, settings_from(settings, used),
-                used, extra)))
+                start = underway.placed.alignment.transform
+            pending.append((index, scorers.submit(_finish, at, recent, underway, used, extra)))
             collect(scoring)
         collect(0)
     return _with_slide([s for s in steps if s is not None], run.poses)
@@ -235,13 +242,15 @@ def local_offset(recent: np.ndarray, side: Placed, prepared: PreparedTruth,
     return float(np.sqrt(np.mean(np.sum(moved**2, axis=1))))
 
 
-def _finish(at: tuple, recent: np.ndarray, side: Placed, prepared: PreparedTruth,
-            settings: Settings, used: Similarity2D | None, extra: dict) -> Step:
-    """A placed step's features matched and scored, and the offset of its ``recent`` readings
-    (:func:`local_offset`): its :class:`Step` (``slide_m`` unset)."""
-    extra = {"local_offset_m": local_offset(recent, side, prepared, settings), **extra}
+def _finish(at: tuple, recent: np.ndarray, underway: Underway, used: Similarity2D | None,
+            extra: dict) -> Step:
+    """A placed step's evaluation finished (its features matched and scored,
+    :func:`~pcmapq.evaluation.pipeline.finish_evaluation`), and the offset of its ``recent``
+    readings (:func:`local_offset`): its :class:`Step` (``slide_m`` unset)."""
+    extra = {"local_offset_m": local_offset(recent, underway.placed, underway.prepared,
+                                            underway.settings), **extra}
     try:
-        result = score(side, prepared, settings)
+        result = finish_evaluation(underway)
     except (EvaluationError, InputError) as err:
         return Step(*at, {"slide_m": None, **extra}, str(err), used)
     return Step(*at, {**figures_of(result), "slide_m": None, **extra}, "", used,
@@ -273,5 +282,5 @@ def result_at(run: Run, prepared: PreparedTruth, settings: Settings, step: Step)
     it computed it (the same map, the same start: the same result)."""
     if step.result is not None:
         return step.result
-    settings = settings_from(settings, step.start)
-    return score(place(next(run.maps([step.scans])), prepared, settings), prepared, settings)
+    return evaluate_prepared(next(run.maps([step.scans])), prepared,
+                             settings_from(settings, step.start))
