@@ -11,9 +11,9 @@ from typer.testing import CliRunner
 
 from pcmapq.cli import app
 from pcmapq.io import load_map
-from pcmapq.testing.carmen import flaser_log
-from pcmapq.testing.paths import SAMPLE
-from pcmapq.testing.recordings import write_recording
+from testkit.carmen import flaser_log
+from testkit.paths import SAMPLE
+from testkit.recordings import write_recording
 
 #: KITTI odometry sequence 00's Tr (velodyne -> left camera), row-major 3x4
 #: (../shared/README.md).
