@@ -17,8 +17,9 @@ from pcmapq.core.errors import InputError
 from pcmapq.core.transform import Similarity2D
 from pcmapq.io.map_yaml import Thresholds
 from pcmapq.io.writers import one_line
-from pcmapq.settings import Settings, plain
 from pcmapq.settings.build import check
+from pcmapq.settings.configs import Settings
+from pcmapq.settings.plain import plain
 from pcmapq.settings.table import FLOAT, INT, OPTIONS, SWITCH, TEXT, OptionError
 
 #: Groups that are null by default and take these keys when a file gives them.

@@ -15,8 +15,8 @@ import numpy as np
 
 from pcmapq.core.errors import InputError
 from pcmapq.core.transform import Similarity2D
+from pcmapq.features.names import DETECTOR_NAMES
 from pcmapq.raster.rules import FOOTPRINT_RULES
-from pcmapq.settings import DETECTOR_NAMES
 
 #: Kinds of option: a number, an integer, text read by the option's parser, or a switch
 #: (``--noref/--no-noref``: a yes or no the command line can give either way).
