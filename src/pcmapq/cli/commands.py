@@ -9,6 +9,7 @@ import typer
 
 from pcmapq.cli import options
 from pcmapq.cli.base import HELP, new_app
+from pcmapq.core.memory import DEFAULT_SHARE
 
 app = new_app()
 __all__ = ["HELP", "app"]
@@ -42,7 +43,7 @@ TfFrame = Annotated[str | None, typer.Option(
 #: The memory limit of eval and track, in GB (:func:`memory_limit` in bytes).
 MaxMemory = Annotated[float | None, typer.Option(
     help="Stop (exit 2) before a run estimated to need more than this many GB "
-    "(default: 75 % of this machine's memory).", min=0.0, show_default=False,
+    f"(default: {DEFAULT_SHARE * 100:g} % of this machine's memory).", min=0.0, show_default=False,
     callback=options.finite)]
 
 

@@ -22,6 +22,7 @@ from pcmapq.core.words import count
 from pcmapq.io import targets
 from pcmapq.io.formats import scan_formats
 from pcmapq.io.writers import OutputSet, write_atomic
+from pcmapq.settings import TRACK_EVERY
 
 
 @app.command("track", help=HELP["track"])
@@ -47,7 +48,8 @@ def track_command(
         "they are moved into the scanner's frame, inv(T) P_k T, the frame of the run's "
         "poses.")] = None,
     every: Annotated[int | None, typer.Option(
-        help="Score the map every N scans (default 20).", min=1, show_default=False)] = None,
+        help=f"Score the map every N scans (default {TRACK_EVERY}).", min=1,
+        show_default=False)] = None,
     every_m: Annotated[float | None, typer.Option(
         help="Score the map every D metres travelled instead.", min=1e-6,
         callback=options.finite)] = None,
@@ -171,7 +173,7 @@ def _track_scans(run_path: Path, truth_path: Path, settings, *, poses: Path | No
                        pose_topic=topics[1], frame=topics[2])
     reference = (None if reference_poses is None
                  else reference_poses_of(reference_poses, len(run), calib))
-    ends = step_ends(len(run), (every or 20) if every_m is None else None, every_m,
+    ends = step_ends(len(run), (every or TRACK_EVERY) if every_m is None else None, every_m,
                      travelled(run.poses))
     _check_step(step, len(ends), "run")
     tracked = track_run(run, truth_path, settings, ends, reference=reference,
@@ -180,7 +182,7 @@ def _track_scans(run_path: Path, truth_path: Path, settings, *, poses: Path | No
                         tick=lambda done: progress(f"scoring: {done} of "
                                                    f"{count(len(run), 'scan')}"),
                         memory_limit=limit)
-    return tracked, {"every_scans": None if every_m is not None else (every or 20),
+    return tracked, {"every_scans": None if every_m is not None else (every or TRACK_EVERY),
                      "every_m": every_m}
 
 

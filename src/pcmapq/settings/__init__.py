@@ -11,6 +11,9 @@ from pcmapq.settings.configs import (
     EVAL_MAX_WARD,
     EVAL_NOREF_SAMPLE,
     EVAL_NOREF_VOXEL,
+    MIN_HITS_2D,
+    MIN_HITS_3D,
+    TRACK_EVERY,
     AlignmentConfig,
     DistancesConfig,
     FootprintConfig,
@@ -24,6 +27,6 @@ from pcmapq.settings.configs import (
 from pcmapq.settings.plain import plain
 
 __all__ = ["DEFAULT_DETECTORS", "DETECTOR_NAMES", "EVAL_MAX_WARD", "EVAL_NOREF_SAMPLE",
-           "EVAL_NOREF_VOXEL", "AlignmentConfig", "DistancesConfig", "FootprintConfig",
-           "MatchingConfig", "NoRefConfig", "RasterConfig", "Settings", "SourceConfig",
-           "default_params", "plain"]
+           "EVAL_NOREF_VOXEL", "MIN_HITS_2D", "MIN_HITS_3D", "TRACK_EVERY", "AlignmentConfig",
+           "DistancesConfig", "FootprintConfig", "MatchingConfig", "NoRefConfig", "RasterConfig",
+           "Settings", "SourceConfig", "default_params", "plain"]

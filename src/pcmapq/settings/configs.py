@@ -13,7 +13,7 @@ from typing import Any
 from pcmapq.align.params import AlignParams
 from pcmapq.core.bounds import Box
 from pcmapq.core.transform import Similarity2D
-from pcmapq.features.names import DEFAULT_DETECTORS
+from pcmapq.features.names import DEFAULT_DETECTORS, MATCH_THRESHOLD
 from pcmapq.io.map_yaml import Thresholds
 from pcmapq.metrics.defaults import DEFAULT_TAUS, LIDAR_RADIUS, MAX_NN, MAX_WARD_POINTS, MIN_KNN
 from pcmapq.settings.plain import plain
@@ -50,15 +50,21 @@ class SourceConfig:
     at: float | None = None
 
 
+#: Points that mark a cloud's cell occupied when ``RasterConfig.min_hits`` is None: a 3D cloud's,
+#: a 2D cloud's.
+MIN_HITS_3D, MIN_HITS_2D = 2, 1
+
+
 @dataclass(frozen=True)
 class RasterConfig:
     """How inputs become plans and grids (raster stage).
 
     cloud_resolution: cell size used for a point-cloud truth when none is given, metres.
     band_low, band_high: the wall band of a 3D cloud, metres above the floor.
-    min_hits: a cloud cell is occupied when it holds at least this many points; by default 2
-        for a 3D cloud (its wall band stacks many points on a wall cell, and a lone outlier is
-        dropped) and 1 for a 2D cloud (a laser map puts one or two points per wall cell).
+    min_hits: a cloud cell is occupied when it holds at least this many points; None:
+        :data:`MIN_HITS_3D` for a 3D cloud (its wall band stacks many points on a wall cell, and
+        a lone outlier is dropped), :data:`MIN_HITS_2D` for a 2D cloud (a laser map puts one or
+        two points per wall cell).
     """
 
     cloud_resolution: float = 0.05
@@ -122,7 +128,7 @@ class MatchingConfig:
     """
 
     detectors: tuple[str, ...] = DEFAULT_DETECTORS
-    threshold: float = 0.5
+    threshold: float = MATCH_THRESHOLD
     params: dict[str, Any] = field(default_factory=default_params, hash=False)
 
 
@@ -169,6 +175,8 @@ EVAL_NOREF_SAMPLE = 20_000
 #: ``eval``'s Ward tree for MOM's planes: 2,000 normals, a small share of the run (the tree's
 #: time grows with the square of the normals).
 EVAL_MAX_WARD = 2_000
+#: ``track``'s steps: every this many scans of a run when no other rule is given (``--every``).
+TRACK_EVERY = 20
 
 
 @dataclass(frozen=True)

@@ -16,7 +16,15 @@ import numpy as np
 from pcmapq.core.errors import InputError
 from pcmapq.core.transform import Similarity2D
 from pcmapq.features.names import DETECTOR_NAMES
+from pcmapq.io.map_yaml import MapMeta
 from pcmapq.raster.rules import FOOTPRINT_RULES
+from pcmapq.settings.configs import (
+    EVAL_NOREF_SAMPLE,
+    EVAL_NOREF_VOXEL,
+    MIN_HITS_2D,
+    MIN_HITS_3D,
+    RasterConfig,
+)
 
 #: Kinds of option: a number, an integer, text read by the option's parser, or a switch
 #: (``--noref/--no-noref``: a yes or no the command line can give either way).
@@ -166,11 +174,11 @@ def _thresholds(side: str) -> list[Option]:
         Option(f"{side}_occupied_thresh", f"{side}.thresholds.occupied", FLOAT,
                f"Truth image: {other}occupied-thresh." if other else
                "Map image: occupied if p > this (map_server's occupied_thresh; overrides the "
-               "YAML's, default 0.65).", 0.0, 1.0),
+               f"YAML's, default {MapMeta.occupied_thresh:g}).", 0.0, 1.0),
         Option(f"{side}_free_thresh", f"{side}.thresholds.free", FLOAT,
                f"Truth image: {other}free-thresh." if other else
                "Map image: free if p < this (map_server's free_thresh; overrides the YAML's, "
-               "default 0.196).", 0.0, 1.0),
+               f"default {MapMeta.free_thresh:g}).", 0.0, 1.0),
         Option(f"{side}_negate", f"{side}.thresholds.negate", SWITCH,
                f"Truth image: {other}negate." if other else
                "Map image: p = v / 255 instead of (255 - v) / 255 (map_server's negate; "
@@ -193,7 +201,8 @@ OPTIONS: tuple[Option, ...] = (
            "Metres per pixel of an image without YAML.", 1e-6, commands=(INSPECT,)),
     Option("truth_resolution", "truth.resolution", FLOAT,
            "Metres per pixel of a truth image without YAML; cell size for a cloud truth "
-           "(default 0.05).", 1e-6, commands=(EVAL, BATCH, TRACK), helps={TRACK: "As eval's."}),
+           f"(default {RasterConfig.cloud_resolution:g}).", 1e-6, commands=(EVAL, BATCH, TRACK),
+           helps={TRACK: "As eval's."}),
     *_thresholds("map"), *_thresholds("truth"),
     Option("map_crop", "map.crop", TEXT,
            "Keep only the map's part inside this box, metres, in its own frame (outlier "
@@ -242,8 +251,8 @@ OPTIONS: tuple[Option, ...] = (
     Option("band_high", "raster.band_high", FLOAT,
            "Wall band of a 3D cloud: upper bound, metres above the floor."),
     Option("min_hits", "raster.min_hits", INT,
-           "Points needed to mark a cloud's cell occupied (default: 2 for a 3D cloud, 1 for a "
-           "2D one).", 1),
+           f"Points needed to mark a cloud's cell occupied (default: {MIN_HITS_3D} for a 3D "
+           f"cloud, {MIN_HITS_2D} for a 2D one).", 1),
     Option("detectors", "matching.detectors", TEXT,
            f"Comma-separated detectors to run, any of {', '.join(DETECTOR_NAMES)}.",
            metavar="<" + ",".join(DETECTOR_NAMES) + ">", read=parse_detectors, show=show_list,
@@ -293,12 +302,12 @@ OPTIONS: tuple[Option, ...] = (
            commands=(INSPECT,)),
     Option("voxel", "noref.voxel", FLOAT,
            "First reduce a 3D cloud to one point (the centroid) per cell of this size, "
-           "metres; 0: as it is, as map-metrics ('pcmapq eval' uses 0.1).", 0.0,
+           f"metres; 0: as it is, as map-metrics ('pcmapq eval' uses {EVAL_NOREF_VOXEL:g}).", 0.0,
            commands=(INSPECT,)),
     Option("sample", "noref.sample", INT,
            "MME and MPV over this many points drawn at random (seeded), with their standard "
            "errors, and MOM's planes from the cloud at a third of the radius; 0: every point, "
-           "as map-metrics ('pcmapq eval' uses 20000).", 0, commands=(INSPECT,)),
+           f"as map-metrics ('pcmapq eval' uses {EVAL_NOREF_SAMPLE}).", 0, commands=(INSPECT,)),
 )
 
 
