@@ -34,7 +34,8 @@ RowsFailOver = Annotated[str | None, typer.Option(
     "--fail-over", metavar="<KEY=VALUE,...>",
     help="CI gate for distances: exit 3 when a figure of any row is above its bound, e.g. "
     "accuracy.mean=0.05 (metres).")]
-#: A recording's scan topic and the tf frame of its scans' poses (map and track).
+#: A recording's scan topic (eval's --scans, map and track) and the tf frame of its scans'
+#: poses (map and track).
 ScanTopic = Annotated[str | None, typer.Option(
     help="A recording's PointCloud2 or LaserScan topic (default: the only one).")]
 TfFrame = Annotated[str | None, typer.Option(
