@@ -77,7 +77,7 @@ def settings_options(command: str) -> Callable:
                                    annotation=Annotated[Path | None, typer.Option(
                                        help=CONFIG_HELP, metavar="FILE")])]
         extra += [_parameter(o, command) for o in options_of(command)]
-        extra += [_former(r, command) for r in renamed_of(command)]
+        extra += [_former(r) for r in renamed_of(command)]
 
         @functools.wraps(func)
         def command_function(*args: Any, **kwargs: Any) -> Any:
@@ -119,7 +119,7 @@ def _parameter(option: Option, command: str) -> inspect.Parameter:
                              default=default, annotation=Annotated[kind, info])
 
 
-def _former(renamed: Renamed, command: str) -> inspect.Parameter:
+def _former(renamed: Renamed) -> inspect.Parameter:
     """The hidden parameter of an option's former name: read as the option is, no default."""
     option = option_named(renamed.new)
     bounds = {k: v for k, v in (("min", option.lo), ("max", option.hi)) if math.isfinite(v)}
