@@ -37,7 +37,7 @@ def test_a_3d_cloud_gets_the_library_figures_and_the_same_json_twice(tmp_path):
     np.save(path, points)
     texts = []
     for _ in range(2):  # one path: the JSON holds the command line
-        code, _, stderr = _inspect(str(path), "--radius", "0.3", "--json",
+        code, _, stderr = _inspect(str(path), "--noref-radius", "0.3", "--json",
                                    str(tmp_path / "r.json"), "--quiet")
         assert code == 0, stderr
         texts.append((tmp_path / "r.json").read_text())
@@ -48,7 +48,7 @@ def test_a_3d_cloud_gets_the_library_figures_and_the_same_json_twice(tmp_path):
     assert got["mme"] == round(want.mme, 6) and got["mpv"] == float(f"{want.mpv:.6g}")
     assert got["points"] == len(points) and got["radius_m"] == 0.3
     np.save(path, floor)  # one plane alone: MPV is the noise's variance, 1e-4 m^2
-    code, stdout, stderr = _inspect(str(path), "--radius", "0.3", "--json", "-")
+    code, stdout, stderr = _inspect(str(path), "--noref-radius", "0.3", "--json", "-")
     assert code == 0, stderr
     assert json.loads(stdout)["cloud"]["mpv"] == pytest.approx(1e-4, rel=0.1)
 

@@ -95,7 +95,7 @@ def test_inspect_of_binary_pcd_scans_loads_no_open3d(tmp_path):
     poses.write_text("1 0 0 0 0 1 0 0 0 0 1 0\n" * 3)
     np.savez(tmp_path / "orth.npz", *[p[:50] for p in planes])
     out = tmp_path / "figures.json"
-    found, _ = imported(["inspect", "--scans", str(scans), "--poses", str(poses), "--radius",
+    found, _ = imported(["inspect", "--scans", str(scans), "--poses", str(poses), "--noref-radius",
                          "0.2", "--orth-subset", str(tmp_path / "orth.npz"), "--json", str(out),
                          "--quiet"], NOT_FOR_INSPECT)
     assert found == []

@@ -44,13 +44,13 @@ def test_eval_reports_the_figures_inspect_gives_for_map_and_truth():
     # in the JSON, to six significant digits (MPV and MOM are small areas)
     assert Result.from_json(result.to_json()).noref == significant(result.noref)
     assert significant(cloud)["mme"] != cloud["mme"]  # the rounding is not a no-op here
-    got = CliRunner().invoke(app, ["inspect", str(SAMPLE / "scan.ply"), "--voxel", "0.1",
-                                   "--sample", "20000", "--json", "-"])
+    got = CliRunner().invoke(app, ["inspect", str(SAMPLE / "scan.ply"), "--noref-voxel",
+                                   "0.1", "--noref-sample", "20000", "--json", "-"])
     assert got.exit_code == 0, got.stderr
-    # what the docs say: inspect --voxel 0.1 --sample 20000
+    # what the docs say: inspect --noref-voxel 0.1 --noref-sample 20000
     assert json.loads(got.stdout)["cloud"] == significant(cloud)
-    whole = CliRunner().invoke(app, ["inspect", str(SAMPLE / "scan.ply"), "--voxel", "0.1",
-                                     "--json", "-"])
+    whole = CliRunner().invoke(app, ["inspect", str(SAMPLE / "scan.ply"),
+                                     "--noref-voxel", "0.1", "--json", "-"])
     whole = json.loads(whole.stdout)["cloud"]
     assert whole["sampled_points"] is None and whole["mpv_points"] > 100_000
     for name in ("mme", "mpv"):

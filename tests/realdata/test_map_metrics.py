@@ -45,7 +45,7 @@ def test_depth_scans_at_their_poses_give_map_metrics_figures():
     """map-metrics' own test data through the command line: its published MME, MPV and MOM."""
     depth = shared("map-metrics", "depth")
     code, stdout, stderr = _inspect(
-        "--scans", str(depth / "pcs"), "--poses", str(depth / "poses"), "--radius", "0.2",
+        "--scans", str(depth / "pcs"), "--poses", str(depth / "poses"), "--noref-radius", "0.2",
         "--orth-subset", str(depth / "orth_subset" / "orth-0091.npy"),
         "--orth-pose", str(depth / "poses" / "pose-0091.txt"), "--json", "-")
     assert code == 0, stderr

@@ -9,7 +9,7 @@ from typing import Any
 
 from pcmapq.evaluation.inspect_map import inspect_map
 from pcmapq.io import OccupancyMap, PointMap, load_map
-from pcmapq.settings import NoRefConfig, Settings
+from pcmapq.settings import TRACK_EVERY, NoRefConfig, Settings
 from pcmapq.track import RunOptions, Tracked, plan_run, track_plan
 
 __all__ = ["inspect", "track_quality"]
@@ -24,7 +24,7 @@ def inspect(map_path: str | Path, config: NoRefConfig | None = None,
 
 
 def track_quality(run_path: str | Path, truth_path: str | Path, settings: Settings | None = None, *,
-          every: int | None = 20, every_m: float | None = None,
+          every: int | None = TRACK_EVERY, every_m: float | None = None,
           poses: str | Path | None = None, reference_poses: str | Path | None = None,
           calib: str | Path | None = None) -> Tracked:
     """``pcmapq track``: the run's map scored every ``every`` scans (or ``every_m`` metres

@@ -11,6 +11,7 @@ import glob
 import math
 import os
 import shlex
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -27,19 +28,27 @@ from pcmapq.settings.table import (
     INT,
     SWITCH,
     TEXT,
+    Option,
     OptionError,
     options_of,
+    renamed_of,
 )
 
 #: Names a row cannot take: the batch's own table and figure are written beside the rows.
 RESERVED = ("table", "figure")
 MANIFEST_SUFFIXES = (".csv", ".yaml", ".yml")
+#: The columns of a row that are no option.
+ROW_COLUMNS = ("name", "map", "truth")
 
 
-#: The per-row options: eval's settings options, by name (the option table's).
-OPTIONS = {o.name: o for o in options_of(BATCH)}
-#: Every column a manifest may have.
-COLUMNS = ("name", "map", "truth", *OPTIONS)
+def row_options() -> dict[str, Option]:
+    """The per-row options: eval's settings options, by name (the option table's)."""
+    return {o.name: o for o in options_of(BATCH)}
+
+
+def columns() -> tuple[str, ...]:
+    """Every column a manifest may have."""
+    return (*ROW_COLUMNS, *row_options())
 
 
 @dataclass(frozen=True)
@@ -83,6 +92,7 @@ def read_rows(manifest: Path, defaults: dict[str, object],
     cells = _csv_cells(manifest, text) if suffix == ".csv" else _yaml_cells(manifest, text)
     if not cells:
         raise InputError(f"{manifest}: no rows")
+    _warn_renamed([k for row in cells for k in row], str(manifest))
     base = Path(os.path.abspath(manifest.parent))
     start = _start(config)
     rows = [make_row({**defaults, **row}, base, f"{manifest}: row {i}", start)
@@ -115,10 +125,11 @@ def parse_assignments(pairs: list[str]) -> dict[str, object]:
     values: dict[str, object] = {}
     for pair in pairs:
         key, sep, value = pair.partition("=")
+        _warn_renamed([key], "--set")
         key = _column(key, f"--set {pair}")
         if not sep or key in ("name", "map"):
             raise InputError(f"--set {pair}: expected KEY=VALUE with KEY an option of a row "
-                             f"({', '.join(c for c in COLUMNS if c not in ('name', 'map'))})")
+                             f"({', '.join(c for c in columns() if c not in ('name', 'map'))})")
         values[key] = os.path.abspath(Path(value).expanduser()) \
             if key == "truth" and value.strip() else value
     return values
@@ -134,7 +145,8 @@ def make_row(cells: dict[str, object], base: Path, where: str,
     for required in ("map", "truth"):
         if required not in given:
             raise InputError(f"{where}: no '{required}'")
-    values = {k: _value(k, v, where) for k, v in given.items() if k in OPTIONS}
+    options = row_options()
+    values = {k: _value(options[k], v, where) for k, v in given.items() if k in options}
     map_path = Path(os.path.abspath(base / Path(given["map"]).expanduser()))
     name = given.get("name", map_path.stem)
     try:
@@ -213,12 +225,29 @@ def _yaml_cells(manifest: Path, text: str) -> list[dict[str, object]]:
     return [{**defaults, **row} for row in doc]
 
 
+def _name(key: object) -> str:
+    """A column as named (``map-resolution`` and ``map_resolution`` alike)."""
+    return str(key).strip().lower().replace("-", "_")
+
+
 def _column(key: object, where: str) -> str:
-    """A column's name (``map-resolution`` and ``map_resolution`` alike); refuse others."""
-    name = str(key).strip().lower().replace("-", "_")
-    if name not in COLUMNS:
-        raise InputError(f"{where}: unknown column {str(key)!r}; columns: {', '.join(COLUMNS)}")
+    """A column's name, a former one read as its option's (see :func:`_warn_renamed`);
+    refuse others."""
+    name = _name(key)
+    name = {r.old: r.new for r in renamed_of(BATCH)}.get(name, name)
+    if name not in columns():
+        raise InputError(f"{where}: unknown column {str(key)!r}; columns: "
+                         f"{', '.join(columns())}")
     return name
+
+
+def _warn_renamed(keys: list[object], where: str) -> None:
+    """One warning for each former option name among ``keys`` (a manifest's columns)."""
+    given = {_name(k) for k in keys}
+    for renamed in renamed_of(BATCH):
+        if renamed.old in given:
+            warnings.warn(f"{where}: column {renamed.old} is renamed {renamed.new}",
+                          stacklevel=2)
 
 
 def _text(value: object, where: str, column: object) -> str:
@@ -237,9 +266,9 @@ def _text(value: object, where: str, column: object) -> str:
 TRUE, FALSE = ("true", "yes", "1", "on"), ("false", "no", "0", "off")
 
 
-def _value(column: str, text: str, where: str) -> object:
-    """A cell's text as its column's type, within its bounds."""
-    option = OPTIONS[column]
+def _value(option: Option, text: str, where: str) -> object:
+    """A cell's text as its option's type, within its bounds."""
+    column = option.name
     if option.kind == SWITCH:
         if text.lower() not in TRUE + FALSE:
             raise InputError(f"{where}: {column}: expected true or false, got {text!r}")

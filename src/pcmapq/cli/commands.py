@@ -9,6 +9,7 @@ import typer
 
 from pcmapq.cli import options
 from pcmapq.cli.base import HELP, new_app
+from pcmapq.core.memory import DEFAULT_SHARE
 
 app = new_app()
 __all__ = ["HELP", "app"]
@@ -33,7 +34,8 @@ RowsFailOver = Annotated[str | None, typer.Option(
     "--fail-over", metavar="<KEY=VALUE,...>",
     help="CI gate for distances: exit 3 when a figure of any row is above its bound, e.g. "
     "accuracy.mean=0.05 (metres).")]
-#: A recording's scan topic and the tf frame of its scans' poses (map and track).
+#: A recording's scan topic (eval's --scans, map and track) and the tf frame of its scans'
+#: poses (map and track).
 ScanTopic = Annotated[str | None, typer.Option(
     help="A recording's PointCloud2 or LaserScan topic (default: the only one).")]
 TfFrame = Annotated[str | None, typer.Option(
@@ -42,7 +44,7 @@ TfFrame = Annotated[str | None, typer.Option(
 #: The memory limit of eval and track, in GB (:func:`memory_limit` in bytes).
 MaxMemory = Annotated[float | None, typer.Option(
     help="Stop (exit 2) before a run estimated to need more than this many GB "
-    "(default: 75 % of this machine's memory).", min=0.0, show_default=False,
+    f"(default: {DEFAULT_SHARE * 100:g} % of this machine's memory).", min=0.0, show_default=False,
     callback=options.finite)]
 
 

@@ -12,7 +12,15 @@ import typer
 from rich.console import Console
 
 from pcmapq.cli import options, terminal
-from pcmapq.cli.commands import HELP, FailOver, FailUnder, MaxMemory, app, memory_limit
+from pcmapq.cli.commands import (
+    HELP,
+    FailOver,
+    FailUnder,
+    MaxMemory,
+    ScanTopic,
+    app,
+    memory_limit,
+)
 from pcmapq.cli.terminal import (
     report_errors,
     step_progress,
@@ -44,9 +52,7 @@ def eval_command(
         "ROS recording) with KISS-ICP (see 'pcmapq map') and score it.")] = None,
     max_scans: Annotated[int | None, typer.Option(
         help="With --scans: use only the first N scans.", min=1)] = None,
-    scan_topic: Annotated[str | None, typer.Option(
-        help="With --scans of a ROS recording: its PointCloud2 or LaserScan topic (default: "
-        "the only one).")] = None,
+    scan_topic: ScanTopic = None,
     json_path: Annotated[str | None, typer.Option(
         "--json", help="Write the result as JSON to this path ('-' for stdout only).")] = None,
     vectors: Annotated[Path | None, typer.Option(

@@ -26,7 +26,7 @@ if TYPE_CHECKING:
     from pcmapq.io import OccupancyMap, PointMap
 
 #: The crop option of inspect, named in messages.
-CROP = "--crop"
+CROP = "--map-crop"
 
 
 def checked(source: OccupancyMap | PointMap, box: Box | None,
@@ -83,6 +83,10 @@ def inspect_command(
     json_path = targets.kept(json_path)
     with report_errors(err), terminal.show_warnings(err):
         settings = options.settings_of(ctx, "inspect", settings_values)
+        if settings_values.get("map_resolution") == "auto":
+            raise typer.BadParameter("'auto' estimates a map's scale against a truth, which "
+                                     "inspect has none of: give metres per pixel",
+                                     param_hint="--map-resolution")
         if (map_path is None) == (scans is None) or (scans is None) != (poses is None):
             raise typer.BadParameter("give MAP, or --scans DIR with --poses FILE",
                                      param_hint="MAP")
@@ -101,7 +105,7 @@ def inspect_command(
         else:
             source = load_map(map_path, settings.map.resolution,
                               memory_limit=memory_limit(max_memory), topic=settings.map.topic,
-                              topic_option="--topic")
+                              topic_option="--map-topic")
         source = checked(source, settings.map.crop, memory_limit(max_memory))
         planes = None if orth_subset is None else read_orthogonal_subset(orth_subset)
         if planes is not None and orth_pose is not None:

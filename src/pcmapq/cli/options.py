@@ -1,6 +1,6 @@
 """The command line's options: the settings options of a command made from the option table
-(:mod:`pcmapq.settings.table`) with ``--config FILE``, the Settings a command's parsed options
-give, and the command line rebuilt from them."""
+(:mod:`pcmapq.settings.table`) with ``--config FILE`` and, hidden, the former names it still
+reads; the Settings a command's parsed options give, and the command line rebuilt from them."""
 
 from __future__ import annotations
 
@@ -8,6 +8,7 @@ import functools
 import inspect
 import math
 import shlex
+import warnings
 from collections.abc import Callable
 from pathlib import Path
 from typing import Annotated, Any
@@ -17,7 +18,17 @@ import typer
 from pcmapq.settings import Settings
 from pcmapq.settings.build import base_settings, build, default_of
 from pcmapq.settings.file import read_settings
-from pcmapq.settings.table import FLOAT, INT, SWITCH, Option, OptionError, options_of
+from pcmapq.settings.table import (
+    FLOAT,
+    INT,
+    SWITCH,
+    Option,
+    OptionError,
+    Renamed,
+    option_named,
+    options_of,
+    renamed_of,
+)
 
 #: Python types of the option kinds, as typer reads them.
 TYPES = {FLOAT: float | None, INT: int | None, SWITCH: bool | None}
@@ -28,8 +39,10 @@ CONFIG_HELP = ("Settings file (YAML, as 'pcmapq config --dump' writes): its sett
 
 def command_line(ctx: typer.Context) -> str:
     """The command as given, rebuilt from its parsed parameters (defaults left out), so a saved
-    result says how it was made: ``pcmapq eval MAP TRUTH --option value ...``."""
+    result says how it was made: ``pcmapq eval MAP TRUTH --option value ...``; an option given
+    by its former name is written by its name."""
     words = ["pcmapq", ctx.info_name or "eval"]
+    now = {r.old: option_named(r.new).option for r in renamed_of(ctx.info_name or "eval")}
     for param in ctx.command.params:
         value = ctx.params.get(param.name)
         source = ctx.get_parameter_source(param.name)
@@ -41,7 +54,7 @@ def command_line(ctx: typer.Context) -> str:
             if value or param.secondary_opts:
                 words.append(param.opts[0] if value else param.secondary_opts[0])
         else:
-            words += [param.opts[0], str(value)]
+            words += [now.get(param.name or "", param.opts[0]), str(value)]
     return shlex.join(words)
 
 
@@ -64,6 +77,7 @@ def settings_options(command: str) -> Callable:
                                    annotation=Annotated[Path | None, typer.Option(
                                        help=CONFIG_HELP, metavar="FILE")])]
         extra += [_parameter(o, command) for o in options_of(command)]
+        extra += [_former(r) for r in renamed_of(command)]
 
         @functools.wraps(func)
         def command_function(*args: Any, **kwargs: Any) -> Any:
@@ -81,6 +95,7 @@ def settings_of(ctx: typer.Context, command: str, values: dict[str, Any]) -> Set
     usage error naming its option."""
     given = {name: value for name, value in values.items() if name != "config" and
              getattr(ctx.get_parameter_source(name), "name", "") in ("COMMANDLINE", "ENVIRONMENT")}
+    given = _renamed(given, command)
     config = values.get("config")
     base = base_settings(command) if config is None else read_settings(config,
                                                                        base_settings(command))
@@ -102,3 +117,30 @@ def _parameter(option: Option, command: str) -> inspect.Parameter:
                         **(bounds if option.kind in (FLOAT, INT) else {}))
     return inspect.Parameter(option.name, inspect.Parameter.KEYWORD_ONLY,
                              default=default, annotation=Annotated[kind, info])
+
+
+def _former(renamed: Renamed) -> inspect.Parameter:
+    """The hidden parameter of an option's former name: read as the option is, no default."""
+    option = option_named(renamed.new)
+    bounds = {k: v for k, v in (("min", option.lo), ("max", option.hi)) if math.isfinite(v)}
+    info = typer.Option(renamed.option, hidden=True, metavar=option.metavar,
+                        callback=finite if option.kind == FLOAT else None,
+                        **(bounds if option.kind in (FLOAT, INT) else {}))
+    return inspect.Parameter(renamed.old, inspect.Parameter.KEYWORD_ONLY, default=None,
+                             annotation=Annotated[TYPES.get(option.kind, str | None), info])
+
+
+def _renamed(given: dict[str, Any], command: str) -> dict[str, Any]:
+    """``given`` with each option given by its former name under its name, and a warning
+    naming it; a usage error when both names are given."""
+    out = dict(given)
+    for renamed in renamed_of(command):
+        if renamed.old not in out:
+            continue
+        now = option_named(renamed.new).option
+        if renamed.new in out:
+            raise typer.BadParameter(f"give it once ({renamed.option} is its former name)",
+                                     param_hint=now)
+        warnings.warn(f"{renamed.option} is renamed {now}", stacklevel=2)
+        out[renamed.new] = out.pop(renamed.old)
+    return out

@@ -22,6 +22,7 @@ from pcmapq.core.words import count
 from pcmapq.io import targets
 from pcmapq.io.formats import scan_formats
 from pcmapq.io.writers import OutputSet, write_atomic
+from pcmapq.settings import TRACK_EVERY
 
 if TYPE_CHECKING:  # imported when the command runs: the command line starts without it
     from pcmapq.track import RunOptions
@@ -50,7 +51,8 @@ def track_command(
         "they are moved into the scanner's frame, inv(T) P_k T, the frame of the run's "
         "poses.")] = None,
     every: Annotated[int | None, typer.Option(
-        help="Score the map every N scans (default 20).", min=1, show_default=False)] = None,
+        help=f"Score the map every N scans (default {TRACK_EVERY}).", min=1,
+        show_default=False)] = None,
     every_m: Annotated[float | None, typer.Option(
         help="Score the map every D metres travelled instead.", min=1e-6,
         callback=options.finite)] = None,

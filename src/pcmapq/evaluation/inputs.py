@@ -30,7 +30,7 @@ from pcmapq.io.occupancy import NO_RESOLUTION, open_outside
 from pcmapq.raster.draw import OCCUPIED, points_to_grid
 from pcmapq.raster.seen import seen_of_scans
 from pcmapq.raster.slice import wall_band
-from pcmapq.settings import Settings, SourceConfig
+from pcmapq.settings import MIN_HITS_2D, MIN_HITS_3D, Settings, SourceConfig
 
 #: The crop option of each side, named in messages.
 MAP_CROP, TRUTH_CROP = "--map-crop", "--truth-crop"
@@ -199,7 +199,7 @@ def min_hits(cloud: PointMap, settings: Settings) -> int:
     """Points needed to mark a cell of this cloud occupied (see RasterConfig.min_hits)."""
     if settings.raster.min_hits is not None:
         return settings.raster.min_hits
-    return 2 if cloud.is_3d else 1
+    return MIN_HITS_3D if cloud.is_3d else MIN_HITS_2D
 
 
 def truth_grid(truth: OccupancyMap | PointMap, truth_xy: np.ndarray,

@@ -21,3 +21,6 @@ DETECTOR_NAMES: tuple[str, ...] = tuple(DETECTOR_SOURCES)
 #: The detectors an evaluation runs when none are named: every one (a detector run only when
 #: named is left out here, and says ``by_default=False``).
 DEFAULT_DETECTORS: tuple[str, ...] = DETECTOR_NAMES
+#: Largest distance between matched features by default, metres: ``MatchingConfig.threshold``
+#: (``--threshold``) and :func:`pcmapq.match.match`'s default.
+MATCH_THRESHOLD = 0.5

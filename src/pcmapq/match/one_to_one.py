@@ -31,6 +31,7 @@ from scipy.sparse.csgraph import connected_components
 
 from pcmapq.core.words import count
 from pcmapq.features import Features, detector
+from pcmapq.features.names import MATCH_THRESHOLD
 
 
 @dataclass(frozen=True)
@@ -144,7 +145,7 @@ def harmonic_mean(quality: float | None, precision: float | None) -> float | Non
     return 2 * quality * precision / (quality + precision) if quality + precision > 0 else 0.0
 
 
-def match(name: str, truth: Features, map_: Features, threshold: float = 0.5,
+def match(name: str, truth: Features, map_: Features, threshold: float = MATCH_THRESHOLD,
           params: Any = None) -> Matching:
     """Match ``map_`` features to ``truth`` features of detector ``name``, one to one.
 

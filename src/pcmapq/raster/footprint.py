@@ -119,7 +119,7 @@ def check_rule(requested: str, image: bool, views: bool = False) -> None:
         raise ValueError("a point cloud has no known cells: footprint 'walls' or 'all'")
 
 
-def map_footprint(rule: str, occupied: np.ndarray, grid: MetricGrid, margin: float = 0.3,
+def map_footprint(rule: str, occupied: np.ndarray, grid: MetricGrid, margin: float,
                   known: np.ndarray | None = None,
                   rectangle: np.ndarray | None = None,
                   seen: np.ndarray | None = None) -> np.ndarray:

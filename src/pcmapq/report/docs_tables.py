@@ -11,20 +11,24 @@ import re
 from pcmapq.results import figures as table
 from pcmapq.results.figures import ALIASES, AT_TAU_COLUMN, MEAN_PRECISION, TAU_FIELDS
 from pcmapq.settings.build import base_settings, get_path
-from pcmapq.settings.table import FLOAT, INT, SWITCH, Option, options_of
+from pcmapq.settings.table import FLOAT, INT, SWITCH, Option, option_named, options_of, renamed_of
 
 BLOCK = re.compile(r"(<!-- options: (\w+) -->\n).*?(<!-- /options -->)", re.S)
 FIGURE_BLOCK = re.compile(r"(<!-- figures -->\n).*?(<!-- /figures -->)", re.S)
 
 
 def options_table(command: str) -> str:
-    """The settings options of ``command`` as a markdown table."""
+    """The settings options of ``command`` as a markdown table, then the former names it
+    still reads (:data:`~pcmapq.settings.table.RENAMED`)."""
     rows = ["| option | setting | default | meaning |", "| --- | --- | --- | --- |"]
     defaults = base_settings(command)
     for option in options_of(command):
         rows.append(f"| {_typed(option)} | `{option.path}` | "
                     f"{_default(option.show(get_path(defaults, option.path)))} | "
                     f"{option.help_for(command).replace('|', '/')} |")
+    former = [f"`{r.option}` (`{option_named(r.new).option}`)" for r in renamed_of(command)]
+    if former:
+        rows += ["", "Former names, still read with a warning: " + ", ".join(former) + "."]
     return "\n".join(rows) + "\n"
 
 

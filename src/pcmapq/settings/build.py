@@ -9,7 +9,7 @@ from dataclasses import MISSING, fields, is_dataclass, replace
 from typing import Any
 
 from pcmapq.core.errors import InputError
-from pcmapq.settings import NoRefConfig, Settings
+from pcmapq.settings.configs import NoRefConfig, Settings
 from pcmapq.settings.table import SWITCH, Option, options_of
 
 

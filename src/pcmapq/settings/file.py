@@ -17,9 +17,10 @@ from pcmapq.core.errors import InputError
 from pcmapq.core.transform import Similarity2D
 from pcmapq.io.map_yaml import Thresholds
 from pcmapq.io.writers import one_line
-from pcmapq.settings import Settings, plain
 from pcmapq.settings.build import check
-from pcmapq.settings.table import FLOAT, INT, OPTIONS, SWITCH, TEXT, OptionError
+from pcmapq.settings.configs import Settings
+from pcmapq.settings.plain import plain
+from pcmapq.settings.table import FLOAT, INT, SWITCH, TEXT, OptionError, options_of
 
 #: Groups that are null by default and take these keys when a file gives them.
 NULL_GROUPS = {"thresholds": {"occupied": None, "free": None, "negate": None},
@@ -67,7 +68,7 @@ def read_settings(path: str | Path, base: Settings | None = None) -> Settings:
         raise InputError(f"{path}: expected a mapping of settings groups (map, truth, raster, "
                          "alignment, footprint, matching, distances, noref)")
     merged = _merge(base.to_dict(), _read_words(doc, path), path, "")
-    for option in OPTIONS:
+    for option in options_of():
         _check_option(merged, option, path)
     try:
         settings = Settings.from_dict(merged)
@@ -85,11 +86,9 @@ def _read_words(doc: dict, path: str | Path) -> dict:
     ``init: "1,2,30"``, ``detectors: harris,hough``) read by its option's parser, as the
     command line reads it, and the settings that value implies (``also``) set too."""
     out = copy.deepcopy(doc)
-    seen: set[str] = set()
-    for option in OPTIONS:
-        if option.kind != TEXT or option.path in seen:
+    for option in options_of():
+        if option.kind != TEXT:
             continue
-        seen.add(option.path)
         *groups, key = option.path.split(".")
         group = _group(out, groups)
         if group is None or not isinstance(group.get(key), str):

@@ -2,7 +2,9 @@
 command-line option, its kind and bounds, its help, the commands that take it and its path in
 :class:`~pcmapq.settings.Settings`. The typer commands, the batch manifest's columns, the
 settings builder (:mod:`pcmapq.settings.build`) and the settings file
-(:mod:`pcmapq.settings.file`) all read it: an option added here reaches every one of them."""
+(:mod:`pcmapq.settings.file`) and the docs' option tables (:mod:`pcmapq.report.docs_tables`)
+all read it: an option added here reaches every one of them. An option has one name on every
+command; :data:`RENAMED` lists the former names still read, with a warning."""
 
 from __future__ import annotations
 
@@ -11,26 +13,38 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
-import numpy as np
-
-from pcmapq.core.errors import InputError
-from pcmapq.core.transform import Similarity2D
+from pcmapq.features.names import DETECTOR_NAMES
+from pcmapq.io.map_yaml import MapMeta
 from pcmapq.raster.rules import FOOTPRINT_RULES
-from pcmapq.settings import DETECTOR_NAMES
+from pcmapq.settings.configs import (
+    EVAL_NOREF_SAMPLE,
+    EVAL_NOREF_VOXEL,
+    MIN_HITS_2D,
+    MIN_HITS_3D,
+    RasterConfig,
+)
+from pcmapq.settings.parsers import (
+    OptionError,
+    parse_box,
+    parse_detectors,
+    parse_footprint,
+    parse_init,
+    parse_map_resolution,
+    parse_scale,
+    parse_taus,
+    show_init,
+    show_list,
+)
+
+__all__ = ["BATCH", "EVAL", "FLOAT", "INSPECT", "INT", "OPTIONS", "RENAMED", "SWITCH", "TEXT",
+           "TRACK", "Option", "OptionError", "Renamed", "option_named", "options_of",
+           "parse_box", "renamed_of"]
 
 #: Kinds of option: a number, an integer, text read by the option's parser, or a switch
 #: (``--noref/--no-noref``: a yes or no the command line can give either way).
 FLOAT, INT, TEXT, SWITCH = "float", "int", "text", "switch"
 #: The commands that take settings.
 EVAL, BATCH, TRACK, INSPECT = "eval", "batch", "track", "inspect"
-
-
-class OptionError(InputError):
-    """An option's value that cannot be read: one line, naming the option (exit 2)."""
-
-    def __init__(self, message: str, option: str) -> None:
-        super().__init__(message)
-        self.message, self.option = message, option
 
 
 def _same(value: Any) -> Any:
@@ -78,87 +92,6 @@ class Option:
         return self.helps.get(command, self.help)
 
 
-def parse_init(text: str) -> Similarity2D:
-    """``x,y,yaw`` (metres, metres, degrees; finite) as a map -> truth guess."""
-    try:
-        x, y, yaw = (float(v) for v in text.split(","))
-        if not all(math.isfinite(v) for v in (x, y, yaw)):
-            raise ValueError(text)
-    except ValueError:
-        raise OptionError(f"expected finite x,y,yaw (metres, metres, degrees), got {text!r}",
-                          "--init") from None
-    return Similarity2D(x, y, float(np.radians(yaw)))
-
-
-def show_init(tf: Similarity2D | None) -> str | None:
-    return None if tf is None else f"{tf.tx:g},{tf.ty:g},{np.degrees(tf.yaw):g}"
-
-
-def parse_box(text: str, option: str) -> tuple[float, float, float, float]:
-    """A box ``x0,y0,x1,y1`` (metres, finite, x0 < x1, y0 < y1)."""
-    try:
-        x0, y0, x1, y1 = (float(v) for v in text.split(","))
-        if not (all(math.isfinite(v) for v in (x0, y0, x1, y1)) and x0 < x1 and y0 < y1):
-            raise ValueError(text)
-    except ValueError:
-        raise OptionError(f"expected a box x0,y0,x1,y1 in metres with x0 < x1 and y0 < y1, got "
-                          f"{text!r}", option) from None
-    return x0, y0, x1, y1
-
-
-def show_list(values: tuple | None) -> str | None:
-    return None if values is None else ",".join(f"{v:g}" if isinstance(v, float) else str(v)
-                                                for v in values)
-
-
-def parse_map_resolution(text: str) -> float | None:
-    """Metres per pixel, or ``auto`` (None: the scale is estimated)."""
-    if text == "auto":
-        return None
-    try:
-        value = float(text)
-    except ValueError:
-        value = -1.0
-    if not 0 < value < math.inf:
-        raise OptionError(f"expected metres per pixel or 'auto', got {text!r}",
-                          "--map-resolution")
-    return value
-
-
-def parse_scale(text: str) -> bool:
-    if text not in ("fixed", "auto"):
-        raise OptionError(f"expected 'fixed' or 'auto', got {text!r}", "--scale")
-    return text == "auto"
-
-
-def parse_taus(text: str) -> tuple[float, ...]:
-    """Positive finite distances, metres, comma-separated."""
-    try:
-        taus = tuple(float(v) for v in text.split(","))
-    except ValueError:
-        taus = ()
-    if not taus or not all(0 < t < math.inf for t in taus):
-        raise OptionError(f"expected positive finite distances in metres, got {text!r}",
-                          "--tau")
-    return taus
-
-
-def parse_detectors(text: str) -> tuple[str, ...]:
-    names = tuple(n.strip() for n in text.split(",") if n.strip())
-    unknown = [n for n in names if n not in DETECTOR_NAMES]
-    if unknown or not names:
-        raise OptionError(f"unknown detector(s) {unknown}; choose from "
-                          f"{','.join(DETECTOR_NAMES)}", "--detectors")
-    return names
-
-
-def parse_footprint(text: str) -> str:
-    if text not in FOOTPRINT_RULES:
-        raise OptionError(f"expected one of {', '.join(FOOTPRINT_RULES)}, got {text!r}",
-                          "--footprint")
-    return text
-
-
 def _thresholds(side: str) -> list[Option]:
     """map_server's reading options of one side's image."""
     other = "as --map-" if side == "truth" else None
@@ -166,11 +99,11 @@ def _thresholds(side: str) -> list[Option]:
         Option(f"{side}_occupied_thresh", f"{side}.thresholds.occupied", FLOAT,
                f"Truth image: {other}occupied-thresh." if other else
                "Map image: occupied if p > this (map_server's occupied_thresh; overrides the "
-               "YAML's, default 0.65).", 0.0, 1.0),
+               f"YAML's, default {MapMeta.occupied_thresh:g}).", 0.0, 1.0),
         Option(f"{side}_free_thresh", f"{side}.thresholds.free", FLOAT,
                f"Truth image: {other}free-thresh." if other else
                "Map image: free if p < this (map_server's free_thresh; overrides the YAML's, "
-               "default 0.196).", 0.0, 1.0),
+               f"default {MapMeta.free_thresh:g}).", 0.0, 1.0),
         Option(f"{side}_negate", f"{side}.thresholds.negate", SWITCH,
                f"Truth image: {other}negate." if other else
                "Map image: p = v / 255 instead of (255 - v) / 255 (map_server's negate; "
@@ -188,33 +121,29 @@ OPTIONS: tuple[Option, ...] = (
            "Metres per pixel of a map image without YAML (overrides its YAML); 'auto' "
            "estimates the map's scale (same as --scale auto).", metavar="<metres|auto>",
            read=parse_map_resolution, show=lambda r: None if r is None else f"{r:g}",
-           also=lambda r: {"alignment.scale": True} if r is None else {}),
-    Option("map_resolution", "map.resolution", FLOAT,
-           "Metres per pixel of an image without YAML.", 1e-6, commands=(INSPECT,)),
+           also=lambda r: {"alignment.scale": True} if r is None else {},
+           commands=(EVAL, BATCH, INSPECT),
+           helps={INSPECT: "Metres per pixel of an image without YAML (overrides its "
+                           "YAML)."}),
     Option("truth_resolution", "truth.resolution", FLOAT,
            "Metres per pixel of a truth image without YAML; cell size for a cloud truth "
-           "(default 0.05).", 1e-6, commands=(EVAL, BATCH, TRACK), helps={TRACK: "As eval's."}),
+           f"(default {RasterConfig.cloud_resolution:g}).", 1e-6, commands=(EVAL, BATCH, TRACK),
+           helps={TRACK: "As eval's."}),
     *_thresholds("map"), *_thresholds("truth"),
     Option("map_crop", "map.crop", TEXT,
            "Keep only the map's part inside this box, metres, in its own frame (outlier "
            "points far away).", metavar="<x0,y0,x1,y1>",
-           read=lambda t: parse_box(t, "--map-crop"), show=show_list),
-    Option("crop", "map.crop", TEXT,
-           "Keep only the part of the map inside this box, metres, in its own frame (as "
-           "eval's --map-crop).", metavar="<x0,y0,x1,y1>",
-           read=lambda t: parse_box(t, "--crop"), show=show_list, commands=(INSPECT,)),
+           read=lambda t: parse_box(t, "--map-crop"), show=show_list,
+           commands=(EVAL, BATCH, INSPECT)),
     Option("map_topic", "map.topic", TEXT,
            "A ROS recording map: its OccupancyGrid topic (default: the only one, or /map).",
-           metavar="<topic>"),
+           metavar="<topic>", commands=(EVAL, BATCH, INSPECT)),
     Option("at", "map.at", FLOAT,
            "A ROS recording map: the map recorded at this time, seconds from the recording's "
            "start (its first message; the last map at or before it; default: the last)."),
     Option("truth_topic", "truth.topic", TEXT,
            "A ROS recording truth: its OccupancyGrid topic (default: the only one, or /map).",
            metavar="<topic>"),
-    Option("topic", "map.topic", TEXT,
-           "A ROS recording map: its OccupancyGrid topic (default: the only one, or /map).",
-           metavar="<topic>", commands=(INSPECT,)),
     Option("truth_crop", "truth.crop", TEXT,
            "Keep only the truth's part inside this box, metres, in its own frame.",
            metavar="<x0,y0,x1,y1>", read=lambda t: parse_box(t, "--truth-crop"),
@@ -242,8 +171,8 @@ OPTIONS: tuple[Option, ...] = (
     Option("band_high", "raster.band_high", FLOAT,
            "Wall band of a 3D cloud: upper bound, metres above the floor."),
     Option("min_hits", "raster.min_hits", INT,
-           "Points needed to mark a cloud's cell occupied (default: 2 for a 3D cloud, 1 for a "
-           "2D one).", 1),
+           f"Points needed to mark a cloud's cell occupied (default: {MIN_HITS_3D} for a 3D "
+           f"cloud, {MIN_HITS_2D} for a 2D one).", 1),
     Option("detectors", "matching.detectors", TEXT,
            f"Comma-separated detectors to run, any of {', '.join(DETECTOR_NAMES)}.",
            metavar="<" + ",".join(DETECTOR_NAMES) + ">", read=parse_detectors, show=show_list,
@@ -274,34 +203,75 @@ OPTIONS: tuple[Option, ...] = (
            "MPV, MOM of a 3D cloud; occupancy figures of a 2D map).", flag="--noref/--no-noref"),
     Option("noref_radius", "noref.radius", FLOAT,
            "Neighbourhood of the 3D no-reference figures, metres (0.2 for depth-camera maps, "
-           "with --noref-voxel 0.02).", 1e-6),
+           "with --noref-voxel 0.02).", 1e-6, commands=(EVAL, BATCH, INSPECT),
+           helps={INSPECT: "Neighbourhood radius of MME, MPV and MOM, metres (1 for LiDAR "
+                           "maps, 0.2 for depth cameras)."}),
     Option("noref_voxel", "noref.voxel", FLOAT,
            "A 3D cloud is first reduced to one point per cell of this size for its "
-           "no-reference figures, metres (0: as it is).", 0.0),
+           "no-reference figures, metres (0: as it is).", 0.0, commands=(EVAL, BATCH, INSPECT),
+           helps={INSPECT: "First reduce a 3D cloud to one point (the centroid) per cell of "
+                           "this size, metres; 0: as it is, as map-metrics ('pcmapq eval' uses "
+                           f"{EVAL_NOREF_VOXEL:g})."}),
     Option("noref_sample", "noref.sample", INT,
            "MME and MPV of a 3D cloud are means over this many of its points drawn at random "
            "(seeded), their standard errors reported, and MOM's planes are found on the cloud "
-           "at a third of the radius (0: every point, as 'pcmapq inspect').", 0),
-    Option("radius", "noref.radius", FLOAT,
-           "Neighbourhood radius of MME, MPV and MOM, metres (1 for LiDAR maps, 0.2 for depth "
-           "cameras).", 1e-6, commands=(INSPECT,)),
-    Option("min_knn", "noref.min_knn", INT,
+           "at a third of the radius (0: every point, as 'pcmapq inspect').", 0,
+           commands=(EVAL, BATCH, INSPECT),
+           helps={INSPECT: "MME and MPV over this many points drawn at random (seeded), with "
+                           "their standard errors, and MOM's planes from the cloud at a third "
+                           "of the radius; 0: every point, as map-metrics ('pcmapq eval' uses "
+                           f"{EVAL_NOREF_SAMPLE})."}),
+    Option("noref_min_knn", "noref.min_knn", INT,
            "A point counts when it has more than this many neighbours.", 0,
            commands=(INSPECT,)),
-    Option("max_nn", "noref.max_nn", INT,
+    Option("noref_max_nn", "noref.max_nn", INT,
            "Nearest neighbours of the normals that pick MOM's orthogonal planes.", 3,
            commands=(INSPECT,)),
-    Option("voxel", "noref.voxel", FLOAT,
-           "First reduce a 3D cloud to one point (the centroid) per cell of this size, "
-           "metres; 0: as it is, as map-metrics ('pcmapq eval' uses 0.1).", 0.0,
-           commands=(INSPECT,)),
-    Option("sample", "noref.sample", INT,
-           "MME and MPV over this many points drawn at random (seeded), with their standard "
-           "errors, and MOM's planes from the cloud at a third of the radius; 0: every point, "
-           "as map-metrics ('pcmapq eval' uses 20000).", 0, commands=(INSPECT,)),
 )
 
 
-def options_of(command: str) -> tuple[Option, ...]:
-    """The options ``command`` takes, in table order."""
-    return tuple(o for o in OPTIONS if command in o.commands)
+@dataclass(frozen=True)
+class Renamed:
+    """An option's former name (``radius``), still read where it was taken: as a command's
+    option (``--radius``, hidden from the help) or a batch manifest's column, with one warning
+    naming the option now (``--noref-radius``). ``commands``: the commands that took it. A
+    switch is not renamed this way."""
+
+    old: str
+    new: str
+    commands: tuple[str, ...]
+
+    @property
+    def option(self) -> str:
+        """The former option as typed: ``--radius``."""
+        return "--" + self.old.replace("_", "-")
+
+
+#: Every renamed option: inspect named its settings apart from eval's until each setting had
+#: one name on every command (the setting's group and key: ``--noref-radius`` for
+#: ``noref.radius``). The docs' option tables list them (:mod:`pcmapq.report.docs_tables`).
+RENAMED: tuple[Renamed, ...] = (
+    Renamed("crop", "map_crop", (INSPECT,)),
+    Renamed("topic", "map_topic", (INSPECT,)),
+    Renamed("radius", "noref_radius", (INSPECT,)),
+    Renamed("voxel", "noref_voxel", (INSPECT,)),
+    Renamed("sample", "noref_sample", (INSPECT,)),
+    Renamed("min_knn", "noref_min_knn", (INSPECT,)),
+    Renamed("max_nn", "noref_max_nn", (INSPECT,)),
+)
+
+
+def options_of(command: str | None = None) -> tuple[Option, ...]:
+    """The options ``command`` takes (None: every option), in table order. Read when called,
+    not when imported, so that an option added to :data:`OPTIONS` reaches every reader."""
+    return tuple(o for o in OPTIONS if command is None or command in o.commands)
+
+
+def option_named(name: str) -> Option:
+    """The option of this name (KeyError when none)."""
+    return {o.name: o for o in OPTIONS}[name]
+
+
+def renamed_of(command: str) -> tuple[Renamed, ...]:
+    """The former names ``command`` still reads."""
+    return tuple(r for r in RENAMED if command in r.commands)

@@ -14,15 +14,12 @@ import numpy as np
 
 from pcmapq.core.words import count
 from pcmapq.io.bags import has_grids
-from pcmapq.settings import Settings
+from pcmapq.settings import TRACK_EVERY, Settings
 from pcmapq.track.recording import Recording
 from pcmapq.track.runs import Run, open_run, reference_poses_of
 from pcmapq.track.steps import step_ends, travelled
 from pcmapq.track.timeline import PoseOptions
 from pcmapq.track.tracked import Tracked, track_recording, track_run
-
-#: Scans between steps when neither ``every`` nor ``every_m`` is given.
-EVERY = 20
 
 
 @dataclass(frozen=True)
@@ -31,8 +28,9 @@ class RunOptions:
     ``poses`` (a KITTI or TUM file; default a log's own, KISS-ICP's for scans), a recording's
     ``scan_topic``, ``pose_topic`` and ``frame``, ``reference_poses`` (with ``calib``, their
     scanner -> pose-frame transform) and how they compare (``pose_options``), a step every
-    ``every`` scans (default :data:`EVERY`) or ``every_m`` metres travelled. A recording's
-    published maps: their ``map_topic``, at most one every ``every_s`` seconds."""
+    ``every`` scans (default :data:`~pcmapq.settings.TRACK_EVERY`) or ``every_m`` metres
+    travelled. A recording's published maps: their ``map_topic``, at most one every
+    ``every_s`` seconds."""
 
     poses: Path | None = None
     reference_poses: Path | None = None
@@ -82,7 +80,7 @@ def plan_run(run_path: Path, options: RunOptions = RunOptions(),  # noqa: B008 (
                    pose_topic=options.pose_topic, frame=options.frame)
     reference = (None if options.reference_poses is None
                  else reference_poses_of(options.reference_poses, len(run), options.calib))
-    every = (options.every or EVERY) if options.every_m is None else None
+    every = (options.every or TRACK_EVERY) if options.every_m is None else None
     ends = step_ends(len(run), every, options.every_m, travelled(run.poses))
     return Plan(run, ends, reference, options, {"every_scans": every,
                                                 "every_m": options.every_m})

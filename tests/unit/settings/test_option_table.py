@@ -10,7 +10,7 @@ from dataclasses import replace
 import pytest
 import typer
 
-from pcmapq.batch.manifest import COLUMNS, make_row
+from pcmapq.batch.manifest import columns, make_row
 from pcmapq.cli import app
 from pcmapq.cli.options import settings_of
 from pcmapq.settings import Settings
@@ -31,9 +31,8 @@ from testkit.paths import REPO
 
 #: A value other than the default for each text option, as typed.
 TEXTS = {"scale": "auto", "map_resolution": "0.1", "map_crop": "-5,-5,5,5",
-         "truth_crop": "-6,-6,6,6", "crop": "-5,-5,5,5", "init": "1,2,3", "detectors": "sift",
-         "tau": "0.3,0.4", "footprint": "walls", "map_topic": "/slam/map",
-         "truth_topic": "/truth_map", "topic": "/slam/map"}
+         "truth_crop": "-6,-6,6,6", "init": "1,2,3", "detectors": "sift", "tau": "0.3,0.4",
+         "footprint": "walls", "map_topic": "/slam/map", "truth_topic": "/truth_map"}
 
 
 def sample(option: Option, command: str) -> object:
@@ -68,7 +67,7 @@ def test_an_option_on_the_command_line_a_manifest_and_a_file_gives_one_setting(o
     words = option_words({option.name: value}, EVAL)
     ctx = command(EVAL).make_context("eval", ["m.png", "t.png", *words])
     assert settings_of(ctx, EVAL, ctx.params) == built  # the command line rebuilt, parsed
-    assert option.name in COLUMNS
+    assert option.name in columns()
     row = make_row({"map": "m.png", "truth": "t.png", option.name: str(value).lower()
                     if isinstance(value, bool) else str(value)}, tmp_path, "row 1")
     assert row.settings == built
@@ -103,7 +102,7 @@ def test_every_option_has_a_setting_and_a_sample():
 
 
 def test_inspect_takes_its_noref_settings_from_the_table_with_no_voxel_by_default():
-    ctx = command("inspect").make_context("inspect", ["m.ply", "--radius", "0.2"])
+    ctx = command("inspect").make_context("inspect", ["m.ply", "--noref-radius", "0.2"])
     settings = settings_of(ctx, "inspect", ctx.params)
     assert settings.noref.radius == 0.2 and settings.noref.voxel == 0.0
 
