@@ -26,9 +26,9 @@ LISTING = ([], ["--help"], ["-h"], ["--version"])
 #: pipeline's own threads (docs/benchmarks.md). Set before NumPy loads; the user's value wins.
 BLAS_THREADS = "1"
 #: Modules the command never uses that a library it loads would import when installed, marked
-#: absent for the command's process: Open3D loads Dash, whose notebook support loads IPython
-#: (0.2-0.4 s of every run that aligns; Dash carries on without it). The library, imported in
-#: the user's own process, is left alone.
+#: absent for the command's process: Open3D loads Dash, whose notebook support loads IPython,
+#: a noticeable part of a short run's start (Dash carries on without it). The library, imported
+#: in the user's own process, is left alone.
 UNUSED = ("IPython",)
 #: Each command's module in pcmapq.cli, in the order ``pcmapq --help`` lists them
 #: (:data:`~pcmapq.cli.base.HELP`).
@@ -70,5 +70,5 @@ def main() -> None:
             __getattr__("app")()
     finally:
         # The command is over: the interpreter's exit need not search the objects of every
-        # module it loaded for cycles (0.3 s after Numba ran); they go with the process.
+        # module it loaded for cycles (many, once Numba ran); they go with the process.
         gc.freeze()
