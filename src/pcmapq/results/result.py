@@ -14,6 +14,7 @@ from pcmapq.core.grid import MetricGrid
 from pcmapq.core.stats import significant
 from pcmapq.core.transform import Similarity2D
 from pcmapq.metrics.distances import Distances
+from pcmapq.metrics.map_gaussians import MapGaussians
 from pcmapq.results import csv_files, document
 from pcmapq.results import figures as figure_table
 from pcmapq.results.blocks import (  # noqa: F401  (the names every reader imports from here)
@@ -50,6 +51,8 @@ class Result:
     rooms detector's rooms, each with its status (:func:`pcmapq.match.rooms.room_table`), None
     when it did not run. map_message: the recording's message the map was read from (topic,
     index, ``time_s`` from the recording's start, header ``stamp_s``), None for a file.
+    map_3d: MapEval's AWD and SCS of two 3D clouds in one frame
+    (:mod:`pcmapq.metrics.map_gaussians`), None otherwise.
     truth_occupied, map_occupied (and the overlap's footprint): the rasters on ``grid``; None
     in a result read back by :meth:`from_json`, which holds everything the JSON holds and no
     more.
@@ -79,6 +82,7 @@ class Result:
     truth_sha256: str | None = None
     rooms: dict | None = None
     map_message: dict | None = None
+    map_3d: MapGaussians | None = None
 
     @property
     def transform(self) -> Similarity2D:

@@ -13,12 +13,21 @@ from pcmapq.core.bounds import Box
 from pcmapq.core.transform import Similarity2D
 from pcmapq.features.names import DEFAULT_DETECTORS, DETECTOR_NAMES
 from pcmapq.io.map_yaml import Thresholds
-from pcmapq.metrics.defaults import DEFAULT_TAUS, LIDAR_RADIUS, MAX_NN, MAX_WARD_POINTS, MIN_KNN
+from pcmapq.metrics.defaults import (
+    AWD_MIN_POINTS,
+    AWD_VOXEL,
+    DEFAULT_TAUS,
+    LIDAR_RADIUS,
+    MAX_NN,
+    MAX_WARD_POINTS,
+    MIN_KNN,
+    SCS_RADIUS,
+)
 
 __all__ = ["DEFAULT_DETECTORS", "DETECTOR_NAMES", "EVAL_MAX_WARD", "EVAL_NOREF_SAMPLE",
            "EVAL_NOREF_VOXEL", "AlignmentConfig", "DistancesConfig", "FootprintConfig",
-           "MatchingConfig", "NoRefConfig", "RasterConfig", "Settings", "SourceConfig",
-           "default_params", "plain"]
+           "Map3DConfig", "MatchingConfig", "NoRefConfig", "RasterConfig", "Settings",
+           "SourceConfig", "default_params", "plain"]
 
 
 def default_params() -> dict[str, Any]:
@@ -136,6 +145,20 @@ class DistancesConfig:
 
 
 @dataclass(frozen=True)
+class Map3DConfig:
+    """MapEval's map figures of two 3D clouds, AWD and SCS (:mod:`pcmapq.metrics.map_gaussians`;
+    MapEval's defaults). A result records this group only when it has them.
+
+    voxel: the voxels' side, metres. min_points: the points a voxel needs in each cloud to be
+    compared. radius: SCS's neighbourhood, in voxels along each axis.
+    """
+
+    voxel: float = AWD_VOXEL
+    min_points: int = AWD_MIN_POINTS
+    radius: int = SCS_RADIUS
+
+
+@dataclass(frozen=True)
 class NoRefConfig:
     """The no-reference figures of each input (:mod:`pcmapq.evaluation.noref_figures`, ``pcmapq
     inspect``).
@@ -190,6 +213,7 @@ class Settings:
     distances: DistancesConfig = field(default_factory=DistancesConfig)
     noref: NoRefConfig = field(default_factory=lambda: NoRefConfig(
         voxel=EVAL_NOREF_VOXEL, max_ward=EVAL_MAX_WARD, sample=EVAL_NOREF_SAMPLE))
+    map_3d: Map3DConfig = field(default_factory=Map3DConfig)
 
     def to_dict(self) -> dict:
         """Every option as plain JSON types, one object per stage, in metres and degrees:
@@ -222,7 +246,8 @@ class Settings:
                                     {name: detector(name).params(**p)
                                      for name, p in m["params"].items()}),
             distances=DistancesConfig(tuple(doc["distances"]["taus"])),
-            noref=NoRefConfig(**doc.get("noref", {"enabled": False})))  # saved before noref
+            noref=NoRefConfig(**doc.get("noref", {"enabled": False})),  # saved before noref
+            map_3d=Map3DConfig(**doc.get("map_3d", {})))  # absent without two 3D clouds
 
 
 def plain(value):
