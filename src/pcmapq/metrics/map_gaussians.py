@@ -14,6 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from pcmapq.core.bounds import bounds
 from pcmapq.core.errors import InputError
 from pcmapq.core.voxels import voxel_groups
 from pcmapq.metrics.defaults import AWD_MIN_POINTS, AWD_VOXEL, SCS_RADIUS
@@ -55,7 +56,7 @@ def map_gaussians(map_xyz: np.ndarray, truth_xyz: np.ndarray, voxel: float = AWD
                           for c in (map_xyz, truth_xyz))
     # keyed from a corner of whole voxels below both clouds: the same voxels, and keys that
     # fit however far from the origin the clouds lie (UTM coordinates)
-    both = [c.min(axis=0) for c in (map_xyz, truth_xyz) if len(c)]
+    both = [bounds(c)[0] for c in (map_xyz, truth_xyz) if len(c)]
     corner = np.floor(np.min(both, axis=0) / voxel) * voxel if both else np.zeros(3)
     keys_m, mean_m, cov_m = voxel_gaussians(map_xyz - corner, voxel, min_points)
     keys_t, mean_t, cov_t = voxel_gaussians(truth_xyz - corner, voxel, min_points)
@@ -76,19 +77,17 @@ def voxel_gaussians(points: np.ndarray, voxel: float, min_points: int = 2
     square metres. Two passes (means, then products about them): exact far from the origin."""
     points = np.asarray(points, dtype=np.float64).reshape(-1, 3)
     keys, inverse = voxel_groups(points, voxel)
-    counts = np.bincount(inverse, minlength=len(keys))
-    kept = counts >= max(min_points, 2)
-    slot = np.cumsum(kept) - 1  # each voxel's place among the kept ones
-    mine = kept[inverse]
-    inv, pts, n = slot[inverse[mine]], points[mine], counts[kept].astype(np.float64)
-    size = int(np.count_nonzero(kept))
-    mean = np.column_stack([np.bincount(inv, weights=pts[:, a], minlength=size)
-                            for a in range(3)]) / n[:, None]
-    centred = pts - mean[inv]
-    cov = np.empty((size, 3, 3))
+    n = np.bincount(inverse, minlength=len(keys)).astype(np.float64)
+    kept = n >= max(min_points, 2)
+    columns = [np.ascontiguousarray(points[:, a]) for a in range(3)]
+    means = [np.bincount(inverse, weights=c, minlength=len(keys)) / np.maximum(n, 1.0)
+             for c in columns]
+    centred = [c - np.take(m, inverse) for c, m in zip(columns, means, strict=True)]
+    cov = np.empty((int(np.count_nonzero(kept)), 3, 3))
     for a, b in ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)):
         cov[:, a, b] = cov[:, b, a] = np.bincount(
-            inv, weights=centred[:, a] * centred[:, b], minlength=size) / (n - 1)
+            inverse, weights=centred[a] * centred[b], minlength=len(keys))[kept] / (n[kept] - 1)
+    mean = np.column_stack(means)[kept]
     return keys[kept], mean, cov
 
 
