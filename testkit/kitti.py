@@ -1,4 +1,5 @@
-"""KITTI odometry sequence 00's calibration: its velodyne -> left camera transform."""
+"""KITTI odometry sequence 00: its velodyne -> left camera transform, and maps of its first
+scans at the reference poses and at poses that drift in pitch (:func:`pitch_ladder`)."""
 
 from __future__ import annotations
 
@@ -17,3 +18,28 @@ def tr_00() -> np.ndarray:
     tr = np.eye(4)
     tr[:3, :4] = np.array(TR_00.split(), dtype=np.float64).reshape(3, 4)
     return tr
+
+
+def pitch_ladder(steps_deg: tuple[float, ...], voxel: float = 0.1
+                 ) -> tuple[np.ndarray, dict[float, np.ndarray]]:
+    """KITTI 00's scans (../shared/data/kitti00) placed at its reference LiDAR poses, the truth
+    map, and for each step of ``steps_deg`` a drifted map: scan k's pose pitched by k times the
+    step, degrees, about the scanner's own lateral (y) axis, so its far points rise or sink
+    more with every scan. Maps (N, 3), metres, voxel centroids of ``voxel`` metres, in the
+    first scan's frame."""
+    from scipy.spatial.transform import Rotation
+
+    from pcmapq.mapping import build_map_from_poses, lidar_poses_from_camera, read_kitti_poses
+
+    from .paths import shared
+
+    folder = shared("kitti00")
+    poses = lidar_poses_from_camera(read_kitti_poses(folder / "poses.txt"), tr_00())
+    truth = build_map_from_poses(folder, poses, voxel=voxel)
+    drifted = {}
+    for step in steps_deg:
+        pitched = poses.copy()
+        turns = Rotation.from_euler("y", np.arange(len(poses))[:, None] * step, degrees=True)
+        pitched[:, :3, :3] = poses[:, :3, :3] @ turns.as_matrix()
+        drifted[step] = build_map_from_poses(folder, pitched, voxel=voxel)
+    return truth, drifted

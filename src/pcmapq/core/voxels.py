@@ -22,7 +22,7 @@ from pcmapq.core import voxel_table
 from pcmapq.core.bounds import bounds
 from pcmapq.core.errors import InputError
 
-__all__ = ["VoxelMap", "evenly", "voxel_centroids", "voxel_count"]
+__all__ = ["VoxelMap", "evenly", "voxel_centroids", "voxel_count", "voxel_groups"]
 
 #: Grouping by counting is used when the points' box holds at most this many voxels per point
 #: and at most DENSE_CELLS voxels (8 bytes of memory each).
@@ -102,6 +102,16 @@ def voxel_keys(points: np.ndarray, voxel: float) -> np.ndarray:
     Raises InputError when a point lies beyond +-2**(bits - 1) voxels of the origin.
     """
     return _packed(voxel_index(points, voxel))
+
+
+def voxel_groups(points: np.ndarray, voxel: float) -> tuple[np.ndarray, np.ndarray]:
+    """The occupied voxels' packed keys (sorted, :func:`voxel_keys`) and each point's (N, d,
+    metres) place among them, as ``np.unique(voxel_keys(points, voxel), return_inverse=True)``
+    gives them: by counting on the voxels' bounding box when it is small for the points
+    (linear time), else by sorting."""
+    index = voxel_index(np.asarray(points, dtype=np.float64), voxel)
+    dense = _dense_groups(index)
+    return np.unique(_packed(index), return_inverse=True) if dense is None else dense
 
 
 def voxel_index(points: np.ndarray, voxel: float) -> np.ndarray:

@@ -24,6 +24,7 @@ from pcmapq.io import OccupancyMap, PointMap
 from pcmapq.match import match
 from pcmapq.match.rooms import room_table
 from pcmapq.metrics.distances import distances, distances_3d
+from pcmapq.metrics.map_gaussians import map_gaussians
 from pcmapq.results.result import OTHER, DetectorResult, Result
 from pcmapq.settings import Settings
 
@@ -40,7 +41,7 @@ def score(placed: Placed, prepared: PreparedTruth, settings: Settings,
     with ThreadPoolExecutor(2, thread_name_prefix="pcmapq-score") as pool:
         # the consistency map and the 3D distances need only the placed map: found while the
         # map's features are
-        consistency_job = cloud_job = None
+        consistency_job = cloud_job = gaussians_job = None
         if side.cover.verdict != OTHER and side.target is not None and \
                 side.target.lines is not None:
             progress("aligning the map's regions on their own")
@@ -52,6 +53,10 @@ def score(placed: Placed, prepared: PreparedTruth, settings: Settings,
             progress("distances in 3D")
             cloud_job = pool.submit(distances_3d, side.source.points, truth.points,
                                     settings.raster.cloud_resolution, settings.distances.taus)
+        if in_one_frame_3d(side, truth, settings):
+            m3 = settings.map_3d
+            gaussians_job = pool.submit(map_gaussians, side.source.points, truth.points,
+                                        m3.voxel, m3.min_points, m3.radius)
         if placed.features is None:
             progress("drawing the walls' centre lines and detecting features")
             sides = SideBySide(settings.matching.detectors, settings.matching.params)
@@ -59,6 +64,7 @@ def score(placed: Placed, prepared: PreparedTruth, settings: Settings,
                                                            threads=FEATURE_THREADS))
         consistency = None if consistency_job is None else consistency_job.result()
         cloud_distances = None if cloud_job is None else cloud_job.result()
+        gaussians = None if gaussians_job is None else gaussians_job.result()
     frames = Frames(alignment.transform, side.level, prepared.level,
                     None if registration is None else registration.transform)
     detectors = {}
@@ -91,11 +97,26 @@ def score(placed: Placed, prepared: PreparedTruth, settings: Settings,
                                       _band_words(side.source, truth, settings)),
                   registration_3d=registration, distances_3d=cloud_distances,
                   threshold=threshold, full=full, detectors=detectors,
-                  footprint_rule=rule, frames=frames, settings=settings.to_dict(),
+                  footprint_rule=rule, frames=frames,
+                  settings=recorded_settings(settings, gaussians is not None),
                   truth_occupied=prepared.occupied, map_occupied=side.occupied, noref=noref,
-                  consistency=consistency, rooms=rooms,
+                  consistency=consistency, rooms=rooms, map_3d=gaussians,
                   map_message=None if getattr(loaded, "message", None) is None
                   else loaded.message.to_dict())
+
+
+def in_one_frame_3d(placed: Placed, truth: OccupancyMap | PointMap, settings: Settings) -> bool:
+    """Whether the map and the truth are two 3D clouds in one frame: registered in 3D, or in
+    the frame the map was given in (``--no-align``). MapEval's map figures need them so."""
+    both_3d = all(isinstance(c, PointMap) and c.is_3d for c in (placed.source, truth))
+    return both_3d and (placed.registration is not None or not settings.alignment.enabled)
+
+
+def recorded_settings(settings: Settings, map_3d: bool) -> dict:
+    """The settings a result records (:meth:`Settings.to_dict`), the ``map_3d`` group only
+    when the result has MapEval's map figures, which alone it sets."""
+    doc = settings.to_dict()
+    return doc if map_3d else {k: v for k, v in doc.items() if k != "map_3d"}
 
 
 def inside(features: Features, area: np.ndarray, grid: MetricGrid,

@@ -17,3 +17,9 @@ MAX_NN = 30
 #: clustered through an evenly spaced sample of this many. A single scan's planar points stay
 #: below it, so an extraction from a scan is map-metrics' own.
 MAX_WARD_POINTS = 10_000
+
+#: MapEval's AWD and SCS (Cloud_Map_Evaluation's ``vmd_voxel_size``, the points a voxel needs
+#: in both maps, and SCS's neighbourhood in voxels along each axis).
+AWD_VOXEL = 3.0
+AWD_MIN_POINTS = 100
+SCS_RADIUS = 5

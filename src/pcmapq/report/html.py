@@ -15,7 +15,7 @@ from pcmapq.report.arrows import arrow_scale
 from pcmapq.report.heatmap import distance_heatmap
 from pcmapq.report.plot import png_bytes, vectorial_figure
 from pcmapq.report.style import FIGURE_WIDTH_PX
-from pcmapq.report.text import number, score
+from pcmapq.report.text import map_3d_parts, number, score
 from pcmapq.report.viewer import nearest_distances, viewer_html
 from pcmapq.report.viewer_page import STYLE as VIEWER_STYLE
 from pcmapq.results.result import DetectorResult, Result
@@ -162,6 +162,10 @@ def report_html(result: Result, scale: float | None = None) -> str:
                 "clouds:</p>"
         dist += _stats_table("points", [("3D accuracy (map to truth)", d3.accuracy),
                                         ("3D completeness (truth to map)", d3.completeness)])
+    if result.map_3d is not None:
+        parts = ", ".join(map_3d_parts(result.map_3d, result.settings))
+        dist += "<p class=\"note\">MapEval's map figures of the two 3D clouds (lower is " \
+                f"better): {html.escape(parts)}.</p>"
     gain = arrow_scale(result, scale)
     viewer = viewer_html(result, gain)
     vectors = _img(png_bytes(vectorial_figure(result, gain)), "vectorial map per detector")

@@ -11,7 +11,16 @@ from rich.table import Table
 
 from pcmapq.core.stats import FIELDS, Stats
 from pcmapq.core.words import count, length
-from pcmapq.report.text import LEGEND, metres, number, score, verdict, words, wrap
+from pcmapq.report.text import (
+    LEGEND,
+    map_3d_parts,
+    metres,
+    number,
+    score,
+    verdict,
+    words,
+    wrap,
+)
 from pcmapq.results.result import DetectorResult, Result
 
 #: Width of the labels of the key-value lines, characters.
@@ -108,6 +117,8 @@ def _distances(result: Result) -> list[tuple[str, list[str]]]:
         lines += [("3D accuracy", _stats_parts(d3.accuracy, f"map -> truth on {voxels}")),
                   ("3D complete", _stats_parts(d3.completeness, "truth -> map, 3D")),
                   ("3D", [f"Chamfer {metres(d3.chamfer_m)}"])]
+    if result.map_3d is not None:
+        lines.append(("3D map", map_3d_parts(result.map_3d, result.settings)))
     return lines
 
 

@@ -7,6 +7,7 @@ import re
 from collections.abc import Sequence
 
 from pcmapq.core.words import count
+from pcmapq.metrics.map_gaussians import MapGaussians
 from pcmapq.results.result import INCONSISTENT, LOW, OTHER, Result
 
 #: What the terms of the table mean, in one short paragraph (their definitions:
@@ -36,6 +37,15 @@ def number(value: float | None, digits: int = 3) -> str:
 def metres(value: float | None, digits: int = 3) -> str:
     """A length in metres, 'x.xxx m'; '-' when there is none (nothing measured)."""
     return "-" if value is None else f"{value:.{digits}f} m"
+
+
+def map_3d_parts(figures: MapGaussians, settings: dict | None) -> list[str]:
+    """MapEval's AWD and SCS of two 3D clouds and the voxels they are over (their side from
+    the result's ``settings``), as values: ``AWD 0.052 m``, ``SCS 0.412``, ``over 812 voxels
+    of 3 m``."""
+    voxel = ((settings or {}).get("map_3d") or {}).get("voxel")
+    over = count(figures.voxels, "voxel") + ("" if voxel is None else f" of {voxel:g} m")
+    return [f"AWD {metres(figures.awd_m)}", f"SCS {number(figures.scs)}", f"over {over}"]
 
 
 def alignment_words(result: Result) -> str:

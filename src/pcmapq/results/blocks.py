@@ -16,6 +16,7 @@ from pcmapq.core.transform import Similarity2D
 from pcmapq.features import Features
 from pcmapq.match import Matching
 from pcmapq.metrics.distances import Distances
+from pcmapq.metrics.map_gaussians import MapGaussians
 
 if TYPE_CHECKING:  # the alignment modules load Open3D; a result only holds their outputs
     from pcmapq.align import Alignment
@@ -123,6 +124,8 @@ class Findings:
     rooms detector's rooms, each with its status (:func:`pcmapq.match.rooms.room_table`), None
     when it did not run. map_message: the recording's message the map was read from (topic,
     index, ``time_s`` from the recording's start, header ``stamp_s``), None for a file.
+    map_3d: MapEval's AWD and SCS of two 3D clouds in one frame
+    (:mod:`pcmapq.metrics.map_gaussians`), None otherwise.
     truth_occupied, map_occupied (and the overlap's footprint): the rasters on ``grid``; None
     in a result read back by :meth:`Result.from_json`, which holds everything the JSON holds and no
     more.
@@ -152,6 +155,7 @@ class Findings:
     truth_sha256: str | None = None
     rooms: dict | None = None
     map_message: dict | None = None
+    map_3d: MapGaussians | None = None
 
     @property
     def transform(self) -> Similarity2D:

@@ -18,6 +18,7 @@ from pcmapq.core.transform import Similarity2D
 from pcmapq.features import Features
 from pcmapq.match import Matching
 from pcmapq.metrics.distances import Distances
+from pcmapq.metrics.map_gaussians import MapGaussians
 from pcmapq.results import schema as s
 from pcmapq.results.blocks import DetectorResult, Findings, Overlap
 
@@ -40,6 +41,10 @@ def document(r: Findings, features: bool = True) -> s.ResultDocument:
         optional["alignment_3d"] = s.Registration3D(matrix=reg.transform.tolist(),
                                                     fitness=reg.fitness, rmse_m=reg.rmse_m)
         optional["distances_3d"] = _distances(r.distances_3d)
+    if r.map_3d is not None:
+        g = r.map_3d
+        optional["map_3d"] = s.Map3D(computed_on=g.basis, voxels=g.voxels, awd_m=g.awd_m,
+                                     scs=g.scs)
     if r.rooms is not None:
         optional["rooms"] = r.rooms
     rows = _feature_rows(r) if features else ([], [], [])
@@ -103,7 +108,9 @@ def fields(doc: s.ResultDocument) -> dict[str, Any]:
         truth_occupied=None, map_occupied=None, frames=frames,
         footprint_rule=doc.footprint, settings=doc.settings, command=doc.pcmapq.command,
         noref=doc.noref, truth_sha256=t.sha256, map_message=message or None,
-        consistency=_consistency_of(doc.consistency, a.tolerance_m), rooms=doc.rooms)
+        consistency=_consistency_of(doc.consistency, a.tolerance_m), rooms=doc.rooms,
+        map_3d=None if doc.map_3d is None else MapGaussians(
+            doc.map_3d.awd_m, doc.map_3d.scs, doc.map_3d.voxels, doc.map_3d.computed_on))
 
 
 def consistency_block(c: Consistency | None) -> s.ConsistencyMap:

@@ -110,6 +110,8 @@ FIGURES: tuple[Figure, ...] = (
       if a not in ("confidence", "fitness", "x_m", "y_m", "yaw_deg", "scale")),
     *_stats("accuracy", "distances_3d", "_3d"), *_stats("completeness", "distances_3d", "_3d"),
     Figure("chamfer_3d", ("distances_3d", "chamfer_m"), optional=True, label="Chamfer 3D"),
+    Figure("awd_3d", ("map_3d", "awd_m"), column=True, label="AWD", optional=True),
+    Figure("scs_3d", ("map_3d", "scs"), column=True, label="SCS", optional=True),
 )
 #: Other names of figures that gates have always read: the one list of aliases.
 ALIASES = {"chamfer.mean": "chamfer", "chamfer_3d.mean": "chamfer_3d"}

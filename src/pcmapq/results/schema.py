@@ -190,6 +190,22 @@ class Distances(Block):
     f_score: list[FScore]
 
 
+class Map3D(Block):
+    """MapEval's map figures of two 3D clouds in one frame (docs/metrics.md): each cloud cut
+    into voxels, one Gaussian (mean, covariance) per voxel and cloud."""
+
+    computed_on: str
+    """The voxels, the points they need and SCS's neighbourhood, in words."""
+    voxels: int
+    """Voxels both clouds hold enough points in: AWD's mean is over them."""
+    awd_m: float | None
+    """AWD: the mean 2-Wasserstein distance between the two clouds' Gaussians of those voxels
+    (lower is better); null when no voxel is compared."""
+    scs: float | None
+    """SCS: the mean, over those voxels, of their neighbours' distances' standard deviation
+    over their mean (no unit; lower is better); null when no voxel has a neighbour."""
+
+
 class Detector(Block):
     """One detector's scores (the paper's quality q and more)."""
 
@@ -280,6 +296,8 @@ class ResultDocument(Block):
     extra: list[Extra]
     alignment_3d: Registration3D | None = None
     distances_3d: Distances | None = None
+    map_3d: Map3D | None = None
+    """Two 3D clouds in one frame: MapEval's AWD and SCS."""
     rooms: dict[str, Any] | None = None
     """The rooms detector's rooms and doors, each with its status."""
     gates: list[Gate] | None = None

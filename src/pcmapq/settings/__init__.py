@@ -17,6 +17,7 @@ from pcmapq.settings.configs import (
     AlignmentConfig,
     DistancesConfig,
     FootprintConfig,
+    Map3DConfig,
     MatchingConfig,
     NoRefConfig,
     RasterConfig,
@@ -28,5 +29,5 @@ from pcmapq.settings.plain import plain
 
 __all__ = ["DEFAULT_DETECTORS", "DETECTOR_NAMES", "EVAL_MAX_WARD", "EVAL_NOREF_SAMPLE",
            "EVAL_NOREF_VOXEL", "MIN_HITS_2D", "MIN_HITS_3D", "TRACK_EVERY", "AlignmentConfig",
-           "DistancesConfig", "FootprintConfig", "MatchingConfig", "NoRefConfig", "RasterConfig",
+           "DistancesConfig", "FootprintConfig", "Map3DConfig", "MatchingConfig", "NoRefConfig", "RasterConfig",
            "Settings", "SourceConfig", "default_params", "plain"]

@@ -15,7 +15,16 @@ from pcmapq.core.bounds import Box
 from pcmapq.core.transform import Similarity2D
 from pcmapq.features.names import DEFAULT_DETECTORS, MATCH_THRESHOLD
 from pcmapq.io.map_yaml import Thresholds
-from pcmapq.metrics.defaults import DEFAULT_TAUS, LIDAR_RADIUS, MAX_NN, MAX_WARD_POINTS, MIN_KNN
+from pcmapq.metrics.defaults import (
+    AWD_MIN_POINTS,
+    AWD_VOXEL,
+    DEFAULT_TAUS,
+    LIDAR_RADIUS,
+    MAX_NN,
+    MAX_WARD_POINTS,
+    MIN_KNN,
+    SCS_RADIUS,
+)
 from pcmapq.settings.plain import plain
 
 
@@ -180,6 +189,20 @@ TRACK_EVERY = 20
 
 
 @dataclass(frozen=True)
+class Map3DConfig:
+    """MapEval's map figures of two 3D clouds, AWD and SCS (:mod:`pcmapq.metrics.map_gaussians`;
+    MapEval's defaults). A result records this group only when it has them.
+
+    voxel: the voxels' side, metres. min_points: the points a voxel needs in each cloud to be
+    compared. radius: SCS's neighbourhood, in voxels along each axis.
+    """
+
+    voxel: float = AWD_VOXEL
+    min_points: int = AWD_MIN_POINTS
+    radius: int = SCS_RADIUS
+
+
+@dataclass(frozen=True)
 class Settings:
     """Options of ``pcmapq eval``, one group per stage; defaults are the documented ones.
 
@@ -196,6 +219,7 @@ class Settings:
     distances: DistancesConfig = field(default_factory=DistancesConfig)
     noref: NoRefConfig = field(default_factory=lambda: NoRefConfig(
         voxel=EVAL_NOREF_VOXEL, max_ward=EVAL_MAX_WARD, sample=EVAL_NOREF_SAMPLE))
+    map_3d: Map3DConfig = field(default_factory=Map3DConfig)
 
     def to_dict(self) -> dict:
         """Every option as plain JSON types, one object per stage, in metres and degrees:
@@ -228,4 +252,5 @@ class Settings:
                                     {name: detector(name).params(**p)
                                      for name, p in m["params"].items()}),
             distances=DistancesConfig(tuple(doc["distances"]["taus"])),
-            noref=NoRefConfig(**doc.get("noref", {"enabled": False})))  # saved before noref
+            noref=NoRefConfig(**doc.get("noref", {"enabled": False})),  # saved before noref
+            map_3d=Map3DConfig(**doc.get("map_3d", {})))  # absent without two 3D clouds

@@ -180,6 +180,14 @@ OPTIONS: tuple[Option, ...] = (
     Option("voxel_3d", "alignment.voxel_3d", FLOAT,
            "Working voxel of the 3D registration of two 3D clouds, metres (0.5-1 for outdoor "
            "maps).", 0.01, flag="--voxel-3d"),
+    Option("awd_voxel", "map_3d.voxel", FLOAT,
+           "Two 3D clouds: side of the voxels of AWD and SCS, metres (MapEval's 3; 2-4 "
+           "outdoors, 2-3 indoors).", 0.01),
+    Option("awd_min_points", "map_3d.min_points", INT,
+           "Two 3D clouds: points a voxel needs in each cloud to count in AWD and SCS.", 2),
+    Option("scs_radius", "map_3d.radius", INT,
+           "Two 3D clouds: SCS compares a voxel's neighbours within this many voxels along "
+           "each axis.", 1),
     Option("tau", "distances.taus", TEXT,
            "Distance thresholds of the F-score, metres, comma-separated.", metavar="<M,M,...>",
            read=parse_taus, show=show_list, commands=(EVAL, BATCH, TRACK),

@@ -15,6 +15,7 @@ from pcmapq.core.voxels import (
     evenly,
     voxel_centroids,
     voxel_count,
+    voxel_groups,
     voxel_index,
     voxel_keys,
 )
@@ -65,6 +66,19 @@ def test_voxel_count_is_the_number_of_centroids(dims: int) -> None:
     sparse = rng.uniform(-500, 500, (20_000, dims))  # sorted by voxel_centroids
     for points in (dense, sparse, np.vstack([sparse, sparse[:100]]), np.empty((0, dims))):
         assert voxel_count(points, 0.05) == len(voxel_centroids(points, 0.05))
+
+
+def test_voxel_groups_are_numpys_unique_keys_and_inverse() -> None:
+    rng = np.random.default_rng(7)
+    dense = rng.normal(0, 0.3, (50_000, 3))  # counted
+    sparse = rng.uniform(-500, 500, (2_000, 3))  # sorted
+    assert voxels._dense_groups(voxel_index(dense, 0.05)) is not None
+    assert voxels._dense_groups(voxel_index(sparse, 0.05)) is None
+    for points in (dense, sparse):
+        keys, inverse = voxel_groups(points, 0.05)
+        want = np.unique(voxel_keys(points, 0.05), return_inverse=True)
+        np.testing.assert_array_equal(keys, want[0])
+        np.testing.assert_array_equal(inverse, want[1])
 
 
 def test_evenly_spreads_over_the_order() -> None:

@@ -179,6 +179,15 @@ def test_the_regions_line_counts_in_words_and_rounds_the_tile_as_metres():
     assert "1 region of 6.6 m" in text
 
 
+def test_the_3d_map_line_gives_awd_and_scs_only_when_the_result_has_them():
+    assert "AWD" not in shown(sample_result(), 132)
+    doc = copy.deepcopy(SAMPLE_DOC)
+    doc["map_3d"] = {"computed_on": "3 m voxels", "voxels": 812, "awd_m": 0.0523, "scs": None}
+    doc["settings"]["map_3d"] = {"voxel": 3.0, "min_points": 100, "radius": 5}
+    text = " ".join(shown(sample_result(doc), 132).split())
+    assert "3D map AWD 0.052 m, SCS -, over 812 voxels of 3 m" in text
+
+
 def test_lines_break_between_values_only():
     assert wrap(["x 6.016 m", "y 7.985 m", "yaw 36.99 deg"], 21) == [
         "x 6.016 m, y 7.985 m,", "yaw 36.99 deg"]

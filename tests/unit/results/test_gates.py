@@ -69,6 +69,8 @@ def test_parse_refuses_in_one_line_naming_the_option(text, words):
     ("accuracy.mean", ("distances", "accuracy_m", "mean")),
     ("completeness.median", ("distances", "completeness_m", "median")),
     ("accuracy_3d.p95", ("distances_3d", "accuracy_m", "p95")),
+    ("awd_3d", ("map_3d", "awd_m")),
+    ("scs_3d", ("map_3d", "scs")),
     ("chamfer", ("distances", "chamfer_m")),
     ("chamfer.mean", ("distances", "chamfer_m")),
     ("f_score@0.1", ("distances", "f_score", 1, "f")),
@@ -121,6 +123,7 @@ def test_a_null_figure_fails_its_gate_saying_why():
     ("f_score@0.2", "no F-score at that tau"),
     ("f_score_3d@0.1", "no 3D distances"),
     ("accuracy_3d.mean", "no 'distances_3d' in the top level"),
+    ("awd_3d", "no 'map_3d' in the top level"),
 ])
 def test_a_key_the_result_lacks_is_a_usage_error(key, words):
     rules = parse_gates(f"{key}=1", OVER)

@@ -62,7 +62,7 @@ def test_a_document_off_the_schema_is_refused(doc: dict, change: str):
 
 def _full(doc: dict) -> dict:
     """The sample's document with the blocks it lacks: a recording's message, a 3D
-    registration and its distances, gates; no truth digest."""
+    registration, its distances and map figures, gates; no truth digest."""
     full = copy.deepcopy(doc)
     full["map"].update(topic="/map", index=2, time_s=10.5, stamp_s=None)
     del full["truth"]["sha256"]
@@ -70,6 +70,7 @@ def _full(doc: dict) -> dict:
                                        [0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0]],
                             "fitness": 0.9, "rmse_m": 0.02}
     full["distances_3d"] = {**copy.deepcopy(full["distances"]), "computed_on": "points"}
+    full["map_3d"] = {"computed_on": "3 m voxels", "voxels": 12, "awd_m": 0.05, "scs": None}
     full["rooms"] = full.pop("rooms")  # written after the 3D blocks
     return with_gates(full, check(parse_rules("harris.quality=0.5", None), full))
 

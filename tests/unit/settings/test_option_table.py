@@ -120,3 +120,10 @@ def test_the_command_pages_list_the_tables_options():
     for page in pages:
         assert update(page.read_text()) == page.read_text(), \
             f"{page.name}: run python tools/options_doc.py"
+
+
+def test_settings_recorded_without_the_3d_map_group_read_back_with_its_defaults():
+    """A result of no two 3D clouds records no ``map_3d`` group (nor did results before it)."""
+    doc = Settings().to_dict()
+    del doc["map_3d"]
+    assert Settings.from_dict(doc) == Settings()

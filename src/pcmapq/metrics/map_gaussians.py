@@ -1,0 +1,158 @@
+"""MapEval's map figures between two 3D clouds in one frame (Hu et al., RA-L 2025; definitions
+and where they differ from MapEval's code in docs/metrics.md): each cloud cut into cubic
+voxels, the points of a voxel summed up as a Gaussian (mean, sample covariance); AWD, the mean
+2-Wasserstein distance between the two clouds' Gaussians of the voxels both fill, metres; SCS,
+how much those distances vary among neighbouring voxels (a coefficient of variation, no unit).
+
+Vectorised: the voxels' sums by ``np.bincount`` on packed voxel keys, the distances by batched
+eigendecompositions of 3 x 3 matrices, the neighbourhoods by sorted keys (one pass per column
+of neighbours, never per voxel)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from pcmapq.core.bounds import bounds
+from pcmapq.core.errors import InputError
+from pcmapq.core.voxels import voxel_groups
+from pcmapq.metrics.defaults import AWD_MIN_POINTS, AWD_VOXEL, SCS_RADIUS
+
+#: Eigenvalues of a voxel's covariance are raised to at least this, m^2 (MapEval's floor): a
+#: flat voxel (a wall) keeps a finite thickness.
+COVARIANCE_FLOOR = 1e-6
+#: A squared distance within this share of the two covariances' traces is rounding, and 0
+#: (identical Gaussians computed in two orders): below a micrometre for metre-sized voxels.
+ROUNDING = 1e-12
+#: Bits of an axis in a packed voxel key (:func:`pcmapq.core.voxels.voxel_keys`, 3D).
+_BITS = 21
+
+
+@dataclass(frozen=True)
+class MapGaussians:
+    """AWD (metres) and SCS (no unit) of two clouds, each None when nothing was compared.
+
+    voxels: the voxels both clouds hold at least ``min_points`` points in (AWD's mean is
+    over them); basis: what the figures are computed on, in words."""
+
+    awd_m: float | None
+    scs: float | None
+    voxels: int
+    basis: str = ""
+
+
+def map_gaussians(map_xyz: np.ndarray, truth_xyz: np.ndarray, voxel: float = AWD_VOXEL,
+                  min_points: int = AWD_MIN_POINTS, radius: int = SCS_RADIUS) -> MapGaussians:
+    """AWD and SCS of a map cloud (N, 3) against a truth cloud (M, 3), metres, both in the
+    truth's frame, on ``voxel``-metre cubes (floor of each coordinate over the voxel, as
+    MapEval). A voxel counts when each cloud holds at least ``min_points`` points in it; SCS
+    looks at the counted voxels within ``radius`` voxels along every axis (a cube of side
+    ``2 * radius + 1``, the voxel itself left out). InputError for clouds spanning more than
+    about a million voxels."""
+    basis = (f"in 3D: {voxel:g} m voxels holding at least {min_points} points of each cloud, "
+             f"one Gaussian per voxel and cloud; SCS over neighbours within {radius} voxels")
+    map_xyz, truth_xyz = (np.asarray(c, dtype=np.float64).reshape(-1, 3)
+                          for c in (map_xyz, truth_xyz))
+    # keyed from a corner of whole voxels below both clouds: the same voxels, and keys that
+    # fit however far from the origin the clouds lie (UTM coordinates)
+    both = [bounds(c)[0] for c in (map_xyz, truth_xyz) if len(c)]
+    corner = np.floor(np.min(both, axis=0) / voxel) * voxel if both else np.zeros(3)
+    keys_m, mean_m, cov_m = voxel_gaussians(map_xyz - corner, voxel, min_points)
+    keys_t, mean_t, cov_t = voxel_gaussians(truth_xyz - corner, voxel, min_points)
+    common, in_m, in_t = np.intersect1d(keys_m, keys_t, assume_unique=True,
+                                        return_indices=True)
+    if len(common) == 0:
+        return MapGaussians(None, None, 0, basis)
+    w = gaussian_w2(mean_t[in_t], cov_t[in_t], mean_m[in_m], cov_m[in_m])
+    return MapGaussians(float(w.mean()), spatial_consistency(common, w, radius),
+                        int(len(common)), basis)
+
+
+def voxel_gaussians(points: np.ndarray, voxel: float, min_points: int = 2
+                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The voxels of ``points`` (N, 3, metres) holding at least ``min_points`` (>= 2) of them:
+    their packed keys (V,) int64 sorted (:func:`~pcmapq.core.voxels.voxel_keys`), the mean
+    (V, 3) of their points, metres, and its sample covariance (V, 3, 3, divided by n - 1),
+    square metres. Two passes (means, then products about them): exact far from the origin."""
+    points = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+    keys, inverse = voxel_groups(points, voxel)
+    n = np.bincount(inverse, minlength=len(keys)).astype(np.float64)
+    kept = n >= max(min_points, 2)
+    columns = [np.ascontiguousarray(points[:, a]) for a in range(3)]
+    means = [np.bincount(inverse, weights=c, minlength=len(keys)) / np.maximum(n, 1.0)
+             for c in columns]
+    centred = [c - np.take(m, inverse) for c, m in zip(columns, means, strict=True)]
+    cov = np.empty((int(np.count_nonzero(kept)), 3, 3))
+    for a, b in ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)):
+        cov[:, a, b] = cov[:, b, a] = np.bincount(
+            inverse, weights=centred[a] * centred[b], minlength=len(keys))[kept] / (n[kept] - 1)
+    mean = np.column_stack(means)[kept]
+    return keys[kept], mean, cov
+
+
+def gaussian_w2(mean_a: np.ndarray, cov_a: np.ndarray, mean_b: np.ndarray,
+                cov_b: np.ndarray) -> np.ndarray:
+    """The 2-Wasserstein distance (V,), metres, between Gaussians paired by row: means (V, 3)
+    metres, covariances (V, 3, 3) square metres, each covariance's eigenvalues first raised to
+    :data:`COVARIANCE_FLOOR`. ``W^2 = |ma - mb|^2 + tr(A + B - 2 (A^1/2 B A^1/2)^1/2)`` with
+    symmetric square roots (eigendecompositions)."""
+    a, b = _floored(cov_a), _floored(cov_b)
+    value, vector = np.linalg.eigh(a)
+    root = (vector * np.sqrt(value)[:, None, :]) @ vector.transpose(0, 2, 1)
+    middle = root @ b @ root
+    middle = 0.5 * (middle + middle.transpose(0, 2, 1))
+    cross = np.sqrt(np.clip(np.linalg.eigvalsh(middle), 0.0, None)).sum(axis=1)
+    spread = np.trace(a, axis1=1, axis2=2) + np.trace(b, axis1=1, axis2=2)
+    squared = np.sum((mean_a - mean_b) ** 2, axis=1) + spread - 2.0 * cross
+    squared[squared <= ROUNDING * spread] = 0.0
+    return np.sqrt(squared)
+
+
+def spatial_consistency(keys: np.ndarray, w: np.ndarray, radius: int) -> float | None:
+    """SCS: over the voxels (packed keys (V,) sorted, their distances ``w`` (V,), metres) that
+    have any other voxel within ``radius`` voxels along every axis, the mean of those
+    neighbours' coefficient of variation (population standard deviation over mean; 0 where
+    their mean is 0). None when no voxel has a neighbour.
+
+    One pass per (dx, dy) column of the neighbourhood: the keys of a column's voxels z - radius
+    to z + radius are one range of the sorted keys (z is a key's lowest bits), so prefix sums
+    over it give each voxel's count, sum and sum of squares."""
+    index = (keys[:, None] >> np.array([2 * _BITS, _BITS, 0])) & ((1 << _BITS) - 1)
+    if len(keys) and (index.min() < radius or index.max() >= (1 << _BITS) - radius):
+        raise InputError("a cloud reaches the edge of the voxel index; use a larger voxel")
+    centre = float(w.mean()) if len(w) else 0.0  # sums about it: no cancellation
+    shifted = w - centre
+    sums = np.concatenate([[0.0], np.cumsum(shifted)])
+    squares = np.concatenate([[0.0], np.cumsum(shifted**2)])
+    nonzero = np.concatenate([[0], np.cumsum(w > 0)])
+    count, moving = np.zeros(len(keys), dtype=np.int64), np.zeros(len(keys), dtype=np.int64)
+    total, total_sq = np.zeros(len(keys)), np.zeros(len(keys))
+    for dx in range(-radius, radius + 1):
+        for dy in range(-radius, radius + 1):
+            column = keys + (dx << 2 * _BITS) + (dy << _BITS)
+            lo = np.searchsorted(keys, column - radius, side="left")
+            hi = np.searchsorted(keys, column + radius, side="right")
+            count += hi - lo
+            moving += nonzero[hi] - nonzero[lo]
+            total += sums[hi] - sums[lo]
+            total_sq += squares[hi] - squares[lo]
+    count -= 1  # the voxel itself is not its own neighbour
+    total, total_sq = total - shifted, total_sq - shifted**2
+    moving -= w > 0
+    has = count > 0
+    if not has.any():
+        return None
+    n = count[has]
+    mean = total[has] / n + centre
+    variance = np.clip(total_sq[has] / n - (total[has] / n) ** 2, 0.0, None)
+    ratio = np.divide(np.sqrt(variance), mean, out=np.zeros_like(mean),
+                      where=moving[has] > 0)  # all neighbours at 0: perfectly consistent
+    return float(ratio.mean())
+
+
+def _floored(cov: np.ndarray) -> np.ndarray:
+    """Covariances (V, 3, 3) symmetrised, their eigenvalues raised to COVARIANCE_FLOOR."""
+    value, vector = np.linalg.eigh(0.5 * (cov + cov.transpose(0, 2, 1)))
+    return (vector * np.maximum(value, COVARIANCE_FLOOR)[:, None, :]) @ \
+        vector.transpose(0, 2, 1)

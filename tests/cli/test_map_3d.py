@@ -1,0 +1,75 @@
+"""MapEval's AWD and SCS through ``pcmapq eval`` on two 3D clouds: in the frame given
+(``--no-align``) they are the plain reference's on the files' points; after a 3D registration,
+those of the map in the truth's frame."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from testkit import synth
+from testkit.command import run
+from testkit.mapeval import reference_awd_scs
+from testkit.poses import rotation_about
+
+PLAN = synth.building_plan(0)
+
+
+@pytest.fixture(scope="module")
+def clouds(tmp_path_factory) -> tuple[Path, np.ndarray, np.ndarray]:
+    """A 3D cloud of the plan (the truth) and a noisier one with a wall moved 0.3 m (the map),
+    in one frame, as .npy files."""
+    folder = tmp_path_factory.mktemp("map3d")
+    truth = synth.lidar_cloud(PLAN, spacing=0.1, noise=0.005, outliers=0)
+    cloud = synth.lidar_cloud(synth.move_wall(PLAN, 7, (0.3, 0.0)), spacing=0.1, noise=0.01,
+                              outliers=0, seed=1)
+    np.save(folder / "truth.npy", truth)
+    np.save(folder / "map.npy", cloud)
+    return folder, cloud, truth
+
+
+def evaluate(folder: Path, map_name: str, *options: str) -> tuple[dict, str]:
+    out = folder / f"{map_name}{len(options)}.json"
+    proc = run("eval", str(folder / map_name), str(folder / "truth.npy"), "--json", str(out),
+               *options)
+    assert proc.returncode == 0, proc.stderr
+    return json.loads(out.read_text()), proc.stdout
+
+
+@pytest.mark.parametrize("settings", [(3.0, 100, 5), (1.5, 20, 2)])
+def test_in_the_frame_given_the_figures_are_the_references(clouds, settings):
+    folder, cloud, truth = clouds
+    voxel, min_points, radius = settings
+    options = ("--awd-voxel", f"{voxel:g}", "--awd-min-points", str(min_points),
+               "--scs-radius", str(radius))
+    doc, stdout = evaluate(folder, "map.npy", "--no-align",
+                           *(options if settings != (3.0, 100, 5) else ()))
+    awd, scs, voxels = reference_awd_scs(cloud, truth, voxel, min_points, radius)
+    got = doc["map_3d"]
+    assert got["voxels"] == voxels > 20
+    assert got["awd_m"] == pytest.approx(awd, abs=1e-6)  # the JSON keeps 6 decimals
+    assert got["scs"] == pytest.approx(scs, abs=1e-6)
+    assert doc["settings"]["map_3d"] == {"voxel": voxel, "min_points": min_points,
+                                         "radius": radius}
+    assert f"{voxel:g} m voxels holding at least {min_points} points" in got["computed_on"]
+    assert "alignment_3d" not in doc and "distances_3d" not in doc  # no 3D registration
+    assert f"AWD {awd:.3f} m" in stdout and f"SCS {scs:.3f}" in stdout
+
+
+def test_after_a_3d_registration_the_figures_are_the_maps_in_the_truths_frame(clouds):
+    """The map turned 30 degrees and moved: registered, its figures are within a centimetre
+    of those of the map given in the truth's frame."""
+    folder, cloud, truth = clouds
+    pose = np.eye(4)
+    pose[:3, :3], pose[:3, 3] = rotation_about([0, 0, 1], 30.0), [2.0, -1.0, 0.0]
+    np.save(folder / "moved.npy", cloud @ pose[:3, :3].T + pose[:3, 3])
+    doc, _ = evaluate(folder, "moved.npy", "--fail-over", "awd_3d=1")
+    awd, scs, voxels = reference_awd_scs(cloud, truth)
+    assert doc["alignment_3d"] is not None
+    assert doc["map_3d"]["awd_m"] == pytest.approx(awd, abs=0.01)
+    assert doc["map_3d"]["voxels"] == pytest.approx(voxels, abs=2)
+    assert doc["gates"] == [{"key": "awd_3d", "path": "map_3d.awd_m", "option": "--fail-over",
+                             "bound": 1.0, "value": doc["map_3d"]["awd_m"], "passed": True}]
