@@ -11,6 +11,7 @@ from typer.testing import CliRunner
 
 from pcmapq.cli import app
 from pcmapq.results import gates
+from pcmapq.results.figures import TAU_FIELDS
 from pcmapq.results.gates import (
     UNDER,
     Gate,
@@ -54,9 +55,10 @@ def test_every_short_name_reaches_a_figure_of_a_real_result(plain):
     assert set(gates.TOP_LEVEL) - set(doc) == {"alignment_3d", "distances_3d", "map_3d"}
     taus = [f["tau_m"] for f in doc["distances"]["f_score"]]
     run = set(doc["detectors"])  # a detector not run has no figures
-    keys = [k for k in gates.short_names() if "3d" not in k and "f_score" not in k
+    at_tau = tuple(TAU_FIELDS)  # named at one of the result's taus
+    keys = [k for k in gates.short_names() if "3d" not in k and not k.startswith(at_tau)
             and (k.split(".")[0] not in DETECTOR_NAMES or k.split(".")[0] in run)]
-    keys += [f"f_score@{t:g}" for t in taus]
+    keys += [f"{name}@{t:g}" for name in at_tau for t in taus]
     # the free space's figures are null for a map without free space (this one is a cloud)
     free = ("contradiction", "free_on_truth", "seen_through")
     assert all(doc["alignment"][k] is None for k in free)

@@ -29,5 +29,5 @@ from pcmapq.settings.plain import plain
 
 __all__ = ["DEFAULT_DETECTORS", "DETECTOR_NAMES", "EVAL_MAX_WARD", "EVAL_NOREF_SAMPLE",
            "EVAL_NOREF_VOXEL", "MIN_HITS_2D", "MIN_HITS_3D", "TRACK_EVERY", "AlignmentConfig",
-           "DistancesConfig", "FootprintConfig", "Map3DConfig", "MatchingConfig", "NoRefConfig", "RasterConfig",
-           "Settings", "SourceConfig", "default_params", "plain"]
+           "DistancesConfig", "FootprintConfig", "Map3DConfig", "MatchingConfig", "NoRefConfig",
+           "RasterConfig", "Settings", "SourceConfig", "default_params", "plain"]
