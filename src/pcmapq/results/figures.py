@@ -34,7 +34,8 @@ class Figure:
     :attr:`header`; ``label`` overrides the header's words). ``optional``: a result without
     it reads None (a detector not run, a result without a consistency map); otherwise a
     document without it is not a result. ``number``: False for a word (the verdict), which
-    no gate reads."""
+    no gate reads. ``sparse``: a column only of the tables where some row has it (a figure of
+    two 3D clouds), so a table of 2D maps keeps its columns."""
 
     name: str
     path: tuple[str, ...]
@@ -42,6 +43,7 @@ class Figure:
     label: str | None = None
     optional: bool = False
     number: bool = True
+    sparse: bool = False
 
     @property
     def unit(self) -> str:
@@ -110,8 +112,8 @@ FIGURES: tuple[Figure, ...] = (
       if a not in ("confidence", "fitness", "x_m", "y_m", "yaw_deg", "scale")),
     *_stats("accuracy", "distances_3d", "_3d"), *_stats("completeness", "distances_3d", "_3d"),
     Figure("chamfer_3d", ("distances_3d", "chamfer_m"), optional=True, label="Chamfer 3D"),
-    Figure("awd_3d", ("map_3d", "awd_m"), column=True, label="AWD", optional=True),
-    Figure("scs_3d", ("map_3d", "scs"), column=True, label="SCS", optional=True),
+    Figure("awd_3d", ("map_3d", "awd_m"), column=True, label="AWD", optional=True, sparse=True),
+    Figure("scs_3d", ("map_3d", "scs"), column=True, label="SCS", optional=True, sparse=True),
 )
 #: Other names of figures that gates have always read: the one list of aliases.
 ALIASES = {"chamfer.mean": "chamfer", "chamfer_3d.mean": "chamfer_3d"}
@@ -205,7 +207,8 @@ def table_row(name: str, doc: dict) -> dict[str, object]:
     values = figures(doc)
     row: dict[str, object] = {"name": name, "rank": None, "map": _get(doc, "map", "path"),
                               "truth": _get(doc, "truth", "path")}
-    row.update((f.column_name, values[f.name]) for f in FIGURES if f.column)
+    row.update((f.column_name, values[f.name]) for f in FIGURES
+               if f.column and not (f.sparse and values[f.name] is None))
     for f in _get(doc, "distances", "f_score"):
         tau = f["tau_m"]
         row[F_SCORE_COLUMN.format(tau=tau)] = values[F_SCORE.format(dim="", tau=tau)]
@@ -216,7 +219,7 @@ def failed_row(name: str, map_path: str, truth_path: str, exit_code: int,
                error: str, verdict: str | None = None) -> dict[str, object]:
     """The row of an evaluation that failed: its inputs, exit code and one-line error, every
     figure None but the ``verdict`` of a map refused as another place."""
-    row: dict[str, object] = dict.fromkeys(head())
+    row: dict[str, object] = dict.fromkeys(c for c in head() if c not in _sparse())
     return {**row, "name": name, "map": str(map_path), "truth": str(truth_path),
             "verdict": verdict, "gates": "", "exit_code": int(exit_code),
             "error": " ".join(str(error).split())}
@@ -249,11 +252,19 @@ def gates_verdict(gates: list[dict] | None) -> str:
 
 
 def columns(rows: list[dict[str, object]]) -> list[str]:
-    """A table's columns: :func:`head`, the F-score of every tau any row has (ascending),
-    :data:`TAIL`."""
+    """A table's columns: :func:`head` (a sparse figure's only when some row has it), the
+    F-score of every tau any row has (ascending), :data:`TAIL`."""
     taus = sorted({float(k[len("f_score@"):-1]) for row in rows for k in row
                    if k.startswith("f_score@")})
-    return [*head(), *(F_SCORE_COLUMN.format(tau=t) for t in taus), *TAIL]
+    sparse = _sparse()
+    kept = [c for c in head()
+            if c not in sparse or any(row.get(c) is not None for row in rows)]
+    return [*kept, *(F_SCORE_COLUMN.format(tau=t) for t in taus), *TAIL]
+
+
+def _sparse() -> set[str]:
+    """The columns of :attr:`Figure.sparse` figures."""
+    return {f.column_name for f in FIGURES if f.column and f.sparse}
 
 
 def _read(doc: dict, fig: Figure) -> float | str | None:
