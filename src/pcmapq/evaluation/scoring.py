@@ -1,6 +1,6 @@
 """A placed map scored against its prepared truth (:func:`score`): features matched one to one
-inside the footprint, wall distances, the consistency map of its regions, and the optional
-no-reference and 3D figures, gathered in a :class:`~pcmapq.results.result.Result`."""
+inside the footprint, wall distances, the consistency map of its regions (and of two 3D clouds,
+its 3D one), and the optional no-reference and 3D figures, gathered in a :class:`~pcmapq.results.result.Result`."""
 
 from __future__ import annotations
 
@@ -12,6 +12,7 @@ import numpy as np
 
 from pcmapq.align.parts import broken_off
 from pcmapq.align.regions import regions
+from pcmapq.align.regions3d import regions_3d
 from pcmapq.core.frames import Frames
 from pcmapq.core.grid import MetricGrid
 from pcmapq.evaluation.noref_figures import EarlyFigures, input_figures
@@ -40,7 +41,7 @@ def score(placed: Placed, prepared: PreparedTruth, settings: Settings,
     with ThreadPoolExecutor(2, thread_name_prefix="pcmapq-score") as pool:
         # the consistency map and the 3D distances need only the placed map: found while the
         # map's features are
-        consistency_job = cloud_job = None
+        consistency_job = cloud_job = consistency_3d_job = None
         if side.cover.verdict != OTHER and side.target is not None and \
                 side.target.lines is not None:
             progress("aligning the map's regions on their own")
@@ -52,6 +53,11 @@ def score(placed: Placed, prepared: PreparedTruth, settings: Settings,
             progress("distances in 3D")
             cloud_job = pool.submit(distances_3d, side.source.points, truth.points,
                                     settings.raster.cloud_resolution, settings.distances.taus)
+            progress("registering the map's regions in 3D on their own")
+            consistency_3d_job = pool.submit(
+                regions_3d, side.source.points, truth.points, tile_m=settings.alignment.tile_3d,
+                voxel=settings.alignment.voxel_3d,
+                level=None if prepared.level is None else prepared.level.rotation)
         if placed.features is None:
             progress("drawing the walls' centre lines and detecting features")
             sides = SideBySide(settings.matching.detectors, settings.matching.params)
@@ -59,6 +65,7 @@ def score(placed: Placed, prepared: PreparedTruth, settings: Settings,
                                                            threads=FEATURE_THREADS))
         consistency = None if consistency_job is None else consistency_job.result()
         cloud_distances = None if cloud_job is None else cloud_job.result()
+        consistency_3d = None if consistency_3d_job is None else consistency_3d_job.result()
     frames = Frames(alignment.transform, side.level, prepared.level,
                     None if registration is None else registration.transform)
     detectors = {}
@@ -93,7 +100,7 @@ def score(placed: Placed, prepared: PreparedTruth, settings: Settings,
                   threshold=threshold, full=full, detectors=detectors,
                   footprint_rule=rule, frames=frames, settings=settings.to_dict(),
                   truth_occupied=prepared.occupied, map_occupied=side.occupied, noref=noref,
-                  consistency=consistency, rooms=rooms,
+                  consistency=consistency, rooms=rooms, consistency_3d=consistency_3d,
                   map_message=None if getattr(loaded, "message", None) is None
                   else loaded.message.to_dict())
 

@@ -34,7 +34,8 @@ class Figure:
     :attr:`header`; ``label`` overrides the header's words). ``optional``: a result without
     it reads None (a detector not run, a result without a consistency map); otherwise a
     document without it is not a result. ``number``: False for a word (the verdict), which
-    no gate reads."""
+    no gate reads. ``column_words``: the column's name without its unit, when the path's
+    words name another figure's column (the 3D consistency map's beside the 2D one's)."""
 
     name: str
     path: tuple[str, ...]
@@ -42,6 +43,7 @@ class Figure:
     label: str | None = None
     optional: bool = False
     number: bool = True
+    column_words: str | None = None
 
     @property
     def unit(self) -> str:
@@ -62,7 +64,8 @@ class Figure:
         it is not a column."""
         if not self.column:
             return None
-        return "_".join(self.words) + (f"_{self.unit}" if self.unit else "")
+        words = self.column_words or "_".join(self.words)
+        return words + (f"_{self.unit}" if self.unit else "")
 
     @property
     def short(self) -> str:
@@ -101,6 +104,11 @@ FIGURES: tuple[Figure, ...] = (
     Figure("alignment.scale", ("alignment", "scale"), column=True),
     Figure("consistency.largest_offset_m", ("consistency", "largest_offset_m"), column=True,
            label="largest region offset", optional=True),
+    Figure("consistency_3d.largest_offset_m", ("consistency_3d", "largest_offset_m"),
+           column=True, label="largest region offset 3D", optional=True,
+           column_words="largest_offset_3d"),
+    Figure("consistency_3d.largest_dz_m", ("consistency_3d", "largest_dz_m"), column=True,
+           label="largest region dz", optional=True),
     *(f for f in _stats("accuracy", "distances", "") if f.column),
     *(f for f in _stats("completeness", "distances", "") if f.column),
     Figure("chamfer", ("distances", "chamfer_m"), column=True, label="Chamfer"),

@@ -29,6 +29,11 @@ def default_params() -> dict[str, Any]:
     return of_detectors()
 
 
+#: The metadata of a setting saved (``Settings.to_dict``) only when it is not its default: one
+#: that only some inputs use, so that the results of the others stay as they were.
+WHEN_SET = {"saved": "when set"}
+
+
 @dataclass(frozen=True)
 class SourceConfig:
     """How one input is read (load stage).
@@ -79,6 +84,8 @@ class AlignmentConfig:
         or wrong. A map image without resolution then starts from the truth's.
     voxel_3d: working voxel of the 3D registration when both sides are 3D clouds, metres
         (0.3 indoors; 0.5-1 for outdoor maps).
+    tile_3d: side of the tiles of the 3D consistency map (two 3D clouds: each tile of the map
+        registered to the truth on its own, :mod:`pcmapq.align.regions3d`), metres.
     min_confidence: the map is taken to show another place when its ``confidence`` (see
         :func:`pcmapq.evaluation.same_place.confidence`) is below this.
     force: evaluate even when the confidence is below ``min_confidence``.
@@ -93,6 +100,7 @@ class AlignmentConfig:
     min_confidence: float = 0.5
     force: bool = False
     params: AlignParams = field(default_factory=AlignParams)
+    tile_3d: float = field(default=8.0, metadata=WHEN_SET)
 
 
 @dataclass(frozen=True)
@@ -230,7 +238,8 @@ def plain(value):
     if isinstance(value, Similarity2D):
         return value.to_dict()
     if is_dataclass(value):
-        return {f.name: plain(getattr(value, f.name)) for f in fields(value)}
+        return {f.name: plain(getattr(value, f.name)) for f in fields(value)
+                if f.metadata != WHEN_SET or getattr(value, f.name) != f.default}
     if isinstance(value, dict):
         return {k: plain(v) for k, v in value.items()}
     if isinstance(value, tuple):

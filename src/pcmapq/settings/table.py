@@ -251,6 +251,9 @@ OPTIONS: tuple[Option, ...] = (
     Option("voxel_3d", "alignment.voxel_3d", FLOAT,
            "Working voxel of the 3D registration of two 3D clouds, metres (0.5-1 for outdoor "
            "maps).", 0.01, flag="--voxel-3d"),
+    Option("tile_3d", "alignment.tile_3d", FLOAT,
+           "Side of the tiles of the 3D consistency map of two 3D clouds (each tile of the map "
+           "registered to the truth on its own), metres.", 1.0, flag="--tile-3d"),
     Option("tau", "distances.taus", TEXT,
            "Distance thresholds of the F-score, metres, comma-separated.", metavar="<M,M,...>",
            read=parse_taus, show=show_list, commands=(EVAL, BATCH, TRACK),
