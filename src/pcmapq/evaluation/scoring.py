@@ -1,6 +1,7 @@
 """A placed map scored against its prepared truth (:func:`score`): features matched one to one
-inside the footprint, wall distances, the consistency map of its regions (and of two 3D clouds,
-its 3D one), and the optional no-reference and 3D figures, gathered in a :class:`~pcmapq.results.result.Result`."""
+inside the footprint, wall distances, the consistency map of its regions (and of two 3D
+clouds, its 3D one), and the optional no-reference and 3D figures, gathered in a
+:class:`~pcmapq.results.result.Result`."""
 
 from __future__ import annotations
 

@@ -11,7 +11,16 @@ from rich.table import Table
 
 from pcmapq.core.stats import FIELDS, Stats
 from pcmapq.core.words import count, length
-from pcmapq.report.text import LEGEND, metres, number, score, verdict, words, wrap
+from pcmapq.report.text import (
+    LEGEND,
+    metres,
+    number,
+    relief_parts,
+    score,
+    verdict,
+    words,
+    wrap,
+)
 from pcmapq.results.result import DetectorResult, Result
 
 #: Width of the labels of the key-value lines, characters.
@@ -90,6 +99,8 @@ def _summary(result: Result) -> list[tuple[str, list[str]]]:
         reg = result.registration_3d
         lines.append(("3D", [f"registration fitness {reg.fitness:.3f}",
                              f"rmse {reg.rmse_m:.3f} m"]))
+    if parts := relief_parts(result):
+        lines.append(("3D regions", parts))
     return lines
 
 
