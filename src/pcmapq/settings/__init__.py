@@ -199,10 +199,12 @@ class Settings:
     noref: NoRefConfig = field(default_factory=lambda: NoRefConfig(
         voxel=EVAL_NOREF_VOXEL, max_ward=EVAL_MAX_WARD, sample=EVAL_NOREF_SAMPLE))
 
-    def to_dict(self) -> dict:
+    def to_dict(self, full: bool = False) -> dict:
         """Every option as plain JSON types, one object per stage, in metres and degrees:
-        ``init`` as ``{"x_m", "y_m", "yaw_deg", "scale"}``, tuples as lists."""
-        return plain(self)
+        ``init`` as ``{"x_m", "y_m", "yaw_deg", "scale"}``, tuples as lists; a setting saved
+        only when set (:data:`WHEN_SET`) left out at its default unless ``full`` (a settings
+        file: every setting)."""
+        return plain(self, full)
 
     @classmethod
     def from_dict(cls, doc: dict) -> Settings:
@@ -233,15 +235,16 @@ class Settings:
             noref=NoRefConfig(**doc.get("noref", {"enabled": False})))  # saved before noref
 
 
-def plain(value):
-    """A settings value as plain JSON types (see :meth:`Settings.to_dict`)."""
+def plain(value, full: bool = True):
+    """A settings value as plain JSON types (see :meth:`Settings.to_dict`; ``full`` False
+    leaves out a setting saved only when set that is at its default)."""
     if isinstance(value, Similarity2D):
         return value.to_dict()
     if is_dataclass(value):
-        return {f.name: plain(getattr(value, f.name)) for f in fields(value)
-                if f.metadata != WHEN_SET or getattr(value, f.name) != f.default}
+        return {f.name: plain(getattr(value, f.name), full) for f in fields(value)
+                if full or f.metadata != WHEN_SET or getattr(value, f.name) != f.default}
     if isinstance(value, dict):
-        return {k: plain(v) for k, v in value.items()}
+        return {k: plain(v, full) for k, v in value.items()}
     if isinstance(value, tuple):
-        return [plain(v) for v in value]
+        return [plain(v, full) for v in value]
     return value

@@ -28,7 +28,7 @@ NULL_GROUPS = {"thresholds": {"occupied": None, "free": None, "negate": None},
 
 def dump_settings(settings: Settings) -> str:
     """Every setting as YAML, in :meth:`Settings.to_dict`'s order."""
-    return yaml.safe_dump(settings.to_dict(), sort_keys=False)
+    return yaml.safe_dump(settings.to_dict(full=True), sort_keys=False)
 
 
 def changed_settings(settings: Settings, base: Settings) -> dict:
@@ -45,7 +45,7 @@ def changed_settings(settings: Settings, base: Settings) -> dict:
                 out[key] = value
         return out
 
-    return diff(settings.to_dict(), base.to_dict())
+    return diff(settings.to_dict(full=True), base.to_dict(full=True))
 
 
 def read_settings(path: str | Path, base: Settings | None = None) -> Settings:
@@ -66,7 +66,7 @@ def read_settings(path: str | Path, base: Settings | None = None) -> Settings:
     if not isinstance(doc, dict):
         raise InputError(f"{path}: expected a mapping of settings groups (map, truth, raster, "
                          "alignment, footprint, matching, distances, noref)")
-    merged = _merge(base.to_dict(), _read_words(doc, path), path, "")
+    merged = _merge(base.to_dict(full=True), _read_words(doc, path), path, "")
     for option in OPTIONS:
         _check_option(merged, option, path)
     try:
