@@ -51,7 +51,7 @@ def gated(plain, tmp_path_factory):
 def test_every_short_name_reaches_a_figure_of_a_real_result(plain):
     doc = plain[1]
     assert set(doc) <= set(gates.TOP_LEVEL)
-    assert set(gates.TOP_LEVEL) - set(doc) == {"alignment_3d", "distances_3d"}
+    assert set(gates.TOP_LEVEL) - set(doc) == {"alignment_3d", "distances_3d", "consistency_3d"}
     taus = [f["tau_m"] for f in doc["distances"]["f_score"]]
     run = set(doc["detectors"])  # a detector not run has no figures
     keys = [k for k in gates.short_names() if "3d" not in k and "f_score" not in k
