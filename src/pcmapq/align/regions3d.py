@@ -36,6 +36,9 @@ __all__ = ["Consistency3D", "regions_3d"]
 
 #: A tile's side by default, metres: a 20-scan KITTI stretch (about 16 m) spans a few tiles.
 TILE_M = 8.0
+#: Regions at most this many tiles across the map's larger side (a larger map gets larger
+#: tiles: the cost stays that of a map of this many tiles).
+MAX_TILES = 32
 #: A tile holding fewer map points than this (at the working voxel) is no region.
 MIN_POINTS = 200
 #: ICP stages: the largest pairing distance of each, in units of the working voxel (wide first:
@@ -144,20 +147,21 @@ def _pinned(hessian: np.ndarray, half_side: float) -> float:
 
 
 def regions_3d(map_xyz: np.ndarray, truth_xyz: np.ndarray, *, tile_m: float = TILE_M,
-               voxel: float = 0.15, level: np.ndarray | None = None) -> Consistency3D:
+               voxel: float = 0.3, level: np.ndarray | None = None) -> Consistency3D:
     """The regions of the map ``map_xyz`` (N, 3, already in the truth cloud's frame), each
     registered on its own to ``truth_xyz`` (M, 3), metres.
 
-    tile_m: a tile's side, metres. voxel: both clouds are taken at this voxel (centroids),
-    metres; the pairing distances scale with it (STAGES) and a point fits within half of it.
-    level: the truth's levelling rotation (3x3), applied to both
-    first, so that tiles lie on its ground and dz is vertical; None: the truth frame as it is.
-    Deterministic."""
+    tile_m: a tile's side, metres (grown so that the map spans at most MAX_TILES tiles).
+    voxel: both clouds are taken at this voxel (centroids), metres; the pairing distances
+    scale with it (STAGES) and a point fits within half of it. level: the truth's levelling
+    rotation (3x3), applied to both first, so that tiles lie on its ground and dz is
+    vertical; None: the truth frame as it is. Deterministic."""
     tolerance = voxel / 2
     placed = levelled(voxel_centroids(np.asarray(map_xyz, dtype=np.float64), voxel), level)
     truth = levelled(voxel_centroids(np.asarray(truth_xyz, dtype=np.float64), voxel), level)
     if len(placed) == 0 or len(truth) < NORMAL_NEIGHBOURS:
         return Consistency3D.empty(tile_m, voxel, tolerance)
+    tile_m = max(tile_m, float(np.ptp(placed[:, :2], axis=0).max()) / MAX_TILES)
     keys = np.floor(placed[:, :2] / tile_m).astype(np.int64)
     tiles, inverse, counts = np.unique(keys, axis=0, return_inverse=True, return_counts=True)
     order = np.argsort(inverse.ravel(), kind="stable")

@@ -95,3 +95,12 @@ def test_repeatable(truth, scan, sank):
     a, b = sank, regions_3d(sunk(scan, 10.0, 0.3), truth, tile_m=TILE, voxel=VOXEL)
     for name in ("centre", "offset", "angles_deg", "fit_before", "fit_after", "held"):
         np.testing.assert_array_equal(getattr(a, name), getattr(b, name))
+
+
+def test_a_long_map_gets_larger_tiles():
+    """A 400 m long ground is cut into at most 32 tiles along it: 12.5 m each."""
+    rng = np.random.default_rng(1)
+    ground = np.column_stack([rng.uniform(0, 400, (40000,)), rng.uniform(0, 4, 40000),
+                              np.zeros(40000)])
+    assert regions_3d(ground, ground, tile_m=TILE, voxel=0.5).tile_m == pytest.approx(12.5,
+                                                                                     rel=1e-3)
