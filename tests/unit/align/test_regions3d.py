@@ -10,18 +10,18 @@ from pcmapq.align.regions3d import Consistency3D, regions_3d
 from testkit.street import street, sunk, tilted
 
 #: The tests' working voxel and tile, metres (a tile edge lies on x = 10).
-VOXEL, TILE = 0.15, 10.0
+VOXEL, TILE = 0.2, 10.0
 
 
 @pytest.fixture(scope="module")
 def truth() -> np.ndarray:
-    return street(0.0, 30.0, seed=0)
+    return street(0.0, 30.0, spacing=0.15, seed=0)
 
 
 @pytest.fixture(scope="module")
 def scan() -> np.ndarray:
     """The same street sampled again: fresh noise, the same layout."""
-    cloud = street(0.0, 30.0, seed=0)
+    cloud = street(0.0, 30.0, spacing=0.15, seed=0)
     return cloud + np.random.default_rng(7).normal(0.0, 0.005, cloud.shape)
 
 
