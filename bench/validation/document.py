@@ -11,6 +11,7 @@ from pcmapq.io.writers import write_atomic
 from . import (
     carmen,
     consistency,
+    consistency_3d,
     corpus,
     drawings,
     drawings_eval,
@@ -40,7 +41,8 @@ SECTIONS: dict[str, ModuleType] = {
     "kitti": kitti, "gazebo": gazebo,
     "halmstad": halmstad, "floorplans": floorplans, "carmen": carmen, "noref": noref,
     "same_place": same_place, "house": house,
-    "corpus": corpus, "consistency": consistency, "track": track,
+    "corpus": corpus, "consistency": consistency, "consistency_3d": consistency_3d,
+    "track": track,
     "recording": recording, "rooms": rooms, "rooms_drift": rooms_drift,
     "rooms_halmstad": rooms_halmstad, "rooms_bent": rooms_bent,
 }

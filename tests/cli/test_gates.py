@@ -52,7 +52,8 @@ def gated(plain, tmp_path_factory):
 def test_every_short_name_reaches_a_figure_of_a_real_result(plain):
     doc = plain[1]
     assert set(doc) <= set(gates.TOP_LEVEL)
-    assert set(gates.TOP_LEVEL) - set(doc) == {"alignment_3d", "distances_3d", "map_3d"}
+    assert set(gates.TOP_LEVEL) - set(doc) == {"alignment_3d", "distances_3d", "map_3d",
+                                               "consistency_3d"}
     taus = [f["tau_m"] for f in doc["distances"]["f_score"]]
     run = set(doc["detectors"])  # a detector not run has no figures
     at_tau = tuple(TAU_FIELDS)  # named at one of the result's taus

@@ -4,6 +4,7 @@ imported when the command runs, not when its help is shown (tests/cli/test_start
 from __future__ import annotations
 
 import sys
+import warnings
 from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any
@@ -63,6 +64,11 @@ def eval_command(
         help="Write the consistency map as CSV: one row per region of the map (truth frame, "
         "metres), the offset and turn (degrees) that fit it to the truth on its own, its "
         "points, its fitness before and after, and whether its walls hold it (held).")] = None,
+    regions_3d: Annotated[Path | None, typer.Option(
+        "--regions-3d", help="Two 3D clouds: write the 3D consistency map as CSV, one row per "
+        "tile of the ground (truth frame levelled, metres): where the map has the region from "
+        "where it fits the truth on its own (dx, dy, dz; roll, pitch, yaw in degrees), its "
+        "points, its fitness before and after, and whether it is held.")] = None,
     plot: Annotated[Path | None, typer.Option(
         help="Draw the vectorial map, one panel per detector: PNG, SVG or PDF by the file's "
         "extension.")] = None,
@@ -103,9 +109,9 @@ def eval_command(
         raise typer.BadParameter("give MAP and TRUTH, or --scans DIR and TRUTH",
                                  param_hint="MAP TRUTH")
     truth_path = paths[-1]
-    json_path, vectors, regions, plot, report, aligned, transform, distances = (
-        targets.kept(p) for p in (json_path, vectors, regions, plot, report, aligned, transform,
-                                  distances))
+    json_path, vectors, regions, regions_3d, plot, report, aligned, transform, distances = (
+        targets.kept(p) for p in (json_path, vectors, regions, regions_3d, plot, report, aligned,
+                                  transform, distances))
     exports = {"--aligned": aligned, "--transform": transform, "--distances": distances}
     err = Console(stderr=True)
     out = Console(quiet=quiet or json_path == "-")  # not a terminal: COLUMNS or 80 wide
@@ -117,7 +123,8 @@ def eval_command(
             raise InputError(f"{'--max-scans N' if max_scans is not None else '--scan-topic'}"
                              ": only with --scans DIR (the scans to map)")
         targets.check_outputs({"--json": json_path, "--vectors": vectors,
-                               "--regions": regions, "--plot": plot,
+                               "--regions": regions, "--regions-3d": regions_3d,
+                               "--plot": plot,
                                "--report": report, **exports}, None if scans else paths[0],
                               inputs=(*paths, settings_values.get("config")))
         if scans is None:
@@ -134,8 +141,8 @@ def eval_command(
         json_text = gates.to_json(gates.with_gates(doc, outcomes)) if rules else None
         progress("writing outputs")
         wrote = _write_outputs(result, map_path, settings, arrow_scale, json_path=json_path,
-                               vectors=vectors, regions=regions, plot=plot, report=report,
-                               exports=exports, json_text=json_text)
+                               vectors=vectors, regions=regions, regions_3d=regions_3d,
+                               plot=plot, report=report, exports=exports, json_text=json_text)
         if json_path == "-":
             sys.stdout.write(json_text or result.to_json())
     if not quiet:
@@ -152,7 +159,8 @@ def eval_command(
 def _write_outputs(result: Result, map_path: Path | PointMap, settings: Settings,
                    arrow_scale: float | None, *, json_path: str | None, vectors: Path | None,
                    regions: Path | None, plot: Path | None, report: Path | None,
-                   exports: dict[str, Path | None], json_text: str | None = None) -> list[Path]:
+                   exports: dict[str, Path | None], json_text: str | None = None,
+                   regions_3d: Path | None = None) -> list[Path]:
     """Write the run's output files, all or nothing: each is produced into a temporary file
     beside its target, and all are renamed into place only once every one is produced
     (:class:`OutputSet`); the JSON is ``json_text`` when given (with gates), else the result's.
@@ -170,6 +178,12 @@ def _write_outputs(result: Result, map_path: Path | PointMap, settings: Settings
         if regions is not None:
             write_atomic(regions, result.regions_csv(), outputs)
             wrote.append(regions)
+        if regions_3d is not None:
+            if result.consistency_3d is None:
+                warnings.warn(f"{regions_3d}: no 3D consistency map (it needs two 3D clouds): "
+                              "the header alone", stacklevel=1)
+            write_atomic(regions_3d, result.regions_3d_csv(), outputs)
+            wrote.append(regions_3d)
         if plot is not None or report is not None:
             from pcmapq.report.html import report_html
             from pcmapq.report.plot import figure_bytes, vectorial_figure

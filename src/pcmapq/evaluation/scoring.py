@@ -1,6 +1,7 @@
 """A placed map scored against its prepared truth (:func:`score`): features matched one to one
-inside the footprint, wall distances, the consistency map of its regions, and the optional
-no-reference and 3D figures, gathered in a :class:`~pcmapq.results.result.Result`."""
+inside the footprint, wall distances, the consistency map of its regions (and of two 3D
+clouds, its 3D one), and the optional no-reference and 3D figures, gathered in a
+:class:`~pcmapq.results.result.Result`."""
 
 from __future__ import annotations
 
@@ -12,6 +13,7 @@ import numpy as np
 
 from pcmapq.align.parts import broken_off
 from pcmapq.align.regions import regions
+from pcmapq.align.regions3d import regions_3d
 from pcmapq.core.frames import Frames
 from pcmapq.core.grid import MetricGrid
 from pcmapq.evaluation.noref_figures import EarlyFigures, input_figures
@@ -41,7 +43,7 @@ def score(placed: Placed, prepared: PreparedTruth, settings: Settings,
     with ThreadPoolExecutor(2, thread_name_prefix="pcmapq-score") as pool:
         # the consistency map and the 3D distances need only the placed map: found while the
         # map's features are
-        consistency_job = cloud_job = gaussians_job = None
+        consistency_job = cloud_job = gaussians_job = consistency_3d_job = None
         if side.cover.verdict != OTHER and side.target is not None and \
                 side.target.lines is not None:
             progress("aligning the map's regions on their own")
@@ -57,6 +59,11 @@ def score(placed: Placed, prepared: PreparedTruth, settings: Settings,
             m3 = settings.map_3d
             gaussians_job = pool.submit(map_gaussians, side.source.points, truth.points,
                                         m3.voxel, m3.min_points, m3.radius)
+            progress("registering the map's regions in 3D on their own")
+            consistency_3d_job = pool.submit(
+                regions_3d, side.source.points, truth.points, tile_m=settings.map_3d.tile,
+                voxel=settings.alignment.voxel_3d,
+                level=None if prepared.level is None else prepared.level.rotation)
         if placed.features is None:
             progress("drawing the walls' centre lines and detecting features")
             sides = SideBySide(settings.matching.detectors, settings.matching.params)
@@ -65,6 +72,7 @@ def score(placed: Placed, prepared: PreparedTruth, settings: Settings,
         consistency = None if consistency_job is None else consistency_job.result()
         cloud_distances = None if cloud_job is None else cloud_job.result()
         gaussians = None if gaussians_job is None else gaussians_job.result()
+        consistency_3d = None if consistency_3d_job is None else consistency_3d_job.result()
     frames = Frames(alignment.transform, side.level, prepared.level,
                     None if registration is None else registration.transform)
     detectors = {}
@@ -98,9 +106,11 @@ def score(placed: Placed, prepared: PreparedTruth, settings: Settings,
                   registration_3d=registration, distances_3d=cloud_distances,
                   threshold=threshold, full=full, detectors=detectors,
                   footprint_rule=rule, frames=frames,
-                  settings=recorded_settings(settings, gaussians is not None),
+                  settings=recorded_settings(
+                      settings, gaussians is not None or consistency_3d is not None),
                   truth_occupied=prepared.occupied, map_occupied=side.occupied, noref=noref,
                   consistency=consistency, rooms=rooms, map_3d=gaussians,
+                  consistency_3d=consistency_3d,
                   map_message=None if getattr(loaded, "message", None) is None
                   else loaded.message.to_dict())
 
@@ -114,7 +124,7 @@ def in_one_frame_3d(placed: Placed, truth: OccupancyMap | PointMap, settings: Se
 
 def recorded_settings(settings: Settings, map_3d: bool) -> dict:
     """The settings a result records (:meth:`Settings.to_dict`), the ``map_3d`` group only
-    when the result has MapEval's map figures, which alone it sets."""
+    when the result has the figures it sets (AWD and SCS, the 3D consistency map)."""
     doc = settings.to_dict()
     return doc if map_3d else {k: v for k, v in doc.items() if k != "map_3d"}
 

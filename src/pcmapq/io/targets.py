@@ -16,6 +16,7 @@ from pcmapq.io.writers import same_file
 
 #: What each output option writes, by extension (``--aligned``: see :func:`output_suffixes`).
 OUTPUT_SUFFIXES = {"--json": (".json",), "--vectors": (".csv",), "--regions": (".csv",),
+                   "--regions-3d": (".csv",),
                    "--plot": (".png", ".svg", ".pdf"), "--report": (".html", ".htm"),
                    "--transform": (".txt",), "--distances": (".ply", ".las", ".laz"),
                    "--out": (".ply", ".pcd"), "--poses-out": (".txt", ".kitti"),

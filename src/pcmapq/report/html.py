@@ -14,8 +14,9 @@ from pcmapq.core.stats import Stats
 from pcmapq.report.arrows import arrow_scale
 from pcmapq.report.heatmap import distance_heatmap
 from pcmapq.report.plot import png_bytes, vectorial_figure
+from pcmapq.report.relief import has_relief, relief_figure
 from pcmapq.report.style import FIGURE_WIDTH_PX
-from pcmapq.report.text import map_3d_parts, number, score
+from pcmapq.report.text import map_3d_parts, number, relief_parts, score
 from pcmapq.report.viewer import nearest_distances, viewer_html
 from pcmapq.report.viewer_page import STYLE as VIEWER_STYLE
 from pcmapq.results.result import DetectorResult, Result
@@ -116,6 +117,22 @@ def _run(result: Result) -> str:
             f"<details><summary>settings</summary><pre>{settings}</pre></details>")
 
 
+def _relief(result: Result) -> str:
+    """Two 3D clouds: the 3D consistency map's section (its figures in words, the top view of
+    each region's vertical offset and the side profile); '' otherwise."""
+    if result.consistency_3d is None:
+        return ""
+    figure = _img(png_bytes(relief_figure(result)),
+                  "each region's vertical offset dz: top view and side profile") \
+        if has_relief(result) else ""
+    return (f"<h2>Where the map bends in 3D</h2><p>{html.escape('; '.join(relief_parts(result)))}"
+            f"</p>{figure}<p class=\"note\">The map, as the 3D registration placed it, cut into "
+            "tiles of the ground, each registered to the truth on its own in 3D. dz: where the "
+            "map has a region, from where it fits the truth (below 0: the map lies too low "
+            "there). Held: its geometry pins the fit in every direction and it fits; the "
+            "others are hatched (their offset is not sure). Truth frame levelled, metres.</p>")
+
+
 def report_html(result: Result, scale: float | None = None) -> str:
     """The whole report as one HTML document (figures as embedded PNGs, no network needed);
     every arrow, of the interactive map and of the figure, ``scale`` times its length (None:
@@ -168,7 +185,8 @@ def report_html(result: Result, scale: float | None = None) -> str:
                 f"better): {html.escape(parts)}.</p>"
     gain = arrow_scale(result, scale)
     viewer = viewer_html(result, gain)
-    vectors = _img(png_bytes(vectorial_figure(result, gain)), "vectorial map per detector")
+    vectors = _img(png_bytes(vectorial_figure(result, gain, relief=False)),
+                   "vectorial map per detector")
     heat = _img(png_bytes(distance_heatmap(result)),
                 "distance heatmaps: accuracy (map to truth) and completeness (truth to map)")
     lists = "".join(_lists(name, det) for name, det in result.detectors.items())
@@ -197,7 +215,7 @@ map feature.</p>
 docs/metrics.md.</p>{fscore}
 <h2>Interactive map</h2>{viewer}
 <h2>Vectorial map</h2>{vectors}
-<h2>Distance heatmaps</h2>{heat}
+{_relief(result)}<h2>Distance heatmaps</h2>{heat}
 <p class="note">Left, accuracy: each wall cell of the aligned map coloured by its distance to
 the nearest truth wall. Right, completeness: each truth wall cell the scores count coloured by
 its distance to the nearest map wall.</p>

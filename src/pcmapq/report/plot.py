@@ -57,6 +57,7 @@ from pcmapq.report.canvas import (  # noqa: E402
     thinned,
     window,
 )
+from pcmapq.report.relief import draw_top_view, has_relief, relief_panels  # noqa: E402
 from pcmapq.report.rooms_layer import draw_rooms, rooms_legend  # noqa: E402
 from pcmapq.report.style import (  # noqa: E402
     DPI,
@@ -203,17 +204,21 @@ def _grid_shape(n: int) -> tuple[int, int]:
     return -(-n // cols), cols
 
 
-def vectorial_figure(result: Result, scale: float | None = None) -> Figure:
+def vectorial_figure(result: Result, scale: float | None = None,
+                     relief: bool = True) -> Figure:
     """One panel per detector: the truth dark over the aligned map light, matched features with
     their displacement arrows, missing truth features and extra map features (thinned where
-    crowded), the footprint outline; then the regions' panel; over the part of the truth grid
-    that holds walls (:func:`~pcmapq.report.canvas.window`). Every arrow is ``scale`` times its
-    length (None: :func:`~pcmapq.report.arrows.auto_arrow_scale`)."""
+    crowded), the footprint outline; then the regions' panel; then, for two 3D clouds (and
+    ``relief``), the 3D consistency map's top view and side profile
+    (:mod:`pcmapq.report.relief`); over the part of the truth grid that holds walls
+    (:func:`~pcmapq.report.canvas.window`). Every arrow is ``scale`` times its length (None:
+    :func:`~pcmapq.report.arrows.auto_arrow_scale`)."""
     gain = arrow_scale(result, scale)
     names = list(result.detectors)
     shown = window(result)
     width, height = size_m(result, shown)
-    panels = len(names) + _has_regions(result)
+    relief = relief and has_relief(result)
+    panels = len(names) + _has_regions(result) + 2 * relief
     rows, cols = _grid_shape(panels)
     panel_w = WIDTH_IN / cols
     spare = rows * cols > panels
@@ -229,12 +234,14 @@ def vectorial_figure(result: Result, scale: float | None = None) -> Figure:
                   f"{ARROW_WORDS}; axes and arrows in metres", grid.flat[-1] if spare else None)
     for ax, name in zip(axes, names, strict=False):
         _title(ax, result, name)
+    plans = axes[:-1] if relief else axes  # every panel but the side profile shows the plan
     if _has_regions(result):
-        axes[-1].set_title(f"{result.overlap.verdict}: each region's fit\non its own",
-                           fontsize=TITLE_PT)
-    for ax in axes:
+        plans[len(names)].set_title(f"{result.overlap.verdict}: each region's fit\non its own",
+                                    fontsize=TITLE_PT)
+    colours = relief_panels(fig, axes[-2], axes[-1], result) if relief else None
+    for ax in plans:
         frame(ax, result, shown)
-    factor, pixel_m = pooling(fig, axes, result.truth_occupied[shown].shape)
+    factor, pixel_m = pooling(fig, plans, result.truth_occupied[shown].shape)
     box = extent(result, factor, shown)
     image = overlay(shade(result.truth_occupied[shown], factor, as_density),
                     grown(shade(result.map_occupied[shown], factor, as_density)))
@@ -243,7 +250,9 @@ def vectorial_figure(result: Result, scale: float | None = None) -> Figure:
         _panel(ax, result, box, image, footprint, result.detectors[name], gain,
                thin_px * pixel_m)
     if _has_regions(result):
-        _regions_panel(axes[-1], result, box, image, gain)
+        _regions_panel(plans[len(names)], result, box, image, gain)
+    if colours is not None:
+        draw_top_view(axes[-2], result, box, image, colours)
     return fig
 
 

@@ -16,6 +16,7 @@ from pcmapq.report.text import (
     map_3d_parts,
     metres,
     number,
+    relief_parts,
     score,
     verdict,
     words,
@@ -99,6 +100,8 @@ def _summary(result: Result) -> list[tuple[str, list[str]]]:
         reg = result.registration_3d
         lines.append(("3D", [f"registration fitness {reg.fitness:.3f}",
                              f"rmse {reg.rmse_m:.3f} m"]))
+    if parts := relief_parts(result):
+        lines.append(("3D regions", parts))
     return lines
 
 

@@ -101,6 +101,25 @@ def breaks(result: Result) -> str:
             f"by {c.offset_m[k]:.2f} m and turned by {abs(c.turn_deg[k]):.1f} deg")
 
 
+def relief_parts(result: Result) -> list[str]:
+    """Two 3D clouds' 3D consistency map (:mod:`pcmapq.align.regions3d`) in short parts: the
+    held regions' longest offset and largest vertical offset and where (truth frame levelled,
+    metres), and how many regions are held; [] without one."""
+    c = result.consistency_3d
+    if c is None:
+        return []
+    parts = []
+    if (k := c.largest()) is not None:
+        parts.append(f"largest offset {c.offset_m[k]:.3f} m at ({c.centre[k, 0]:.1f}, "
+                     f"{c.centre[k, 1]:.1f}, {c.centre[k, 2]:.1f}) m")
+    if (k := c.largest_dz()) is not None:
+        dz = c.offset[k, 2]
+        parts.append(f"largest dz {dz:+.3f} m ({'too low' if dz < 0 else 'too high'}) at "
+                     f"({c.centre[k, 0]:.1f}, {c.centre[k, 1]:.1f}, {c.centre[k, 2]:.1f}) m")
+    return [*parts, f"{int(c.held.sum())} of {len(c.points)} regions of "
+                    f"{c.tile_m:g} m held"]
+
+
 def verdict(result: Result) -> str:
     """How good the map is and why, in one sentence built from the result only: how it was
     aligned, how much of the truth it covers, each detector's quality and precision (a map

@@ -22,6 +22,7 @@ if TYPE_CHECKING:  # the alignment modules load Open3D; a result only holds thei
     from pcmapq.align import Alignment
     from pcmapq.align.parts import Part
     from pcmapq.align.regions import Consistency
+    from pcmapq.align.regions3d import Consistency3D
     from pcmapq.align.rigid3d import Registration3D
 
 #: Decimals kept in saved numbers: micrometres, so reruns give byte-identical files.
@@ -126,6 +127,8 @@ class Findings:
     index, ``time_s`` from the recording's start, header ``stamp_s``), None for a file.
     map_3d: MapEval's AWD and SCS of two 3D clouds in one frame
     (:mod:`pcmapq.metrics.map_gaussians`), None otherwise.
+    consistency_3d: two 3D clouds' 3D consistency map (:mod:`pcmapq.align.regions3d`), None
+    otherwise.
     truth_occupied, map_occupied (and the overlap's footprint): the rasters on ``grid``; None
     in a result read back by :meth:`Result.from_json`, which holds everything the JSON holds and no
     more.
@@ -156,6 +159,7 @@ class Findings:
     rooms: dict | None = None
     map_message: dict | None = None
     map_3d: MapGaussians | None = None
+    consistency_3d: Consistency3D | None = None
 
     @property
     def transform(self) -> Similarity2D:

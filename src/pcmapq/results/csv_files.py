@@ -1,5 +1,5 @@
-"""A result's CSV files: the vectorial map (``--vectors``) and the consistency map
-(``--regions``), truth frame, metres and degrees."""
+"""A result's CSV files: the vectorial map (``--vectors``), the consistency map (``--regions``)
+and two 3D clouds' 3D consistency map (``--regions-3d``), truth frame, metres and degrees."""
 
 from __future__ import annotations
 
@@ -8,6 +8,7 @@ import io
 import numpy as np
 
 from pcmapq.results.blocks import DECIMALS, Findings
+from pcmapq.results.blocks3d import REGION_3D_COLUMNS, consistency_3d_block
 from pcmapq.results.document import REGION_COLUMNS, consistency_block
 
 
@@ -34,10 +35,26 @@ def regions_csv(result: Findings) -> str:
     """One row per region of the consistency map (the JSON's ``consistency.regions``):
     where the region is, the offset and turn that fit it to the truth on its own, its
     points and its fitness before and after, truth frame, metres and degrees."""
+    return _rows(REGION_COLUMNS, consistency_block(result.consistency).regions)
+
+
+def regions_3d_csv(result: Findings) -> str:
+    """One row per region of the 3D consistency map (the JSON's ``consistency_3d.regions``):
+    where the region is, the map's error there (dx, dy, dz and roll, pitch, yaw: where the map
+    has it from where it fits the truth on its own), its points, its fitness before and after
+    and whether it is held, in the truth's levelled frame, metres and degrees. The header
+    alone when there is none (not two 3D clouds)."""
+    c = result.consistency_3d
+    return _rows(REGION_3D_COLUMNS, [] if c is None else consistency_3d_block(c).regions)
+
+
+def _rows(columns: tuple[str, ...], regions: list) -> str:
+    """The CSV of ``regions`` (schema blocks): a header of ``columns``, then one row each,
+    flags and counts as integers, lengths to the micrometre."""
     out = io.StringIO()
-    out.write(",".join(REGION_COLUMNS) + "\n")
-    for region in consistency_block(result.consistency).regions:
+    out.write(",".join(columns) + "\n")
+    for region in regions:
         row = region.model_dump()
         out.write(",".join(str(int(v)) if isinstance(v, bool | int) else f"{v:.{DECIMALS}f}"
-                           for v in (row[k] for k in REGION_COLUMNS)) + "\n")
+                           for v in (row[k] for k in columns)) + "\n")
     return out.getvalue()

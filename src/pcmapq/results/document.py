@@ -21,6 +21,7 @@ from pcmapq.metrics.distances import Distances
 from pcmapq.metrics.map_gaussians import MapGaussians
 from pcmapq.results import schema as s
 from pcmapq.results.blocks import DetectorResult, Findings, Overlap
+from pcmapq.results.blocks3d import consistency_3d_block, consistency_3d_of
 
 if TYPE_CHECKING:
     from pcmapq.align.regions import Consistency
@@ -45,6 +46,8 @@ def document(r: Findings, features: bool = True) -> s.ResultDocument:
         g = r.map_3d
         optional["map_3d"] = s.Map3D(computed_on=g.basis, voxels=g.voxels, awd_m=g.awd_m,
                                      scs=g.scs)
+    if r.consistency_3d is not None:
+        optional["consistency_3d"] = consistency_3d_block(r.consistency_3d)
     if r.rooms is not None:
         optional["rooms"] = r.rooms
     rows = _feature_rows(r) if features else ([], [], [])
@@ -110,7 +113,8 @@ def fields(doc: s.ResultDocument) -> dict[str, Any]:
         noref=doc.noref, truth_sha256=t.sha256, map_message=message or None,
         consistency=_consistency_of(doc.consistency, a.tolerance_m), rooms=doc.rooms,
         map_3d=None if doc.map_3d is None else MapGaussians(
-            doc.map_3d.awd_m, doc.map_3d.scs, doc.map_3d.voxels, doc.map_3d.computed_on))
+            doc.map_3d.awd_m, doc.map_3d.scs, doc.map_3d.voxels, doc.map_3d.computed_on),
+        consistency_3d=consistency_3d_of(doc.consistency_3d))
 
 
 def consistency_block(c: Consistency | None) -> s.ConsistencyMap:

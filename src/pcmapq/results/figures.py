@@ -35,7 +35,9 @@ class Figure:
     it reads None (a detector not run, a result without a consistency map); otherwise a
     document without it is not a result. ``number``: False for a word (the verdict), which
     no gate reads. ``sparse``: a column only of the tables where some row has it (a figure of
-    two 3D clouds), so a table of 2D maps keeps its columns."""
+    two 3D clouds), so a table of 2D maps keeps its columns. ``column_words``: the column's
+    name without its unit, when the path's words name another figure's column (the 3D
+    consistency map's beside the 2D one's)."""
 
     name: str
     path: tuple[str, ...]
@@ -44,6 +46,7 @@ class Figure:
     optional: bool = False
     number: bool = True
     sparse: bool = False
+    column_words: str | None = None
 
     @property
     def unit(self) -> str:
@@ -64,7 +67,8 @@ class Figure:
         it is not a column."""
         if not self.column:
             return None
-        return "_".join(self.words) + (f"_{self.unit}" if self.unit else "")
+        words = self.column_words or "_".join(self.words)
+        return words + (f"_{self.unit}" if self.unit else "")
 
     @property
     def short(self) -> str:
@@ -103,6 +107,11 @@ FIGURES: tuple[Figure, ...] = (
     Figure("alignment.scale", ("alignment", "scale"), column=True),
     Figure("consistency.largest_offset_m", ("consistency", "largest_offset_m"), column=True,
            label="largest region offset", optional=True),
+    Figure("consistency_3d.largest_offset_m", ("consistency_3d", "largest_offset_m"),
+           column=True, label="largest region offset 3D", optional=True, sparse=True,
+           column_words="largest_offset_3d"),
+    Figure("consistency_3d.largest_dz_m", ("consistency_3d", "largest_dz_m"), column=True,
+           label="largest region dz", optional=True, sparse=True),
     *(f for f in _stats("accuracy", "distances", "") if f.column),
     *(f for f in _stats("completeness", "distances", "") if f.column),
     Figure("chamfer", ("distances", "chamfer_m"), column=True, label="Chamfer"),

@@ -70,3 +70,8 @@ class Result(Findings):
         """The consistency map as CSV, one row per region
         (:func:`pcmapq.results.csv_files.regions_csv`)."""
         return csv_files.regions_csv(self)
+
+    def regions_3d_csv(self) -> str:
+        """The 3D consistency map as CSV, one row per region
+        (:func:`pcmapq.results.csv_files.regions_3d_csv`)."""
+        return csv_files.regions_3d_csv(self)

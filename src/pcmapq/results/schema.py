@@ -158,6 +158,48 @@ class ConsistencyMap(Block):
     regions: list[Region]
 
 
+Point3 = tuple[float, float, float]
+
+
+class Region3D(Block):
+    """One region of the 3D consistency map, registered to the truth on its own: where it is
+    (its points' centroid) and the map's error there, where the map has it from where it fits
+    the truth (a region the map has too low: dz_m < 0)."""
+
+    x_m: float
+    y_m: float
+    z_m: float
+    dx_m: float
+    dy_m: float
+    dz_m: float
+    offset_m: float
+    roll_deg: float
+    pitch_deg: float
+    yaw_deg: float
+    points: int
+    fitness_before: float
+    fitness_after: float
+    held: bool
+    """Its geometry pins the fit in all six directions and it fits (its offset is sure)."""
+
+
+class ConsistencyMap3D(Block):
+    """Two 3D clouds: the map, as the 3D registration placed it, cut into tiles of the ground,
+    each registered to the truth on its own in 3D; in the truth's levelled frame (x, y its
+    plan, z up), metres and degrees. Largest: of the held regions; null without one."""
+
+    tile_m: float
+    voxel_m: float
+    tolerance_m: float
+    """A point within this of a truth point fits (fitness)."""
+    largest_offset_m: float | None
+    largest_at_m: Point3 | None
+    largest_dz_m: float | None
+    """The largest vertical offset, |dz|."""
+    largest_dz_at_m: Point3 | None
+    regions: list[Region3D]
+
+
 class Levelling(Block):
     """A 3D cloud's levelling: the rotation that makes its floor horizontal."""
 
@@ -298,6 +340,8 @@ class ResultDocument(Block):
     distances_3d: Distances | None = None
     map_3d: Map3D | None = None
     """Two 3D clouds in one frame: MapEval's AWD and SCS."""
+    consistency_3d: ConsistencyMap3D | None = None
+    """Only when both inputs are 3D clouds."""
     rooms: dict[str, Any] | None = None
     """The rooms detector's rooms and doors, each with its status."""
     gates: list[Gate] | None = None

@@ -190,16 +190,20 @@ TRACK_EVERY = 20
 
 @dataclass(frozen=True)
 class Map3DConfig:
-    """MapEval's map figures of two 3D clouds, AWD and SCS (:mod:`pcmapq.metrics.map_gaussians`;
-    MapEval's defaults). A result records this group only when it has them.
+    """The figures of two 3D clouds: MapEval's AWD and SCS (:mod:`pcmapq.metrics.map_gaussians`;
+    MapEval's defaults) and the 3D consistency map. A result records this group only when it
+    has some of them.
 
     voxel: the voxels' side, metres. min_points: the points a voxel needs in each cloud to be
-    compared. radius: SCS's neighbourhood, in voxels along each axis.
+    compared. radius: SCS's neighbourhood, in voxels along each axis. tile: side of the tiles
+    of the 3D consistency map (each tile of the map registered to the truth on its own,
+    :mod:`pcmapq.align.regions3d`), metres.
     """
 
     voxel: float = AWD_VOXEL
     min_points: int = AWD_MIN_POINTS
     radius: int = SCS_RADIUS
+    tile: float = 8.0
 
 
 @dataclass(frozen=True)

@@ -188,6 +188,9 @@ OPTIONS: tuple[Option, ...] = (
     Option("scs_radius", "map_3d.radius", INT,
            "Two 3D clouds: SCS compares a voxel's neighbours within this many voxels along "
            "each axis.", 1),
+    Option("tile_3d", "map_3d.tile", FLOAT,
+           "Side of the tiles of the 3D consistency map of two 3D clouds (each tile of the map "
+           "registered to the truth on its own), metres.", 1.0, flag="--tile-3d"),
     Option("tau", "distances.taus", TEXT,
            "Distance thresholds of the F-score, metres, comma-separated.", metavar="<M,M,...>",
            read=parse_taus, show=show_list, commands=(EVAL, BATCH, TRACK),

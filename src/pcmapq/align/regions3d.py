@@ -1,0 +1,197 @@
+"""Where a 3D map bends: each region of a 3D cloud map, already placed on the truth cloud by the
+global 3D registration, registered again on its own to the truth in six degrees of freedom. A
+consistent map needs no region to move; a map that sinks, tilts or drifts along the run needs its
+regions moved by offsets that grow where it bends, and the vertical part of those offsets (dz)
+shows what a plan cannot.
+
+Regions are square tiles of the truth's ground plane. Each region's own map points (at
+``voxel``) are registered by small_gicp's point-to-plane ICP, seeded at identity (the global
+pose), on one thread, against the truth's points within the tile grown by the widest pairing
+distance on every side, coarse to fine. Frame: the truth cloud levelled as its plan is (x, y the
+truth's plan, the 2D consistency map's frame; z up), metres and degrees. ``offset`` is the map's
+error there: where the map (as the global registration placed it) has the region's centroid,
+from where the region fits the truth on its own (a map that sank has dz < 0); roll, pitch and
+yaw are the region's turn about x, y and z from its fit, the same way round.
+
+A region is held when the ICP's information pins all six of its degrees of freedom and it fits:
+the 6 x 6 Hessian of the point-to-plane cost at the fit, per pair and with its turns taken as
+the movement of a point at the region's half side, has its smallest eigenvalue at least
+MIN_INFORMATION (a ground alone leaves x, y and yaw free; a straight facade on it, x), and at
+least MIN_FIT of the region's points lie within the tolerance of a truth point once it is
+registered."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import small_gicp
+from scipy.spatial import cKDTree
+from scipy.spatial.transform import Rotation
+
+from pcmapq.core.transform import affine
+from pcmapq.core.voxels import voxel_centroids
+
+__all__ = ["Consistency3D", "regions_3d"]
+
+#: A tile's side by default, metres: a 20-scan KITTI stretch (about 16 m) spans a few tiles.
+TILE_M = 8.0
+#: Regions at most this many tiles across the map's larger side (a larger map gets larger
+#: tiles: the cost stays that of a map of this many tiles).
+MAX_TILES = 32
+#: A tile holding fewer map points than this (at the working voxel) is no region.
+MIN_POINTS = 200
+#: ICP stages: the largest pairing distance of each, in units of the working voxel (wide first:
+#: at the 0.3 m default, offsets of up to about a metre are caught).
+STAGES = (4.0, 2.0, 1.0)
+#: Iterations per stage, at most; a stage stops when a step turns less than SETTLED radians and
+#: moves less than SETTLED metres.
+ITERATIONS = 30
+SETTLED = 1e-4
+#: Neighbours of a truth point that fit its normal.
+NORMAL_NEIGHBOURS = 20
+#: A region is held when the smallest eigenvalue of its normalised information (module
+#: docstring) is at least this: every direction has at least this share of a pair's pull.
+MIN_INFORMATION = 0.01
+#: ... and at least this share of its points lie within the tolerance of the truth once fitted.
+MIN_FIT = 0.5
+
+
+@dataclass(frozen=True)
+class Consistency3D:
+    """The regions of one registered 3D map, as arrays (K regions), in the truth's levelled
+    frame (module docstring), metres and degrees.
+
+    tile_m: a tile's side. voxel_m: the working voxel the points are taken at. tolerance_m: the
+    distance within which a point fits a truth point. centre: (K, 3) centroid of each region's
+    map points. offset: (K, 3) dx, dy, dz, the map's error: its region from where the region
+    fits the truth. angles_deg: (K, 3) roll, pitch, yaw, likewise. points: (K,) the region's
+    map points. fit_before, fit_after: (K,) share of them within the tolerance of a truth point
+    at the global pose and once the region is registered on its own. held: (K,) whether its
+    fit is pinned in every direction and fits (module docstring)."""
+
+    tile_m: float
+    voxel_m: float
+    tolerance_m: float
+    centre: np.ndarray
+    offset: np.ndarray
+    angles_deg: np.ndarray
+    points: np.ndarray
+    fit_before: np.ndarray
+    fit_after: np.ndarray
+    held: np.ndarray
+
+    @classmethod
+    def empty(cls, tile_m: float, voxel_m: float, tolerance_m: float) -> Consistency3D:
+        """A consistency map with no region."""
+        none = np.zeros((0, 3))
+        return cls(tile_m, voxel_m, tolerance_m, none, none, none, np.zeros(0, int),
+                   np.zeros(0), np.zeros(0), np.zeros(0, bool))
+
+    @property
+    def offset_m(self) -> np.ndarray:
+        """(K,) length of each region's offset, metres."""
+        return np.linalg.norm(self.offset, axis=1)
+
+    def largest(self) -> int | None:
+        """Index of the held region with the longest offset; None without one."""
+        return self._most(self.offset_m)
+
+    def largest_dz(self) -> int | None:
+        """Index of the held region with the largest vertical offset |dz|; None without one."""
+        return self._most(np.abs(self.offset[:, 2]))
+
+    def _most(self, values: np.ndarray) -> int | None:
+        held = np.flatnonzero(self.held)
+        return None if len(held) == 0 else int(held[np.argmax(values[held])])
+
+
+def levelled(points: np.ndarray, rotation: np.ndarray | None) -> np.ndarray:
+    """Points (N, 3) turned by the truth's levelling ``rotation`` (3x3; None: as they are)."""
+    return points if rotation is None else points @ np.asarray(rotation).T
+
+
+def _in_box(sorted_xy: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """Indices into ``sorted_xy`` (N, 2, sorted by x) of the points with lo <= xy < hi."""
+    start, stop = np.searchsorted(sorted_xy[:, 0], [lo[0], hi[0]])
+    y = sorted_xy[start:stop, 1]
+    return start + np.flatnonzero((y >= lo[1]) & (y < hi[1]))
+
+
+def _register(own: np.ndarray, window: np.ndarray, voxel: float
+              ) -> tuple[np.ndarray, np.ndarray]:
+    """Point-to-plane ICP of ``own`` (N, 3) onto ``window`` (M, 3), both centred on ``own``'s
+    centroid, from identity, coarse to fine: the 4x4 move and the last stage's 6 x 6 Hessian
+    (turns about x, y, z, then x, y, z translations) per pair."""
+    src, tgt = small_gicp.PointCloud(own), small_gicp.PointCloud(window)
+    tree = small_gicp.KdTree(tgt, num_threads=1)
+    small_gicp.estimate_normals(tgt, tree, num_neighbors=NORMAL_NEIGHBOURS, num_threads=1)
+    move, hessian = np.eye(4), np.zeros((6, 6))
+    for units in STAGES:
+        result = small_gicp.align(tgt, src, tree, init_T_target_source=move,
+                                  registration_type="PLANE_ICP",
+                                  max_correspondence_distance=units * voxel, num_threads=1,
+                                  max_iterations=ITERATIONS, rotation_epsilon=SETTLED,
+                                  translation_epsilon=SETTLED)
+        move = np.array(result.T_target_source, dtype=np.float64)
+        hessian = np.array(result.H, dtype=np.float64) / max(int(result.num_inliers), 1)
+    return move, hessian
+
+
+def _pinned(hessian: np.ndarray, half_side: float) -> float:
+    """The smallest eigenvalue of ``hessian`` (per pair; turns first) with its turns scaled to
+    the movement of a point ``half_side`` metres from the centre: 1 for a pull as strong as
+    one pair's in every direction, 0 for a direction nothing holds."""
+    scale = np.array([half_side] * 3 + [1.0] * 3)
+    return float(np.linalg.eigvalsh(hessian / np.outer(scale, scale))[0])
+
+
+def regions_3d(map_xyz: np.ndarray, truth_xyz: np.ndarray, *, tile_m: float = TILE_M,
+               voxel: float = 0.3, level: np.ndarray | None = None) -> Consistency3D:
+    """The regions of the map ``map_xyz`` (N, 3, already in the truth cloud's frame), each
+    registered on its own to ``truth_xyz`` (M, 3), metres.
+
+    tile_m: a tile's side, metres (grown so that the map spans at most MAX_TILES tiles).
+    voxel: both clouds are taken at this voxel (centroids), metres; the pairing distances
+    scale with it (STAGES) and a point fits within half of it. level: the truth's levelling
+    rotation (3x3), applied to both first, so that tiles lie on its ground and dz is
+    vertical; None: the truth frame as it is. Deterministic."""
+    tolerance = voxel / 2
+    placed = levelled(voxel_centroids(np.asarray(map_xyz, dtype=np.float64), voxel), level)
+    truth = levelled(voxel_centroids(np.asarray(truth_xyz, dtype=np.float64), voxel), level)
+    if len(placed) == 0 or len(truth) < NORMAL_NEIGHBOURS:
+        return Consistency3D.empty(tile_m, voxel, tolerance)
+    tile_m = max(tile_m, float(np.ptp(placed[:, :2], axis=0).max()) / MAX_TILES)
+    keys = np.floor(placed[:, :2] / tile_m).astype(np.int64)
+    tiles, inverse, counts = np.unique(keys, axis=0, return_inverse=True, return_counts=True)
+    order = np.argsort(inverse.ravel(), kind="stable")
+    bounds_at = np.concatenate([[0], np.cumsum(counts)])
+    by_x = np.argsort(truth[:, 0], kind="stable")
+    truth_sorted = truth[by_x]
+    tree = cKDTree(truth)
+    margin = STAGES[0] * voxel
+    rows = []
+    for k in np.flatnonzero(counts >= MIN_POINTS):
+        own = placed[order[bounds_at[k]:bounds_at[k + 1]]]
+        window = truth_sorted[_in_box(truth_sorted[:, :2], tiles[k] * tile_m - margin,
+                                      (tiles[k] + 1) * tile_m + margin)]
+        if len(window) < NORMAL_NEIGHBOURS:
+            continue
+        centre = own.mean(axis=0)
+        move, hessian = _register(own - centre, window - centre, voxel)
+        before = tree.query(own, distance_upper_bound=tolerance, workers=1)[0]
+        fitted = affine(own - centre, move) + centre
+        after = tree.query(fitted, distance_upper_bound=tolerance, workers=1)[0]
+        fit_after = float(np.isfinite(after).mean())
+        # the map's error: its region's centroid from where the fit puts it, and its turn
+        angles = Rotation.from_matrix(move[:3, :3].T).as_euler("xyz", degrees=True)
+        held = _pinned(hessian, tile_m / 2) >= MIN_INFORMATION and fit_after >= MIN_FIT
+        rows.append((*centre, *-move[:3, 3], *angles, len(own),
+                     float(np.isfinite(before).mean()), fit_after, held))
+    if not rows:
+        return Consistency3D.empty(tile_m, voxel, tolerance)
+    # to the micrometre (and 1e-6 of a share or degree), as results are saved: the figures
+    # made from them are then the same read back from JSON
+    table = np.round(np.array(rows, dtype=np.float64), 6) + 0.0
+    return Consistency3D(tile_m, voxel, tolerance, table[:, :3], table[:, 3:6], table[:, 6:9],
+                         table[:, 9].astype(int), table[:, 10], table[:, 11], table[:, 12] > 0)

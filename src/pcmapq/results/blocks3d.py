@@ -1,0 +1,51 @@
+"""The 3D consistency map (:class:`~pcmapq.align.regions3d.Consistency3D`) as its JSON block
+(:class:`~pcmapq.results.schema.ConsistencyMap3D`) and back, and as the rows of its CSV."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from pcmapq.results import schema as s
+
+if TYPE_CHECKING:  # the alignment modules load small_gicp; a result only holds their outputs
+    from pcmapq.align.regions3d import Consistency3D
+
+#: The columns of a 3D region, in the JSON and the ``--regions-3d`` CSV.
+REGION_3D_COLUMNS = tuple(s.Region3D.model_fields)
+
+
+def _at(c: Consistency3D, k: int | None) -> tuple[float, float, float] | None:
+    return None if k is None else tuple(float(v) for v in c.centre[k])
+
+
+def consistency_3d_block(c: Consistency3D) -> s.ConsistencyMap3D:
+    """The block: the tile, the held regions' longest offset and largest |dz| and where they
+    are, and every region."""
+    columns = (*c.centre.T, *c.offset.T, c.offset_m, *c.angles_deg.T)
+    regions = [s.Region3D(**dict(zip(REGION_3D_COLUMNS, (*row, n, before, after, held),
+                                     strict=True)))
+               for row, n, before, after, held in zip(
+                   np.column_stack(columns).tolist(), c.points.astype(int).tolist(),
+                   c.fit_before.tolist(), c.fit_after.tolist(), c.held.astype(bool).tolist(),
+                   strict=True)]
+    k, dz = c.largest(), c.largest_dz()
+    return s.ConsistencyMap3D(
+        tile_m=c.tile_m, voxel_m=c.voxel_m, tolerance_m=c.tolerance_m,
+        largest_offset_m=None if k is None else float(c.offset_m[k]), largest_at_m=_at(c, k),
+        largest_dz_m=None if dz is None else abs(float(c.offset[dz, 2])),
+        largest_dz_at_m=_at(c, dz), regions=regions)
+
+
+def consistency_3d_of(doc: s.ConsistencyMap3D | None) -> Consistency3D | None:
+    """The 3D consistency map a document holds (None when it holds none)."""
+    from pcmapq.align.regions3d import Consistency3D
+
+    if doc is None:
+        return None
+    table = np.array([[getattr(r, key) for key in REGION_3D_COLUMNS] for r in doc.regions],
+                     dtype=np.float64).reshape(-1, len(REGION_3D_COLUMNS))
+    return Consistency3D(doc.tile_m, doc.voxel_m, doc.tolerance_m, table[:, 0:3],
+                         table[:, 3:6], table[:, 7:10], table[:, 10].astype(int),
+                         table[:, 11], table[:, 12], table[:, 13] > 0)

@@ -1,0 +1,106 @@
+"""Where a 3D map bends: a street whose far end sank, or that tilts more and more along its
+length, registered region by region against the straight street (known answers)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from pcmapq.align.regions3d import Consistency3D, regions_3d
+from testkit.street import street, sunk, tilted
+
+#: The tests' working voxel and tile, metres (a tile edge lies on x = 10).
+VOXEL, TILE = 0.2, 10.0
+
+
+@pytest.fixture(scope="module")
+def truth() -> np.ndarray:
+    return street(0.0, 30.0, spacing=0.15, seed=0)
+
+
+@pytest.fixture(scope="module")
+def scan() -> np.ndarray:
+    """The same street sampled again: fresh noise, the same layout."""
+    cloud = street(0.0, 30.0, spacing=0.15, seed=0)
+    return cloud + np.random.default_rng(7).normal(0.0, 0.005, cloud.shape)
+
+
+@pytest.fixture(scope="module")
+def sank(truth, scan) -> Consistency3D:
+    """The regions of the scan lowered by 0.3 m beyond x = 10."""
+    return regions_3d(sunk(scan, 10.0, 0.3), truth, tile_m=TILE, voxel=VOXEL)
+
+
+def test_a_street_that_sank_beyond_10_m(sank):
+    """Lowered by 0.3 m beyond x = 10: the regions there lie 0.3 m low (dz -0.3 within 5 cm),
+    the others in place (|dz| < 5 cm), every region held, and the largest |dz| beyond 10 m."""
+    c = sank
+    assert len(c.points) == 6 and c.held.all()
+    far = c.centre[:, 0] > 10.0
+    assert far.any() and (~far).any()
+    np.testing.assert_allclose(c.offset[far, 2], -0.3, atol=0.05)
+    assert np.all(np.abs(c.offset[~far, 2]) < 0.05)
+    assert np.all(np.abs(c.offset[:, :2]) < 0.05)  # nothing moved across the street
+    assert np.all(c.fit_after[far] > c.fit_before[far])
+    k = c.largest_dz()
+    assert k is not None and c.centre[k, 0] > 10.0
+    assert c.largest() is not None and c.centre[c.largest(), 0] > 10.0
+
+
+def test_a_tilt_growing_along_the_street(truth, scan):
+    """A pitch growing by 0.05 deg a metre: each region lies lower the farther along it is,
+    dz within 2 cm of the drop at its centroid, and pitched up by about the slope there."""
+    c = regions_3d(tilted(scan, 0.05), truth, tile_m=TILE, voxel=VOXEL)
+    rate = np.tan(np.radians(0.05))
+    order = np.argsort(c.centre[:, 0])
+    for side in (c.centre[order, 1] < 0, c.centre[order, 1] > 0):
+        dz = c.offset[order][side, 2]
+        assert np.all(np.diff(dz) < 0)  # lower and lower along x
+    np.testing.assert_allclose(c.offset[:, 2], -rate * c.centre[:, 0] ** 2 / 2, atol=0.02)
+    # the map's region turns nose down along +x: a positive pitch about y
+    np.testing.assert_allclose(c.angles_deg[:, 1], 0.05 * c.centre[:, 0], atol=0.1)
+    assert c.centre[c.largest_dz(), 0] > 20.0
+
+
+def test_a_ground_alone_is_not_held():
+    """A flat ground pins z, roll and pitch only: its region is registered, not held."""
+    rng = np.random.default_rng(0)
+    ground = np.column_stack([rng.uniform(0, 5, (20000, 2)), rng.normal(0, 0.005, 20000)])
+    c = regions_3d(ground - [0, 0, 0.2], ground, tile_m=TILE, voxel=VOXEL)
+    assert len(c.points) == 1 and not c.held[0]
+    assert c.offset[0, 2] == pytest.approx(-0.2, abs=0.01)
+    assert c.largest() is None and c.largest_dz() is None
+
+
+def test_the_truth_frame_is_levelled_first(truth, scan):
+    """With the truth's levelling given, both clouds are turned by it: a street tilted 2 deg
+    about x, and its map sunk beyond 10 m along the tilted street, reads as the level one."""
+    turn = np.radians(2.0)
+    tilt = np.array([[1, 0, 0], [0, np.cos(turn), -np.sin(turn)], [0, np.sin(turn),
+                                                                    np.cos(turn)]])
+    c = regions_3d(sunk(scan, 10.0, 0.3) @ tilt.T, truth @ tilt.T, tile_m=TILE, voxel=VOXEL,
+                   level=tilt.T)
+    far = c.centre[:, 0] > 10.0
+    np.testing.assert_allclose(c.offset[far, 2], -0.3, atol=0.05)
+    assert np.all(np.abs(c.offset[~far, 2]) < 0.05)
+
+
+def test_empty_inputs_give_no_region():
+    c = regions_3d(np.zeros((0, 3)), np.zeros((0, 3)), tile_m=TILE, voxel=VOXEL)
+    assert isinstance(c, Consistency3D) and len(c.points) == 0 and c.largest() is None
+
+
+def test_repeatable(truth, scan, sank):
+    """The same inputs give the same regions, bit for bit."""
+    a, b = sank, regions_3d(sunk(scan, 10.0, 0.3), truth, tile_m=TILE, voxel=VOXEL)
+    for name in ("centre", "offset", "angles_deg", "fit_before", "fit_after", "held"):
+        np.testing.assert_array_equal(getattr(a, name), getattr(b, name))
+
+
+def test_a_long_map_gets_larger_tiles():
+    """A 400 m long ground is cut into at most 32 tiles along it: 12.5 m each."""
+    rng = np.random.default_rng(1)
+    ground = np.column_stack([rng.uniform(0, 400, (40000,)), rng.uniform(0, 4, 40000),
+                              np.zeros(40000)])
+    assert regions_3d(ground, ground, tile_m=TILE, voxel=0.5).tile_m == pytest.approx(12.5,
+                                                                                     rel=1e-3)
