@@ -52,7 +52,8 @@ def test_in_the_frame_given_the_figures_are_the_references(clouds, settings):
     assert got["voxels"] == voxels > 20
     assert got["awd_m"] == pytest.approx(awd, abs=1e-6)  # the JSON keeps 6 decimals
     assert got["scs"] == pytest.approx(scs, abs=1e-6)
-    assert doc["settings"]["map_3d"] == {"voxel": voxel, "min_points": min_points,
+    assert doc["settings"]["map_3d"] == {**doc["settings"]["map_3d"], "voxel": voxel,
+                                         "min_points": min_points,
                                          "radius": radius}
     assert f"{voxel:g} m voxels holding at least {min_points} points" in got["computed_on"]
     assert "alignment_3d" not in doc and "distances_3d" not in doc  # no 3D registration
