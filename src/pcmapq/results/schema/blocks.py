@@ -1,26 +1,11 @@
-"""The result's JSON document, declared once: :meth:`Result.to_dict` writes these models and
-:meth:`Result.from_json` reads them, and docs/result.schema.json is generated from them. Truth
-frame, metres and degrees. A key that may be absent has a default (a field left unset is not
-written); every other key is always written, null where undefined."""
+"""The blocks of any result's document: its inputs, alignment, consistency map, frames,
+distances, detectors, features and gates. Truth frame, metres and degrees."""
 
 from __future__ import annotations
 
-import json
-from typing import Any
-
-from pydantic import BaseModel, ConfigDict, ValidationError
-
 from pcmapq.core.stats import Stats
 from pcmapq.metrics.distances import FScore
-
-Point = tuple[float, float]
-Matrix = list[list[float]]
-
-
-class Block(BaseModel):
-    """A block of the document: its keys are exactly its fields, in their order."""
-
-    model_config = ConfigDict(extra="forbid", frozen=True, use_attribute_docstrings=True)
+from pcmapq.results.schema.base import Block, Matrix, Point
 
 
 class Producer(Block):
@@ -158,48 +143,6 @@ class ConsistencyMap(Block):
     regions: list[Region]
 
 
-Point3 = tuple[float, float, float]
-
-
-class Region3D(Block):
-    """One region of the 3D consistency map, registered to the truth on its own: where it is
-    (its points' centroid) and the map's error there, where the map has it from where it fits
-    the truth (a region the map has too low: dz_m < 0)."""
-
-    x_m: float
-    y_m: float
-    z_m: float
-    dx_m: float
-    dy_m: float
-    dz_m: float
-    offset_m: float
-    roll_deg: float
-    pitch_deg: float
-    yaw_deg: float
-    points: int
-    fitness_before: float
-    fitness_after: float
-    held: bool
-    """Its geometry pins the fit in all six directions and it fits (its offset is sure)."""
-
-
-class ConsistencyMap3D(Block):
-    """Two 3D clouds: the map, as the 3D registration placed it, cut into tiles of the ground,
-    each registered to the truth on its own in 3D; in the truth's levelled frame (x, y its
-    plan, z up), metres and degrees. Largest: of the held regions; null without one."""
-
-    tile_m: float
-    voxel_m: float
-    tolerance_m: float
-    """A point within this of a truth point fits (fitness)."""
-    largest_offset_m: float | None
-    largest_at_m: Point3 | None
-    largest_dz_m: float | None
-    """The largest vertical offset, |dz|."""
-    largest_dz_at_m: Point3 | None
-    regions: list[Region3D]
-
-
 class Levelling(Block):
     """A 3D cloud's levelling: the rotation that makes its floor horizontal."""
 
@@ -230,22 +173,6 @@ class Distances(Block):
     """Truth -> map."""
     chamfer_m: float | None
     f_score: list[FScore]
-
-
-class Map3D(Block):
-    """MapEval's map figures of two 3D clouds in one frame (docs/metrics.md): each cloud cut
-    into voxels, one Gaussian (mean, covariance) per voxel and cloud."""
-
-    computed_on: str
-    """The voxels, the points they need and SCS's neighbourhood, in words."""
-    voxels: int
-    """Voxels both clouds hold enough points in: AWD's mean is over them."""
-    awd_m: float | None
-    """AWD: the mean 2-Wasserstein distance between the two clouds' Gaussians of those voxels
-    (lower is better); null when no voxel is compared."""
-    scs: float | None
-    """SCS: the mean, over those voxels, of their neighbours' distances' standard deviation
-    over their mean (no unit; lower is better); null when no voxel has a neighbour."""
 
 
 class Detector(Block):
@@ -295,14 +222,6 @@ class Extra(Block):
     map_xy_m: Point
 
 
-class Registration3D(Block):
-    """The 3D registration of two clouds."""
-
-    matrix: Matrix
-    fitness: float
-    rmse_m: float
-
-
 class Gate(Block):
     """One gate (``--fail-under``, ``--fail-over``) judged on the result."""
 
@@ -312,67 +231,3 @@ class Gate(Block):
     bound: float
     value: float | None
     passed: bool
-
-
-class ResultDocument(Block):
-    """What ``pcmapq eval --json`` writes: everything a run found."""
-
-    pcmapq: Producer
-    settings: dict[str, Any] | None
-    """The options it ran with (docs/config.md)."""
-    map: MapInput
-    truth: TruthInput
-    alignment: Alignment
-    consistency: ConsistencyMap | None = None
-    frames: Frames
-    coverage: float
-    footprint: str
-    scored_against: str
-    """"whole truth" or "footprint"."""
-    distances: Distances
-    noref: dict[str, Any] | None
-    """Each input's no-reference figures, ``{"map": ..., "truth": ...}``."""
-    detectors: dict[str, Detector]
-    matches: list[Match]
-    missing: list[Missing]
-    extra: list[Extra]
-    alignment_3d: Registration3D | None = None
-    distances_3d: Distances | None = None
-    map_3d: Map3D | None = None
-    """Two 3D clouds in one frame: MapEval's AWD and SCS."""
-    consistency_3d: ConsistencyMap3D | None = None
-    """Only when both inputs are 3D clouds."""
-    rooms: dict[str, Any] | None = None
-    """The rooms detector's rooms and doors, each with its status."""
-    gates: list[Gate] | None = None
-
-
-def json_schema() -> dict[str, Any]:
-    """The document's JSON Schema (draft 2020-12), as published in docs/result.schema.json."""
-    return {"$schema": "https://json-schema.org/draft/2020-12/schema",
-            **_untitled(ResultDocument.model_json_schema(mode="serialization"))}
-
-
-def _untitled(node: Any) -> Any:
-    """``node`` without the titles pydantic makes of field names (``"X M"``)."""
-    if isinstance(node, dict):
-        return {k: _untitled(v) for k, v in node.items()
-                if not (k == "title" and isinstance(v, str) and "properties" not in node)}
-    if isinstance(node, list):
-        return [_untitled(v) for v in node]
-    return node
-
-
-def schema_text() -> str:
-    """:func:`json_schema` as docs/result.schema.json holds it."""
-    return json.dumps(json_schema(), indent=2) + "\n"
-
-
-def problem(error: ValidationError) -> str:
-    """A document's departure from the schema in one line: the shallowest one (a missing
-    group before the keys inside it), where and what, and how many more there are."""
-    first = min(error.errors(), key=lambda e: len(e["loc"]))
-    where = ".".join(str(k) for k in first["loc"]) or "the document"
-    more = error.error_count() - 1
-    what = f"no '{where}'" if first["type"] == "missing" else f"{where}: {first['msg']}"
-    return what + (f" (and {more} more)" if more else "")
