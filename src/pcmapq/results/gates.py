@@ -203,7 +203,8 @@ def _tau_index(key: str, text: str | None, block: dict | None) -> int:
         raise GateError(f"{key}: the result has no 3D distances (two 3D clouds only)")
     scores = block.get("f_score") or []
     taus = [s["tau_m"] for s in scores]
-    listed = ", ".join(f"f_score@{t:g}" for t in taus) or "none"
+    name = key.split("@")[0]
+    listed = ", ".join(f"{name}@{t:g}" for t in taus) or "none"
     if text is None:
         if len(taus) == 1:
             return 0
