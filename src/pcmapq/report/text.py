@@ -116,7 +116,7 @@ def relief_parts(result: Result) -> list[str]:
         dz = c.offset[k, 2]
         parts.append(f"largest dz {dz:+.3f} m ({'too low' if dz < 0 else 'too high'}) at "
                      f"({c.centre[k, 0]:.1f}, {c.centre[k, 1]:.1f}, {c.centre[k, 2]:.1f}) m")
-    return [*parts, f"{int(c.held.sum())} of {len(c.points)} regions of "
+    return [*parts, f"{int(c.held.sum())} of {count(len(c.points), 'region')} of "
                     f"{c.tile_m:g} m held"]
 
 
