@@ -55,15 +55,15 @@ def score(placed: Placed, prepared: PreparedTruth, settings: Settings,
             progress("distances in 3D")
             cloud_job = pool.submit(distances_3d, side.source.points, truth.points,
                                     settings.raster.cloud_resolution, settings.distances.taus)
-        if in_one_frame_3d(side, truth, settings):
-            m3 = settings.map_3d
-            gaussians_job = pool.submit(map_gaussians, side.source.points, truth.points,
-                                        m3.voxel, m3.min_points, m3.radius)
             progress("registering the map's regions in 3D on their own")
             consistency_3d_job = pool.submit(
                 regions_3d, side.source.points, truth.points, tile_m=settings.map_3d.tile,
                 voxel=settings.alignment.voxel_3d,
                 level=None if prepared.level is None else prepared.level.rotation)
+        if in_one_frame_3d(side, truth, settings):
+            m3 = settings.map_3d
+            gaussians_job = pool.submit(map_gaussians, side.source.points, truth.points,
+                                        m3.voxel, m3.min_points, m3.radius)
         if placed.features is None:
             progress("drawing the walls' centre lines and detecting features")
             sides = SideBySide(settings.matching.detectors, settings.matching.params)
