@@ -16,6 +16,7 @@ from pcmapq.core.frames import Frames
 from pcmapq.core.grid import MetricGrid
 from pcmapq.core.transform import Similarity2D
 from pcmapq.features import Features
+from pcmapq.features.names import MATCH_THRESHOLD
 from pcmapq.match import Matching
 from pcmapq.metrics.distances import Distances
 from pcmapq.metrics.map_gaussians import MapGaussians
@@ -207,10 +208,8 @@ def _threshold(doc: s.ResultDocument) -> float:
     """The matching threshold: the detectors', else the settings' (metres)."""
     for d in doc.detectors.values():
         return d.threshold_m
-    from pcmapq.settings import MatchingConfig
-
     matching = (doc.settings or {}).get("matching") or {}
-    return matching.get("threshold", MatchingConfig().threshold)
+    return matching.get("threshold", MATCH_THRESHOLD)
 
 
 def _consistency_of(doc: s.ConsistencyMap | None, tolerance: float) -> Consistency | None:
