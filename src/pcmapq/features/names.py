@@ -21,3 +21,6 @@ DETECTOR_NAMES: tuple[str, ...] = tuple(DETECTOR_SOURCES)
 #: The detectors an evaluation runs when none are named: every one (a detector run only when
 #: named is left out here, and says ``by_default=False``).
 DEFAULT_DETECTORS: tuple[str, ...] = DETECTOR_NAMES
+#: The detectors of 3D structures of two 3D clouds (:mod:`pcmapq.match.structures`), in the
+#: order they are written and shown.
+STRUCTURE_NAMES: tuple[str, ...] = ("planes", "plane_lines")
