@@ -6,6 +6,7 @@ out, to make maps whose structures differ from the truth's by known amounts."""
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -98,3 +99,20 @@ def changed(parts: list[Face], moved: dict[str, float] | None = None,
     and those named in ``removed`` left out."""
     moved = moved or {}
     return [f.moved(moved.get(f.name, 0.0)) for f in parts if f.name not in removed]
+
+
+def moved_map(seed: int = 2) -> np.ndarray:
+    """The building's map with room B's far wall 0.3 m further (+x; room B 0.3 m longer)
+    and room A's floor 0.05 m higher (+z), another draw of the noise."""
+    return cloud(changed(faces(b_end=10.6), {"A.floor": 0.05}), seed=seed)
+
+
+@functools.cache
+def known_structures():
+    """The structures of :func:`moved_map` against the building (seed 1), both taken to be in
+    the truth frame, with the default settings (a
+    :class:`~pcmapq.match.structures.Structures3D`; made once)."""
+    from pcmapq.evaluation.scoring import structures_3d
+    from pcmapq.settings import StructuresConfig
+
+    return structures_3d(cloud(faces(), seed=1), moved_map(), StructuresConfig())

@@ -1,6 +1,7 @@
 """A placed map scored against its prepared truth (:func:`score`): features matched one to one
 inside the footprint, wall distances, the consistency map of its regions, and the optional
-no-reference and 3D figures, gathered in a :class:`~pcmapq.results.result.Result`."""
+no-reference and 3D figures (two 3D clouds' distances and structures), gathered in a
+:class:`~pcmapq.results.result.Result`."""
 
 from __future__ import annotations
 
@@ -18,14 +19,16 @@ from pcmapq.evaluation.noref_figures import EarlyFigures, input_figures
 from pcmapq.evaluation.placing import Placed, Progress
 from pcmapq.evaluation.truth import FEATURE_THREADS, PreparedTruth
 from pcmapq.features import Features, SideBySide, default_params
+from pcmapq.features.planes3d import PlaneParams
 from pcmapq.features.rooms import Params as RoomParams
 from pcmapq.features.rooms import drawn, share_inside
 from pcmapq.io import OccupancyMap, PointMap
 from pcmapq.match import match
 from pcmapq.match.rooms import room_table
+from pcmapq.match.structures import Structures3D, compare_structures
 from pcmapq.metrics.distances import distances, distances_3d
 from pcmapq.results.result import OTHER, DetectorResult, Result
-from pcmapq.settings import Settings
+from pcmapq.settings import Settings, StructuresConfig
 
 
 def score(placed: Placed, prepared: PreparedTruth, settings: Settings,
@@ -37,7 +40,7 @@ def score(placed: Placed, prepared: PreparedTruth, settings: Settings,
     side, loaded, rule = placed, placed.given, placed.rule
     truth, grid, alignment = prepared.source, prepared.grid, side.alignment
     registration, footprint = side.registration, side.cover.footprint
-    with ThreadPoolExecutor(2, thread_name_prefix="pcmapq-score") as pool:
+    with ThreadPoolExecutor(3, thread_name_prefix="pcmapq-score") as pool:
         # the consistency map and the 3D distances need only the placed map: found while the
         # map's features are
         consistency_job = cloud_job = None
@@ -52,6 +55,11 @@ def score(placed: Placed, prepared: PreparedTruth, settings: Settings,
             progress("distances in 3D")
             cloud_job = pool.submit(distances_3d, side.source.points, truth.points,
                                     settings.raster.cloud_resolution, settings.distances.taus)
+        structures_job = None
+        if registration is not None and settings.structures.enabled:
+            progress("3D structures")
+            structures_job = pool.submit(structures_3d, truth.points, side.source.points,
+                                         settings.structures)
         if placed.features is None:
             progress("drawing the walls' centre lines and detecting features")
             sides = SideBySide(settings.matching.detectors, settings.matching.params)
@@ -59,6 +67,7 @@ def score(placed: Placed, prepared: PreparedTruth, settings: Settings,
                                                            threads=FEATURE_THREADS))
         consistency = None if consistency_job is None else consistency_job.result()
         cloud_distances = None if cloud_job is None else cloud_job.result()
+        structures = None if structures_job is None else structures_job.result()
     frames = Frames(alignment.transform, side.level, prepared.level,
                     None if registration is None else registration.transform)
     detectors = {}
@@ -91,11 +100,30 @@ def score(placed: Placed, prepared: PreparedTruth, settings: Settings,
                                       _band_words(side.source, truth, settings)),
                   registration_3d=registration, distances_3d=cloud_distances,
                   threshold=threshold, full=full, detectors=detectors,
-                  footprint_rule=rule, frames=frames, settings=settings.to_dict(),
+                  footprint_rule=rule, frames=frames,
+                  settings=saved_settings(settings, registration is not None),
                   truth_occupied=prepared.occupied, map_occupied=side.occupied, noref=noref,
-                  consistency=consistency, rooms=rooms,
+                  consistency=consistency, rooms=rooms, structures=structures,
                   map_message=None if getattr(loaded, "message", None) is None
                   else loaded.message.to_dict())
+
+
+def structures_3d(truth: np.ndarray, map_: np.ndarray, option: StructuresConfig
+                  ) -> Structures3D:
+    """The 3D structures of two clouds (N, 3), both in the truth frame, metres, found and
+    matched with ``option`` (:func:`~pcmapq.match.structures.compare_structures`)."""
+    return compare_structures(truth, map_, PlaneParams(option.voxel, option.min_points,
+                                                       option.min_area),
+                              option.line_margin, option.max_angle, option.max_offset)
+
+
+def saved_settings(settings: Settings, clouds_3d: bool) -> dict:
+    """The settings a result holds (:meth:`Settings.to_dict`): those of the 3D structures only
+    when its two inputs are 3D clouds registered in 3D, so that a 2D result holds none."""
+    doc = settings.to_dict()
+    if not clouds_3d:
+        del doc["structures"]
+    return doc
 
 
 def inside(features: Features, area: np.ndarray, grid: MetricGrid,

@@ -22,6 +22,7 @@ if TYPE_CHECKING:  # the alignment modules load Open3D; a result only holds thei
     from pcmapq.align.parts import Part
     from pcmapq.align.regions import Consistency
     from pcmapq.align.rigid3d import Registration3D
+    from pcmapq.match.structures import Structures3D
 
 #: Decimals kept in saved numbers: micrometres, so reruns give byte-identical files.
 DECIMALS = 6
@@ -123,6 +124,8 @@ class Findings:
     rooms detector's rooms, each with its status (:func:`pcmapq.match.rooms.room_table`), None
     when it did not run. map_message: the recording's message the map was read from (topic,
     index, ``time_s`` from the recording's start, header ``stamp_s``), None for a file.
+    structures: the 3D structures of two 3D clouds registered in 3D, matched one to one
+    (:mod:`pcmapq.match.structures`), None when not found.
     truth_occupied, map_occupied (and the overlap's footprint): the rasters on ``grid``; None
     in a result read back by :meth:`Result.from_json`, which holds everything the JSON holds and no
     more.
@@ -152,6 +155,7 @@ class Findings:
     truth_sha256: str | None = None
     rooms: dict | None = None
     map_message: dict | None = None
+    structures: Structures3D | None = None
 
     @property
     def transform(self) -> Similarity2D:

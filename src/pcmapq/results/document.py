@@ -20,6 +20,7 @@ from pcmapq.match import Matching
 from pcmapq.metrics.distances import Distances
 from pcmapq.results import schema as s
 from pcmapq.results.blocks import DetectorResult, Findings, Overlap
+from pcmapq.results.structures_doc import structures_block, structures_of
 
 if TYPE_CHECKING:
     from pcmapq.align.regions import Consistency
@@ -40,6 +41,8 @@ def document(r: Findings, features: bool = True) -> s.ResultDocument:
         optional["alignment_3d"] = s.Registration3D(matrix=reg.transform.tolist(),
                                                     fitness=reg.fitness, rmse_m=reg.rmse_m)
         optional["distances_3d"] = _distances(r.distances_3d)
+    if r.structures is not None:
+        optional["structures_3d"] = structures_block(r.structures, features)
     if r.rooms is not None:
         optional["rooms"] = r.rooms
     rows = _feature_rows(r) if features else ([], [], [])
@@ -103,7 +106,8 @@ def fields(doc: s.ResultDocument) -> dict[str, Any]:
         truth_occupied=None, map_occupied=None, frames=frames,
         footprint_rule=doc.footprint, settings=doc.settings, command=doc.pcmapq.command,
         noref=doc.noref, truth_sha256=t.sha256, map_message=message or None,
-        consistency=_consistency_of(doc.consistency, a.tolerance_m), rooms=doc.rooms)
+        consistency=_consistency_of(doc.consistency, a.tolerance_m), rooms=doc.rooms,
+        structures=structures_of(doc.structures_3d))
 
 
 def consistency_block(c: Consistency | None) -> s.ConsistencyMap:

@@ -26,11 +26,12 @@ EXIT_CODE = 3
 #: The two directions and the option of each.
 UNDER, OVER = "under", "over"
 OPTIONS = {UNDER: "--fail-under", OVER: "--fail-over"}
-#: The top-level keys of the result's JSON (``alignment_3d``, ``distances_3d``: two 3D clouds;
-#: ``rooms``: the rooms detector ran).
+#: The top-level keys of the result's JSON (``alignment_3d``, ``distances_3d``,
+#: ``structures_3d``: two 3D clouds; ``rooms``: the rooms detector ran).
 TOP_LEVEL = ("pcmapq", "settings", "map", "truth", "alignment", "consistency", "frames",
              "coverage", "footprint", "scored_against", "distances", "noref", "detectors",
-             "matches", "missing", "extra", "alignment_3d", "distances_3d", "rooms")
+             "matches", "missing", "extra", "alignment_3d", "distances_3d", "rooms",
+             "structures_3d")
 _F_SCORE = re.compile(r"^(f_score|wall_precision)(_3d)?(?:@(.*))?$")
 
 

@@ -12,6 +12,7 @@ from pydantic import BaseModel, ConfigDict, ValidationError
 
 from pcmapq.core.stats import Stats
 from pcmapq.metrics.distances import FScore
+from pcmapq.results.structures_schema import Structures3D
 
 Point = tuple[float, float]
 Matrix = list[list[float]]
@@ -280,6 +281,7 @@ class ResultDocument(Block):
     extra: list[Extra]
     alignment_3d: Registration3D | None = None
     distances_3d: Distances | None = None
+    structures_3d: Structures3D | None = None
     rooms: dict[str, Any] | None = None
     """The rooms detector's rooms and doors, each with its status."""
     gates: list[Gate] | None = None

@@ -18,6 +18,7 @@ from pcmapq.metrics.defaults import DEFAULT_TAUS, LIDAR_RADIUS, MAX_NN, MAX_WARD
 __all__ = ["DEFAULT_DETECTORS", "DETECTOR_NAMES", "EVAL_MAX_WARD", "EVAL_NOREF_SAMPLE",
            "EVAL_NOREF_VOXEL", "AlignmentConfig", "DistancesConfig", "FootprintConfig",
            "MatchingConfig", "NoRefConfig", "RasterConfig", "Settings", "SourceConfig",
+           "StructuresConfig",
            "default_params", "plain"]
 
 
@@ -162,6 +163,32 @@ class NoRefConfig:
     sample: int = 0
 
 
+@dataclass(frozen=True)
+class StructuresConfig:
+    """The 3D structures of two 3D clouds registered in 3D (:mod:`pcmapq.match.structures`):
+    their planes and the lines where two planes meet, found on each cloud in the truth frame
+    and matched one to one.
+
+    enabled: find and match them (``--no-structures``: not).
+    voxel: each cloud is reduced to one point per voxel of this side before its planes are
+        found, metres (0.1 indoors; 0.3 for outdoor LiDAR maps).
+    min_points: the fewest reduced points a plane keeps.
+    min_area: the least area a plane covers, square metres.
+    max_angle: the largest angle between a matched truth and map structure, degrees.
+    max_offset: the largest distance between them, metres: a plane's along the truth plane's
+        normal, a line's from the truth line.
+    line_margin: two planes meet in a line where their extents touch within this, metres.
+    """
+
+    enabled: bool = True
+    voxel: float = 0.1
+    min_points: int = 30
+    min_area: float = 1.0
+    max_angle: float = 5.0
+    max_offset: float = 0.5
+    line_margin: float = 0.2
+
+
 #: ``eval``'s voxel for the 3D no-reference figures, metres: a tenth of LiDAR's radius. It bounds
 #: their cost on dense clouds and puts maps of unlike density on one footing (MME depends on it).
 EVAL_NOREF_VOXEL = 0.1
@@ -190,6 +217,7 @@ class Settings:
     distances: DistancesConfig = field(default_factory=DistancesConfig)
     noref: NoRefConfig = field(default_factory=lambda: NoRefConfig(
         voxel=EVAL_NOREF_VOXEL, max_ward=EVAL_MAX_WARD, sample=EVAL_NOREF_SAMPLE))
+    structures: StructuresConfig = field(default_factory=StructuresConfig)
 
     def to_dict(self) -> dict:
         """Every option as plain JSON types, one object per stage, in metres and degrees:
@@ -222,7 +250,8 @@ class Settings:
                                     {name: detector(name).params(**p)
                                      for name, p in m["params"].items()}),
             distances=DistancesConfig(tuple(doc["distances"]["taus"])),
-            noref=NoRefConfig(**doc.get("noref", {"enabled": False})))  # saved before noref
+            noref=NoRefConfig(**doc.get("noref", {"enabled": False})),  # saved before noref
+            structures=StructuresConfig(**doc.get("structures", {})))  # a 2D result has none
 
 
 def plain(value):
