@@ -113,9 +113,10 @@ def local_shape(points: np.ndarray, k: int = NEIGHBOURS
     """Each point's k nearest neighbours (N, k) indices (itself first), its unit normal
     (N, 3) and its surface variation (N,), from their covariance."""
     k = min(k, len(points))
-    _, near = cKDTree(points).query(points, k=k)
+    _, near = cKDTree(points).query(points, k=k, workers=-1)
     near = near.reshape(len(points), k)
-    centred = points[near] - points[near].mean(axis=1, keepdims=True)
+    centred = points[near]
+    centred -= centred.mean(axis=1, keepdims=True)
     values, vectors = np.linalg.eigh(np.einsum("nki,nkj->nij", centred, centred) / k)
     variation = values[:, 0] / np.maximum(values.sum(axis=1), 1e-18)
     return near, vectors[:, :, 0], variation
