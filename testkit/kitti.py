@@ -1,4 +1,5 @@
-"""KITTI odometry sequence 00's calibration: its velodyne -> left camera transform."""
+"""KITTI odometry sequence 00's calibration (its velodyne -> left camera transform) and a pitch
+drift of its scans' poses."""
 
 from __future__ import annotations
 
@@ -17,3 +18,14 @@ def tr_00() -> np.ndarray:
     tr = np.eye(4)
     tr[:3, :4] = np.array(TR_00.split(), dtype=np.float64).reshape(3, 4)
     return tr
+
+
+def pitched(poses: np.ndarray, level_deg: float) -> np.ndarray:
+    """LiDAR poses (K, 4, 4) with scan k's turned ``k * level_deg`` degrees about its lateral
+    axis (the velodyne's y: it looks along x, y to its left, z up): a pitch drift growing scan
+    by scan, the first scan where it was."""
+    angle = np.radians(level_deg * np.arange(len(poses)))
+    turn = np.tile(np.eye(4), (len(poses), 1, 1))
+    turn[:, 0, 0] = turn[:, 2, 2] = np.cos(angle)
+    turn[:, 0, 2], turn[:, 2, 0] = np.sin(angle), -np.sin(angle)
+    return poses @ turn
