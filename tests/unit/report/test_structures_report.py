@@ -9,6 +9,7 @@ import pytest
 from rich.console import Console
 
 from pcmapq.match.structures import StructureMatching
+from pcmapq.report import structures
 from pcmapq.report.html import report_html
 from pcmapq.report.table import print_table
 from pcmapq.report.text import verdict
@@ -66,4 +67,5 @@ def test_the_report_lists_them_beside_the_2d_detectors(result):
 def test_a_2d_result_shows_no_structures(sample_result):
     assert not [line for line in shown(sample_result).splitlines()
                 if line.startswith(("planes", "plane_lines")) or "3D structure" in line]
-    assert "(3D)" not in report_html(sample_result)
+    assert structures.html_rows(sample_result, lambda stats: []) == []
+    assert structures.planes_html(sample_result) == ""
