@@ -1,7 +1,7 @@
 """Run the ratio benchmarks (:mod:`bench.ratios`) and print their table.
 
-    python -m bench [--only noref,kitti,clouds,campus] [--repeat 2] [--check] [--save] [--doc]
-                    [--cache DIR]
+    python -m bench [--only noref,kitti,clouds,campus,structures] [--repeat 2] [--check]
+                    [--save] [--doc] [--cache DIR]
 
 --check: exit 1 when a ratio is worse than its stored one (bench/ratios.json) by more
 than 20 %. --save: store the ratios measured. --doc: write them into docs/benchmarks.md's

@@ -15,7 +15,10 @@ Each case runs its commands in fresh processes (wall seconds and peak RSS of the
 - ``clouds``: ``pcmapq eval`` of a 10 M-point cloud against its plan, against Open3D reading
   it and downsampling it at 0.05 m (:mod:`bench.bench_clouds`);
 - ``campus``: the ``size`` x ``size`` campus grid pair against OpenCV reading both images and
-  one distance transform (:mod:`bench.bench_grids`).
+  one distance transform (:mod:`bench.bench_grids`);
+- ``structures``: ``pcmapq eval`` by default against ``--no-structures`` (the price of the 3D
+  structures) on the synthetic building of :mod:`testkit.building3d` and KITTI 00's 20-scan
+  pair.
 
 Inputs are built once into a cache folder outside the repository (``--cache``); cases whose
 data (``../shared/data``) is absent are skipped with the reason.
@@ -182,6 +185,41 @@ def rooms(cache: Path, repeat: int) -> list[Ratio]:
     return out
 
 
+def building_pair(cache: Path) -> tuple[Path, Path]:
+    """The synthetic building of :mod:`testkit.building3d` and its moved map, written once."""
+    def write(folder: Path) -> None:
+        from pcmapq.io.writers import write_cloud
+        from testkit import building3d
+
+        write_cloud(folder / "truth.ply", building3d.cloud(building3d.faces(), seed=1))
+        write_cloud(folder / "moved.ply", building3d.moved_map())
+
+    folder = written(cache / "building3d", write)
+    return folder / "moved.ply", folder / "truth.ply"
+
+
+def structures(cache: Path, repeat: int) -> list[Ratio]:
+    """The 3D structures' price: eval by default / eval --no-structures, on the synthetic
+    building and on KITTI 00's 20-scan pair (at the structures' voxel for outdoor maps,
+    0.3 m, and at the default, 0.1 m)."""
+    cases = [("building", *building_pair(cache), ())]
+    kitti = kitti_pair(cache)
+    if kitti is not None:
+        cases += [("KITTI 20 scans", *kitti, ("--structures-voxel", "0.3")),
+                  ("KITTI 20 scans, 0.1 m voxel", *kitti, ())]
+    else:
+        print("structures: KITTI skipped, ../shared/data/kitti00 is absent", file=sys.stderr)
+    out = []
+    for name, map_path, truth, extra in cases:
+        on, off = paired(eval_cmd(map_path, truth, cache / "on.json", *extra),
+                         eval_cmd(map_path, truth, cache / "off.json", *extra,
+                                  "--no-structures"), repeat)
+        out.append(Ratio(f"structures/{name}/time", on[0] / off[0],
+                         f"default{' ' + ' '.join(extra) if extra else ''} {on[0]:.1f} s",
+                         f"--no-structures {off[0]:.1f} s"))
+    return out
+
+
 def kitti(cache: Path, repeat: int) -> list[Ratio]:
     """KITTI 00's 20-scan pair by default against Open3D reading and downsampling both."""
     pair = kitti_pair(cache)
@@ -224,6 +262,7 @@ def campus(cache: Path, repeat: int, size: int = 8000) -> list[Ratio]:
 #: name -> case; each returns its ratios.
 CASES: dict[str, Callable[[Path, int], list[Ratio]]] = {
     "noref": noref, "rooms": rooms, "kitti": kitti, "clouds": clouds, "campus": campus,
+    "structures": structures,
 }
 
 

@@ -1,5 +1,6 @@
-"""KITTI odometry sequence 00: its velodyne -> left camera transform, and maps of its first
-scans at the reference poses and at poses that drift in pitch (:func:`pitch_ladder`)."""
+"""KITTI odometry sequence 00: its velodyne -> left camera transform, a pitch drift of its
+scans' poses (:func:`pitched`), and maps of its first scans at the reference poses and at poses
+that drift in pitch (:func:`pitch_ladder`)."""
 
 from __future__ import annotations
 
@@ -27,8 +28,6 @@ def pitch_ladder(steps_deg: tuple[float, ...], voxel: float = 0.1
     step, degrees, about the scanner's own lateral (y) axis, so its far points rise or sink
     more with every scan. Maps (N, 3), metres, voxel centroids of ``voxel`` metres, in the
     first scan's frame."""
-    from scipy.spatial.transform import Rotation
-
     from pcmapq.mapping import build_map_from_poses, lidar_poses_from_camera, read_kitti_poses
 
     from .paths import shared
@@ -36,10 +35,17 @@ def pitch_ladder(steps_deg: tuple[float, ...], voxel: float = 0.1
     folder = shared("kitti00")
     poses = lidar_poses_from_camera(read_kitti_poses(folder / "poses.txt"), tr_00())
     truth = build_map_from_poses(folder, poses, voxel=voxel)
-    drifted = {}
-    for step in steps_deg:
-        pitched = poses.copy()
-        turns = Rotation.from_euler("y", np.arange(len(poses))[:, None] * step, degrees=True)
-        pitched[:, :3, :3] = poses[:, :3, :3] @ turns.as_matrix()
-        drifted[step] = build_map_from_poses(folder, pitched, voxel=voxel)
+    drifted = {step: build_map_from_poses(folder, pitched(poses, step), voxel=voxel)
+               for step in steps_deg}
     return truth, drifted
+
+
+def pitched(poses: np.ndarray, level_deg: float) -> np.ndarray:
+    """LiDAR poses (K, 4, 4) with scan k's turned ``k * level_deg`` degrees about its lateral
+    axis (the velodyne's y: it looks along x, y to its left, z up): a pitch drift growing scan
+    by scan, the first scan where it was."""
+    angle = np.radians(level_deg * np.arange(len(poses)))
+    turn = np.tile(np.eye(4), (len(poses), 1, 1))
+    turn[:, 0, 0] = turn[:, 2, 2] = np.cos(angle)
+    turn[:, 0, 2], turn[:, 2, 0] = np.sin(angle), -np.sin(angle)
+    return poses @ turn

@@ -30,6 +30,8 @@ FIELDS: dict[str, Any] = {
     "distances_3d": _DISTANCES,
     "detectors": {"*": ("quality", "precision", "f1", "truth_features", "map_features",
                         "matched")},
+    "structures_3d": {"*": ("quality", "precision", "f1", "truth_structures", "map_structures",
+                            "matched")},
 }
 
 

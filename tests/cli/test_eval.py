@@ -79,10 +79,10 @@ def test_json_says_how_it_was_made(sample_json):
     assert doc["pcmapq"]["version"] == pcmapq.__version__
     assert doc["pcmapq"]["command"].startswith("pcmapq eval ")
     assert "--json" in doc["pcmapq"]["command"] and "--threshold" not in doc["pcmapq"]["command"]
-    # a 2D pair: no MapEval figures of two 3D clouds, nor the settings that only they take
-    assert "map_3d" not in doc
+    # a 2D pair: no figures of two 3D clouds, nor the settings that only they take
+    assert "map_3d" not in doc and "structures_3d" not in doc
     assert doc["settings"] == json.loads(json.dumps(
-        {k: v for k, v in Settings().to_dict().items() if k != "map_3d"}))
+        {k: v for k, v in Settings().to_dict().items() if k not in ("map_3d", "structures")}))
 
 
 @pytest.mark.parametrize("case", ["missing", "garbage_png", "yaml_without_resolution",

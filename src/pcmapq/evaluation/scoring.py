@@ -1,6 +1,7 @@
 """A placed map scored against its prepared truth (:func:`score`): features matched one to one
 inside the footprint, wall distances, the consistency map of its regions (and of two 3D
-clouds, its 3D one), and the optional no-reference and 3D figures, gathered in a
+clouds, its 3D one), and the optional no-reference and 3D figures (two 3D clouds' distances,
+AWD and SCS, and structures), gathered in a
 :class:`~pcmapq.results.result.Result`."""
 
 from __future__ import annotations
@@ -20,15 +21,17 @@ from pcmapq.evaluation.noref_figures import EarlyFigures, input_figures
 from pcmapq.evaluation.placing import Placed, Progress
 from pcmapq.evaluation.truth import FEATURE_THREADS, PreparedTruth
 from pcmapq.features import Features, SideBySide, default_params
+from pcmapq.features.planes3d import PlaneParams
 from pcmapq.features.rooms import Params as RoomParams
 from pcmapq.features.rooms import drawn, share_inside
 from pcmapq.io import OccupancyMap, PointMap
 from pcmapq.match import match
 from pcmapq.match.rooms import room_table
+from pcmapq.match.structures import Structures3D, compare_structures
 from pcmapq.metrics.distances import distances, distances_3d
 from pcmapq.metrics.map_gaussians import map_gaussians
 from pcmapq.results.result import OTHER, DetectorResult, Result
-from pcmapq.settings import Settings
+from pcmapq.settings import Settings, StructuresConfig
 
 
 def score(placed: Placed, prepared: PreparedTruth, settings: Settings,
@@ -40,7 +43,7 @@ def score(placed: Placed, prepared: PreparedTruth, settings: Settings,
     side, loaded, rule = placed, placed.given, placed.rule
     truth, grid, alignment = prepared.source, prepared.grid, side.alignment
     registration, footprint = side.registration, side.cover.footprint
-    with ThreadPoolExecutor(2, thread_name_prefix="pcmapq-score") as pool:
+    with ThreadPoolExecutor(3, thread_name_prefix="pcmapq-score") as pool:
         # the consistency map and the 3D distances need only the placed map: found while the
         # map's features are
         consistency_job = cloud_job = gaussians_job = consistency_3d_job = None
@@ -64,6 +67,11 @@ def score(placed: Placed, prepared: PreparedTruth, settings: Settings,
             m3 = settings.map_3d
             gaussians_job = pool.submit(map_gaussians, side.source.points, truth.points,
                                         m3.voxel, m3.min_points, m3.radius)
+        structures_job = None
+        if registration is not None and settings.structures.enabled:
+            progress("3D structures")
+            structures_job = pool.submit(structures_3d, truth.points, side.source.points,
+                                         settings.structures)
         if placed.features is None:
             progress("drawing the walls' centre lines and detecting features")
             sides = SideBySide(settings.matching.detectors, settings.matching.params)
@@ -73,6 +81,7 @@ def score(placed: Placed, prepared: PreparedTruth, settings: Settings,
         cloud_distances = None if cloud_job is None else cloud_job.result()
         gaussians = None if gaussians_job is None else gaussians_job.result()
         consistency_3d = None if consistency_3d_job is None else consistency_3d_job.result()
+        structures = None if structures_job is None else structures_job.result()
     frames = Frames(alignment.transform, side.level, prepared.level,
                     None if registration is None else registration.transform)
     detectors = {}
@@ -107,10 +116,11 @@ def score(placed: Placed, prepared: PreparedTruth, settings: Settings,
                   threshold=threshold, full=full, detectors=detectors,
                   footprint_rule=rule, frames=frames,
                   settings=recorded_settings(
-                      settings, gaussians is not None or consistency_3d is not None),
+                      settings, gaussians is not None or consistency_3d is not None,
+                      registration is not None),
                   truth_occupied=prepared.occupied, map_occupied=side.occupied, noref=noref,
                   consistency=consistency, rooms=rooms, map_3d=gaussians,
-                  consistency_3d=consistency_3d,
+                  consistency_3d=consistency_3d, structures=structures,
                   map_message=None if getattr(loaded, "message", None) is None
                   else loaded.message.to_dict())
 
@@ -122,11 +132,22 @@ def in_one_frame_3d(placed: Placed, truth: OccupancyMap | PointMap, settings: Se
     return both_3d and (placed.registration is not None or not settings.alignment.enabled)
 
 
-def recorded_settings(settings: Settings, map_3d: bool) -> dict:
+def recorded_settings(settings: Settings, map_3d: bool, structures: bool) -> dict:
     """The settings a result records (:meth:`Settings.to_dict`), the ``map_3d`` group only
-    when the result has the figures it sets (AWD and SCS, the 3D consistency map)."""
-    doc = settings.to_dict()
-    return doc if map_3d else {k: v for k, v in doc.items() if k != "map_3d"}
+    when the result has the figures it sets (AWD and SCS, the 3D consistency map), the
+    ``structures`` group only for two 3D clouds registered in 3D (where ``--no-structures``
+    is a choice worth recording): a 2D result records neither."""
+    kept = {"map_3d": map_3d, "structures": structures}
+    return {k: v for k, v in settings.to_dict().items() if kept.get(k, True)}
+
+
+def structures_3d(truth: np.ndarray, map_: np.ndarray, option: StructuresConfig
+                  ) -> Structures3D:
+    """The 3D structures of two clouds (N, 3), both in the truth frame, metres, found and
+    matched with ``option`` (:func:`~pcmapq.match.structures.compare_structures`)."""
+    return compare_structures(truth, map_, PlaneParams(option.voxel, option.min_points,
+                                                       option.min_area),
+                              option.line_margin, option.max_angle, option.max_offset)
 
 
 def inside(features: Features, area: np.ndarray, grid: MetricGrid,

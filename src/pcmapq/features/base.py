@@ -40,6 +40,7 @@ class Features:
         room, feature k at k + 1; else None.
     doors: rooms: (D, 5) the doors between them: the two rooms (feature indices, the smaller
         first), the door's x, y (metres) and width (metres); else None.
+    bounding: rooms: the share of the walls' cells next to a room, in [0, 1]; else None.
     """
 
     xy: np.ndarray
@@ -49,6 +50,7 @@ class Features:
     segments: np.ndarray | None = None
     labels: np.ndarray | None = None
     doors: np.ndarray | None = None
+    bounding: float | None = None
 
     def __len__(self) -> int:
         return len(self.xy)
@@ -78,6 +80,9 @@ class Detector:
         have anything to find; with fewer its three scores are undefined (rooms: 2, since a
         place that is one room has no rooms to tell apart; 0: no such minimum).
     noun: what one feature is called in a sentence ("corner", "room").
+    nothing_to_find: why the truth's features leave the detector nothing to find though
+        there are ``min_truth`` of them (rooms: pockets its walls close off, not rooms), its
+        three scores then undefined; None when they do not.
     """
 
     name: str
@@ -87,6 +92,7 @@ class Detector:
     by_default: bool = True
     min_truth: int = 0
     noun: str = "feature"
+    nothing_to_find: Callable[[Features], str | None] = lambda truth: None
 
     def checked(self, params: Any = None) -> Any:
         """``params``, or the defaults when None; InputError when they are not this

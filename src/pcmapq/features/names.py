@@ -24,3 +24,7 @@ DEFAULT_DETECTORS: tuple[str, ...] = DETECTOR_NAMES
 #: Largest distance between matched features by default, metres: ``MatchingConfig.threshold``
 #: (``--threshold``) and :func:`pcmapq.match.match`'s default.
 MATCH_THRESHOLD = 0.5
+
+#: The detectors of 3D structures of two 3D clouds (:mod:`pcmapq.match.structures`), in the
+#: order they are written and shown.
+STRUCTURE_NAMES: tuple[str, ...] = ("planes", "plane_lines")

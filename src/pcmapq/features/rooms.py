@@ -25,7 +25,8 @@ from pcmapq.features.resample import resample
 from pcmapq.features.room_segmentation import Params, Rooms, segment, without_wall_furniture
 from pcmapq.features.walls import WallImage
 
-__all__ = ["DETECTOR", "PIECE", "Params", "RoomOverlap", "candidates", "detect", "drawn",
+__all__ = ["DETECTOR", "MIN_BOUNDING", "PIECE", "Params", "RoomOverlap", "bounding", "candidates",
+           "detect", "drawn", "no_closed_rooms",
            "inside_rooms", "label_cell", "overlap", "room_cell", "room_overlap", "share_inside"]
 
 
@@ -53,32 +54,45 @@ def room_cell(grid: MetricGrid, cell_m: float) -> float:
     return float(np.ceil(needed / grid.resolution) * grid.resolution)
 
 
-def inside_rooms(walls: WallImage, params: Params) -> tuple[Rooms, np.ndarray, MetricGrid]:
+def inside_rooms(walls: WallImage, params: Params
+                 ) -> tuple[Rooms, np.ndarray, MetricGrid, np.ndarray]:
     """The rooms of the walls (see the module docstring) on cells of ``params.cell_m`` (or
     larger, :func:`room_cell`), the new number of each room (0: it reaches the raster's edge,
-    the outside; else 1, 2, ...), and the rooms' grid."""
+    the outside; else 1, 2, ...), the rooms' grid and its wall cells (bool)."""
     cell = room_cell(walls.grid, params.cell_m)
     share, grid = resample(walls.image, walls.grid, cell)
-    rooms = segment(without_wall_furniture(share < WALL_SHARE, cell, params), cell, params)
+    wall = share >= WALL_SHARE
+    rooms = segment(without_wall_furniture(~wall, cell, params), cell, params)
     labels = rooms.labels
     edge = on_edge(labels, len(rooms) + 1)
     edge[0] = True
     keep = np.flatnonzero(~edge[1:])
     number = np.zeros(len(rooms) + 1, np.int32)
     number[keep + 1] = np.arange(1, len(keep) + 1)
-    return rooms, number, grid
+    return rooms, number, grid, wall
+
+
+def bounding(wall: np.ndarray, labels: np.ndarray) -> float:
+    """The share of the wall cells next to a room cell (labels > 0; 8-neighbours), [0, 1]."""
+    room = np.pad(labels > 0, 1)
+    near = np.zeros(wall.shape, dtype=bool)
+    rows, cols = wall.shape
+    for dr in (0, 1, 2):
+        for dc in (0, 1, 2):
+            near |= room[dr:dr + rows, dc:dc + cols]
+    return float(np.count_nonzero(wall & near)) / max(int(np.count_nonzero(wall)), 1)
 
 
 def detect(walls: WallImage, params: Params) -> Features:
     """The rooms of the walls as features: centroids (metres, the walls' frame), area (m^2)
-    as strength, every room strong, their cells as labels and the doors between them
-    (ordered as the features)."""
-    rooms, inside, grid = inside_rooms(walls, params)
+    as strength, every room strong, their cells as labels, the doors between them (ordered
+    as the features) and the share of the walls that bound them."""
+    rooms, inside, grid, wall = inside_rooms(walls, params)
     labels = inside[rooms.labels]
     count = int(labels.max(initial=0))
     if count == 0:  # no room: its cells (none) are still there to say so
         return replace(empty_features(), labels=labels.astype(np.int32),
-                       doors=np.zeros((0, 5)))
+                       doors=np.zeros((0, 5)), bounding=0.0)
     cells = np.bincount(labels.ravel(), minlength=count + 1)[1:]
     rows, cols = np.indices(labels.shape)
     centre = np.column_stack([
@@ -98,7 +112,7 @@ def detect(walls: WallImage, params: Params) -> Features:
     doors = np.column_stack([ends, at, rooms.door_width_m[inner]]).reshape(-1, 5)
     doors = doors[np.lexsort((doors[:, 1], doors[:, 0]))]
     return Features(xy=xy[order], strength=area[order], strong=np.ones(count, dtype=bool),
-                    labels=number[labels], doors=doors)
+                    labels=number[labels], doors=doors, bounding=bounding(wall, labels))
 
 
 def label_cell(features: Features) -> float:
@@ -220,4 +234,20 @@ def candidates(truth: Features, map_: Features, threshold: float,
 #: A truth of one room (an outdoor place, a single hall) has no rooms to tell apart: its rooms'
 #: scores are undefined, not 0 or 1.
 MIN_ROOMS = 2
-DETECTOR = Detector("rooms", detect, candidates, Params, min_truth=MIN_ROOMS, noun="room")
+#: A truth whose rooms are next to less than this share of its walls has no closed rooms: what
+#: its walls close off are pockets (parked cars, a corner of a building seen from the street,
+#: a map whose doors all stand open), and its rooms' scores are undefined. The walls of a
+#: building's plan bound its rooms for about half their cells or more; a street's, an eighth.
+MIN_BOUNDING = 0.25
+
+
+def no_closed_rooms(truth: Features) -> str | None:
+    """Why a truth's rooms leave nothing to find (:data:`MIN_BOUNDING`), or None."""
+    if truth.bounding is None or truth.bounding >= MIN_BOUNDING:
+        return None
+    return (f"the truth has no closed rooms: {100 * truth.bounding:.0f} % of its walls bound "
+            f"one, fewer than {100 * MIN_BOUNDING:.0f} %: nothing to find")
+
+
+DETECTOR = Detector("rooms", detect, candidates, Params, min_truth=MIN_ROOMS, noun="room",
+                    nothing_to_find=no_closed_rooms)

@@ -16,7 +16,8 @@ precision = matched strong map / strong map features; f1 = their harmonic mean. 
 nothing to count (no strong feature on that side) is undefined, None, not 0: a round room has no
 corner, and its perfect map must not score 0 for missing none. So are all three when the truth
 has fewer features than the detector needs to have anything to find (rooms: a place of one room
-has no rooms to tell apart). f1 is None when either is None, 0 when both are 0.
+has no rooms to tell apart), or none of the kind it finds (rooms: a street's walls close off
+pockets, not rooms). f1 is None when either is None, 0 when both are 0.
 """
 
 from __future__ import annotations
@@ -53,7 +54,8 @@ class Matching:
     missing: indices of strong truth features left unmatched.
     extra: indices of strong map features left unmatched.
     unscored: why the detector had nothing to find (the truth has fewer features than it
-        needs, :attr:`~pcmapq.features.base.Detector.min_truth`): its three scores are None.
+        needs, :attr:`~pcmapq.features.base.Detector.min_truth`, or none of the kind it finds,
+        :attr:`~pcmapq.features.base.Detector.nothing_to_find`): its three scores are None.
     """
 
     truth_idx: np.ndarray
@@ -179,6 +181,9 @@ def match(name: str, truth: Features, map_: Features, threshold: float = MATCH_T
     if len(truth) < found.min_truth:  # nothing to find: undefined, not 0
         unscored = (f"the truth has {count(len(truth), found.noun)}, fewer than "
                     f"{found.min_truth}: nothing to find")
+    else:
+        unscored = found.nothing_to_find(truth)
+    if unscored is not None:
         quality = precision = None
     return Matching(
         truth_idx=ti,

@@ -11,6 +11,7 @@ import numpy as np
 
 from pcmapq import __version__
 from pcmapq.core.stats import Stats
+from pcmapq.report import structures
 from pcmapq.report.arrows import arrow_scale
 from pcmapq.report.heatmap import distance_heatmap
 from pcmapq.report.plot import png_bytes, vectorial_figure
@@ -162,10 +163,14 @@ def report_html(result: Result, scale: float | None = None) -> str:
         rows.append([name, score(m.quality), score(m.precision), score(m.f1),
                      str(m.truth_features), str(m.map_features), str(m.matched),
                      str(m.matched_map), *_stats_cells(det.displacement_stats())])
+    rows += structures.html_rows(result, _stats_cells)  # beside them: the 3D structures
     scores = _table(["detector", "quality q", "precision", "f1", "truth features",
                      "map features", "truth matched", "map matched",
                      *(f"disp. {h}" for _, h in STATS_COLUMNS)], rows)
-    scores += "".join(f'<p class="note">{html.escape(n)}</p>' for n in result.notes())
+    scores += "".join(f'<p class="note">{html.escape(n)}</p>'
+                      for n in result.notes() + structures.notes(result))
+    if result.structures is not None:
+        scores += f'<p class="note">{html.escape(structures.thresholds(result))}.</p>'
     d = result.distances
     dist = _stats_table("cells", [("accuracy (map to truth)", d.accuracy),
                                   ("completeness (truth to map)", d.completeness)])
@@ -189,7 +194,8 @@ def report_html(result: Result, scale: float | None = None) -> str:
                    "vectorial map per detector")
     heat = _img(png_bytes(distance_heatmap(result)),
                 "distance heatmaps: accuracy (map to truth) and completeness (truth to map)")
-    lists = "".join(_lists(name, det) for name, det in result.detectors.items())
+    lists = "".join(_lists(name, det) for name, det in result.detectors.items()) + \
+        structures.planes_html(result)
     title = f"pcmapq: {html.escape(result.map_path.name)} against " \
             f"{html.escape(result.truth_path.name)}"
     return f"""<!DOCTYPE html>

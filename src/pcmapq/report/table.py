@@ -11,6 +11,8 @@ from rich.table import Table
 
 from pcmapq.core.stats import FIELDS, Stats
 from pcmapq.core.words import count, length
+from pcmapq.report.structures import displacement_stats, structure_scores, thresholds
+from pcmapq.report.structures import notes as structure_notes
 from pcmapq.report.text import (
     LEGEND,
     map_3d_parts,
@@ -41,7 +43,7 @@ def print_table(result: Result, console: Console) -> None:
     console.print()
     for label, parts in _summary(result):
         _field(console, label, _values(console, parts))
-    if result.detectors:
+    if result.detectors or result.structures is not None:
         console.print()
         _scores(console, result)
         console.print()
@@ -49,7 +51,7 @@ def print_table(result: Result, console: Console) -> None:
     console.print()
     for label, parts in _distances(result) + _noref(result):
         _field(console, label, _values(console, parts))
-    for i, note in enumerate(result.notes()):
+    for i, note in enumerate(result.notes() + structure_notes(result)):
         _field(console, "notes" if i == 0 else "", words(note, width - LABEL - 1))
     console.print()
     _lines(console, words(LEGEND, width))
@@ -162,10 +164,13 @@ def _stats_parts(stats: Stats, direction: str) -> list[str]:
 def _scores(console: Console, result: Result) -> None:
     """Quality, precision, f1 and the four counts per detector."""
     rows = {name: score_row(det) for name, det in result.detectors.items()}
+    rows.update(structure_scores(result))  # beside them: the 3D structures
+    also = f"; {thresholds(result)}" if result.structures is not None else ""
     _table_or_blocks(
         console, _table(SCORE_COLUMNS, rows),
         f"features matched within {result.threshold:g} m (counts of strong features; "
-        "quality = matched truth / truth features, precision = matched map / map features)",
+        f"quality = matched truth / truth features, precision = matched map / map features)"
+        f"{also}",
         f"features matched within {result.threshold:g} m",
         {name: [f"quality {q} ({matched}/{truth} truth)",
                 f"precision {p} ({matched_map}/{map_} map)", f"f1 {f1}"]
@@ -176,6 +181,8 @@ def _displacements(console: Console, result: Result) -> None:
     """The displacement statistics of each detector's matched pairs, metres."""
     rows = {name: displacement_row(det.displacement_stats())
             for name, det in result.detectors.items()}
+    rows.update((name, displacement_row(stats))
+                for name, stats in displacement_stats(result).items())
     _table_or_blocks(
         console, _table(DISPLACEMENT_COLUMNS, rows),
         "displacement from truth feature to map feature over the matched pairs (every pair, "

@@ -7,6 +7,7 @@ import re
 from collections.abc import Sequence
 
 from pcmapq.core.words import count
+from pcmapq.match.structures import NOUNS
 from pcmapq.metrics.map_gaussians import MapGaussians
 from pcmapq.results.result import INCONSISTENT, LOW, OTHER, Result
 
@@ -139,6 +140,11 @@ def verdict(result: Result) -> str:
     parts = [alignment_words(result), covered]
     if features:
         parts.append("feature quality/precision " + ", ".join(features))
+    if result.structures is not None:
+        parts.append("3D structure quality/precision " + ", ".join(
+            _quality_precision(name, found.matching.quality, found.matching.precision,
+                               found.matching.note(NOUNS[name]))
+            for name, found in result.structures.detectors.items()))
     return f"{result.map_path.name}: " + "; ".join(parts + [walls]) + "."
 
 

@@ -24,6 +24,7 @@ if TYPE_CHECKING:  # the alignment modules load Open3D; a result only holds thei
     from pcmapq.align.regions import Consistency
     from pcmapq.align.regions3d import Consistency3D
     from pcmapq.align.rigid3d import Registration3D
+    from pcmapq.match.structures import Structures3D
 
 #: Decimals kept in saved numbers: micrometres, so reruns give byte-identical files.
 DECIMALS = 6
@@ -129,6 +130,8 @@ class Findings:
     (:mod:`pcmapq.metrics.map_gaussians`), None otherwise.
     consistency_3d: two 3D clouds' 3D consistency map (:mod:`pcmapq.align.regions3d`), None
     otherwise.
+    structures: the 3D structures of two 3D clouds registered in 3D, matched one to one
+    (:mod:`pcmapq.match.structures`), None when not found.
     truth_occupied, map_occupied (and the overlap's footprint): the rasters on ``grid``; None
     in a result read back by :meth:`Result.from_json`, which holds everything the JSON holds and no
     more.
@@ -160,6 +163,7 @@ class Findings:
     map_message: dict | None = None
     map_3d: MapGaussians | None = None
     consistency_3d: Consistency3D | None = None
+    structures: Structures3D | None = None
 
     @property
     def transform(self) -> Similarity2D:

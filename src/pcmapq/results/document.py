@@ -23,6 +23,7 @@ from pcmapq.metrics.map_gaussians import MapGaussians
 from pcmapq.results import schema as s
 from pcmapq.results.blocks import DetectorResult, Findings, Overlap
 from pcmapq.results.blocks3d import consistency_3d_block, consistency_3d_of
+from pcmapq.results.structures_doc import structures_block, structures_of
 
 if TYPE_CHECKING:
     from pcmapq.align.regions import Consistency
@@ -49,6 +50,8 @@ def document(r: Findings, features: bool = True) -> s.ResultDocument:
                                      scs=g.scs)
     if r.consistency_3d is not None:
         optional["consistency_3d"] = consistency_3d_block(r.consistency_3d)
+    if r.structures is not None:
+        optional["structures_3d"] = structures_block(r.structures, features)
     if r.rooms is not None:
         optional["rooms"] = r.rooms
     rows = _feature_rows(r) if features else ([], [], [])
@@ -115,7 +118,8 @@ def fields(doc: s.ResultDocument) -> dict[str, Any]:
         consistency=_consistency_of(doc.consistency, a.tolerance_m), rooms=doc.rooms,
         map_3d=None if doc.map_3d is None else MapGaussians(
             doc.map_3d.awd_m, doc.map_3d.scs, doc.map_3d.voxels, doc.map_3d.computed_on),
-        consistency_3d=consistency_3d_of(doc.consistency_3d))
+        consistency_3d=consistency_3d_of(doc.consistency_3d),
+        structures=structures_of(doc.structures_3d))
 
 
 def consistency_block(c: Consistency | None) -> s.ConsistencyMap:

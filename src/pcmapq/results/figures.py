@@ -12,6 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from pcmapq.core.stats import FIELDS as STAT_FIELDS
+from pcmapq.features.names import STRUCTURE_NAMES
 from pcmapq.settings import DETECTOR_NAMES
 
 #: A detector's scores, each in [0, 1], in table order.
@@ -96,6 +97,8 @@ def _stats(side: str, block: str, suffix: str) -> list[Figure]:
 FIGURES: tuple[Figure, ...] = (
     *(Figure(f"{d}.{s}", ("detectors", d, s), column=True, optional=True)
       for s in SCORES for d in DETECTOR_NAMES),
+    *(Figure(f"{d}.{s}", ("structures_3d", d, s), column=True, optional=True, sparse=True)
+      for s in SCORES for d in STRUCTURE_NAMES),
     Figure("coverage", ("coverage",), column=True),
     Figure("alignment.fitness", ("alignment", "fitness"), column=True),
     Figure("alignment.confidence", ("alignment", "confidence"), column=True),
@@ -123,6 +126,9 @@ FIGURES: tuple[Figure, ...] = (
     Figure("chamfer_3d", ("distances_3d", "chamfer_m"), optional=True, label="Chamfer 3D"),
     Figure("awd_3d", ("map_3d", "awd_m"), column=True, label="AWD", optional=True, sparse=True),
     Figure("scs_3d", ("map_3d", "scs"), column=True, label="SCS", optional=True, sparse=True),
+    *(Figure(f"{d}.{k}.{s}", ("structures_3d", d, f"{k}_{u}", s), optional=True)
+      for d in STRUCTURE_NAMES for k, u in (("displacement", "m"), ("angle", "deg"))
+      for s in ("mean", "max")),
 )
 #: Other names of figures that gates have always read: the one list of aliases.
 ALIASES = {"chamfer.mean": "chamfer", "chamfer_3d.mean": "chamfer_3d"}

@@ -28,11 +28,11 @@ UNDER, OVER = "under", "over"
 OPTIONS = {UNDER: "--fail-under", OVER: "--fail-over"}
 #: The top-level keys of the result's JSON (``alignment_3d``, ``distances_3d``,
 #: ``consistency_3d``: two 3D clouds registered; ``map_3d``: two 3D clouds in one frame;
-#: ``rooms``: the rooms detector ran).
+#: ``structures_3d``: two 3D clouds; ``rooms``: the rooms detector ran).
 TOP_LEVEL = ("pcmapq", "settings", "map", "truth", "alignment", "consistency", "frames",
              "coverage", "footprint", "scored_against", "distances", "noref", "detectors",
              "matches", "missing", "extra", "alignment_3d", "distances_3d", "map_3d",
-             "consistency_3d", "rooms")
+             "consistency_3d", "structures_3d", "rooms")
 _F_SCORE = re.compile(r"^(f_score|wall_precision)(_3d)?(?:@(.*))?$")
 
 

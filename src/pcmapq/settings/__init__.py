@@ -23,6 +23,7 @@ from pcmapq.settings.configs import (
     RasterConfig,
     Settings,
     SourceConfig,
+    StructuresConfig,
     default_params,
 )
 from pcmapq.settings.plain import plain
@@ -30,4 +31,5 @@ from pcmapq.settings.plain import plain
 __all__ = ["DEFAULT_DETECTORS", "DETECTOR_NAMES", "EVAL_MAX_WARD", "EVAL_NOREF_SAMPLE",
            "EVAL_NOREF_VOXEL", "MIN_HITS_2D", "MIN_HITS_3D", "TRACK_EVERY", "AlignmentConfig",
            "DistancesConfig", "FootprintConfig", "Map3DConfig", "MatchingConfig", "NoRefConfig",
-           "RasterConfig", "Settings", "SourceConfig", "default_params", "plain"]
+           "RasterConfig", "Settings", "SourceConfig", "StructuresConfig", "default_params",
+           "plain"]

@@ -207,6 +207,32 @@ class Map3DConfig:
 
 
 @dataclass(frozen=True)
+class StructuresConfig:
+    """The 3D structures of two 3D clouds registered in 3D (:mod:`pcmapq.match.structures`):
+    their planes and the lines where two planes meet, found on each cloud in the truth frame
+    and matched one to one. A result records this group only when it has them.
+
+    enabled: find and match them (``--no-structures``: not).
+    voxel: each cloud is reduced to one point per voxel of this side before its planes are
+        found, metres (0.1 indoors; 0.3 for outdoor LiDAR maps).
+    min_points: the fewest reduced points a plane keeps.
+    min_area: the least area a plane covers, square metres.
+    max_angle: the largest angle between a matched truth and map structure, degrees.
+    max_offset: the largest distance between them, metres: a plane's along the truth plane's
+        normal, a line's from the truth line.
+    line_margin: two planes meet in a line where their extents touch within this, metres.
+    """
+
+    enabled: bool = True
+    voxel: float = 0.1
+    min_points: int = 30
+    min_area: float = 1.0
+    max_angle: float = 5.0
+    max_offset: float = 0.5
+    line_margin: float = 0.2
+
+
+@dataclass(frozen=True)
 class Settings:
     """Options of ``pcmapq eval``, one group per stage; defaults are the documented ones.
 
@@ -224,6 +250,7 @@ class Settings:
     noref: NoRefConfig = field(default_factory=lambda: NoRefConfig(
         voxel=EVAL_NOREF_VOXEL, max_ward=EVAL_MAX_WARD, sample=EVAL_NOREF_SAMPLE))
     map_3d: Map3DConfig = field(default_factory=Map3DConfig)
+    structures: StructuresConfig = field(default_factory=StructuresConfig)
 
     def to_dict(self) -> dict:
         """Every option as plain JSON types, one object per stage, in metres and degrees:
@@ -257,4 +284,5 @@ class Settings:
                                      for name, p in m["params"].items()}),
             distances=DistancesConfig(tuple(doc["distances"]["taus"])),
             noref=NoRefConfig(**doc.get("noref", {"enabled": False})),  # saved before noref
-            map_3d=Map3DConfig(**doc.get("map_3d", {})))  # absent without two 3D clouds
+            map_3d=Map3DConfig(**doc.get("map_3d", {})),  # absent without two 3D clouds
+            structures=StructuresConfig(**doc.get("structures", {})))

@@ -66,7 +66,8 @@ def read_settings(path: str | Path, base: Settings | None = None) -> Settings:
         return base
     if not isinstance(doc, dict):
         raise InputError(f"{path}: expected a mapping of settings groups (map, truth, raster, "
-                         "alignment, footprint, matching, distances, noref, map_3d)")
+                         "alignment, footprint, matching, distances, noref, map_3d, "
+                         "structures)")
     merged = _merge(base.to_dict(), _read_words(doc, path), path, "")
     for option in options_of():
         _check_option(merged, option, path)

@@ -238,6 +238,26 @@ OPTIONS: tuple[Option, ...] = (
     Option("noref_max_nn", "noref.max_nn", INT,
            "Nearest neighbours of the normals that pick MOM's orthogonal planes.", 3,
            commands=(INSPECT,)),
+    Option("structures", "structures.enabled", SWITCH,
+           "Two 3D clouds: also find their planes and the lines where two planes meet, and "
+           "match them one to one (quality, precision, f1, displacements).",
+           flag="--structures/--no-structures"),
+    Option("structures_voxel", "structures.voxel", FLOAT,
+           "3D structures: each cloud is reduced to one point per voxel of this side before "
+           "its planes are found, metres (0.3 for outdoor LiDAR maps).", 0.01),
+    Option("plane_min_points", "structures.min_points", INT,
+           "3D structures: the fewest reduced points of a plane.", 3),
+    Option("plane_min_area", "structures.min_area", FLOAT,
+           "3D structures: the least area of a plane, square metres.", 0.0),
+    Option("structures_angle", "structures.max_angle", FLOAT,
+           "3D structures: the largest angle between matched planes or lines, degrees.",
+           0.0, 90.0),
+    Option("structures_offset", "structures.max_offset", FLOAT,
+           "3D structures: the largest distance between matched planes (along the truth "
+           "plane's normal) or lines, metres.", 1e-6),
+    Option("line_margin", "structures.line_margin", FLOAT,
+           "3D structures: two planes meet in a line where their extents touch within this, "
+           "metres.", 0.0),
 )
 
 

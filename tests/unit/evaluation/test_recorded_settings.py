@@ -11,7 +11,7 @@ from pcmapq.settings import Settings
 
 def test_the_3d_group_is_recorded_only_with_3d_figures():
     given = replace(Settings(), map_3d=replace(Settings().map_3d, tile=12.0))
-    assert "map_3d" not in recorded_settings(given, False)
-    assert recorded_settings(given, True)["map_3d"]["tile"] == 12.0
-    assert Settings.from_dict(recorded_settings(given, True)) == given
-    assert Settings.from_dict(recorded_settings(Settings(), False)).map_3d.tile == 8.0
+    assert "map_3d" not in recorded_settings(given, False, False)
+    assert recorded_settings(given, True, True)["map_3d"]["tile"] == 12.0
+    assert Settings.from_dict(recorded_settings(given, True, True)) == given
+    assert Settings.from_dict(recorded_settings(Settings(), False, False)).map_3d.tile == 8.0

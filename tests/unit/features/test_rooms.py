@@ -313,3 +313,33 @@ def test_a_short_wall_between_two_doors_is_no_wall_furniture():
     free[high - 6:high, 70:72] = True  # another: 0.6 m of wall between them
     kept = without_wall_furniture(free, cell, Params())
     np.testing.assert_array_equal(kept, free)
+
+
+def street(cars: int = 2) -> np.ndarray:
+    """Free cells (bool) of a street 60 m long between two facades 10 m apart, both running
+    off the raster (the street and what lies behind its facades are outside), with ``cars``
+    parked cars 4 x 2 m: solid blocks, whose outlines close their insides off."""
+    free = np.ones((cells(20.0), cells(60.0)), dtype=bool)
+    free[cells(5.0), :] = free[cells(15.0), :] = False
+    for k in range(cars):
+        x = cells(10.0 + 15.0 * k)
+        free[cells(7.0):cells(9.0), x:x + cells(4.0)] = False
+    return free
+
+
+def test_a_street_has_no_closed_rooms_and_nothing_to_find():
+    """The insides of parked cars are closed off by their outlines (and the street between
+    them by its narrows), but a street's walls are its facades: the rooms' scores are
+    undefined, with why, and the counts stay."""
+    t, m, found = scored(street(), street())
+    assert len(t) == len(m) >= 2
+    assert t.bounding < 0.25
+    assert (found.quality, found.precision, found.f1) == (None, None, None)
+    assert found.note() == (f"the truth has no closed rooms: {100 * t.bounding:.0f} % of its "
+                            "walls bound one, fewer than 25 %: nothing to find")
+    assert found.truth_features == found.map_features == found.matched == len(t)
+
+
+def test_the_walls_of_a_plan_bound_its_rooms():
+    t, _, found = scored(plan(), plan())
+    assert t.bounding > 0.4 and found.note() is None

@@ -24,6 +24,7 @@ from pcmapq.results.schema.blocks import (
     TruthInput,
 )
 from pcmapq.results.schema.blocks_3d import ConsistencyMap3D, Map3D, Registration3D
+from pcmapq.results.schema.structures import Structures3D
 
 
 class ResultDocument(Block):
@@ -54,6 +55,8 @@ class ResultDocument(Block):
     """Two 3D clouds in one frame: MapEval's AWD and SCS."""
     consistency_3d: ConsistencyMap3D | None = None
     """Only when both inputs are 3D clouds."""
+    structures_3d: Structures3D | None = None
+    """Two 3D clouds registered in 3D: their planes and plane lines, matched."""
     rooms: dict[str, Any] | None = None
     """The rooms detector's rooms and doors, each with its status."""
     gates: list[Gate] | None = None
