@@ -134,6 +134,28 @@ def furnished_map(seed: int = 2) -> np.ndarray:
     return cloud(faces(a_box_shift=0.2, cabinet=True), seed=seed)
 
 
+def planes_of(parts: list[Face]):
+    """The faces as exact planes, in their order (a
+    :class:`~pcmapq.features.planes3d.Planes`): normals along their axes, offsets their
+    places, corners their rectangles (the first edge along the longer side), no noise."""
+    from pcmapq.features.planes3d import Planes
+
+    corners = np.zeros((len(parts), 4, 3))
+    extent = np.zeros((len(parts), 2))
+    for k, f in enumerate(parts):
+        other = [a for a in range(3) if a != f.axis]
+        (u0, v0), (u1, v1) = f.lo, f.hi
+        uv = [[u0, v0], [u1, v0], [u1, v1], [u0, v1]]
+        if v1 - v0 > u1 - u0:  # the longer side first
+            uv = [[u0, v0], [u0, v1], [u1, v1], [u1, v0]]
+        corners[k][:, f.axis] = f.at
+        corners[k][:, other] = uv
+        extent[k] = sorted((u1 - u0, v1 - v0), reverse=True)
+    return Planes(np.eye(3)[[f.axis for f in parts]], np.array([f.at for f in parts]),
+                  corners.mean(axis=1), corners, extent, np.array([f.area for f in parts]),
+                  np.full(len(parts), 100, dtype=np.int64))
+
+
 def face_names(normal: np.ndarray, point: np.ndarray, parts: list[Face] | None = None,
                near: float = 0.1, margin: float = 0.25) -> list[str]:
     """The faces (of ``parts``, the building's by default) a plane lies on, sorted: those
