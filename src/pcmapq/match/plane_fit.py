@@ -7,18 +7,19 @@ rests on the planes that agree: each matched pair votes with the four corners of
 plane's rectangle, their distances from the truth plane along its normal (metres) the
 residuals; the motion is linearised about the planes' centre and solved by iteratively
 reweighted least squares, first towards the least sum of each plane's RMS corner distance (an
-L1 fit, which a few planes cannot pull), then with Tukey's biweight (each plane's weight falls
-to 0 at :data:`TUKEY_C` robust deviations of those distances, their median absolute deviation
-and at least :data:`MIN_SCALE`). A direction of the motion (an eigenvector of the fit's normal
-matrix, rotations in radians times the corners' RMS radius, so in metres alike) is corrected
-only when at least :data:`MIN_SUPPORT` planes' worth of weight hold it (the inverse of the sum
-of the squared shares of the planes in it): a plane alone in its direction (the one horizontal
-plane of a street) keeps the displacement the registration gave it rather than being fitted
-to 0. The fit is applied only when it moves no matched map plane's corner further than the
-registration's last ICP stage matched points (its ``reach``): structures that moved can pull
-the registration no further than that, and a larger motion (a map bent by drift, whose planes
-agree only in parts) would be another registration, not a correction of this one. No random
-draw; metres, radians inside, degrees out.
+L1 fit, which a few planes cannot pull; least squares below :data:`MIN_SCALE`), then with
+Tukey's biweight (each plane's weight falls to 0 at :data:`TUKEY_C` robust deviations of those
+distances, their median absolute deviation and at least :data:`MIN_SCALE`). A direction of the
+motion (an eigenvector of the fit's normal matrix, rotations in radians times the corners' RMS
+radius, so in metres alike) is corrected only when at least :data:`MIN_SUPPORT` planes' worth
+of weight hold it (the inverse of the sum of the squared shares of the planes in it): a plane
+alone in its direction (the one horizontal plane of a street) keeps the displacement the
+registration gave it rather than being fitted to 0. The fit is applied only when it moves no
+matched map plane's corner further than the distance within which the registration's last ICP
+stage pairs points (its ``reach``): structures that moved can pull the registration no further
+than that, and a larger motion (a map bent by drift, whose planes agree only in parts) would be
+another registration, not a correction of this one. No random draw; metres, radians inside,
+degrees out.
 """
 
 from __future__ import annotations
@@ -38,7 +39,8 @@ TUKEY_C = 4.685
 MIN_SCALE = 0.005
 #: A direction of the motion is corrected when at least this many planes' worth hold it.
 MIN_SUPPORT = 3.0
-#: Rounds stop when a step moves every corner less than this, metres.
+#: The Tukey rounds stop when a step (its rotation times the corners' radius, and its shift)
+#: is below this, metres.
 CONVERGED = 1e-9
 
 
