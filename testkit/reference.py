@@ -18,6 +18,7 @@ FOLDER = REFERENCES / "validation"
 
 _STATS = ("mean", "median")
 _DISTANCES = {"accuracy_m": _STATS, "completeness_m": _STATS, "chamfer_m": None, "f_score": None}
+_STRUCTURES = ("quality", "precision", "f1", "truth_structures", "map_structures", "matched")
 #: The fields of ``Result.to_dict()`` a reference keeps: a tuple names the keys kept of a dict,
 #: None keeps the whole value, ``"*"`` applies its spec to every entry; absent keys are skipped.
 FIELDS: dict[str, Any] = {
@@ -30,8 +31,7 @@ FIELDS: dict[str, Any] = {
     "distances_3d": _DISTANCES,
     "detectors": {"*": ("quality", "precision", "f1", "truth_features", "map_features",
                         "matched")},
-    "structures_3d": {"*": ("quality", "precision", "f1", "truth_structures", "map_structures",
-                            "matched")},
+    "structures_3d": {name: _STRUCTURES for name in ("planes", "plane_lines")},
 }
 
 

@@ -20,7 +20,7 @@ from testkit.paths import REPO, SHARED_DATA, shared
 pytestmark = pytest.mark.realdata
 #: Sections whose whole run is cheap, and the prefix of their cases' names.
 SECTIONS = {"drawings": "drawings-", "fr79": "fr79-", "lidar": "lidar-",
-            "floorplans": "floorplans-", "rooms": "rooms-"}
+            "floorplans": "floorplans-", "rooms": "rooms-", "building3d": "building-"}
 
 
 @pytest.mark.parametrize("section", sorted(SECTIONS))

@@ -1,6 +1,8 @@
 """``pcmapq eval`` of two 3D clouds scores their 3D structures beside the 2D detectors: the
-synthetic building against itself and against a map of it with a wall and a floor moved;
-the block the same from run to run; ``--no-structures`` leaves it out."""
+synthetic building against itself, against a map of it with a wall and a floor moved and
+against one with its furniture moved and added, with the known answers
+(:mod:`testkit.building3d_answers`); the block the same from run to run;
+``--no-structures`` leaves it out."""
 
 from __future__ import annotations
 
@@ -11,6 +13,7 @@ import pytest
 
 from pcmapq.io.writers import write_cloud
 from testkit import building3d as b
+from testkit.building3d_answers import Answer, answers, unmatched
 from testkit.command import run
 
 
@@ -47,16 +50,63 @@ def test_a_cloud_against_itself_matches_every_structure(clouds, tmp_path):
     assert json.dumps(again["structures_3d"]) == json.dumps(doc["structures_3d"])
 
 
-def test_the_moved_wall_and_floor_are_displaced_after_the_3d_registration(clouds, tmp_path):
-    """The registration fits the map to the truth as a whole: the wall's 0.3 m and the
-    floor's 0.05 m stay the largest displacements, every plane matched."""
+#: The moved map's changed lines: the raised floor's feet of room A's walls and box, and the
+#: moved wall's four edges, by the faces they lie on.
+MOVED_LINES = {*(f"A.floor+A.wall.{side}" for side in ("x0", "x1", "y0", "y1")),
+               *(f"A.box.{side}+A.floor" for side in ("x0", "x1", "y0", "y1")),
+               *(f"{face}+B.wall.x1" for face in ("B.ceiling", "B.floor")),
+               *(f"B.wall.x1+B.wall.{side}" for side in ("y0", "y1"))}
+#: The furnished map's: the lines on room A's box's x faces, its feet, top edges and corners.
+FURNISHED_LINES = {*(f"A.box.{x}+A.floor" for x in ("x0", "x1")),
+                   *(f"A.box.top+A.box.{x}" for x in ("x0", "x1")),
+                   *(f"A.box.{x}+A.box.{y}" for x in ("x0", "x1") for y in ("y0", "y1"))}
+
+
+def wrong(found: list[Answer]) -> list[Answer]:
+    return [a for a in found if not a.right]
+
+
+def test_the_moved_wall_and_floor_are_exactly_the_structures_displaced(clouds, tmp_path):
+    """Room B's far wall 0.3 m further along its normal (+x) and room A's floor 0.05 m
+    higher (+z): after the 3D registration and the planes' own fit, those two planes and
+    their lines are reported with those displacements (within 5 mm, the wall's +0.3 along
+    the truth plane's +x normal) and every other structure within 1 cm and 0.5 deg of still;
+    every structure matched. (The registration alone, pulled by the two changes, reports the
+    floor 0.027 m higher and room A's ceiling 0.02 m lower.)"""
     truth, _, moved = clouds
-    doc, _ = evaluated(moved, truth, tmp_path / "m.json")
-    planes = doc["structures_3d"]["planes"]
-    assert planes["quality"] == planes["precision"] == 1.0
-    sizes = sorted(abs(m["displacement_m"]) for m in planes["matches"])
-    assert sizes[-1] == pytest.approx(0.3, abs=0.03)
-    assert sizes[-2] < 0.06
+    doc, text = evaluated(moved, truth, tmp_path / "m.json")
+    block = doc["structures_3d"]
+    for name in ("planes", "plane_lines"):
+        assert block[name]["quality"] == block[name]["precision"] == 1.0
+    planes, lines = answers(block, "planes", b.MOVED), answers(block, "plane_lines", b.MOVED)
+    assert {a.name: a.injected for a in planes if a.changed} == b.MOVED
+    assert {a.name for a in lines if a.changed} == MOVED_LINES
+    assert wrong(planes) == wrong(lines) == []
+    fit = block["fit"]
+    assert fit["applied"] and fit["planes_held"] == 16 and fit["planes_matched"] == 18
+    assert "after the planes' own fit of" in " ".join(text.split())
+
+
+def test_furniture_moved_is_displaced_and_furniture_added_is_extra(clouds, tmp_path):
+    """Room A's box 0.2 m further along +x: its two x faces and their eight lines displaced
+    0.2 m, its top and y faces (sliding in their planes) still; a cabinet added to room A:
+    its five faces are the extra planes, its twelve edges the extra lines."""
+    truth = clouds[0]
+    write_cloud(tmp_path / "furnished.ply", b.furnished_map())
+    doc, _ = evaluated(tmp_path / "furnished.ply", truth, tmp_path / "f.json")
+    block = doc["structures_3d"]
+    planes = answers(block, "planes", b.FURNISHED)
+    lines = answers(block, "plane_lines", b.FURNISHED)
+    assert {a.name: a.injected for a in planes if a.changed} == b.FURNISHED
+    assert {a.name for a in lines if a.changed} == FURNISHED_LINES
+    assert wrong(planes) == wrong(lines) == []
+    parts = b.faces(a_box_shift=0.2, cabinet=True)
+    for name, count in (("planes", 5), ("plane_lines", 12)):
+        missing, extra = unmatched(block, name, parts)
+        assert missing == [] and len(extra) == count
+        assert all(e.startswith("A.cabinet.") for e in extra), extra
+        assert block[name]["precision"] == pytest.approx(
+            block[name]["matched"] / (block[name]["matched"] + count))
 
 
 def test_no_structures_leaves_the_block_out(clouds, tmp_path):

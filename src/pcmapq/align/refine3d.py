@@ -21,7 +21,7 @@ import small_gicp
 
 from pcmapq.core.voxels import voxel_centroids
 
-__all__ = ["refine"]
+__all__ = ["last_reach", "refine"]
 
 #: ICP stages: (max correspondence distance, downsampling voxel), in units of ``voxel``.
 ICP_STAGES = ((2.0, 1.0), (1.0, 1.0), (0.5, 0.5))
@@ -58,6 +58,12 @@ def refine(source: np.ndarray, target: np.ndarray, guess: np.ndarray, voxel: flo
                                   rotation_epsilon=CONVERGED, translation_epsilon=CONVERGED)
         transform = np.array(result.T_target_source, dtype=np.float64)
     return transform
+
+
+def last_reach(voxel: float) -> float:
+    """How far apart a source and a target point may be to pair in the last ICP stage,
+    metres, at the working resolution ``voxel`` (metres)."""
+    return ICP_STAGES[-1][0] * voxel
 
 
 def _prepared(source: np.ndarray, target: np.ndarray

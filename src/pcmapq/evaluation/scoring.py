@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from pcmapq.align.parts import broken_off
+from pcmapq.align.refine3d import last_reach
 from pcmapq.align.regions import regions
 from pcmapq.align.regions3d import regions_3d
 from pcmapq.core.frames import Frames
@@ -71,7 +72,8 @@ def score(placed: Placed, prepared: PreparedTruth, settings: Settings,
         if registration is not None and settings.structures.enabled:
             progress("3D structures")
             structures_job = pool.submit(structures_3d, truth.points, side.source.points,
-                                         settings.structures)
+                                         settings.structures,
+                                         last_reach(settings.alignment.voxel_3d))
         if placed.features is None:
             progress("drawing the walls' centre lines and detecting features")
             sides = SideBySide(settings.matching.detectors, settings.matching.params)
@@ -141,13 +143,15 @@ def recorded_settings(settings: Settings, map_3d: bool, structures: bool) -> dic
     return {k: v for k, v in settings.to_dict().items() if kept.get(k, True)}
 
 
-def structures_3d(truth: np.ndarray, map_: np.ndarray, option: StructuresConfig
-                  ) -> Structures3D:
+def structures_3d(truth: np.ndarray, map_: np.ndarray, option: StructuresConfig,
+                  reach: float | None = None) -> Structures3D:
     """The 3D structures of two clouds (N, 3), both in the truth frame, metres, found and
-    matched with ``option`` (:func:`~pcmapq.match.structures.compare_structures`)."""
+    matched with ``option`` (:func:`~pcmapq.match.structures.compare_structures`), the map's
+    moved by the planes' own fit when it moves none more than ``reach`` metres (the 3D
+    registration's last ICP correspondence distance; None: whatever it moves)."""
     return compare_structures(truth, map_, PlaneParams(option.voxel, option.min_points,
                                                        option.min_area),
-                              option.line_margin, option.max_angle, option.max_offset)
+                              option.line_margin, option.max_angle, option.max_offset, reach)
 
 
 def inside(features: Features, area: np.ndarray, grid: MetricGrid,

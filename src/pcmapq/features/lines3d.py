@@ -88,7 +88,9 @@ def _merged(direction: np.ndarray, base: np.ndarray, lo: np.ndarray, hi: np.ndar
             near: float, min_length: float) -> Lines:
     """Lines ``base + t * direction``, t in [lo, hi], with those that are one line (within
     1 degree and ``near`` metres of each other, their segments overlapping) made one: the
-    union of their segments, on the first one's line; then those at least ``min_length``."""
+    union of their segments, on the line of the longest (the first of equals): a sliver
+    where two rectangles merely touch within the margin does not carry a long line to its
+    plane; then those at least ``min_length``."""
     count = len(direction)
     a, b = np.triu_indices(count, k=1)
     same = np.abs(np.einsum("ij,ij->i", direction[a], direction[b])) >= \
@@ -106,9 +108,12 @@ def _merged(direction: np.ndarray, base: np.ndarray, lo: np.ndarray, hi: np.ndar
     graph = sparse.coo_array((np.ones(int(keep.sum())), (a[keep], b[keep])),
                              shape=(count, count))
     _, group = connected_components(graph, directed=False)
-    first = np.full(count, count)
-    np.minimum.at(first, group, np.arange(count))
-    head = first[group]  # each line's group's first line
+    # each line's group's head: its longest line, the first of equals
+    rank = np.empty(count, dtype=np.int64)
+    rank[np.lexsort((np.arange(count), lo - hi))] = np.arange(count)
+    best = np.full(count, count)
+    np.minimum.at(best, group, rank)
+    head = np.argsort(rank)[best[group]]
     gap = base - base[head]
     shift = np.einsum("ij,ij->i", gap, direction[head])
     turn = np.sign(np.einsum("ij,ij->i", direction[head], direction))

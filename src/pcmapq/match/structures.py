@@ -25,6 +25,7 @@ from pcmapq.features.lines3d import Lines, plane_lines
 from pcmapq.features.names import STRUCTURE_NAMES
 from pcmapq.features.planes3d import PlaneParams, Planes, find_planes
 from pcmapq.match.one_to_one import assign, harmonic_mean
+from pcmapq.match.plane_fit import PlaneFit, moved, plane_fit
 
 #: The detectors of 3D structures, in the order they are written and shown.
 STRUCTURES = STRUCTURE_NAMES
@@ -82,12 +83,14 @@ class StructureResult:
 @dataclass(frozen=True)
 class Structures3D:
     """The 3D structures of two clouds: each detector's result (:data:`STRUCTURES` order),
-    and the thresholds they were matched with: ``max_angle`` degrees, ``max_offset``
-    metres."""
+    the thresholds they were matched with: ``max_angle`` degrees, ``max_offset`` metres, and
+    the planes' own fit that moved the map's structures (None: read from a result without
+    it)."""
 
     detectors: dict[str, StructureResult]
     max_angle: float
     max_offset: float
+    fit: PlaneFit | None = None
 
 
 def plane_pairs(truth: Planes, map_: Planes, max_angle: float, max_offset: float) -> Pairs:
@@ -171,16 +174,21 @@ def match_structures(name: str, truth: Planes | Lines, map_: Planes | Lines,
 
 
 def compare_structures(truth_points: np.ndarray, map_points: np.ndarray, params: PlaneParams,
-                       line_margin: float, max_angle: float, max_offset: float
-                       ) -> Structures3D:
+                       line_margin: float, max_angle: float, max_offset: float,
+                       reach: float | None = None) -> Structures3D:
     """The planes and plane lines of two clouds (N, 3), both in the truth frame, metres,
     found with ``params`` (lines: extents touching within ``line_margin`` metres, at least as
     long as the side of the smallest plane, ``sqrt(params.min_area)``) and matched
-    with ``max_angle`` degrees and ``max_offset`` metres."""
-    planes = [find_planes(p, params) for p in (truth_points, map_points)]
+    with ``max_angle`` degrees and ``max_offset`` metres, the map's planes moved first by the
+    planes' own fit (:mod:`pcmapq.match.plane_fit`) to the planes matched so, when it moves
+    none more than ``reach`` metres (None: whatever it moves)."""
+    truth, found = (find_planes(p, params) for p in (truth_points, map_points))
+    first = match_structures("planes", truth, found, max_angle, max_offset)
+    fit = plane_fit(truth, found, first.truth_idx, first.map_idx, reach)
+    planes = [truth, moved(found, fit.matrix)]
     lines = [plane_lines(p, line_margin, np.sqrt(params.min_area)) for p in planes]
-    found = {"planes": planes, "plane_lines": lines}
+    both = {"planes": planes, "plane_lines": lines}
     return Structures3D({name: StructureResult(t, m, match_structures(name, t, m, max_angle,
                                                                       max_offset))
-                         for name, (t, m) in found.items()}, max_angle, max_offset)
+                         for name, (t, m) in both.items()}, max_angle, max_offset, fit)
 

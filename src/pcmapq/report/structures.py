@@ -9,7 +9,7 @@ import html
 import numpy as np
 
 from pcmapq.core.stats import Stats
-from pcmapq.match.structures import NOUNS
+from pcmapq.match.structures import NOUNS, Structures3D
 from pcmapq.report.text import number, score
 from pcmapq.results.result import Result
 
@@ -43,7 +43,20 @@ def thresholds(result: Result) -> str:
     if s is None:
         return ""
     return (f"3D planes and plane lines within {s.max_angle:g} deg and {s.max_offset:g} m "
-            "(a plane's displacement along the truth plane's normal, signed)")
+            f"(a plane's displacement along the truth plane's normal, signed){fit_words(s)}")
+
+
+def fit_words(s: Structures3D) -> str:
+    """The planes' own fit in words, as a clause ('' for a result without it)."""
+    f = s.fit
+    if f is None:
+        return ""
+    if f.applied:
+        return (f", after the planes' own fit of {f.offset:.3f} m and {f.angle:.2f} deg "
+                f"on {f.held} of {f.pairs} matched planes")
+    return (f"; the planes' own fit ({f.offset:.3f} m, {f.angle:.2f} deg) not applied: it "
+            f"would move a plane {f.largest_move:.2f} m, beyond the registration's "
+            f"{f.reach:g} m")
 
 
 def notes(result: Result) -> list[str]:

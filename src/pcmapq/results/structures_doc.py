@@ -10,6 +10,7 @@ import numpy as np
 from pcmapq.core.stats import Stats
 from pcmapq.features.lines3d import Lines
 from pcmapq.features.planes3d import Planes
+from pcmapq.match.plane_fit import PlaneFit
 from pcmapq.match.structures import (
     NOUNS,
     StructureMatching,
@@ -52,13 +53,28 @@ def _scores(name: str, found: StructureResult, result: Structures3D, features: b
                 angle_deg=Stats.of(m.angle), **lists)
 
 
+def _fit(fit: PlaneFit) -> s.PlaneFit3D:
+    return s.PlaneFit3D(applied=fit.applied, matrix=fit.fitted.tolist(),
+                        centre_m=tuple(fit.centre.tolist()), offset_m=fit.offset,
+                        angle_deg=fit.angle, largest_move_m=fit.largest_move,
+                        reach_m=fit.reach, planes_held=fit.held, planes_matched=fit.pairs)
+
+
 def structures_block(result: Structures3D, features: bool = True) -> s.Structures3D:
     """The ``structures_3d`` block; ``features=False``: the scores alone, every list empty."""
     d = result.detectors
+    fit = {} if result.fit is None else {"fit": _fit(result.fit)}
     return s.Structures3D(planes=s.PlaneScores(**_scores("planes", d["planes"], result,
                                                          features)),
                           plane_lines=s.LineScores(**_scores("plane_lines", d["plane_lines"],
-                                                             result, features)))
+                                                             result, features)), **fit)
+
+
+def _fit_of(doc: s.PlaneFit3D | None) -> PlaneFit | None:
+    if doc is None:
+        return None
+    return PlaneFit(np.array(doc.matrix, dtype=np.float64), np.array(doc.centre_m),
+                    doc.planes_held, doc.planes_matched, doc.largest_move_m, doc.reach_m)
 
 
 def _planes_of(rows: list[s.Plane3D]) -> Planes:
@@ -100,4 +116,4 @@ def structures_of(doc: s.Structures3D | None) -> Structures3D | None:
         return None
     return Structures3D({"planes": _result_of("planes", doc.planes),
                          "plane_lines": _result_of("plane_lines", doc.plane_lines)},
-                        doc.planes.max_angle_deg, doc.planes.max_offset_m)
+                        doc.planes.max_angle_deg, doc.planes.max_offset_m, _fit_of(doc.fit))

@@ -78,3 +78,16 @@ def test_the_building_has_its_eighteen_planes():
     planes = find_planes(b.cloud(b.faces(), seed=1))
     assert len(planes) == 18
     assert (planes.area >= 1.0).all()
+
+
+def test_one_line_of_several_pieces_lies_on_its_longest_piece():
+    """A wall's foot on a floor 5 cm up, and on a sliver of floor at 0 that touches the wall's
+    end only within the margin, the sliver's pair first: one line, the union of both pieces,
+    at the floor's height (the sliver's would say the floor did not rise)."""
+    planes = b.planes_of([b.Face("wall", 1, 0.0, (0.0, 0.0), (6.0, 2.5)),
+                          b.Face("sliver", 2, 0.0, (6.1, 0.0), (7.5, 3.0)),
+                          b.Face("floor", 2, 0.05, (0.0, 0.0), (6.0, 3.0))])
+    found = plane_lines(planes, 0.2)
+    assert len(found) == 1
+    np.testing.assert_allclose(found.point[0], [3.0, 0.0, 0.05], atol=1e-9)
+    assert found.length[0] == pytest.approx(6.4)  # from -0.2 to 6.2: both grown by the margin

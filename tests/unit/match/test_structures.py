@@ -53,12 +53,12 @@ def test_a_wall_moved_and_a_floor_raised_are_the_two_displaced_planes(truth):
     """Room B's far wall 0.3 m further along its normal (+x, the room longer), room A's floor
     0.05 m higher (+z), another draw of the noise: exactly those two planes are displaced, by
     their amounts and signs; every other plane is matched within 1 cm."""
-    moved = b.cloud(b.changed(b.faces(b_end=10.6), {"A.floor": 0.05}), seed=2)
+    moved = b.cloud(b.changed(b.faces(b_end=b.B_END + 0.3), {"A.floor": 0.05}), seed=2)
     found = compared(truth, moved)
     planes = found.detectors["planes"]
     m = planes.matching
     assert m.quality == m.precision == 1.0
-    wall = plane_at(planes.truth, (10.3, 2.5, 1.4), 0)
+    wall = plane_at(planes.truth, (b.B_END, 2.5, 1.4), 0)
     floor = plane_at(planes.truth, (3.0, 4.0, 0.0), 2)
     disp = dict(zip(m.truth_idx.tolist(), m.displacement.tolist(), strict=True))
     assert disp.pop(wall) == pytest.approx(0.30, abs=0.02)
@@ -86,13 +86,13 @@ def test_a_wall_removed_is_the_one_missing_plane(truth):
 def test_a_plane_beyond_the_thresholds_does_not_match(truth):
     """Room B's far wall 0.6 m further is too far along its normal (0.5 m): the truth's wall
     is missing and the map's extra."""
-    found = compared(truth, b.cloud(b.faces(b_end=10.9), seed=2))
+    found = compared(truth, b.cloud(b.faces(b_end=b.B_END + 0.6), seed=2))
     planes = found.detectors["planes"]
     m = planes.matching
     n = m.truth_structures
     assert (m.quality, m.precision) == (pytest.approx((n - 1) / n), pytest.approx((n - 1) / n))
-    assert m.missing.tolist() == [plane_at(planes.truth, (10.3, 2.5, 1.4), 0)]
-    assert m.extra.tolist() == [plane_at(planes.map, (10.9, 2.5, 1.4), 0)]
+    assert m.missing.tolist() == [plane_at(planes.truth, (b.B_END, 2.5, 1.4), 0)]
+    assert m.extra.tolist() == [plane_at(planes.map, (b.B_END + 0.6, 2.5, 1.4), 0)]
 
 
 def test_a_truth_without_structures_has_nothing_to_find(truth):
@@ -107,7 +107,7 @@ def test_a_truth_without_structures_has_nothing_to_find(truth):
 
 
 def test_the_structures_are_the_same_from_run_to_run(truth):
-    moved = b.cloud(b.changed(b.faces(b_end=10.6), {"A.floor": 0.05}), seed=2)
+    moved = b.cloud(b.changed(b.faces(b_end=b.B_END + 0.3), {"A.floor": 0.05}), seed=2)
     first, again = compared(truth, moved), compared(truth, moved)
     for name in ("planes", "plane_lines"):
         one, two = first.detectors[name], again.detectors[name]

@@ -32,7 +32,8 @@ def test_the_block_holds_each_detectors_scores_and_structures(result):
     doc = result.to_dict()
     block = doc["structures_3d"]
     ResultDocument.model_validate(doc)
-    assert list(block) == ["planes", "plane_lines"]
+    assert list(block) == ["planes", "plane_lines", "fit"]
+    assert block["fit"]["applied"] is True and block["fit"]["planes_matched"] == 18
     planes = block["planes"]
     assert (planes["quality"], planes["precision"], planes["f1"]) == (1.0, 1.0, 1.0)
     assert planes["truth_structures"] == planes["matched"] == len(planes["matches"]) == 18
@@ -67,6 +68,9 @@ def test_the_block_reads_back(result):
         np.testing.assert_allclose(g.displacement, m.displacement, atol=1e-6)
         np.testing.assert_allclose(g.angle, m.angle, atol=1e-6)
         assert len(got.truth) == m.truth_structures and len(got.map) == m.map_structures
+    fit, was = back.structures.fit, result.structures.fit
+    np.testing.assert_allclose(fit.matrix, was.matrix, atol=1e-6)
+    assert (fit.applied, fit.held, fit.pairs) == (was.applied, was.held, was.pairs)
     planes = back.structures.detectors["planes"]
     first = result.structures.detectors["planes"]
     k = int(first.matching.truth_idx[0])

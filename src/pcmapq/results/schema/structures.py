@@ -5,7 +5,7 @@ metres and degrees."""
 from __future__ import annotations
 
 from pcmapq.core.stats import Stats
-from pcmapq.results.schema.base import Block, Point3
+from pcmapq.results.schema.base import Block, Matrix, Point3
 
 
 class Plane3D(Block):
@@ -92,8 +92,36 @@ class LineScores(StructureScores):
     extra: list[Line3D]
 
 
+class PlaneFit3D(Block):
+    """The planes' own fit: the rigid motion of the registered map onto the truth that the
+    matched planes agree on (a robust fit: a few planes that moved do not pull it)."""
+
+    applied: bool
+    """Whether the map's planes and lines were moved by it before they were matched: it moves
+    no matched map plane's corner further than ``reach_m``."""
+    matrix: Matrix
+    """The motion found, 4 x 4, the registered map to the truth frame."""
+    centre_m: Point3
+    """The matched map planes' centre."""
+    offset_m: float
+    """How far it moves that centre."""
+    angle_deg: float
+    """Its rotation."""
+    largest_move_m: float
+    """How far it moves the farthest corner of a matched map plane."""
+    reach_m: float | None
+    """The most it may: the 3D registration's last ICP correspondence distance."""
+    planes_held: int
+    """The matched planes it rests on (their final weight at least 0.5)."""
+    planes_matched: int
+    """The planes matched before it, which it was fitted to."""
+
+
 class Structures3D(Block):
-    """The 3D structures of two 3D clouds registered in 3D, each detector's."""
+    """The 3D structures of two 3D clouds registered in 3D, each detector's, and the planes'
+    own fit that moved the map's structures."""
 
     planes: PlaneScores
     plane_lines: LineScores
+    fit: PlaneFit3D | None = None
+    """Absent in a result written before the fit was made."""
