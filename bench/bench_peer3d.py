@@ -20,8 +20,11 @@ times (at least :data:`RUNS`), so that the machine's load slows them alike; of e
 wall seconds, peak RSS (``os.wait4``) and CPU seconds (user + system, all its threads). The time
 ratio is pcmapq's median over the sum of the two ``ca`` medians, the bound issue 57 sets being
 1.0; the memory ratio is pcmapq's peak over the larger of the two ``ca`` peaks (they run one
-after the other). Without CloudAnalyzer (``pip install cloudanalyzer``, its ``ca`` command on
-the PATH) or the KITTI data the case is skipped with one line saying so.
+after the other). CloudAnalyzer goes in a virtual environment of its own, its ``ca`` command on
+the PATH (``python -m venv /opt/cloudanalyzer && /opt/cloudanalyzer/bin/pip install
+cloudanalyzer && ln -s /opt/cloudanalyzer/bin/ca /usr/local/bin/ca``): it requires Open3D below
+0.20, and installed beside pcmapq it would overwrite Open3D's files. Without it, or without the
+KITTI data, the case is skipped with one line saying so.
 """
 
 from __future__ import annotations
@@ -111,8 +114,8 @@ def measure(cache: Path, repeat: int = RUNS, log=print) -> dict[str, list[Run]] 
     CloudAnalyzer or the data."""
     ca = shutil.which("ca")
     if ca is None:
-        log("peer3d: skipped, CloudAnalyzer's `ca` is not on the PATH "
-            "(pip install cloudanalyzer)")
+        log("peer3d: skipped, CloudAnalyzer's `ca` is not on the PATH (pip install "
+            "cloudanalyzer, in a virtual environment of its own: bench/bench_peer3d.py)")
         return None
     pair = kitti_pitched_pair(cache)
     if pair is None:

@@ -21,6 +21,7 @@ def test_without_cloudanalyzer_the_case_is_skipped_with_one_line(tmp_path: Path,
                          env={"PATH": str(tmp_path), "PYTHONPATH": str(REPO / "src")})
     assert got.returncode == 0, got.stderr
     assert ("peer3d: skipped, CloudAnalyzer's `ca` is not on the PATH (pip install "
-            "cloudanalyzer)") in got.stderr
+            "cloudanalyzer, in a virtual environment of its own: bench/bench_peer3d.py)"
+            ) in got.stderr
     assert "peer3d/" not in got.stdout  # no ratio measured
     assert not any(tmp_path.iterdir())  # nor the pair written
