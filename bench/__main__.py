@@ -1,6 +1,6 @@
 """Run the ratio benchmarks (:mod:`bench.ratios`) and print their table.
 
-    python -m bench [--only noref,kitti,clouds,campus,structures] [--repeat 2] [--check]
+    python -m bench [--only noref,kitti,clouds,campus,structures,peer3d] [--repeat 2] [--check]
                     [--save] [--doc] [--cache DIR]
 
 --check: exit 1 when a ratio is worse than its stored one (bench/ratios.json) by more

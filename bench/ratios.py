@@ -18,7 +18,10 @@ Each case runs its commands in fresh processes (wall seconds and peak RSS of the
   one distance transform (:mod:`bench.bench_grids`);
 - ``structures``: ``pcmapq eval`` by default against ``--no-structures`` (the price of the 3D
   structures) on the synthetic building of :mod:`testkit.building3d` and KITTI 00's 20-scan
-  pair.
+  pair;
+- ``peer3d``: ``pcmapq eval`` of KITTI 00's 20 scans pitched 0.2 degrees a scan against their
+  reference map, against CloudAnalyzer's ``ca compare`` + ``ca map-evaluate`` on the same pair,
+  medians of three runs (:mod:`bench.bench_peer3d`).
 
 Inputs are built once into a cache folder outside the repository (``--cache``); cases whose
 data (``../shared/data``) is absent are skipped with the reason.
@@ -259,10 +262,17 @@ def campus(cache: Path, repeat: int, size: int = 8000) -> list[Ratio]:
                   40.0)]
 
 
+def peer3d(cache: Path, repeat: int) -> list[Ratio]:
+    """KITTI 00's pitched pair against CloudAnalyzer (:func:`bench.bench_peer3d.case`)."""
+    from bench.bench_peer3d import case  # it builds its Ratios from this module
+
+    return case(cache, repeat)
+
+
 #: name -> case; each returns its ratios.
 CASES: dict[str, Callable[[Path, int], list[Ratio]]] = {
     "noref": noref, "rooms": rooms, "kitti": kitti, "clouds": clouds, "campus": campus,
-    "structures": structures,
+    "structures": structures, "peer3d": peer3d,
 }
 
 
