@@ -2,7 +2,8 @@
 heading, vertically and in scale, five levels each, against the map at KITTI's poses, scored as
 ``pcmapq eval map.ply truth.ply`` scores two 3D clouds: does every figure of two 3D clouds move
 one way, step by step, and does the 3D consistency map find the vertical drift where it is?
-The maps and their checks: :mod:`testkit.realdata.ladders3d`.
+The maps and their checks: :mod:`testkit.realdata.ladders3d`. Fifteen evaluations of about
+two minutes each on 2 cores (the 3D registration's global search most of it).
 
     python -m bench.validation --only kitti_ladders
 """
@@ -54,7 +55,7 @@ def _table(kind: str, rungs: list[Rung]) -> list[str]:
     """One ladder's table, and its line of rank correlations."""
     lines = [header([f"level ({UNIT[kind]})", "at the end (m / deg)", "verdict", "3D fitness",
                      "Chamfer 3D (m)", "AWD (m)", "SCS", "planes f1", "plane lines f1",
-                     "largest region dz (m)", "largest region offset (m)", "held / regions"])]
+                     "largest region |dz| (m)", "largest region offset (m)", "held / regions"])]
     for g in rungs:
         f, r = g.figures, g.run.result
         lines.append(row([

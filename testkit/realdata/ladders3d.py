@@ -15,11 +15,12 @@ truth.ply --structures-voxel 0.3 --no-noref`` scores two 3D clouds.
 The levels, measured (KITTI's car moves 0.86 m a scan, 16 m over the run): a heading or pitch
 drift of 0.025 degrees a scan leaves the run's end 0.07 m and 0.5 degrees off, AWD 0.06 m, the
 3D registration's fitness 1.00: barely off. Doubling at each level, 0.4 degrees a scan leaves
-it 1.15 m and 7.6 degrees off, fitness 0.6-0.7, two planes in three unmatched: a clearly bad
-map. 0.8 would go past what the 3D consistency map can measure: its regions' ICP catches
-offsets of about a metre (four 0.3 m voxels), and only 9 of 105 regions are held there. A
-stretch moves no far point more than the run's end, so it takes a larger share to spoil the
-map as much: 1 % (0.16 m at the end, AWD 0.04 m) is barely off, 16 % (2.6 m) clearly bad.
+it 1.15 m and 7.6 degrees off, fitness 0.6-0.7, the planes' f1 0.25-0.41: a clearly bad map.
+0.8 would go past what the 3D consistency map can measure: its regions' ICP catches offsets of
+about a metre (four 0.3 m voxels), and only 9 of about 105 regions are held there. A stretch
+moves no point more than the run's end, so it takes a larger share to spoil the map as much:
+1 % (0.16 m at the end, AWD 0.04 m, fitness 1.00) is barely off, 16 % (2.6 m, AWD 0.37 m,
+fitness 0.79) clearly bad.
 
 The vertical ladder's 3D consistency map is checked as :mod:`testkit.realdata.bends3d` checks
 it: each region's expected dz from the true place of every point it holds. docs/validation.md's
