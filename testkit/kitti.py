@@ -1,6 +1,7 @@
 """KITTI odometry sequence 00: its velodyne -> left camera transform, a pitch drift of its
-scans' poses (:func:`pitched`), and maps of its first scans at the reference poses and at poses
-that drift in pitch (:func:`pitch_ladder`)."""
+scans' poses (:func:`pitched`), drifts that integrate along the run as odometry's do
+(:func:`curved`, :func:`stretched`), and maps of its first scans at the reference poses and at
+poses that drift in pitch (:func:`pitch_ladder`)."""
 
 from __future__ import annotations
 
@@ -49,3 +50,35 @@ def pitched(poses: np.ndarray, level_deg: float) -> np.ndarray:
     turn[:, 0, 0] = turn[:, 2, 2] = np.cos(angle)
     turn[:, 0, 2], turn[:, 2, 0] = np.sin(angle), -np.sin(angle)
     return poses @ turn
+
+
+def turn(axis: str, degrees: float) -> np.ndarray:
+    """4x4 turn of ``degrees`` about the frame's own ``axis`` ("x", "y" or "z"), right-handed
+    (about z: +x towards +y; about y: +x down, as :func:`pitched`)."""
+    i, j = {"x": (1, 2), "y": (2, 0), "z": (0, 1)}[axis]
+    a = np.radians(degrees)
+    out = np.eye(4)
+    out[i, i] = out[j, j] = np.cos(a)
+    out[j, i], out[i, j] = np.sin(a), -np.sin(a)
+    return out
+
+
+def curved(poses: np.ndarray, axis: str, level_deg: float) -> np.ndarray:
+    """LiDAR poses (K, 4, 4) drifting as odometry that misreads every turn: each step's motion
+    (pose k-1 -> k) turned a further ``level_deg`` degrees about the scanner's own ``axis``
+    ("z": heading, the run curves sideways; "y": pitch, it bends down), so scan k is turned
+    k x ``level_deg`` and its position follows the bent run; the first scan where it was."""
+    step = turn(axis, level_deg)
+    motion = np.linalg.inv(poses[:-1]) @ poses[1:]
+    out = [np.asarray(poses[0], dtype=np.float64)]
+    for move in motion:  # one product per scan, integrated in order
+        out.append(out[-1] @ step @ move)
+    return np.array(out)
+
+
+def stretched(poses: np.ndarray, share: float) -> np.ndarray:
+    """LiDAR poses (K, 4, 4) drifting as odometry whose every step is ``share`` too long:
+    scan k at first + (1 + share) (p_k - first), metres, its orientation kept."""
+    out = np.array(poses, dtype=np.float64)
+    out[:, :3, 3] = out[0, :3, 3] + (1.0 + share) * (out[:, :3, 3] - out[0, :3, 3])
+    return out

@@ -22,6 +22,7 @@ from . import (
     halmstad,
     house,
     kitti,
+    kitti_ladders,
     kitti_planes,
     lidar,
     noref,
@@ -40,7 +41,8 @@ COMMAND = "python -m bench.validation --write"
 #: Every section of the document, in its order: a module with ``cases`` and ``section``.
 SECTIONS: dict[str, ModuleType] = {
     "drawings": drawings, "drawings_eval": drawings_eval, "fr79": fr79, "lidar": lidar,
-    "kitti": kitti, "kitti_planes": kitti_planes, "building3d": building3d, "gazebo": gazebo,
+    "kitti": kitti, "kitti_planes": kitti_planes, "kitti_ladders": kitti_ladders,
+    "building3d": building3d, "gazebo": gazebo,
     "halmstad": halmstad, "floorplans": floorplans, "carmen": carmen, "noref": noref,
     "same_place": same_place, "house": house,
     "corpus": corpus, "consistency": consistency, "consistency_3d": consistency_3d,

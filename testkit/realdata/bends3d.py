@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from pcmapq.core.transform import affine
+from pcmapq.core.voxels import voxel_groups
 from pcmapq.io.writers import write_cloud
 from pcmapq.mapping import build_map_from_poses, lidar_poses_from_camera, read_kitti_poses
 from pcmapq.mapping.reference import scans_for_poses
@@ -94,19 +95,32 @@ def expected_dz(scans: list[np.ndarray], truth: np.ndarray, drift: np.ndarray,
     placed it (``place`` @ drift pose, then levelled) less where it truly is (reference pose,
     levelled), averaged over each voxel of its placed position, then over the voxels of the
     region's tile (``centre`` (K, 3): the regions' centroids)."""
+    placed, error = placed_errors(scans, truth, drift, place, level)
+    return region_dz(placed, error[:, 2], centre, tile, voxel)
+
+
+def placed_errors(scans: list[np.ndarray], truth: np.ndarray, drift: np.ndarray,
+                  place: np.ndarray, level: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+    """Every point of every scan where the evaluation placed it (``place`` @ drift pose, then
+    levelled by ``level``, 3x3 or None) and its error there (placed less true: at the
+    reference pose, levelled), both (N, 3) metres."""
     turn = np.eye(3) if level is None else np.asarray(level)
     placed = np.vstack([affine(p, place @ d) for p, d in zip(scans, drift, strict=True)])
     true = np.vstack([affine(p, t) for p, t in zip(scans, truth, strict=True)])
-    placed, error = placed @ turn.T, (placed - true) @ turn.T
-    _, voxel_of = np.unique(np.floor(placed / voxel).astype(np.int64), axis=0,
-                            return_inverse=True)
-    voxel_of = voxel_of.ravel()
+    return placed @ turn.T, (placed - true) @ turn.T
+
+
+def region_dz(placed: np.ndarray, dz: np.ndarray, centre: np.ndarray, tile: float,
+              voxel: float) -> np.ndarray:
+    """Each region's mean vertical error (K,), metres: the points' (N, 3, placed) errors
+    ``dz`` (N,) averaged over each voxel, then over the voxels in the region's tile."""
+    _, voxel_of = voxel_groups(placed, voxel)
     n = np.bincount(voxel_of)
-    dz = np.bincount(voxel_of, error[:, 2]) / n
+    mean_dz = np.bincount(voxel_of, dz) / n
     xy = np.column_stack([np.bincount(voxel_of, placed[:, i]) / n for i in range(2)])
     tile_of = np.floor(xy / tile).astype(np.int64)
     wanted = np.floor(centre[:, :2] / tile).astype(np.int64)
-    return np.array([dz[np.all(tile_of == t, axis=1)].mean() for t in wanted])
+    return np.array([mean_dz[np.all(tile_of == t, axis=1)].mean() for t in wanted])
 
 
 def measure(folder: Path, kind: str, level: float) -> Rung:

@@ -1,0 +1,206 @@
+"""KITTI 00's 3D drift ladders (issue 57): maps of its first 20 scans at poses that drift in
+heading, vertically and in scale, five levels each, against the map at KITTI's poses, scored as
+``pcmapq eval map.ply truth.ply`` scores two 3D clouds: does every figure of two 3D clouds move
+one way, step by step, and does the 3D consistency map find the vertical drift where it is?
+The maps and their checks: :mod:`testkit.realdata.ladders3d`. Fifteen evaluations of about
+two minutes each on 2 cores (the 3D registration's global search most of it).
+
+    python -m bench.validation --only kitti_ladders
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from pcmapq.report.text import score
+from testkit.realdata.ladders3d import (
+    LEVELS,
+    NOT_ASKED,
+    RHO,
+    SCANS,
+    WAY,
+    WITHIN_M,
+    WITHIN_SHARE,
+    Rung,
+    measure,
+    meets,
+    rho,
+)
+
+from .common import Case, Record, Section, header, row
+
+#: How each ladder's level reads in its table's first column.
+UNIT = {"heading": "deg / scan", "vertical": "deg / scan", "scale": "% longer"}
+#: The figures' names in the rho line.
+NAMES = {"chamfer_3d_m": "Chamfer 3D", "awd_m": "AWD", "scs": "SCS", "planes_f1": "planes f1",
+         "plane_lines_f1": "plane lines f1", "largest_dz_m": "largest region |dz|",
+         "largest_offset_m": "largest region offset"}
+
+
+def _level(kind: str, level: float) -> str:
+    return f"{100 * level:g}" if kind == "scale" else f"{level:g}"
+
+
+def cases(data: Path) -> list[Case]:
+    return [Case(f"kitti-ladder-{kind}-{level:g}",
+                 lambda kind=kind, level=level: measure(data / "kitti00", kind, level))
+            for kind, levels in LEVELS.items() for level in levels]
+
+
+def _metres(value: float | None) -> str:
+    return "-" if value is None else f"{value:.3f}"
+
+
+def _table(kind: str, rungs: list[Rung]) -> list[str]:
+    """One ladder's table, and its line of rank correlations."""
+    lines = [header([f"level ({UNIT[kind]})", "at the end (m / deg)", "verdict", "3D fitness",
+                     "Chamfer 3D (m)", "AWD (m)", "SCS", "planes f1", "plane lines f1",
+                     "largest region |dz| (m)", "largest region offset (m)", "held / regions"])]
+    for g in rungs:
+        f, r = g.figures, g.run.result
+        lines.append(row([
+            _level(kind, g.level), f"{g.injected.offset_m:.2f} / {g.injected.turn_deg:.1f}",
+            r.overlap.verdict, f"{r.registration_3d.fitness:.3f}", _metres(f["chamfer_3d_m"]),
+            _metres(f["awd_m"]), score(f["scs"], 3), score(f["planes_f1"], 2),
+            score(f["plane_lines_f1"], 2), _metres(f["largest_dz_m"]),
+            _metres(f["largest_offset_m"]), f"{f['held']} / {f['regions']}"]))
+    levels = [g.level for g in rungs]
+    parts = []
+    for name in WAY:
+        value = rho(levels, [g.figures[name] for g in rungs])
+        text = f"{NAMES[name]} {'-' if value is None else f'{value:.2f}'}"
+        if name in NOT_ASKED[kind]:
+            text += " (not asked of this drift)"
+        elif not meets(name, value):
+            text += " (**not met**)"
+        parts.append(text)
+    lines += ["", f"Spearman's rho with the level: {', '.join(parts)}."]
+    return lines
+
+
+def _bends(rungs: list[Rung]) -> list[str]:
+    """The vertical ladder's 3D consistency map against each region's expected dz."""
+    lines = [header(["level (deg / scan)", "injected dz (m)", "far region (m)",
+                     "its points' dz errors, 5-95 % (m)", "expected dz (m)", "reported dz (m)",
+                     "within", "largest dz (m)",
+                     "same region", "median / max error, held (m)"])]
+    for g in rungs:
+        b = g.bend
+        lines.append(row([
+            f"{g.level:g}", f"{g.injected.dz_m:.3f}", f"({b.far_at[0]:.1f}, {b.far_at[1]:.1f})",
+            f"{b.spread_m[0]:.2f} to {b.spread_m[1]:.2f}", f"{b.expected_m:.3f}",
+            f"{b.reported_m:.3f}",
+            "yes" if b.within(g.injected.dz_m) else "**no**", f"{b.largest_m:.3f}",
+            "yes" if b.same_region else "**no**",
+            f"{b.median_error_m:.3f} / {b.max_error_m:.3f}"]))
+    return lines
+
+
+def section(data: Path, record: Record) -> Section:
+    """A table per ladder, the rank correlations, and the vertical ladder's bends."""
+    measured = [case.run(record) for case in cases(data)]
+    by_kind = {kind: [g for g in measured if g.kind == kind] for kind in LEVELS}
+    text = [
+        "## KITTI 00's 3D drift ladders: heading, vertical, scale", "",
+        f"The first {SCANS} scans of `kitti00/velodyne` at KITTI's reference poses (the truth) "
+        "and at poses that drift as odometry drifts, each error integrated along the run "
+        "(`testkit/realdata/ladders3d.py`): *heading*: each step's motion turned a further "
+        "*level* degrees about the scanner's vertical axis (scan k turned k x level, the run "
+        "curving sideways); *vertical*: the same about its lateral axis (a pitch drift, the run "
+        "bending down); *scale*: each step's translation (1 + level) as long (the run "
+        "stretching). Both maps built as `pcmapq map --poses` builds them (full range, 0.1 m "
+        "voxels) and scored as `pcmapq eval map.ply truth.ply --structures-voxel 0.3 "
+        "--no-noref` (the KITTI planes section's settings: the structures at the outdoor "
+        "voxel; every other setting the default). *At the end*: how far the last scan's "
+        "position is off and how far it is turned. *Verdict*: the plan's same-place verdict. "
+        "Chamfer 3D, AWD and SCS as docs/metrics.md defines them; planes and plane lines "
+        "matched one to one (f1); the 3D consistency map's largest |dz| and longest offset "
+        "over its held regions. A figure meets the issue's bound when its Spearman's rho with "
+        f"the level is {RHO} or more in the way it should move as a map gets worse (up for the "
+        "distances, AWD and the regions' offsets; down for the f1s; either way for SCS, as "
+        "the issue asks).", "",
+    ]
+    for kind, title in (("heading", "Heading"), ("vertical", "Vertical (pitch)"),
+                        ("scale", "Scale")):
+        text += [f"### {title}", "", *_table(kind, by_kind[kind]), ""]
+    text += [
+        "### Where the vertical drift bends the map", "",
+        "Each held region's expected dz is the mean vertical error of the map points it holds, "
+        "once the map is placed as the evaluation's 3D registration placed it (the same beam "
+        "at the reference pose is the point's true place; in the truth's levelled frame), as "
+        "the 3D consistency section computes it. *Far region*: the held region with the "
+        f"largest expected |dz| (centroid x, y); *within*: reported within {WITHIN_M:g} m + "
+        f"{WITHIN_SHARE:.0%} of the injected dz (the last scan's) of the expected; *largest*: "
+        "the held region with the largest reported |dz|, and whether it is the far region.",
+        "", *_bends(by_kind["vertical"]), "",
+        *_findings(by_kind),
+    ]
+    return Section("\n".join(text))
+
+
+def _rhos(rungs: list[Rung], name: str) -> float | None:
+    return rho([g.level for g in rungs], [g.figures[name] for g in rungs])
+
+
+def _steps(by_kind: dict[str, list[Rung]], name: str) -> bool:
+    """Whether a figure rises at every step of every ladder."""
+    return all(a < b for rungs in by_kind.values()
+               for a, b in zip([g.figures[name] for g in rungs],
+                               [g.figures[name] for g in rungs][1:], strict=False))
+
+
+def _findings(by_kind: dict[str, list[Rung]]) -> list[str]:
+    """What met the bound and what did not, and why, in words around the measured figures."""
+    def listed(name: str) -> str:
+        return ", ".join(f"{kind} {_rhos(rungs, name):.2f}" for kind, rungs in by_kind.items())
+
+    missed = [f"{NAMES[name]} on the {kind} ladder" for kind, rungs in by_kind.items()
+              for name in WAY if name not in NOT_ASKED[kind] and not meets(name,
+                                                                          _rhos(rungs, name))]
+    awd = [[g.figures["awd_m"] for g in rungs] for rungs in by_kind.values()]
+    growth = [b / a for row_ in awd for a, b in zip(row_, row_[1:], strict=False)]
+    first = [rungs[0].figures["planes_f1"] for rungs in by_kind.values()]
+    lines = by_kind["vertical"][0].run.result.structures.detectors["plane_lines"].matching
+    bends = [g.bend.within(g.injected.dz_m) for g in by_kind["vertical"]]
+    same = [g.bend.same_region for g in by_kind["vertical"]]
+    every = [NAMES[n] for n in ("awd_m", "chamfer_3d_m", "largest_offset_m")
+             if _steps(by_kind, n)]
+    return [
+        "### What meets the bound",
+        "",
+        f"Every figure meets it but {', '.join(missed) or 'none'}. "
+        f"{' and '.join(every) or 'No figure'} rise{'s' * (len(every) == 1)} at every step "
+        f"of every ladder (AWD {min(map(min, awd)):.3f} to {max(map(max, awd)):.3f} m). The "
+        f"planes' f1 falls (rho {listed('planes_f1')}); at the lowest levels it stands at "
+        f"{min(first):.2f}-{max(first):.2f}, not 1: the drifted scans put each far surface at "
+        "slightly different places, thicker than a plane's flatness test allows, so the map's "
+        "planes break up differently from the truth's.",
+        "",
+        f"The plane lines' f1 (rho {listed('plane_lines_f1')}): the truth has "
+        f"{lines.truth_structures} plane lines, too few to rank five levels (each is "
+        f"{1 / lines.truth_structures:.0%} of the quality); a street's façades seldom meet a "
+        "found ground plane within the 0.2 m margin (parked cars and kerbs hide their feet), "
+        "and the drifted maps' extra lines come and go.",
+        "",
+        f"SCS does not move one way (rho {listed('scs')}). Each doubling of the level "
+        f"multiplies AWD by {min(growth):.1f} to {max(growth):.1f} (and each compared voxel's "
+        "W by about as much); SCS, the spread of W among neighbouring voxels over their mean, "
+        "is blind to that: it says how evenly the error is spread, not how large it is "
+        "(docs/metrics.md#awd-and-scs-mapeval). A drift's error varies smoothly from voxel to "
+        "voxel; what moves SCS is how that pattern mixes with the maps' own differences (a "
+        "pitch moves every far point, so its error spreads more evenly as it grows, and SCS "
+        "falls). MapEval meant the two so: AWD for the global accuracy, SCS for the local "
+        "consistency, which a drift leaves whole. pcmapq's SCS is MapEval's definition: not "
+        "its fault.",
+        "",
+        f"The vertical drift's largest reported |dz| is within the bound at {sum(bends)} of "
+        f"{len(bends)} levels and in the far region at {sum(same)} of {len(same)}. At full "
+        "range each far region holds points of every scan, each put at another height (the "
+        "5-95 % column): a blur rather than a shifted surface. Its own fit follows its "
+        "densest surfaces, those of the last, nearest scans, while the expected dz is the "
+        "mean over all its points; where the blur is wide they part by more than the bound. "
+        "Where another region shows the largest |dz|, it is a few centimetres from the far "
+        "region's, within the regions' own error (the last column). The [3D consistency "
+        "section](#where-a-3d-map-bends-kitti-00-drifting-vertically) cuts the scans to 12 m "
+        "so that no region holds every scan, and meets the bound there.",
+    ]

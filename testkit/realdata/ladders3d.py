@@ -1,0 +1,290 @@
+"""KITTI 00's 3D drift ladders (issue 57): the map of its first 20 scans at KITTI's reference
+poses (the truth) and maps of the same scans at poses that drift as odometry drifts, each
+error integrated along the run, at five levels of three kinds:
+
+- heading: each step's motion turned a further *level* degrees about the scanner's vertical
+  axis (scan k turned k x level, the run curving sideways; :func:`testkit.kitti.curved`);
+- vertical: the same about its lateral axis (a pitch drift: the run bends down);
+- scale: each step's translation (1 + *level*) as long (the run stretches;
+  :func:`testkit.kitti.stretched`).
+
+All built as ``pcmapq map --poses`` builds them (:func:`pcmapq.mapping.build_map_from_poses`:
+full range, 0.1 m voxels; each map once per process) and scored as ``pcmapq eval map.ply
+truth.ply --structures-voxel 0.3 --no-noref`` scores two 3D clouds.
+
+The levels, measured (KITTI's car moves 0.86 m a scan, 16 m over the run): a heading or pitch
+drift of 0.025 degrees a scan leaves the run's end 0.07 m and 0.5 degrees off, AWD 0.06 m, the
+3D registration's fitness 1.00: barely off. Doubling at each level, 0.4 degrees a scan leaves
+it 1.15 m and 7.6 degrees off, fitness 0.6-0.7, the planes' f1 0.25-0.41: a clearly bad map.
+0.8 would go past what the 3D consistency map can measure: its regions' ICP catches offsets of
+about a metre (four 0.3 m voxels), and only 9 of about 105 regions are held there. A stretch
+moves no point more than the run's end, so it takes a larger share to spoil the map as much:
+1 % (0.16 m at the end, AWD 0.04 m, fitness 1.00) is barely off, 16 % (2.6 m, AWD 0.37 m,
+fitness 0.79) clearly bad.
+
+The vertical ladder's 3D consistency map is checked as :mod:`testkit.realdata.bends3d` checks
+it: each region's expected dz from the true place of every point it holds. docs/validation.md's
+section (``bench/validation/kitti_ladders.py``) and tests/realdata/test_kitti_ladders.py use it.
+"""
+
+from __future__ import annotations
+
+import tempfile
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass
+from functools import cache, lru_cache
+from pathlib import Path
+
+import numpy as np
+from scipy.stats import spearmanr
+
+from pcmapq.align.regions3d import Consistency3D, regions_3d
+from pcmapq.align.rigid3d import apply
+from pcmapq.core.frames import Levelling
+from pcmapq.evaluation.inputs import load_pair, plan_points
+from pcmapq.evaluation.scoring import structures_3d
+from pcmapq.io.writers import write_cloud
+from pcmapq.mapping import build_map_from_poses, lidar_poses_from_camera, read_kitti_poses
+from pcmapq.mapping.reference import scans_for_poses
+from pcmapq.match.structures import Structures3D
+from pcmapq.metrics.distances import distances_3d
+from pcmapq.metrics.map_gaussians import MapGaussians, map_gaussians
+from pcmapq.results.result import Result
+from pcmapq.settings import NoRefConfig, Settings, StructuresConfig
+from testkit.kitti import curved, stretched, tr_00
+from testkit.realdata.bends3d import WITHIN_M, WITHIN_SHARE, placed_errors, region_dz
+from testkit.runs import Run, timed_evaluate
+
+#: Scans of the maps (the first ones of kitti00/velodyne).
+SCANS = 20
+#: The ladders: kind -> its five levels (degrees a scan; a share for scale).
+LEVELS: dict[str, tuple[float, ...]] = {
+    "heading": (0.025, 0.05, 0.1, 0.2, 0.4),
+    "vertical": (0.025, 0.05, 0.1, 0.2, 0.4),
+    "scale": (0.01, 0.02, 0.04, 0.08, 0.16),
+}
+#: As kitti_planes scores its ladder: the structures at the outdoor voxel, no no-reference
+#: figures.
+SETTINGS = Settings(structures=StructuresConfig(voxel=0.3), noref=NoRefConfig(enabled=False))
+#: The scans' range in the maps (build_map_from_poses' default, as ``pcmapq map``), metres.
+MAX_RANGE_M = 100.0
+#: The issue's bound on a figure's rank correlation with the level.
+RHO = 0.9
+
+
+def drifted(poses: np.ndarray, kind: str, level: float) -> np.ndarray:
+    """LiDAR poses (K, 4, 4) drifting by ``kind`` ("heading", "vertical", "scale") at
+    ``level`` (module docstring)."""
+    if kind == "scale":
+        return stretched(poses, level)
+    return curved(poses, {"heading": "z", "vertical": "y"}[kind], level)
+
+
+@lru_cache(maxsize=4)
+def reference_poses(folder: Path) -> np.ndarray:
+    """KITTI 00's LiDAR poses of the first scans (SCANS, 4, 4), in the first scan's frame."""
+    return lidar_poses_from_camera(read_kitti_poses(folder / "poses.txt"), tr_00())[:SCANS]
+
+
+@cache
+def ladder_map(folder: Path, kind: str | None = None, level: float = 0.0) -> np.ndarray:
+    """The map (N, 3) metres of the first scans, as ``pcmapq map --poses`` builds it: at the
+    reference poses (``kind`` None: the truth) or drifted; built once per process."""
+    poses = reference_poses(folder)
+    if kind is not None:
+        poses = drifted(poses, kind, level)
+    return build_map_from_poses(folder / "velodyne", poses, max_scans=SCANS,
+                                max_range=MAX_RANGE_M)
+
+
+@dataclass(frozen=True)
+class Injected:
+    """The drift at the run's end: how far the last scan's position is off (m), how far it
+    is turned (deg) and its vertical error (m)."""
+
+    offset_m: float
+    turn_deg: float
+    dz_m: float
+
+
+def injected(folder: Path, kind: str, level: float) -> Injected:
+    """The last scan's error under the drift."""
+    truth = reference_poses(folder)
+    drift = drifted(truth, kind, level)
+    error = np.linalg.inv(truth[-1]) @ drift[-1]
+    cos = np.clip((np.trace(error[:3, :3]) - 1.0) / 2.0, -1.0, 1.0)
+    return Injected(float(np.linalg.norm(drift[-1, :3, 3] - truth[-1, :3, 3])),
+                    float(np.degrees(np.arccos(cos))), float(drift[-1, 2, 3] - truth[-1, 2, 3]))
+
+
+@dataclass(frozen=True)
+class Bend:
+    """The vertical check of a 3D consistency map: the held region with the largest expected
+    |dz| (its centroid x, y; the 5th and 95th percentiles of its points' vertical errors, m:
+    how far apart the scans put its surfaces; its expected and reported dz, m), the largest
+    reported dz (signed, m) and whether it is that region, and the median and largest
+    |reported - expected| over the held regions (m)."""
+
+    far_at: tuple[float, float]
+    spread_m: tuple[float, float]
+    expected_m: float
+    reported_m: float
+    largest_m: float
+    same_region: bool
+    median_error_m: float
+    max_error_m: float
+
+    def within(self, injected_m: float) -> bool:
+        """Reported within WITHIN_M plus WITHIN_SHARE of the injected offset of expected."""
+        return abs(self.reported_m - self.expected_m) <= WITHIN_M + WITHIN_SHARE * abs(injected_m)
+
+
+@dataclass(frozen=True)
+class Rung:
+    """One drifted map scored: its kind and level, the drift at the run's end, the
+    evaluation, its 3D figures (:func:`figures_3d`) and, for the vertical ladder, the check of
+    its 3D consistency map."""
+
+    kind: str
+    level: float
+    injected: Injected
+    run: Run
+    bend: Bend | None
+
+    @property
+    def figures(self) -> dict[str, float | None]:
+        return figures_3d(self.run.result)
+
+    def summary(self) -> dict:
+        out = self.run.summary()
+        out["figures_3d"] = self.figures
+        out["transform_3d"] = self.run.result.registration_3d.transform.tolist()
+        if self.bend is not None:
+            out["bend"] = {k: list(v) if isinstance(v, tuple) else v
+                           for k, v in self.bend.__dict__.items()}
+        return out
+
+
+#: The figures each ladder ranks by the level: name -> the way the issue asks it to move as
+#: the map gets worse (1 up, -1 down, 0 one way or the other: SCS).
+WAY = {"chamfer_3d_m": 1, "awd_m": 1, "scs": 0, "planes_f1": -1, "plane_lines_f1": -1,
+       "largest_dz_m": 1, "largest_offset_m": 1}
+#: Figures a ladder's drift is not asked to move: a horizontal drift moves no region up.
+NOT_ASKED = {"heading": ("largest_dz_m",), "scale": ("largest_dz_m",), "vertical": ()}
+
+
+def meets(name: str, value: float | None) -> bool:
+    """Whether a figure's rank correlation with the level meets the issue's bound."""
+    if value is None:
+        return False
+    return (abs(value) if WAY[name] == 0 else WAY[name] * value) >= RHO
+
+
+def figures_3d(result: Result) -> dict[str, float | None]:
+    """A result's figures of two 3D clouds (:func:`figures_of`)."""
+    return figures_of(result.distances_3d.chamfer_m, result.map_3d, result.structures,
+                      result.consistency_3d)
+
+
+def figures_of(chamfer_m: float, gaussians: MapGaussians | None,
+               structures: Structures3D | None,
+               consistency: Consistency3D | None) -> dict[str, float | None]:
+    """The figures of two 3D clouds the ladders rank: the Chamfer distance in 3D (m), AWD (m),
+    SCS, the planes' and plane lines' f1, the 3D consistency map's largest |dz| and largest
+    offset over its held regions (m), and its held and all regions."""
+    c, s = consistency, structures
+    dz, off = (None, None) if c is None else (c.largest_dz(), c.largest())
+    return {
+        "chamfer_3d_m": chamfer_m,
+        "awd_m": None if gaussians is None else gaussians.awd_m,
+        "scs": None if gaussians is None else gaussians.scs,
+        "planes_f1": None if s is None else s.detectors["planes"].matching.f1,
+        "plane_lines_f1": None if s is None else s.detectors["plane_lines"].matching.f1,
+        "largest_dz_m": None if dz is None else float(abs(c.offset[dz, 2])),
+        "largest_offset_m": None if off is None else float(c.offset_m[off]),
+        "held": None if c is None else int(c.held.sum()),
+        "regions": None if c is None else len(c.points),
+    }
+
+
+def direct_figures(folder: Path, kind: str, level: float, transform: np.ndarray
+                   ) -> tuple[dict[str, float | None], Bend | None]:
+    """The figures of :func:`figures_of` computed as the evaluation computes them once its 3D
+    registration has placed the map at ``transform`` (4x4 map -> truth), without the
+    registration and the 2D pipeline: both maps written and read as ``pcmapq eval`` reads
+    them, each figure by the function its scoring calls with SETTINGS, on as many threads; and
+    the vertical ladder's check of its 3D consistency map (:func:`bend`)."""
+    settings, m3 = SETTINGS, SETTINGS.map_3d
+    with tempfile.TemporaryDirectory(prefix="pcmapq_ladders3d_") as tmp:
+        truth_path, map_path = Path(tmp) / "truth.ply", Path(tmp) / "map.ply"
+        write_cloud(truth_path, ladder_map(folder))
+        write_cloud(map_path, ladder_map(folder, kind, level))
+        source, truth = load_pair(map_path, truth_path, settings)
+    level_of = plan_points(truth, settings)[1]
+    placed, target = apply(np.asarray(transform, dtype=np.float64), source.points), truth.points
+    with ThreadPoolExecutor(3) as pool:
+        chamfer = pool.submit(distances_3d, placed, target, settings.raster.cloud_resolution,
+                              settings.distances.taus)
+        regions = pool.submit(regions_3d, placed, target, tile_m=m3.tile,
+                              voxel=settings.alignment.voxel_3d,
+                              level=None if level_of is None else level_of.rotation)
+        gaussians = pool.submit(map_gaussians, placed, target, m3.voxel, m3.min_points,
+                                m3.radius)
+        structures = pool.submit(structures_3d, target, placed, settings.structures)
+        figures = figures_of(chamfer.result().chamfer_m, gaussians.result(),
+                             structures.result(), regions.result())
+    return figures, (bend(folder, kind, level, regions.result(), transform, level_of)
+                     if kind == "vertical" else None)
+
+
+def rho(levels: list[float], values: list[float | None]) -> float | None:
+    """Spearman's rank correlation of a figure with the level; None when a level lacks it."""
+    if any(v is None for v in values):
+        return None
+    # rounded: a rank correlation of a few levels is a multiple of a simple fraction
+    return round(float(spearmanr(levels, values)[0]), 6)
+
+
+@lru_cache(maxsize=4)
+def scans(folder: Path) -> tuple[np.ndarray, ...]:
+    """The first scans' points (each (N, 3) metres, the scanner's frame) within the maps'
+    range: the points each map places (read once per process)."""
+    return tuple(p[np.linalg.norm(p, axis=1) <= MAX_RANGE_M]
+                 for p, _ in scans_for_poses(folder / "velodyne", SCANS, max_scans=SCANS))
+
+
+def bend(folder: Path, kind: str, level: float, consistency: Consistency3D | None,
+         transform: np.ndarray, level_of: Levelling | None) -> Bend:
+    """The check of a drifted map's 3D consistency map (the map placed by ``transform``, 4x4
+    map -> truth; ``level_of``: the truth's levelling) against each region's expected dz, the
+    mean error of its points (:func:`testkit.realdata.bends3d.region_dz`)."""
+    c = consistency
+    if c is None or not c.held.any():
+        raise RuntimeError(f"{kind} {level}: no held region of a 3D consistency map")
+    truth = reference_poses(folder)
+    placed, error = placed_errors(list(scans(folder)), truth, drifted(truth, kind, level),
+                                  transform, None if level_of is None else level_of.rotation)
+    expected = region_dz(placed, error[:, 2], c.centre, c.tile_m, c.voxel_m)
+    far = int(np.flatnonzero(c.held)[np.argmax(np.abs(expected[c.held]))])
+    largest = c.largest_dz()
+    gap = np.abs(c.offset[c.held, 2] - expected[c.held])
+    tile = np.floor(placed[:, :2] / c.tile_m) == np.floor(c.centre[far, :2] / c.tile_m)
+    spread = np.percentile(error[np.all(tile, axis=1), 2], [5, 95])
+    return Bend(tuple(np.round(c.centre[far, :2], 1).tolist()),
+                tuple(np.round(spread, 6).tolist()), round(float(expected[far]), 6),
+                float(c.offset[far, 2]), float(c.offset[largest, 2]), largest == far,
+                round(float(np.median(gap)), 6), round(float(gap.max()), 6))
+
+
+def measure(folder: Path, kind: str, level: float) -> Rung:
+    """The drifted map scored against the truth as ``pcmapq eval map.ply truth.ply`` with
+    SETTINGS scores them; the vertical ladder's consistency map checked."""
+    with tempfile.TemporaryDirectory(prefix="pcmapq_ladders3d_") as tmp:
+        truth, cloud = Path(tmp) / "truth.ply", Path(tmp) / "map.ply"
+        write_cloud(truth, ladder_map(folder))
+        write_cloud(cloud, ladder_map(folder, kind, level))
+        run = timed_evaluate(cloud, truth, SETTINGS)
+    r = run.result
+    return Rung(kind, level, injected(folder, kind, level), run,
+                bend(folder, kind, level, r.consistency_3d, r.registration_3d.transform,
+                     r.frames.truth_levelling) if kind == "vertical" else None)
