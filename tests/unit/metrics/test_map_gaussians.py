@@ -126,3 +126,25 @@ def test_clouds_wider_than_the_voxel_index_are_refused():
     cloud = in_voxels(cells=(1, 1, 1))
     with pytest.raises(InputError, match="larger voxel"):
         map_gaussians(cloud, np.vstack([cloud, cloud + [0.0, 0.0, 7.0e6]]))
+
+
+def test_a_cloud_is_read_chunk_by_chunk_with_the_same_figures(monkeypatch):
+    """A large float32 cloud (a file mapped into memory) is read CHUNK points at a time: the
+    figures are those of one pass over all its points, bit for bit, and the memory taken
+    stays below a float64 copy of the cloud (none is made)."""
+    import tracemalloc
+
+    import pcmapq.metrics.map_gaussians as module
+
+    truth = room(200_000).astype(np.float32)
+    bent = (room(200_000, seed=4) + [0.03, 0.0, 0.0]).astype(np.float32)
+    whole = map_gaussians(bent, truth, 3.0, 100, 2)  # one chunk
+    monkeypatch.setattr(module, "CHUNK", 4096, raising=False)
+    tracemalloc.start()
+    try:
+        chunked = map_gaussians(bent, truth, 3.0, 100, 2)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert chunked == whole and whole.voxels > 10
+    assert peak < 2 * truth.nbytes
