@@ -22,8 +22,8 @@ from pcmapq.core import voxel_table
 from pcmapq.core.bounds import bounds
 from pcmapq.core.errors import InputError
 
-__all__ = ["VoxelMap", "evenly", "open3d_centroids", "voxel_centroids", "voxel_count",
-           "voxel_groups"]
+__all__ = ["VoxelMap", "evenly", "index_keys", "open3d_centroids", "voxel_centroids",
+           "voxel_count", "voxel_groups"]
 
 #: Grouping by counting is used when the points' box holds at most this many voxels per point
 #: and at most DENSE_CELLS voxels (8 bytes of memory each).
@@ -132,6 +132,11 @@ def voxel_index(points: np.ndarray, voxel: float) -> np.ndarray:
         raise InputError(f"map extends beyond +-{offset * voxel:.0f} m of its origin at voxel "
                          f"{voxel} m; use a larger voxel")
     return index
+
+
+def index_keys(index: np.ndarray) -> np.ndarray:
+    """:func:`voxel_index` rows (N, d) packed into their keys (:func:`voxel_keys`)."""
+    return _packed(np.asarray(index, dtype=np.int64))
 
 
 def _packed(index: np.ndarray) -> np.ndarray:

@@ -13,13 +13,14 @@ voxel)."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 
 from pcmapq.core.bounds import bounds
 from pcmapq.core.errors import InputError
-from pcmapq.core.voxels import voxel_keys
+from pcmapq.core.voxels import index_keys, voxel_index, voxel_keys
 from pcmapq.metrics.defaults import AWD_MIN_POINTS, AWD_VOXEL, SCS_RADIUS
 
 #: Eigenvalues of a voxel's covariance are raised to at least this, m^2 (MapEval's floor): a
@@ -32,6 +33,9 @@ ROUNDING = 1e-12
 _BITS = 21
 #: Points read at a time (their float64 copy, voxel indices and keys: about 40 MB).
 CHUNK = 1 << 19
+#: A cloud's voxels are every voxel of its box when the box holds at most this many (and at
+#: most DENSE_PER_POINT a point): their sums are then found without a pass to list them.
+DENSE_CELLS, DENSE_PER_POINT = 1 << 20, 4
 #: The pairs of axes of a covariance's six distinct entries.
 _PAIRS = ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))
 
@@ -87,19 +91,17 @@ def voxel_gaussians(points: np.ndarray, voxel: float, min_points: int = 2,
     origin."""
     points = np.asarray(points).reshape(-1, 3)
     origin = np.zeros(3) if origin is None else np.asarray(origin, dtype=np.float64)
-    keys = np.empty(0, dtype=np.int64)
-    for chunk in _chunks(points, origin):
-        keys = np.union1d(keys, voxel_keys(chunk, voxel))
+    keys, rows = _cells(points, origin, voxel)
     n, sums = np.zeros(len(keys)), np.zeros((3, len(keys)))
     for chunk in _chunks(points, origin):
-        at = np.searchsorted(keys, voxel_keys(chunk, voxel))
+        at = rows(chunk)
         np.add.at(n, at, 1.0)
         for a in range(3):
             np.add.at(sums[a], at, chunk[:, a])
     means = sums / np.maximum(n, 1.0)
     products = np.zeros((len(_PAIRS), len(keys)))
     for chunk in _chunks(points, origin):
-        at = np.searchsorted(keys, voxel_keys(chunk, voxel))
+        at = rows(chunk)
         centred = [chunk[:, a] - np.take(means[a], at) for a in range(3)]
         for k, (a, b) in enumerate(_PAIRS):
             np.add.at(products[k], at, centred[a] * centred[b])
@@ -108,6 +110,33 @@ def voxel_gaussians(points: np.ndarray, voxel: float, min_points: int = 2,
     for k, (a, b) in enumerate(_PAIRS):
         cov[:, a, b] = cov[:, b, a] = products[k][kept] / (n[kept] - 1)
     return keys[kept], means.T[kept], cov
+
+
+def _cells(points: np.ndarray, origin: np.ndarray, voxel: float
+           ) -> tuple[np.ndarray, Callable[[np.ndarray], np.ndarray]]:
+    """The voxels the points (N, 3) minus ``origin`` may fill, as packed keys (sorted), and a
+    function giving the rows among them of a chunk of those points: every voxel of the
+    points' box when it holds at most DENSE_CELLS (no pass over the points to find them; the
+    empty ones count no point), else the voxels found in a pass. InputError for points beyond
+    the keys' range."""
+    if len(points):
+        lo, hi = (b.astype(np.float64) - origin for b in bounds(points))
+        first, last = voxel_index(np.array([lo, hi]), voxel)
+        span = last - first + 1
+        cells = int(np.prod(span.astype(object)))
+        if cells <= min(DENSE_CELLS, DENSE_PER_POINT * len(points) + 4096):
+            keys = index_keys(np.column_stack(np.unravel_index(np.arange(cells), tuple(span)))
+                              + first)
+
+            def rows(chunk: np.ndarray) -> np.ndarray:  # row-major in the box: as the keys
+                index = voxel_index(chunk, voxel) - first
+                return (index[:, 0] * span[1] + index[:, 1]) * span[2] + index[:, 2]
+
+            return keys, rows
+    keys = np.empty(0, dtype=np.int64)
+    for chunk in _chunks(points, origin):
+        keys = np.union1d(keys, voxel_keys(chunk, voxel))
+    return keys, lambda chunk: np.searchsorted(keys, voxel_keys(chunk, voxel))
 
 
 def _chunks(points: np.ndarray, origin: np.ndarray):
