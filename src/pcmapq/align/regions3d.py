@@ -157,8 +157,10 @@ def regions_3d(map_xyz: np.ndarray, truth_xyz: np.ndarray, *, tile_m: float = TI
     rotation (3x3), applied to both first, so that tiles lie on its ground and dz is
     vertical; None: the truth frame as it is. Deterministic."""
     tolerance = voxel / 2
-    placed = levelled(voxel_centroids(np.asarray(map_xyz, dtype=np.float64), voxel), level)
-    truth = levelled(voxel_centroids(np.asarray(truth_xyz, dtype=np.float64), voxel), level)
+    # the centroids of a large cloud are streamed (any float type, a file mapped into memory
+    # read in chunks): no copy of all its points is made
+    placed = levelled(voxel_centroids(np.asarray(map_xyz), voxel), level)
+    truth = levelled(voxel_centroids(np.asarray(truth_xyz), voxel), level)
     if len(placed) == 0 or len(truth) < NORMAL_NEIGHBOURS:
         return Consistency3D.empty(tile_m, voxel, tolerance)
     tile_m = max(tile_m, float(np.ptp(placed[:, :2], axis=0).max()) / MAX_TILES)

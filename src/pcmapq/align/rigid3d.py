@@ -62,7 +62,7 @@ def align_3d(source_xyz: np.ndarray, target_xyz: np.ndarray, *, voxel: float = 0
     source = _usable(source_xyz, "source")
     target = _usable(target_xyz, "target")
     src_shift, tgt_shift = _translation(-source.mean(axis=0)), _translation(-target.mean(axis=0))
-    source, target = apply(src_shift, source), apply(tgt_shift, target)
+    source, target = _shifted(source, src_shift), _shifted(target, tgt_shift)
     src_down, tgt_down = voxel_centroids(source, voxel), voxel_centroids(target, voxel)
     if len(src_down) < MIN_POINTS or len(tgt_down) < MIN_POINTS:
         raise EvaluationError(f"too few points at voxel {voxel} m to register "
@@ -104,12 +104,21 @@ def _translation(offset: np.ndarray) -> np.ndarray:
     return out
 
 
+def _shifted(points: np.ndarray, shift: np.ndarray) -> np.ndarray:
+    """``points`` (N, 3, this module's own copy) moved by the translation ``shift`` (4x4) in
+    place: the numbers :func:`apply` gives, without a second copy of all the points."""
+    points += shift[:3, 3]
+    return points
+
+
 def _usable(xyz: np.ndarray, name: str) -> np.ndarray:
-    """(N, 3) float64 finite points, without exact (0, 0, 0) rows."""
-    points = np.asarray(xyz, dtype=np.float64)
+    """(N, 3) float64 finite points, without exact (0, 0, 0) rows: a copy of its own, made
+    once (a float32 cloud, mapped onto its file, is converted straight into it)."""
+    points = np.asarray(xyz)
     if points.ndim != 2 or points.shape[1] != 3:
         raise InputError(f"{name}: expected N x 3 points, got shape {points.shape}")
     keep = np.isfinite(points).all(axis=1) & (points != 0.0).any(axis=1)
     if not keep.any():
         raise InputError(f"{name}: no usable points")
-    return points[keep]
+    return np.array(points, dtype=np.float64) if keep.all() else \
+        np.asarray(points[keep], dtype=np.float64)

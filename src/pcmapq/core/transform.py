@@ -12,7 +12,9 @@ def affine(points: np.ndarray, matrix: np.ndarray) -> np.ndarray:
     ``points @ matrix[:d, :d].T + matrix[:d, d]``, with the rotation made contiguous first
     (NumPy multiplies by a strided view outside BLAS, far more slowly)."""
     d = points.shape[1]
-    return points @ np.ascontiguousarray(matrix[:d, :d].T) + matrix[:d, d]
+    out = points @ np.ascontiguousarray(matrix[:d, :d].T)
+    out += matrix[:d, d]  # in place: no second array of all the points
+    return out
 
 
 @dataclass(frozen=True)

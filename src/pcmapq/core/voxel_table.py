@@ -37,13 +37,14 @@ def _slot(key: int, keys: np.ndarray, shift: np.uint64) -> int:
 
 
 @numba.njit(cache=True, nogil=True)
-def _add(points: np.ndarray, scale: float, voxel: float, keys: np.ndarray, sums: np.ndarray,
-         counts: np.ndarray, used: int, shift: np.uint64, limit: int, lo: int,
+def _add(points: np.ndarray, scale: float, voxel: float, origin: np.ndarray, keys: np.ndarray,
+         sums: np.ndarray, counts: np.ndarray, used: int, shift: np.uint64, limit: int, lo: int,
          hi: int) -> tuple[int, int]:
     """Add the ``points`` (N, d) times ``scale`` whose x index (offset as in the keys) lies in
     [lo, hi) to the table until ``limit`` slots are used: (points gone through, slots used);
-    -1 - i when point i lies beyond the keys' range. Keys pack each axis's index in 63 // d
-    bits, as :func:`pcmapq.core.voxels.voxel_keys` does."""
+    -1 - i when point i lies beyond the keys' range. A point's voxel counts from ``origin``
+    (d,) metres: ``floor((p * scale - origin) / voxel)``. Keys pack each axis's index in
+    63 // d bits, as :func:`pcmapq.core.voxels.voxel_keys` does."""
     dims = points.shape[1]
     bits = 63 // dims
     offset = 1 << (bits - 1)
@@ -53,7 +54,7 @@ def _add(points: np.ndarray, scale: float, voxel: float, keys: np.ndarray, sums:
             return i, used
         key, inside = np.int64(0), True
         for axis in range(dims):
-            index = math.floor(points[i, axis] * scale / voxel) + offset
+            index = math.floor((points[i, axis] * scale - origin[axis]) / voxel) + offset
             if index < 0 or index >= top:
                 return -1 - i, used
             if axis == 0 and (index < lo or index >= hi):
@@ -89,7 +90,8 @@ def _moved(keys: np.ndarray, sums: np.ndarray, counts: np.ndarray, size: int,
 
 def streamed_centroids(points: np.ndarray, voxel: float, scale: float = 1.0,
                        move: Callable[[np.ndarray], np.ndarray] | None = None,
-                       stripe_points: int | None = None) -> np.ndarray:
+                       stripe_points: int | None = None,
+                       origin: np.ndarray | None = None) -> np.ndarray:
     """(M, d) float64: the centroid of ``points`` (N, d, d = 2 or 3, any float type, e.g.
     mapped onto a file) times ``scale``, metres, in each ``voxel``-metre cell, sorted by voxel
     index; the same as ``voxel_centroids(points * scale, voxel)`` bit for bit. Reads ``points``
@@ -98,17 +100,20 @@ def streamed_centroids(points: np.ndarray, voxel: float, scale: float = 1.0,
     whole). ``stripe_points``: with more points than this, the voxels are found in one stripe
     of x after another, a pass over the points each (N / stripe_points stripes of equal
     width), so that the table holds one stripe's voxels at a time; the keys sort by x first,
-    so the stripes' centroids follow one another in order. InputError when a point lies beyond
-    the keys' range (+-2**20 voxels in 3D)."""
+    so the stripes' centroids follow one another in order. ``origin`` (d,) metres: the voxels
+    are the cubes ``origin + voxel * (i, j, k)`` (default: from 0). InputError when a point
+    lies beyond the keys' range (+-2**20 voxels from ``origin`` in 3D)."""
     if not voxel > 0:
         raise InputError(f"voxel must be positive, got {voxel}")
+    origin = np.zeros(points.shape[1]) if origin is None else \
+        np.asarray(origin, dtype=np.float64).reshape(points.shape[1])
     stripes = 1 if stripe_points is None else max(1, -(-len(points) // stripe_points))
     if stripes == 1:
-        return _stripe(points, voxel, scale, move, 0, 1 << (63 // points.shape[1]))
-    first, last = _x_indices(points, voxel, scale, move)
+        return _stripe(points, voxel, scale, move, origin, 0, 1 << (63 // points.shape[1]))
+    first, last = _x_indices(points, voxel, scale, move, origin)
     edges = first + (last + 1 - first) * np.arange(stripes + 1) // stripes
-    return np.concatenate([_stripe(points, voxel, scale, move, int(edges[k]), int(edges[k + 1]))
-                           for k in range(stripes)])
+    return np.concatenate([_stripe(points, voxel, scale, move, origin, int(edges[k]),
+                                   int(edges[k + 1])) for k in range(stripes)])
 
 
 def _chunks(points: np.ndarray, move: Callable[[np.ndarray], np.ndarray] | None):
@@ -119,14 +124,15 @@ def _chunks(points: np.ndarray, move: Callable[[np.ndarray], np.ndarray] | None)
 
 
 def _x_indices(points: np.ndarray, voxel: float, scale: float,
-               move: Callable[[np.ndarray], np.ndarray] | None) -> tuple[int, int]:
+               move: Callable[[np.ndarray], np.ndarray] | None,
+               origin: np.ndarray) -> tuple[int, int]:
     """The least and greatest x index of the points' voxels, offset as in the keys (clipped to
     the keys' range: a point beyond it is refused by the pass that meets it)."""
     bits = 63 // points.shape[1]
     lowest, highest = np.inf, -np.inf
     for chunk in _chunks(points, move):
         if len(chunk):
-            index = np.floor(chunk[:, 0] * scale / voxel)
+            index = np.floor((chunk[:, 0] * scale - origin[0]) / voxel)
             lowest, highest = min(lowest, index.min()), max(highest, index.max())
     offset, top = 1 << (bits - 1), 1 << bits
     if lowest > highest:
@@ -135,7 +141,8 @@ def _x_indices(points: np.ndarray, voxel: float, scale: float,
 
 
 def _stripe(points: np.ndarray, voxel: float, scale: float,
-            move: Callable[[np.ndarray], np.ndarray] | None, lo: int, hi: int) -> np.ndarray:
+            move: Callable[[np.ndarray], np.ndarray] | None, origin: np.ndarray, lo: int,
+            hi: int) -> np.ndarray:
     """The centroids of the voxels whose x index (offset as in the keys) lies in [lo, hi), in
     one pass over the points."""
     dims, bits = points.shape[1], 16
@@ -144,8 +151,9 @@ def _stripe(points: np.ndarray, voxel: float, scale: float,
     for chunk in _chunks(points, move):
         done = 0
         while done < len(chunk):
-            added, used = _add(chunk[done:], float(scale), float(voxel), keys, sums, counts,
-                               used, np.uint64(64 - bits), int(LOAD * len(keys)), lo, hi)
+            added, used = _add(chunk[done:], float(scale), float(voxel), origin, keys, sums,
+                               counts, used, np.uint64(64 - bits), int(LOAD * len(keys)), lo,
+                               hi)
             if added < 0:
                 reach = (1 << (63 // dims - 1)) * voxel
                 raise InputError(f"map extends beyond +-{reach:.0f} m of its origin at "

@@ -22,7 +22,8 @@ from pcmapq.core import voxel_table
 from pcmapq.core.bounds import bounds
 from pcmapq.core.errors import InputError
 
-__all__ = ["VoxelMap", "evenly", "voxel_centroids", "voxel_count", "voxel_groups"]
+__all__ = ["VoxelMap", "evenly", "index_keys", "open3d_centroids", "voxel_centroids",
+           "voxel_count", "voxel_groups"]
 
 #: Grouping by counting is used when the points' box holds at most this many voxels per point
 #: and at most DENSE_CELLS voxels (8 bytes of memory each).
@@ -33,6 +34,13 @@ DENSE_CELLS = 1 << 27
 #: with the voxels rather than the points, and with only the voxels sorted. Smaller ones are
 #: sorted, which spares a short run loading the table.
 STREAM_FROM = 100_000
+#: Voxels from the grid's corner that the compiled table's keys reach along an axis (3D: 2**20
+#: less one): :func:`open3d_centroids` leaves a wider cloud to Open3D.
+REACH = (1 << 20) - 1
+#: A cloud of more points than this is reduced by :func:`open3d_centroids` in stripes of x of
+#: about STRIPE_WIDTH_POINTS points, a pass over its points each: the table holds one stripe's
+#: voxels at a time.
+STRIPE_POINTS, STRIPE_WIDTH_POINTS = 25_000_000, 8_000_000
 
 
 class VoxelMap:
@@ -126,6 +134,11 @@ def voxel_index(points: np.ndarray, voxel: float) -> np.ndarray:
     return index
 
 
+def index_keys(index: np.ndarray) -> np.ndarray:
+    """:func:`voxel_index` rows (N, d) packed into their keys (:func:`voxel_keys`)."""
+    return _packed(np.asarray(index, dtype=np.int64))
+
+
 def _packed(index: np.ndarray) -> np.ndarray:
     """:func:`voxel_index` (N, d) packed into one int64 key per point."""
     bits = 63 // index.shape[1]
@@ -173,6 +186,32 @@ def voxel_centroids(points: np.ndarray, voxel: float, scale: float = 1.0,
     grid = VoxelMap(voxel, dims=points.shape[1])
     grid.add(points)
     return grid.points()
+
+
+def open3d_centroids(points: np.ndarray, voxel: float) -> np.ndarray:
+    """The centroids (M, 3) of the points (N, 3, metres, any float type) in each voxel of
+    Open3D's ``voxel_down_sample``, bit for bit (its cubes start half a voxel below the
+    cloud's least corner; each voxel's points are summed in their order), in lexicographic
+    order (x, then y, then z), so that the order of the input does not matter. Read in chunks
+    by the compiled table (a file mapped into memory is never converted whole; more than
+    STRIPE_POINTS points in stripes of x); Open3D itself reduces a cloud wider than the
+    table's keys reach (a float64 copy of it)."""
+    points = np.asarray(points)
+    if len(points) == 0:
+        return np.zeros((0, 3))
+    lo, hi = (b.astype(np.float64) for b in bounds(points))
+    corner = lo - voxel * 0.5
+    if float(np.max((hi - corner) / voxel)) >= REACH:
+        import open3d as o3d  # only here: Open3D loads in seconds
+
+        cloud = o3d.geometry.PointCloud(o3d.utility.Vector3dVector(
+            np.asarray(points, dtype=np.float64)))
+        out = np.asarray(cloud.voxel_down_sample(voxel).points)
+    else:
+        out = voxel_table.streamed_centroids(points, voxel, origin=corner, stripe_points=None
+                                             if len(points) <= STRIPE_POINTS
+                                             else STRIPE_WIDTH_POINTS)
+    return out[np.lexsort(out.T[::-1])]
 
 
 def voxel_count(points: np.ndarray, voxel: float) -> int:

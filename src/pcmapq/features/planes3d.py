@@ -1,16 +1,18 @@
 """The planes of a 3D cloud (walls, floors, ceilings, facades, ground): :func:`find_planes`.
 
-Region growing on normals, vectorised: the cloud is reduced to one point per voxel
-(Open3D's ``voxel_down_sample``), each point's normal and surface variation come from the
-covariance of its nearest neighbours, and two neighbours join one region when both are flat
-(low variation), their normals agree within :data:`NEIGHBOUR_ANGLE_DEG` and each lies within
-half a voxel of the other's tangent plane: the regions are the connected components of that
-graph (SciPy). A region's plane is fitted to its points (least squares), the points next to
+Region growing on normals, vectorised: the cloud is reduced to one point per voxel (the
+centroids of Open3D's ``voxel_down_sample``, streamed:
+:func:`~pcmapq.core.voxels.open3d_centroids`), each point's normal and surface variation come
+from the covariance of its nearest neighbours, and two neighbours join one region when both are
+flat (low variation), their normals agree within :data:`NEIGHBOUR_ANGLE_DEG` and each lies
+within half a voxel of the other's tangent plane: the regions are the connected components of
+that graph (:mod:`pcmapq.core.components`, the pairs found ROWS points at a time, as is every
+per-point step). A region's plane is fitted to its points (least squares), the points next to
 it within half a voxel of that plane join it (the edges, where normals bend), and the plane is
 fitted again. Each plane is kept with at least ``min_points`` points and ``min_area`` square
-metres (the voxel-sized cells of the plane it covers). No random draw: the same cloud gives
-the same planes. (Open3D's ``detect_planar_patches`` gives boxes without their points, and
-misses faces of a metre or two; its planes could not be refitted nor measured.)
+metres (the voxel-sized cells of the plane it covers). No random draw: the same cloud gives the
+same planes. (Open3D's ``detect_planar_patches`` gives boxes without their points, and misses
+faces of a metre or two; its planes could not be refitted nor measured.)
 
 A plane is ``normal . x = offset``, its normal oriented with its largest component positive
 (a floor's points up, a wall facing +x or +y); its extent is the bounding rectangle of its
@@ -19,12 +21,15 @@ points in the plane, along their principal axes. Metres, in the cloud's frame.
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import ndimage, sparse
-from scipy.sparse.csgraph import connected_components
+from scipy import ndimage
 from scipy.spatial import cKDTree
+
+from pcmapq.core.components import Components
+from pcmapq.core.voxels import open3d_centroids
 
 #: Nearest neighbours of a point's normal and of its edges in the region graph.
 NEIGHBOURS = 12
@@ -35,6 +40,10 @@ MAX_VARIATION = 0.03
 NEIGHBOUR_ANGLE_DEG = 10.0
 #: Rounds of growth: points next to a region and near its plane join it, once per round.
 GROWTH_ROUNDS = 2
+#: Points whose per-point work (neighbours, normals, pairs, products) is done at once.
+ROWS = 1 << 16
+#: The pairs of axes of a 3 x 3 covariance's six distinct entries.
+PAIRS = ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))
 
 
 @dataclass(frozen=True)
@@ -97,80 +106,101 @@ def oriented(normal: np.ndarray) -> np.ndarray:
     return normal * np.where(big < 0, -1.0, 1.0)
 
 
-def reduced(points: np.ndarray, voxel: float) -> np.ndarray:
-    """The cloud (N, 3) reduced to the centroid of its points in each voxel (Open3D), in
-    lexicographic order (x, then y, then z) so that the order of the input does not matter."""
-    import open3d as o3d  # here: a result holding planes loads no Open3D
-
-    cloud = o3d.geometry.PointCloud(o3d.utility.Vector3dVector(
-        np.asarray(points, dtype=np.float64)))
-    out = np.asarray(cloud.voxel_down_sample(voxel).points)
-    return out[np.lexsort(out.T[::-1])]
+def _rows(n: int) -> Iterator[slice]:
+    """The rows 0 .. n - 1, ROWS at a time: the per-point work runs on one such block at a
+    time, its temporaries (neighbours' coordinates, products, pairs) never for all points."""
+    for start in range(0, n, ROWS):
+        yield slice(start, min(start + ROWS, n))
 
 
 def local_shape(points: np.ndarray, k: int = NEIGHBOURS
                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Each point's k nearest neighbours (N, k) indices (itself first), its unit normal
-    (N, 3) and its surface variation (N,), from their covariance."""
-    k = min(k, len(points))
-    _, near = cKDTree(points).query(points, k=k, workers=-1)
-    near = near.reshape(len(points), k)
-    centred = points[near]
-    centred -= centred.mean(axis=1, keepdims=True)
-    values, vectors = np.linalg.eigh(np.einsum("nki,nkj->nij", centred, centred) / k)
-    variation = values[:, 0] / np.maximum(values.sum(axis=1), 1e-18)
-    return near, vectors[:, :, 0], variation
+    """Each point's k nearest neighbours (N, k) indices (itself first; int32 below 2**31
+    points), its unit normal (N, 3) and its surface variation (N,), from their covariance."""
+    n, k = len(points), min(k, len(points))
+    tree = cKDTree(points)
+    near = np.empty((n, k), dtype=np.int32 if n < 2**31 else np.int64)
+    normal, variation = np.empty((n, 3)), np.empty(n)
+    for part in _rows(n):
+        _, found = tree.query(points[part], k=k, workers=-1)
+        near[part] = found = found.reshape(-1, k)
+        centred = points[found]
+        centred -= centred.mean(axis=1, keepdims=True)
+        values, vectors = np.linalg.eigh(np.einsum("nki,nkj->nij", centred, centred) / k)
+        variation[part] = values[:, 0] / np.maximum(values.sum(axis=1), 1e-18)
+        normal[part] = vectors[:, :, 0]
+    return near, normal, variation
 
 
 def regions(points: np.ndarray, near: np.ndarray, normal: np.ndarray, flat: np.ndarray,
             voxel: float) -> np.ndarray:
     """(N,) each flat point's region (connected components of the graph of agreeing flat
-    neighbours), -1 for a point that is not flat."""
+    neighbours, numbered by their first point), -1 for a point that is not flat."""
     n, k = near.shape
-    i, j = np.repeat(np.arange(n), k), near.ravel()
-    keep = flat[i] & flat[j] & (i != j)
-    i, j = i[keep], j[keep]
-    agree = np.abs(np.einsum("ij,ij->i", normal[i], normal[j])) >= \
-        np.cos(np.radians(NEIGHBOUR_ANGLE_DEG))
-    close = np.abs(np.einsum("ij,ij->i", normal[i], points[j] - points[i])) <= voxel / 2
-    keep = agree & close
-    graph = sparse.coo_array((np.ones(int(keep.sum())), (i[keep], j[keep])), shape=(n, n))
-    _, label = connected_components(graph, directed=False)
-    return np.where(flat, label, -1)
+    joined = Components(n)
+    for part in _rows(n):
+        i, j = np.repeat(np.arange(part.start, part.stop), k), near[part].ravel()
+        keep = flat[i] & flat[j] & (i != j)
+        i, j = i[keep], j[keep]
+        agree = np.abs(np.einsum("ij,ij->i", normal[i], normal[j])) >= \
+            np.cos(np.radians(NEIGHBOUR_ANGLE_DEG))
+        close = np.abs(np.einsum("ij,ij->i", normal[i], points[j] - points[i])) <= voxel / 2
+        keep = agree & close
+        joined.join(i[keep], j[keep])
+    return np.where(flat, joined.labels(), -1)
 
 
 def fit(points: np.ndarray, label: np.ndarray, count: int
         ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Least-squares planes of the labelled points (labels 0 .. count - 1; -1 none): their
     oriented normals (count, 3), offsets (count,) and centroids (count, 3)."""
-    on = label >= 0
-    lab, pts = label[on], points[on]
+    on = np.flatnonzero(label >= 0)
+    lab = label[on]
     size = np.maximum(np.bincount(lab, minlength=count), 1)[:, None]
-    centroid = np.stack([np.bincount(lab, weights=pts[:, a], minlength=count)
+    centroid = np.stack([np.bincount(lab, weights=points[on, a], minlength=count)
                          for a in range(3)], axis=1) / size
-    d = pts - centroid[lab]
-    cov = np.zeros((count, 3, 3))
-    np.add.at(cov, lab, np.einsum("ni,nj->nij", d, d))
+    cov = _scatter(points, on, lab, centroid, count)
     normal = oriented(np.linalg.eigh(cov)[1][:, :, 0])
     return normal, np.einsum("ij,ij->i", normal, centroid), centroid
+
+
+def _scatter(points: np.ndarray, on: np.ndarray, lab: np.ndarray, centroid: np.ndarray,
+             count: int) -> np.ndarray:
+    """(count, 3, 3) each plane's sum of the outer products of its points ``points[on]``
+    (labels ``lab``) about its centroid, added in the points' order, ROWS at a time (each of
+    the six distinct entries by a 1-D ``np.add.at``)."""
+    sums = np.zeros((len(PAIRS), count))
+    for part in _rows(len(on)):
+        d = points[on[part]] - centroid[lab[part]]
+        for k, (a, b) in enumerate(PAIRS):
+            np.add.at(sums[k], lab[part], d[:, a] * d[:, b])
+    cov = np.empty((count, 3, 3))
+    for k, (a, b) in enumerate(PAIRS):
+        cov[:, a, b] = cov[:, b, a] = sums[k]
+    return cov
 
 
 def grow(points: np.ndarray, near: np.ndarray, label: np.ndarray, normal: np.ndarray,
          offset: np.ndarray, reach: float) -> np.ndarray:
     """The labels with each unlabelled point next to a labelled one, and within ``reach`` of
-    its plane, given that neighbour's label (the nearest such plane's when several)."""
+    its plane, given that neighbour's label (the nearest such plane's when several); each
+    round's choices made on the labels the round starts with."""
     label = label.copy()
     for _ in range(GROWTH_ROUNDS):
         free = np.flatnonzero(label < 0)
         if not len(free):
             break
-        cand = label[near[free]]  # (F, k) the neighbours' planes
-        dist = np.abs(np.einsum("fkj,fj->fk", normal[np.maximum(cand, 0)], points[free])
-                      - offset[np.maximum(cand, 0)])
-        dist = np.where((cand >= 0) & (dist <= reach), dist, np.inf)
-        best = dist.argmin(axis=1)
-        ok = np.isfinite(dist[np.arange(len(free)), best])
-        label[free[ok]] = cand[ok, best[ok]]
+        taken = np.full(len(free), -1, dtype=label.dtype)
+        for part in _rows(len(free)):
+            rows = free[part]
+            cand = label[near[rows]]  # (F, k) the neighbours' planes
+            dist = np.abs(np.einsum("fkj,fj->fk", normal[np.maximum(cand, 0)], points[rows])
+                          - offset[np.maximum(cand, 0)])
+            dist = np.where((cand >= 0) & (dist <= reach), dist, np.inf)
+            best = dist.argmin(axis=1)
+            ok = np.isfinite(dist[np.arange(len(rows)), best])
+            taken[part][ok] = cand[ok, best[ok]]
+        label[free] = taken
     return label
 
 
@@ -180,14 +210,16 @@ def rectangles(points: np.ndarray, label: np.ndarray, normal: np.ndarray,
     (P, 4, 3) and sides (P, 2), the longer first; and the area its points cover (P,), square
     metres (:func:`covered`)."""
     count = len(normal)
-    on = label >= 0
-    lab, d = label[on], points[on] - centroid[label[on]]
+    on = np.flatnonzero(label >= 0)
+    lab = label[on]
     # the principal axes in the plane: the in-plane eigenvectors of each plane's covariance
-    cov = np.zeros((count, 3, 3))
-    np.add.at(cov, lab, np.einsum("ni,nj->nij", d, d))
+    cov = _scatter(points, on, lab, centroid, count)
     axes = np.linalg.eigh(cov)[1][:, :, [2, 1]].transpose(0, 2, 1)  # (P, 2, 3): u, v
     axes = oriented(axes.reshape(-1, 3)).reshape(count, 2, 3)
-    uv = np.einsum("nj,nkj->nk", d, axes[lab])
+    uv = np.empty((len(on), 2))
+    for part in _rows(len(on)):
+        d = points[on[part]] - centroid[lab[part]]
+        uv[part] = np.einsum("nj,nkj->nk", d, axes[lab[part]])
     lo = np.stack([np.full(count, np.inf), np.full(count, np.inf)], axis=1)
     hi = -lo
     np.minimum.at(lo, lab, uv)
@@ -225,7 +257,7 @@ def find_planes(points: np.ndarray, params: PlaneParams = PlaneParams()) -> Plan
     (ties by centroid), each with at least ``params.min_points`` reduced points and
     ``params.min_area`` square metres."""
     voxel = params.voxel
-    pts = reduced(points, voxel)
+    pts = open3d_centroids(points, voxel)
     if len(pts) < max(params.min_points, 4):
         return no_planes()
     near, normal, variation = local_shape(pts)

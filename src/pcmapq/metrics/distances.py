@@ -112,15 +112,20 @@ def distances_3d(map_xyz: np.ndarray, truth_xyz: np.ndarray, voxel: float = 0.05
 
     The exact nearest neighbours come from Open3D's ``compute_point_cloud_distance`` (a KD-tree,
     every core), one call per direction: the distances SciPy's ``cKDTree`` gives, in about
-    two thirds of its time (``bench/bench_clouds.py``)."""
-    from pcmapq.core.voxels import voxel_centroids
+    two thirds of its time (``bench/bench_clouds.py``). Each cloud's centroids are handed to
+    Open3D once (a cloud of more than STRIPE_POINTS points reduced in stripes of x)."""
+    from pcmapq.core.voxels import STRIPE_POINTS, STRIPE_WIDTH_POINTS, voxel_centroids
 
     basis = (f"in 3D: the map's and the truth's points voxel-downsampled to {voxel:g} m "
              "(centroids), each to the nearest of the other's")
-    m, t = voxel_centroids(map_xyz, voxel), voxel_centroids(truth_xyz, voxel)
+    m, t = (voxel_centroids(c, voxel, stripe_points=None if len(c) <= STRIPE_POINTS
+                            else STRIPE_WIDTH_POINTS) for c in (map_xyz, truth_xyz))
     if len(m) == 0 or len(t) == 0:
         return _summary(np.full(len(m), np.inf), np.full(len(t), np.inf), taus, basis)
-    acc, comp = _nearest_3d(m, t), _nearest_3d(t, m)
+    clouds = [_open3d_cloud(m), _open3d_cloud(t)]
+    del m, t  # Open3D holds its own copies
+    acc = np.asarray(clouds[0].compute_point_cloud_distance(clouds[1]))
+    comp = np.asarray(clouds[1].compute_point_cloud_distance(clouds[0]))
     return _summary(acc, comp, taus, basis)
 
 
@@ -137,7 +142,12 @@ def accuracy_3d(map_xyz: np.ndarray, truth_xyz: np.ndarray,
 
 def _nearest_3d(points: np.ndarray, other: np.ndarray) -> np.ndarray:
     """Each point's (N, 3) distance to the nearest of ``other`` (M, 3), metres (Open3D)."""
+    clouds = [_open3d_cloud(c) for c in (points, other)]
+    return np.asarray(clouds[0].compute_point_cloud_distance(clouds[1]))
+
+
+def _open3d_cloud(points: np.ndarray):  # -> o3d.geometry.PointCloud (Open3D loaded here)
+    """An Open3D cloud of ``points`` (N, 3), metres (a copy)."""
     import open3d as o3d
 
-    clouds = [o3d.geometry.PointCloud(o3d.utility.Vector3dVector(c)) for c in (points, other)]
-    return np.asarray(clouds[0].compute_point_cloud_distance(clouds[1]))
+    return o3d.geometry.PointCloud(o3d.utility.Vector3dVector(points))

@@ -4,19 +4,23 @@ voxels, the points of a voxel summed up as a Gaussian (mean, sample covariance);
 2-Wasserstein distance between the two clouds' Gaussians of the voxels both fill, metres; SCS,
 how much those distances vary among neighbouring voxels (a coefficient of variation, no unit).
 
-Vectorised: the voxels' sums by ``np.bincount`` on packed voxel keys, the distances by batched
-eigendecompositions of 3 x 3 matrices, the neighbourhoods by sorted keys (one pass per column
-of neighbours, never per voxel)."""
+Vectorised and streamed by voxel: the clouds are read CHUNK points at a time (a file mapped into
+memory is never converted whole) and each voxel's count, sums and sums of products are
+accumulated by ``np.add.at`` on packed voxel keys, in the points' order (the same sums, bit for
+bit, as one ``np.bincount`` over all of them); the distances by batched eigendecompositions of
+3 x 3 matrices; the neighbourhoods by sorted keys (one pass per column of neighbours, never per
+voxel)."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 
 from pcmapq.core.bounds import bounds
 from pcmapq.core.errors import InputError
-from pcmapq.core.voxels import voxel_groups
+from pcmapq.core.voxels import index_keys, voxel_index, voxel_keys
 from pcmapq.metrics.defaults import AWD_MIN_POINTS, AWD_VOXEL, SCS_RADIUS
 
 #: Eigenvalues of a voxel's covariance are raised to at least this, m^2 (MapEval's floor): a
@@ -27,6 +31,13 @@ COVARIANCE_FLOOR = 1e-6
 ROUNDING = 1e-12
 #: Bits of an axis in a packed voxel key (:func:`pcmapq.core.voxels.voxel_keys`, 3D).
 _BITS = 21
+#: Points read at a time (their float64 copy, voxel indices and keys: about 40 MB).
+CHUNK = 1 << 19
+#: A cloud's voxels are every voxel of its box when the box holds at most this many (and at
+#: most DENSE_PER_POINT a point): their sums are then found without a pass to list them.
+DENSE_CELLS, DENSE_PER_POINT = 1 << 20, 4
+#: The pairs of axes of a covariance's six distinct entries.
+_PAIRS = ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))
 
 
 @dataclass(frozen=True)
@@ -52,14 +63,13 @@ def map_gaussians(map_xyz: np.ndarray, truth_xyz: np.ndarray, voxel: float = AWD
     about a million voxels."""
     basis = (f"in 3D: {voxel:g} m voxels holding at least {min_points} points of each cloud, "
              f"one Gaussian per voxel and cloud; SCS over neighbours within {radius} voxels")
-    map_xyz, truth_xyz = (np.asarray(c, dtype=np.float64).reshape(-1, 3)
-                          for c in (map_xyz, truth_xyz))
+    map_xyz, truth_xyz = (np.asarray(c).reshape(-1, 3) for c in (map_xyz, truth_xyz))
     # keyed from a corner of whole voxels below both clouds: the same voxels, and keys that
     # fit however far from the origin the clouds lie (UTM coordinates)
-    both = [bounds(c)[0] for c in (map_xyz, truth_xyz) if len(c)]
+    both = [bounds(c)[0].astype(np.float64) for c in (map_xyz, truth_xyz) if len(c)]
     corner = np.floor(np.min(both, axis=0) / voxel) * voxel if both else np.zeros(3)
-    keys_m, mean_m, cov_m = voxel_gaussians(map_xyz - corner, voxel, min_points)
-    keys_t, mean_t, cov_t = voxel_gaussians(truth_xyz - corner, voxel, min_points)
+    keys_m, mean_m, cov_m = voxel_gaussians(map_xyz, voxel, min_points, corner)
+    keys_t, mean_t, cov_t = voxel_gaussians(truth_xyz, voxel, min_points, corner)
     common, in_m, in_t = np.intersect1d(keys_m, keys_t, assume_unique=True,
                                         return_indices=True)
     if len(common) == 0:
@@ -69,26 +79,70 @@ def map_gaussians(map_xyz: np.ndarray, truth_xyz: np.ndarray, voxel: float = AWD
                         int(len(common)), basis)
 
 
-def voxel_gaussians(points: np.ndarray, voxel: float, min_points: int = 2
+def voxel_gaussians(points: np.ndarray, voxel: float, min_points: int = 2,
+                    origin: np.ndarray | None = None
                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The voxels of ``points`` (N, 3, metres) holding at least ``min_points`` (>= 2) of them:
-    their packed keys (V,) int64 sorted (:func:`~pcmapq.core.voxels.voxel_keys`), the mean
-    (V, 3) of their points, metres, and its sample covariance (V, 3, 3, divided by n - 1),
-    square metres. Two passes (means, then products about them): exact far from the origin."""
-    points = np.asarray(points, dtype=np.float64).reshape(-1, 3)
-    keys, inverse = voxel_groups(points, voxel)
-    n = np.bincount(inverse, minlength=len(keys)).astype(np.float64)
+    """The voxels of ``points`` (N, 3, metres, any float type) minus ``origin`` (3,) metres
+    (default 0) holding at least ``min_points`` (>= 2) of them: their packed keys (V,) int64
+    sorted (:func:`~pcmapq.core.voxels.voxel_keys`), the mean (V, 3) of their points, metres,
+    and its sample covariance (V, 3, 3, divided by n - 1), square metres, all in the frame of
+    ``origin``. Three passes over the points, CHUNK at a time, none held whole: the voxels,
+    their counts and sums (the means), then the products about the means: exact far from the
+    origin."""
+    points = np.asarray(points).reshape(-1, 3)
+    origin = np.zeros(3) if origin is None else np.asarray(origin, dtype=np.float64)
+    keys, rows = _cells(points, origin, voxel)
+    n, sums = np.zeros(len(keys)), np.zeros((3, len(keys)))
+    for chunk in _chunks(points, origin):
+        at = rows(chunk)
+        np.add.at(n, at, 1.0)
+        for a in range(3):
+            np.add.at(sums[a], at, chunk[:, a])
+    means = sums / np.maximum(n, 1.0)
+    products = np.zeros((len(_PAIRS), len(keys)))
+    for chunk in _chunks(points, origin):
+        at = rows(chunk)
+        centred = [chunk[:, a] - np.take(means[a], at) for a in range(3)]
+        for k, (a, b) in enumerate(_PAIRS):
+            np.add.at(products[k], at, centred[a] * centred[b])
     kept = n >= max(min_points, 2)
-    columns = [np.ascontiguousarray(points[:, a]) for a in range(3)]
-    means = [np.bincount(inverse, weights=c, minlength=len(keys)) / np.maximum(n, 1.0)
-             for c in columns]
-    centred = [c - np.take(m, inverse) for c, m in zip(columns, means, strict=True)]
     cov = np.empty((int(np.count_nonzero(kept)), 3, 3))
-    for a, b in ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)):
-        cov[:, a, b] = cov[:, b, a] = np.bincount(
-            inverse, weights=centred[a] * centred[b], minlength=len(keys))[kept] / (n[kept] - 1)
-    mean = np.column_stack(means)[kept]
-    return keys[kept], mean, cov
+    for k, (a, b) in enumerate(_PAIRS):
+        cov[:, a, b] = cov[:, b, a] = products[k][kept] / (n[kept] - 1)
+    return keys[kept], means.T[kept], cov
+
+
+def _cells(points: np.ndarray, origin: np.ndarray, voxel: float
+           ) -> tuple[np.ndarray, Callable[[np.ndarray], np.ndarray]]:
+    """The voxels the points (N, 3) minus ``origin`` may fill, as packed keys (sorted), and a
+    function giving the rows among them of a chunk of those points: every voxel of the
+    points' box when it holds at most DENSE_CELLS (no pass over the points to find them; the
+    empty ones count no point), else the voxels found in a pass. InputError for points beyond
+    the keys' range."""
+    if len(points):
+        lo, hi = (b.astype(np.float64) - origin for b in bounds(points))
+        first, last = voxel_index(np.array([lo, hi]), voxel)
+        span = last - first + 1
+        cells = int(np.prod(span.astype(object)))
+        if cells <= min(DENSE_CELLS, DENSE_PER_POINT * len(points) + 4096):
+            keys = index_keys(np.column_stack(np.unravel_index(np.arange(cells), tuple(span)))
+                              + first)
+
+            def rows(chunk: np.ndarray) -> np.ndarray:  # row-major in the box: as the keys
+                index = voxel_index(chunk, voxel) - first
+                return (index[:, 0] * span[1] + index[:, 1]) * span[2] + index[:, 2]
+
+            return keys, rows
+    keys = np.empty(0, dtype=np.int64)
+    for chunk in _chunks(points, origin):
+        keys = np.union1d(keys, voxel_keys(chunk, voxel))
+    return keys, lambda chunk: np.searchsorted(keys, voxel_keys(chunk, voxel))
+
+
+def _chunks(points: np.ndarray, origin: np.ndarray):
+    """The points (N, 3) CHUNK rows at a time, minus ``origin``, as contiguous float64."""
+    for start in range(0, len(points), CHUNK):
+        yield np.ascontiguousarray(points[start:start + CHUNK] - origin, dtype=np.float64)
 
 
 def gaussian_w2(mean_a: np.ndarray, cov_a: np.ndarray, mean_b: np.ndarray,

@@ -104,3 +104,25 @@ def test_a_long_map_gets_larger_tiles():
                               np.zeros(40000)])
     assert regions_3d(ground, ground, tile_m=TILE, voxel=0.5).tile_m == pytest.approx(12.5,
                                                                                      rel=1e-3)
+
+
+def test_a_large_cloud_is_streamed_not_copied(monkeypatch, scan):
+    """A float32 truth of more points than are streamed (a file mapped into memory): its
+    voxel centroids are read in chunks, the regions those of its float64 copy, and the memory
+    taken stays below that copy's size (none is made)."""
+    import tracemalloc
+
+    from pcmapq.core import voxel_table
+
+    dense = street(0.0, 30.0, spacing=0.05, seed=0).astype(np.float32)
+    expected = regions_3d(scan, dense.astype(np.float64), tile_m=TILE, voxel=VOXEL)
+    monkeypatch.setattr(voxel_table, "CHUNK", 4096)
+    tracemalloc.start()
+    try:
+        got = regions_3d(scan, dense, tile_m=TILE, voxel=VOXEL)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    for name in ("centre", "offset", "angles_deg", "fit_before", "fit_after", "held"):
+        np.testing.assert_array_equal(getattr(got, name), getattr(expected, name))
+    assert peak < 2 * dense.nbytes

@@ -89,3 +89,23 @@ def test_far_from_the_origin() -> None:
     result = align_3d(room(1), target, voxel=0.2)
     shift, angle = errors(result.transform, truth)
     assert shift < 0.02 and angle < 0.2
+
+
+def test_the_clouds_are_copied_once_each():
+    """Two float32 clouds (files mapped into memory): the registration holds one float64 copy
+    of each (shifted in place, no copy when every point is usable), not four."""
+    import tracemalloc
+
+    from testkit.street import street
+
+    truth = street(0.0, 40.0, spacing=0.03, seed=0).astype(np.float32)
+    moved = (street(0.0, 40.0, spacing=0.03, seed=0) + [0.2, 0.1, 0.0]).astype(np.float32)
+    align_3d(moved, truth, voxel=0.3)  # compiled code loaded before the measure
+    tracemalloc.start()
+    try:
+        reg = align_3d(moved, truth, voxel=0.3)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    np.testing.assert_allclose(reg.transform[:3, 3], [-0.2, -0.1, 0.0], atol=0.02)
+    assert peak < 2 * 2 * truth.nbytes * 2  # two float64 copies of each cloud at most

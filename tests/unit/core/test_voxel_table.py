@@ -107,3 +107,28 @@ def test_stripes_see_every_point_beyond_the_keys_range():
     points[-1, 1] = 1e9
     with pytest.raises(InputError, match="beyond"):
         voxel_table.streamed_centroids(points, 0.1, stripe_points=5_000)
+
+
+@pytest.mark.parametrize("shift", [0.0, 6.0e5])
+@pytest.mark.parametrize("dtype", [np.float32, np.float64])
+def test_open3d_centroids_are_open3ds_bit_for_bit(dtype, shift, monkeypatch):
+    """Open3D's voxel_down_sample (its grid from half a voxel below the least corner), the
+    same centroids bit for bit, read in small chunks and, past STRIPE_POINTS, in stripes; far
+    from the origin too."""
+    import open3d as o3d
+
+    from pcmapq.core import voxels
+
+    rng = np.random.default_rng(2)
+    points = (np.vstack([rng.normal(0, 3, (30_000, 3)), rng.uniform(0, 0.5, (30_000, 3)),
+                         np.round(rng.uniform(0, 2, (20_000, 3)), 1)])  # on voxel faces
+              + shift).astype(dtype)
+    down = o3d.geometry.PointCloud(o3d.utility.Vector3dVector(points.astype(np.float64)))
+    expected = np.asarray(down.voxel_down_sample(0.1).points)
+    expected = expected[np.lexsort(expected.T[::-1])]
+    monkeypatch.setattr(voxel_table, "CHUNK", 7_000)
+    assert np.array_equal(voxels.open3d_centroids(points, 0.1), expected)
+    monkeypatch.setattr(voxels, "STRIPE_POINTS", 20_000)
+    monkeypatch.setattr(voxels, "STRIPE_WIDTH_POINTS", 15_000)
+    assert np.array_equal(voxels.open3d_centroids(points, 0.1), expected)
+    assert voxels.open3d_centroids(points[:0], 0.1).shape == (0, 3)

@@ -91,3 +91,30 @@ def test_one_line_of_several_pieces_lies_on_its_longest_piece():
     assert len(found) == 1
     np.testing.assert_allclose(found.point[0], [3.0, 0.0, 0.05], atol=1e-9)
     assert found.length[0] == pytest.approx(6.4)  # from -0.2 to 6.2: both grown by the margin
+
+
+def test_a_large_cloud_is_worked_on_a_block_at_a_time(monkeypatch):
+    """A float32 cloud of 0.9 M points (a file mapped into memory): reduced in chunks and its
+    per-point work done ROWS points at a time, it gives the planes of one block bit for bit,
+    in less memory than a float64 copy of the cloud (none is made)."""
+    import tracemalloc
+
+    from pcmapq.core import voxel_table
+    from pcmapq.features import planes3d
+
+    rng = np.random.default_rng(3)
+    cloud = np.vstack([b.sample(f, rng, density=4000.0) for f in b.faces()])
+    cloud = (cloud + rng.normal(0.0, 0.01, cloud.shape)).astype(np.float32)
+    whole = find_planes(cloud)  # its reduced points in one block
+    monkeypatch.setattr(planes3d, "ROWS", 4096)
+    monkeypatch.setattr(voxel_table, "CHUNK", 4096)
+    tracemalloc.start()
+    try:
+        blocks = find_planes(cloud)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert len(blocks) == len(whole) == 18
+    for name in ("normal", "offset", "centroid", "corners", "extent", "area", "points"):
+        assert np.array_equal(getattr(blocks, name), getattr(whole, name))
+    assert peak < 2 * cloud.nbytes

@@ -126,3 +126,40 @@ def test_clouds_wider_than_the_voxel_index_are_refused():
     cloud = in_voxels(cells=(1, 1, 1))
     with pytest.raises(InputError, match="larger voxel"):
         map_gaussians(cloud, np.vstack([cloud, cloud + [0.0, 0.0, 7.0e6]]))
+
+
+def test_a_cloud_is_read_chunk_by_chunk_with_the_same_figures(monkeypatch):
+    """A large float32 cloud (a file mapped into memory) is read CHUNK points at a time: the
+    figures are those of one pass over all its points, bit for bit, and the memory taken
+    stays below a float64 copy of the cloud (none is made)."""
+    import tracemalloc
+
+    import pcmapq.metrics.map_gaussians as module
+
+    truth = room(200_000).astype(np.float32)
+    bent = (room(200_000, seed=4) + [0.03, 0.0, 0.0]).astype(np.float32)
+    whole = map_gaussians(bent, truth, 3.0, 100, 2)  # one chunk
+    monkeypatch.setattr(module, "CHUNK", 4096, raising=False)
+    tracemalloc.start()
+    try:
+        chunked = map_gaussians(bent, truth, 3.0, 100, 2)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert chunked == whole and whole.voxels > 10
+    assert peak < 2 * truth.nbytes
+
+
+def test_the_box_of_voxels_and_the_voxels_listed_give_the_same_gaussians(monkeypatch):
+    """A cloud summed on every voxel of its box, or on its voxels listed in a pass first:
+    the same voxels, means and covariances, bit for bit."""
+    import pcmapq.metrics.map_gaussians as module
+
+    cloud = room(20_000) + [6.0e5, 5.1e6, 300.0]
+    corner = np.floor(cloud.min(axis=0) / 1.5) * 1.5
+    boxed = voxel_gaussians(cloud, 1.5, 10, corner)
+    monkeypatch.setattr(module, "DENSE_CELLS", 0, raising=False)
+    listed = voxel_gaussians(cloud, 1.5, 10, corner)
+    assert len(boxed[0]) > 50
+    for a, b in zip(boxed, listed, strict=True):
+        assert a.shape == b.shape and np.array_equal(a, b)
