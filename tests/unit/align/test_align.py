@@ -9,7 +9,7 @@ from pcmapq.align import Alignment, AlignParams, align, score
 from pcmapq.align.coarse import coarse_search
 from pcmapq.align.finalists import TIE_COVERAGE, TIE_FITNESS, refine_best
 from pcmapq.core.transform import Similarity2D
-from pcmapq.core.voxels import voxel_centroids
+from pcmapq.core.voxels import evenly, voxel_centroids
 from testkit import synth
 from testkit.poses import pose_error
 
@@ -189,6 +189,9 @@ def test_pyramid_bound_holds(campus):
     from pcmapq.align.pyramid import _Level, descend
 
     t_true, map_xy, truth_xy = campus
+    # 20 000 of the map's points, evenly spread, hit every cell of the sweep's 6 m rasters and
+    # more voxels than the descent keeps (max_points) at each of its levels
+    map_xy = evenly(map_xy, 20_000)
     search = coarse_search(map_xy, truth_xy, resolution=6.0)
     level = _Level(map_xy - search.centre, truth_xy, 3.0, search.radius + 12.0, 5000)
     for _, yaw, x, y in search.poses[:40, :4]:
@@ -244,16 +247,16 @@ def test_line_normals_on_demand_equal_the_whole_batch(truth):
     assert np.median(np.abs(whole).max(axis=1)) > 0.999
 
 
-def test_thinned_map_runs_light_icp_and_lands(campus):
+def test_thinned_map_runs_light_icp_and_lands():
     """A map of more voxels than ``max_points`` is thinned; its point-to-point stages then run on
     ICP_POINTS of its points against the truth at THINNED_TRUTH_VOXEL, and the point-to-line
-    finish on all of them. Thinned to 0.16 m voxels, the campus lands within 0.05 m and 0.05
-    degrees (0.6 mm, as before the point-to-point stages were lightened)."""
+    finish on all of them. A campus of 3 x 2 copies of the plan, thinned from 0.05 m voxels to
+    about 0.13 m, lands within 0.05 m and 0.05 degrees."""
     from pcmapq.align.planar import ICP_POINTS, THINNED_TRUTH_VOXEL, _icp_inputs
     from pcmapq.core.voxels import thinned
 
-    t_true, map_xy, truth_xy = campus
-    params = AlignParams(max_points=50_000)
+    t_true, map_xy, truth_xy = synth.placed_campus(3, 2)
+    params = AlignParams(max_points=8_000)
     map_ds, map_voxel = thinned(map_xy, params.voxel, params.max_points)
     assert map_voxel > params.voxel and len(map_ds) > ICP_POINTS
     icp_map, schedule = _icp_inputs(map_ds, True, ((1.0, 0.2), (0.2, 0.05)))
