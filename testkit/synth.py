@@ -72,6 +72,17 @@ def campus(columns: int, rows: int, seed: int = 0, gap: float = 4.0) -> np.ndarr
     return (one[None, :, :] + np.tile(shifts, 2)[:, None, :]).reshape(-1, 4)
 
 
+def placed_campus(columns: int, rows: int
+                  ) -> tuple[Similarity2D, np.ndarray, np.ndarray]:
+    """A :func:`campus` and its map: (T_true, map points, truth points). The map's walls are
+    turned -12 degrees and moved (T_true takes them back), sampled every 10 cm with 3 cm noise;
+    the truth's every 10 cm, no noise. Points (N, 2), metres."""
+    walls = campus(columns, rows)
+    t_true = Similarity2D(31.0, -17.0, np.radians(-12.0))
+    map_xy = wall_points(transform_segments(walls, t_true.inverse()), 0.1, noise=0.03)
+    return t_true, map_xy, wall_points(walls, 0.1)
+
+
 def round_rooms() -> np.ndarray:
     """Three round rooms (radii 5, 4 and 3 m), nothing like :func:`building_plan`: wall
     segments (N, 4), metres, 60 to a room."""

@@ -8,7 +8,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pcmapq.core.transform import Similarity2D
 from testkit import synth
 from testkit.files import write_image_map
 from testkit.paths import SAMPLE
@@ -74,9 +73,6 @@ def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
 @pytest.fixture(scope="module")
 def campus():
     """A campus of 6 x 8 copies of the plan (164 m x 156 m, only its outline tells one copy
-    from the next), and its map: turned -12 degrees and moved, 3 cm noise."""
-    walls = synth.campus(6, 8)
-    t_true = Similarity2D(31.0, -17.0, np.radians(-12.0))
-    map_xy = synth.wall_points(synth.transform_segments(walls, t_true.inverse()), 0.1,
-                               noise=0.03)
-    return t_true, map_xy, synth.wall_points(walls, 0.1)
+    from the next), and its map: turned -12 degrees and moved, 3 cm noise
+    (:func:`testkit.synth.placed_campus`)."""
+    return synth.placed_campus(6, 8)

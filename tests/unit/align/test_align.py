@@ -9,7 +9,7 @@ from pcmapq.align import Alignment, AlignParams, align, score
 from pcmapq.align.coarse import coarse_search
 from pcmapq.align.finalists import TIE_COVERAGE, TIE_FITNESS, refine_best
 from pcmapq.core.transform import Similarity2D
-from pcmapq.core.voxels import voxel_centroids
+from pcmapq.core.voxels import evenly, voxel_centroids
 from testkit import synth
 from testkit.poses import pose_error
 
@@ -28,11 +28,25 @@ def inside(points: np.ndarray, box: tuple[float, float, float, float]) -> np.nda
     return points[keep]
 
 
+@pytest.fixture(scope="module")
+def aligned(truth, scan):
+    """``aligned(yaw, tx, ty, box=None)``: (T_true, the scan (its part inside ``box``) seen
+    through T_true and aligned), once for every test that reads it."""
+    done: dict = {}
+
+    def run(yaw: float, tx: float, ty: float, box: tuple | None = None):
+        if (yaw, tx, ty, box) not in done:
+            t_true, map_xy = to_map_frame(scan if box is None else inside(scan, box), yaw, tx, ty)
+            done[yaw, tx, ty, box] = t_true, align(map_xy, truth)
+        return done[yaw, tx, ty, box]
+
+    return run
+
+
 @pytest.mark.parametrize(("yaw", "tx", "ty"), [(15, 5.0, -3.0), (90, -20.0, 12.0),
                                                (172, 35.0, 40.0), (-47, -12.0, -30.0)])
-def test_rigid_full_map(truth, scan, yaw, tx, ty):
-    t_true, map_xy = to_map_frame(scan, yaw, tx, ty)
-    result = align(map_xy, truth)
+def test_rigid_full_map(aligned, yaw, tx, ty):
+    t_true, result = aligned(yaw, tx, ty)
     dxy, dyaw = pose_error(t_true, result.transform)
     assert dxy < 0.1 and dyaw < 0.5
     assert result.fitness > 0.9 and result.rmse_m < 0.05
@@ -46,9 +60,8 @@ def test_rigid_full_map(truth, scan, yaw, tx, ty):
     ((-1.0, -1.0, 0.775 * WIDTH, 0.775 * HEIGHT), 200, 22.0, 4.0),                 # 60 % corner
     ((-1.0, -1.0, 25.0, 0.3 * HEIGHT), 71, -3.0, -18.0),                           # bottom 30 %
 ])
-def test_partial_map(truth, scan, box, yaw, tx, ty):
-    t_true, map_xy = to_map_frame(inside(scan, box), yaw, tx, ty)
-    result = align(map_xy, truth)
+def test_partial_map(aligned, box, yaw, tx, ty):
+    t_true, result = aligned(yaw, tx, ty, box)
     dxy, dyaw = pose_error(t_true, result.transform)
     assert dxy < 0.1 and dyaw < 0.5
     assert result.fitness > 0.9
@@ -74,13 +87,12 @@ def test_bent_map_still_aligns(truth):
     assert dxy < 1.5 and dyaw < 8.0
 
 
-def test_other_building_scores_low(truth, scan):
+def test_other_building_scores_low(truth, aligned):
     other = synth.wall_points(synth.building_plan(7, 18.0, 20.0), spacing=0.05, noise=0.015,
                               seed=3)
-    _, map_xy = to_map_frame(other, 30, 3.0, 3.0)
+    _, map_xy = to_map_frame(other, 15, 5.0, -3.0)  # a pose of test_rigid_full_map
     wrong = align(map_xy, truth)
-    right = align(to_map_frame(scan, 30, 3.0, 3.0)[1], truth)
-    assert wrong.fitness < 0.6 < 0.9 < right.fitness
+    assert wrong.fitness < 0.6 < 0.9 < aligned(15, 5.0, -3.0)[1].fitness
     assert isinstance(wrong, Alignment) and wrong.method == "coarse+icp"
 
 
@@ -139,9 +151,10 @@ def test_params_reach_the_alignment(scan, truth):
     assert AlignParams(finalists=1).finalists_for(scale=True) == 1
 
 
-def test_deterministic(truth, scan):
-    _, map_xy = to_map_frame(inside(scan, (-1.0, -1.0, 14.0, 17.0)), -47, -12.0, -30.0)
-    assert align(map_xy, truth) == align(map_xy, truth)
+def test_deterministic(truth, scan, aligned):
+    box = (-1.0, -1.0, 0.5 * WIDTH, 17.0)  # a case of test_partial_map
+    _, map_xy = to_map_frame(inside(scan, box), 33, 8.0, -6.0)
+    assert align(map_xy, truth) == aligned(33, 8.0, -6.0, box)[1]
 
 
 def test_coarse_candidates_rank_right_pose_first(truth, scan):
@@ -189,6 +202,9 @@ def test_pyramid_bound_holds(campus):
     from pcmapq.align.pyramid import _Level, descend
 
     t_true, map_xy, truth_xy = campus
+    # 20 000 of the map's points, evenly spread, hit every cell of the sweep's 6 m rasters and
+    # more voxels than the descent keeps (max_points) at each of its levels
+    map_xy = evenly(map_xy, 20_000)
     search = coarse_search(map_xy, truth_xy, resolution=6.0)
     level = _Level(map_xy - search.centre, truth_xy, 3.0, search.radius + 12.0, 5000)
     for _, yaw, x, y in search.poses[:40, :4]:
@@ -244,16 +260,16 @@ def test_line_normals_on_demand_equal_the_whole_batch(truth):
     assert np.median(np.abs(whole).max(axis=1)) > 0.999
 
 
-def test_thinned_map_runs_light_icp_and_lands(campus):
+def test_thinned_map_runs_light_icp_and_lands():
     """A map of more voxels than ``max_points`` is thinned; its point-to-point stages then run on
     ICP_POINTS of its points against the truth at THINNED_TRUTH_VOXEL, and the point-to-line
-    finish on all of them. Thinned to 0.16 m voxels, the campus lands within 0.05 m and 0.05
-    degrees (0.6 mm, as before the point-to-point stages were lightened)."""
+    finish on all of them. A campus of 3 x 2 copies of the plan, thinned from 0.05 m voxels to
+    about 0.13 m, lands within 0.05 m and 0.05 degrees."""
     from pcmapq.align.planar import ICP_POINTS, THINNED_TRUTH_VOXEL, _icp_inputs
     from pcmapq.core.voxels import thinned
 
-    t_true, map_xy, truth_xy = campus
-    params = AlignParams(max_points=50_000)
+    t_true, map_xy, truth_xy = synth.placed_campus(3, 2)
+    params = AlignParams(max_points=8_000)
     map_ds, map_voxel = thinned(map_xy, params.voxel, params.max_points)
     assert map_voxel > params.voxel and len(map_ds) > ICP_POINTS
     icp_map, schedule = _icp_inputs(map_ds, True, ((1.0, 0.2), (0.2, 0.05)))

@@ -61,7 +61,7 @@ def test_a_sample_as_large_as_the_cloud_is_the_whole_cloud():
 
 
 def test_sampled_mom_finds_the_rooms_planes_at_a_third_of_the_radius():
-    points = _box_room(6, growing=0.0)
+    points = _box_room(6, 30_000, growing=0.0)
     whole = noref_figures(points, 0.3, max_ward=2_000)
     part = noref_figures(points, 0.3, max_ward=2_000, sample=5_000)
     assert part["orth_voxel_m"] == 0.3 * SAMPLED_MOM_VOXEL and whole["orth_voxel_m"] is None
@@ -78,9 +78,9 @@ def test_a_cloud_is_reduced_in_chunks_as_at_once():
 
 
 def test_figures_found_while_the_map_is_placed_equal_those_found_after(tmp_path):
-    cloud = PointMap(tmp_path / "room.ply", _box_room(8), True)
-    flat = PointMap(tmp_path / "plan.ply", np.column_stack([_box_room(9)[:, :2], np.zeros(60_000)]),
-                    False)
+    cloud = PointMap(tmp_path / "room.ply", _box_room(8, 20_000), True)
+    flat = PointMap(tmp_path / "plan.ply",
+                    np.column_stack([_box_room(9, 20_000)[:, :2], np.zeros(20_000)]), False)
     settings = Settings()
     early = EarlyFigures({"map": cloud, "truth": flat}, settings)
     assert early.get("truth") is None  # a 2D cloud's figures are left to the caller
@@ -91,7 +91,7 @@ def test_a_large_cloud_s_figures_wait_for_its_walls(tmp_path, monkeypatch):
     """Above DEFER_FROM points the map's figures start once its plan points are found (its wall
     band is over), and are those found at once; a cancelled evaluation's thread does no work."""
     monkeypatch.setattr(early_figures, "DEFER_FROM", 10_000)
-    cloud = PointMap(tmp_path / "room.ply", _box_room(8), True)
+    cloud = PointMap(tmp_path / "room.ply", _box_room(8, 20_000), True)
     settings = Settings()
     early = EarlyFigures({"map": cloud}, settings)
     time.sleep(0.2)
@@ -105,7 +105,7 @@ def test_a_large_cloud_s_figures_wait_for_its_walls(tmp_path, monkeypatch):
 
 
 def test_a_small_cloud_s_figures_start_at_once(tmp_path):
-    cloud = PointMap(tmp_path / "room.ply", _box_room(8), True)
+    cloud = PointMap(tmp_path / "room.ply", _box_room(8, 20_000), True)
     early = EarlyFigures({"map": cloud}, Settings())
     early._thread.join(timeout=60)
     assert set(early._figures) == {"map"}
