@@ -38,6 +38,7 @@ from pathlib import Path
 import numpy as np
 from scipy.stats import spearmanr
 
+from pcmapq.align.refine3d import last_reach
 from pcmapq.align.regions3d import Consistency3D, regions_3d
 from pcmapq.align.rigid3d import apply
 from pcmapq.core.frames import Levelling
@@ -230,7 +231,8 @@ def direct_figures(folder: Path, kind: str, level: float, transform: np.ndarray
                               level=None if level_of is None else level_of.rotation)
         gaussians = pool.submit(map_gaussians, placed, target, m3.voxel, m3.min_points,
                                 m3.radius)
-        structures = pool.submit(structures_3d, target, placed, settings.structures)
+        structures = pool.submit(structures_3d, target, placed, settings.structures,
+                                 last_reach(settings.alignment.voxel_3d))
         figures = figures_of(chamfer.result().chamfer_m, gaussians.result(),
                              structures.result(), regions.result())
     return figures, (bend(folder, kind, level, regions.result(), transform, level_of)
