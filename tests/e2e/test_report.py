@@ -45,6 +45,17 @@ def perfect_result(truth_png):
     return evaluate(truth_png, truth_png)
 
 
+#: The command line the report of :func:`moved_page` names.
+COMMAND = "pcmapq eval moved.png truth.png --threshold 0.5"
+
+
+@pytest.fixture(scope="module")
+def moved_page(moved_result) -> str:
+    """The report of the moved result, its command line COMMAND, made once for the tests that
+    read it."""
+    return report_html(replace(moved_result, command=COMMAND))
+
+
 #: Where the moved L wall's vertical arm stands in the map (truth frame, metres): x0, x1, y0, y1.
 MOVED_ARM = (19.6, 20.2, 2.0, 3.5)
 
@@ -90,8 +101,8 @@ def test_heatmap_colours_the_moved_wall(moved_result, perfect_result):
     assert heatmap_yellow(perfect_result, 0, MOVED_ARM) == 0
 
 
-def test_report_is_self_contained(moved_result):
-    page = report_html(moved_result)
+def test_report_is_self_contained(moved_result, moved_page):
+    page = moved_page
     assert not re.search(r'(src|href)="(https?:)?//', page)  # nothing fetched from a network
     assert page.count("data:image/png;base64,") == 4  # two figures, the viewer's two walls
     assert f"displacement x{auto_arrow_scale(moved_result):g}" not in page  # in the figure
@@ -100,9 +111,9 @@ def test_report_is_self_contained(moved_result):
 
 
 @pytest.mark.skipif(shutil.which("chromium") is None, reason="Debian's chromium is not installed")
-def test_report_renders_in_chromium(moved_result, tmp_path):
+def test_report_renders_in_chromium(moved_page, tmp_path):
     page = tmp_path / "report.html"
-    page.write_text(report_html(moved_result))
+    page.write_text(moved_page)
     shot = tmp_path / "shot.png"
     chromium(page, tmp_path, 1400, 2400, f"--screenshot={shot}")
     img = cv2.imread(str(shot))
@@ -279,11 +290,10 @@ def test_arrow_scale_is_one_for_every_panel_and_run(moved_result, fine_result):
                 [t.get_text() for t in legend.get_texts()]
 
 
-def test_fonts_read_at_the_reports_width(moved_result):
+def test_fonts_read_at_the_reports_width(moved_result, moved_page):
     """The figures are no wider than the report shows them, so none is scaled down there, and
     every text in them is at least 12 pixels high."""
-    page = report_html(moved_result)
-    assert f"max-width: {FIGURE_WIDTH_PX + 50}px" in page
+    assert f"max-width: {FIGURE_WIDTH_PX + 50}px" in moved_page
     for fig in (vectorial_figure(moved_result), distance_heatmap(moved_result)):
         assert fig.get_figwidth() * DPI <= FIGURE_WIDTH_PX
         sizes = [t.get_fontsize() for t in fig.findobj(matplotlib.text.Text)
@@ -334,7 +344,7 @@ def test_lidar_pair_is_drawn_as_density_with_fewer_markers(moved_result):
     assert "occupied share" in " ".join(t.get_text() for t in fig.findobj(matplotlib.text.Text))
 
 
-def test_report_says_how_it_was_made(moved_result):
+def test_report_says_how_it_was_made(moved_result, moved_page):
     """The report holds pcmapq's version, the command line and every setting, as the JSON
     does."""
     import html as html_module
@@ -342,8 +352,7 @@ def test_report_says_how_it_was_made(moved_result):
 
     from pcmapq import __version__
 
-    result = replace(moved_result, command="pcmapq eval moved.png truth.png --threshold 0.5")
-    page = report_html(result)
+    result, page = replace(moved_result, command=COMMAND), moved_page
     assert f"pcmapq {__version__}; command: <code>pcmapq eval moved.png truth.png" in page
     settings = json_module.loads(html_module.unescape(
         page.split("<summary>settings</summary><pre>")[1].split("</pre>")[0]))

@@ -57,11 +57,12 @@ def test_real_plans_same_or_other_place(image, plan, same):
 
 
 def test_carmen_buildings_are_refused():
-    """Two CARMEN buildings, both metric (rigid search): Intel's map on FHW's, and back
-    (measured confidence 0.09, 0)."""
+    """Two CARMEN buildings, both metric (rigid search): FHW's map on Intel's (measured
+    confidence 0). Intel's on FHW's, scored alike, is the validation's case
+    same-place-carmen-intel-vs-fhw, whose confidence tests/realdata/test_validation.py
+    compares with its reference (0)."""
     intel = shared("carmen", "intel-corrected.log.gz")
     fhw = shared("carmen", "fhw-corrected.log.gz")
-    for a, b in ((intel, fhw), (fhw, intel)):
-        result = evaluate(a, b, Settings(matching=MatchingConfig(detectors=()),
-                                         alignment=AlignmentConfig(force=True)))
-        assert result.overlap.confidence < 0.5, (a.name, b.name, result.overlap.confidence)
+    result = evaluate(fhw, intel, Settings(matching=MatchingConfig(detectors=()),
+                                           alignment=AlignmentConfig(force=True)))
+    assert result.overlap.confidence < 0.5, result.overlap.confidence

@@ -75,7 +75,7 @@ def test_tiles_join_into_the_whole_image(resolution):
     """A raster drawn tile by tile (each tile with its halo) gives the image drawn whole, cell for
     cell: walls of every drawing, noise, small objects, tiles cutting through all of them, on a
     grid turned by 20 degrees; at 0.025 m each working cell is two raster cells."""
-    plan = np.vstack([synth.campus(2, 2), synth.clutter(PLAN, 6, seed=3)])
+    plan = np.vstack([synth.campus(2, 1), synth.clutter(PLAN, 6, seed=3)])
     turned = synth.plan_grid(plan, resolution)
     grid = MetricGrid(resolution, (*turned.origin[:2], np.radians(20.0)), turned.shape)
     occ = synth.render(plan, grid, 0.3) == synth.OCCUPIED
@@ -96,7 +96,7 @@ def test_the_walls_window_gives_the_whole_rasters_image(resolution):
     0.025 m each working cell is two raster cells (the window starts on whole ones)."""
     from pcmapq.features.walls import CLOSING, _band
 
-    plan = np.vstack([synth.campus(2, 2), synth.clutter(PLAN, 6, seed=3)])
+    plan = np.vstack([synth.campus(2, 1), synth.clutter(PLAN, 6, seed=3)])
     turned = synth.plan_grid(plan, resolution)
     rows, cols = turned.shape
     grid = MetricGrid(resolution, (*turned.origin[:2], np.radians(20.0)), (3 * rows, 2 * cols))
