@@ -56,3 +56,29 @@ def test_streamed_cloud_scores_as_the_loaded_one(building: tuple[Path, Path],
     assert np.hypot(a.tx - b.tx, a.ty - b.ty) < 0.01 and abs(a.yaw_deg - b.yaw_deg) < 0.05
     assert streamed.frames.map_levelling.floor_z_m == pytest.approx(
         loaded.frames.map_levelling.floor_z_m, abs=0.003)
+
+
+def test_distances_3d_of_large_clouds_in_stripes_and_one_copy(monkeypatch):
+    """Clouds of more than STRIPE_POINTS points are reduced in stripes of x, and their
+    centroids handed to Open3D once: the same distances, in less than three float64 copies
+    of a cloud (the one-pass table and two copies of the centroids took five)."""
+    import tracemalloc
+
+    from pcmapq.core import voxel_table, voxels
+    from pcmapq.metrics.distances import distances_3d
+    from testkit.street import street
+
+    truth = street(0.0, 40.0, spacing=0.03, seed=0).astype(np.float32)
+    moved = (street(0.0, 40.0, spacing=0.03, seed=0) + [0.02, 0.01, 0.0]).astype(np.float32)
+    whole = distances_3d(moved, truth, 0.05)
+    monkeypatch.setattr(voxels, "STRIPE_POINTS", 100_000, raising=False)
+    monkeypatch.setattr(voxels, "STRIPE_WIDTH_POINTS", 60_000, raising=False)
+    monkeypatch.setattr(voxel_table, "CHUNK", 4096)
+    tracemalloc.start()
+    try:
+        striped = distances_3d(moved, truth, 0.05)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert striped == whole
+    assert peak < 3 * 2 * truth.nbytes

@@ -95,29 +95,3 @@ def test_distances_3d_are_the_kd_tree_distances_and_a_known_offset():
     empty = distances_3d(np.zeros((0, 3)), b, 0.1)
     assert empty.accuracy.count == 0 and empty.completeness.count == len(vb)
     assert empty.fscores[0].recall == 0.0
-
-
-def test_distances_3d_of_large_clouds_in_stripes_and_one_copy(monkeypatch):
-    """Clouds of more than STRIPE_POINTS points are reduced in stripes of x, and their
-    centroids handed to Open3D once: the same distances, in less than three float64 copies
-    of a cloud (the one-pass table and two copies of the centroids took five)."""
-    import tracemalloc
-
-    from pcmapq.core import voxel_table, voxels
-    from pcmapq.metrics.distances import distances_3d
-    from testkit.street import street
-
-    truth = street(0.0, 40.0, spacing=0.03, seed=0).astype(np.float32)
-    moved = (street(0.0, 40.0, spacing=0.03, seed=0) + [0.02, 0.01, 0.0]).astype(np.float32)
-    whole = distances_3d(moved, truth, 0.05)
-    monkeypatch.setattr(voxels, "STRIPE_POINTS", 100_000, raising=False)
-    monkeypatch.setattr(voxels, "STRIPE_WIDTH_POINTS", 60_000, raising=False)
-    monkeypatch.setattr(voxel_table, "CHUNK", 4096)
-    tracemalloc.start()
-    try:
-        striped = distances_3d(moved, truth, 0.05)
-        peak = tracemalloc.get_traced_memory()[1]
-    finally:
-        tracemalloc.stop()
-    assert striped == whole
-    assert peak < 3 * 2 * truth.nbytes

@@ -12,7 +12,21 @@ from pcmapq.core.transform import Similarity2D
 from pcmapq.core.voxels import voxel_centroids
 from testkit import synth
 
-from .conftest import HEIGHT, PLAN, WIDTH
+#: The alignment tests' plan and its size, metres (tests/unit/align/conftest.py's).
+PLAN = synth.building_plan(0)
+WIDTH, HEIGHT = 24.0, 16.0
+
+
+@pytest.fixture(scope="module")
+def truth() -> np.ndarray:
+    """The plan's walls as points 5 cm apart, plan frame, metres."""
+    return synth.wall_points(PLAN, spacing=0.05)
+
+
+@pytest.fixture(scope="module")
+def scan() -> np.ndarray:
+    """The same walls sampled again with 1.5 cm noise, in the plan frame."""
+    return synth.wall_points(PLAN, spacing=0.05, noise=0.015, seed=1)
 
 
 def similarity(scale: float, yaw_deg: float, tx: float, ty: float) -> Similarity2D:
