@@ -59,6 +59,18 @@ TESTS = Path(__file__).resolve().parent
 FOLDER_KINDS = {"unit": "unit", "realdata": "realdata"}
 
 
+def pytest_ignore_collect(collection_path: Path, config: pytest.Config) -> bool | None:
+    """With ``-m unit`` alone, a test file outside tests/unit that marks no test ``unit`` by
+    hand holds none to run: it is not imported (the e2e and real-data modules' imports and
+    assertion rewriting would take most of the run)."""
+    if config.option.markexpr != "unit" or collection_path.suffix != ".py":
+        return None
+    parts = collection_path.resolve().relative_to(TESTS).parts
+    if len(parts) < 2 or parts[0] == "unit" or not parts[-1].startswith("test_"):
+        return None
+    return "mark.unit" not in collection_path.read_text()
+
+
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
     """Mark every test ``unit``, ``realdata`` or ``e2e`` by its folder (see FOLDER_KINDS)."""
     for item in items:
