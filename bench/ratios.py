@@ -22,8 +22,8 @@ Each case runs its commands in fresh processes (wall seconds and peak RSS of the
 - ``peer3d``: ``pcmapq eval`` of KITTI 00's 20 scans pitched 0.2 degrees a scan against their
   reference map, against CloudAnalyzer's ``ca compare`` + ``ca map-evaluate`` on the same pair,
   medians of three runs (:mod:`bench.bench_peer3d`);
-- ``large3d`` and ``large3d50`` (opt-in): issue 57's bounds on a pair of 3D clouds of 10 M
-  and 50 M points each (:mod:`bench.bench_large3d`).
+- ``large3d``, and ``large3d50`` (opt-in: run only when named): issue 57's bounds on a pair
+  of 3D clouds of 10 M points each, and of 50 M (:mod:`bench.bench_large3d`).
 
 Inputs are built once into a cache folder outside the repository (``--cache``); cases whose
 data (``../shared/data``) is absent are skipped with the reason.
