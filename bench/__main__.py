@@ -1,11 +1,12 @@
 """Run the ratio benchmarks (:mod:`bench.ratios`) and print their table.
 
-    python -m bench [--only noref,kitti,clouds,campus,structures,peer3d] [--repeat 2] [--check]
-                    [--save] [--doc] [--cache DIR]
+    python -m bench [--only noref,kitti,clouds,campus,structures,peer3d,large3d] [--repeat 2]
+                    [--check] [--save] [--doc] [--cache DIR]
 
 --check: exit 1 when a ratio is worse than its stored one (bench/ratios.json) by more
 than 20 %. --save: store the ratios measured. --doc: write them into docs/benchmarks.md's
-table (the rows of ratios this run does not measure are kept).
+table (the rows of ratios this run does not measure are kept). The cases of ``OPT_IN``
+(large3d50: many minutes a run) run only when named.
 """
 
 from __future__ import annotations
@@ -15,7 +16,7 @@ import json
 import sys
 from pathlib import Path
 
-from bench.ratios import CASES, compare, table
+from bench.ratios import CASES, OPT_IN, compare, table
 
 ROOT = Path(__file__).resolve().parents[1]
 STORED = ROOT / "bench" / "ratios.json"
@@ -25,7 +26,8 @@ BEGIN, END = "<!-- ratios -->", "<!-- /ratios -->"
 
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--only", default=",".join(CASES), help="cases, comma-separated")
+    parser.add_argument("--only", default=",".join(c for c in CASES if c not in OPT_IN),
+                        help=f"cases, comma-separated (run only when named: {', '.join(OPT_IN)})")
     parser.add_argument("--repeat", type=int, default=2, help="runs of each side (best kept)")
     parser.add_argument("--check", action="store_true")
     parser.add_argument("--save", action="store_true")

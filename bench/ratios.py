@@ -21,7 +21,9 @@ Each case runs its commands in fresh processes (wall seconds and peak RSS of the
   pair;
 - ``peer3d``: ``pcmapq eval`` of KITTI 00's 20 scans pitched 0.2 degrees a scan against their
   reference map, against CloudAnalyzer's ``ca compare`` + ``ca map-evaluate`` on the same pair,
-  medians of three runs (:mod:`bench.bench_peer3d`).
+  medians of three runs (:mod:`bench.bench_peer3d`);
+- ``large3d``, and ``large3d50`` (opt-in: run only when named): issue 57's bounds on a pair
+  of 3D clouds of 10 M points each, and of 50 M (:mod:`bench.bench_large3d`).
 
 Inputs are built once into a cache folder outside the repository (``--cache``); cases whose
 data (``../shared/data``) is absent are skipped with the reason.
@@ -269,11 +271,27 @@ def peer3d(cache: Path, repeat: int) -> list[Ratio]:
     return case(cache, repeat)
 
 
+def large3d(cache: Path, repeat: int) -> list[Ratio]:
+    """:func:`bench.bench_large3d.large3d` (loaded when run)."""
+    from bench import bench_large3d
+
+    return bench_large3d.large3d(cache, repeat)
+
+
+def large3d50(cache: Path, repeat: int) -> list[Ratio]:
+    """:func:`bench.bench_large3d.large3d50` (loaded when run)."""
+    from bench import bench_large3d
+
+    return bench_large3d.large3d50(cache, repeat)
+
+
 #: name -> case; each returns its ratios.
 CASES: dict[str, Callable[[Path, int], list[Ratio]]] = {
     "noref": noref, "rooms": rooms, "kitti": kitti, "clouds": clouds, "campus": campus,
-    "structures": structures, "peer3d": peer3d,
+    "structures": structures, "peer3d": peer3d, "large3d": large3d, "large3d50": large3d50,
 }
+#: Cases run only when named (``--only``): each takes many minutes.
+OPT_IN = ("large3d50",)
 
 
 def compare(found: list[Ratio], stored: dict[str, float]) -> list[str]:
