@@ -11,22 +11,19 @@ from pcmapq.align.similarity_icp import fit_similarity
 from pcmapq.core.transform import Similarity2D
 from pcmapq.core.voxels import voxel_centroids
 from testkit import synth
-
-#: The alignment tests' plan and its size, metres (tests/unit/align/conftest.py's).
-PLAN = synth.building_plan(0)
-WIDTH, HEIGHT = 24.0, 16.0
+from testkit.alignment import HEIGHT, PLAN, WIDTH, inside, plan_scan, plan_truth
 
 
 @pytest.fixture(scope="module")
 def truth() -> np.ndarray:
     """The plan's walls as points 5 cm apart, plan frame, metres."""
-    return synth.wall_points(PLAN, spacing=0.05)
+    return plan_truth()
 
 
 @pytest.fixture(scope="module")
 def scan() -> np.ndarray:
     """The same walls sampled again with 1.5 cm noise, in the plan frame."""
-    return synth.wall_points(PLAN, spacing=0.05, noise=0.015, seed=1)
+    return plan_scan()
 
 
 def similarity(scale: float, yaw_deg: float, tx: float, ty: float) -> Similarity2D:
@@ -38,12 +35,6 @@ def errors(expected: Similarity2D, got: Similarity2D) -> tuple[float, float, flo
     dyaw = abs((np.degrees(got.yaw - expected.yaw) + 180.0) % 360.0 - 180.0)
     return (abs(got.scale / expected.scale - 1.0), float(dyaw),
             float(np.hypot(got.tx - expected.tx, got.ty - expected.ty)))
-
-
-def inside(points: np.ndarray, box: tuple[float, float, float, float]) -> np.ndarray:
-    x0, y0, x1, y1 = box
-    keep = (points[:, 0] >= x0) & (points[:, 0] <= x1) & (points[:, 1] >= y0) & (points[:, 1] <= y1)
-    return points[keep]
 
 
 @pytest.fixture(scope="module")

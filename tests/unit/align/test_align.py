@@ -11,21 +11,14 @@ from pcmapq.align.finalists import TIE_COVERAGE, TIE_FITNESS, refine_best
 from pcmapq.core.transform import Similarity2D
 from pcmapq.core.voxels import evenly, voxel_centroids
 from testkit import synth
+from testkit.alignment import HEIGHT, PLAN, WIDTH, inside
 from testkit.poses import pose_error
-
-from .conftest import HEIGHT, PLAN, WIDTH
 
 
 def to_map_frame(points: np.ndarray, yaw_deg: float, tx: float, ty: float):
     """(T_true, points in a map frame such that T_true maps them back to the plan frame)."""
     t_true = Similarity2D(tx, ty, np.radians(yaw_deg))
     return t_true, t_true.inverse().apply(points)
-
-
-def inside(points: np.ndarray, box: tuple[float, float, float, float]) -> np.ndarray:
-    x0, y0, x1, y1 = box
-    keep = (points[:, 0] >= x0) & (points[:, 0] <= x1) & (points[:, 1] >= y0) & (points[:, 1] <= y1)
-    return points[keep]
 
 
 @pytest.fixture(scope="module")
