@@ -65,10 +65,13 @@ def pytest_ignore_collect(collection_path: Path, config: pytest.Config) -> bool 
     assertion rewriting would take most of the run)."""
     if config.option.markexpr != "unit" or collection_path.suffix != ".py":
         return None
-    parts = collection_path.resolve().relative_to(TESTS).parts
+    path = collection_path.resolve()
+    if not path.is_relative_to(TESTS):
+        return None
+    parts = path.relative_to(TESTS).parts
     if len(parts) < 2 or parts[0] == "unit" or not parts[-1].startswith("test_"):
         return None
-    return "mark.unit" not in collection_path.read_text()
+    return True if "mark.unit" not in path.read_text() else None
 
 
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
