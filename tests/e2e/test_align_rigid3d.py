@@ -52,6 +52,36 @@ def test_initial_guess_skips_the_global_search() -> None:
     assert shift < 0.02 and angle < 0.2
 
 
+def test_a_second_guess_is_asked_for_only_where_the_global_search_fits_poorly() -> None:
+    target = room(0)
+    truth = rigid((0.0, 0.0, 40.0), (1.0, -2.0, 0.3))
+    source = apply(np.linalg.inv(truth), room(1))
+
+    def second() -> np.ndarray:
+        raise AssertionError("a second guess was asked for where the first fits")
+
+    shift, angle = errors(align_3d(source, target, voxel=0.2, second=second).transform, truth)
+    assert shift < 0.02 and angle < 0.2
+
+
+def test_a_second_guess_that_fits_more_is_refined(monkeypatch) -> None:
+    """The global search's guess turned upside down (as alike features can give it) fits
+    little of the room: the second guess, which fits it, is the one refined."""
+    from pcmapq.align import features3d
+
+    target = room(0)
+    truth = rigid((0.0, 0.0, 40.0), (1.0, -2.0, 0.3))
+    source = apply(np.linalg.inv(truth), room(1))
+    flipped = rigid((180.0, 0.0, 0.0), (0.0, 0.0, 0.0))
+    monkeypatch.setattr(features3d, "global_registration", lambda *_: flipped)
+    shift, angle = errors(align_3d(source, target, voxel=0.2).transform, truth)
+    assert angle > 90.0  # the flipped guess alone stays wrong
+    near = truth @ rigid((0.0, 0.0, 3.0), (0.3, -0.2, 0.0))
+    shift, angle = errors(align_3d(source, target, voxel=0.2, second=lambda: near).transform,
+                          truth)
+    assert shift < 0.02 and angle < 0.2
+
+
 def test_the_target_prepared_on_every_core_gives_the_same_registration(monkeypatch) -> None:
     """The target's KD-tree and normals built on 4 threads give the transform of one thread,
     bit for bit."""

@@ -9,7 +9,10 @@ stay small and sums precise with UTM coordinates); ``T`` is given back in the in
    order).
 2. Global (:mod:`pcmapq.align.features3d`, skipped when ``init`` is given): FPFH at no more
    than 8,000 evenly spread points per cloud, matched as mutual nearest neighbours in feature
-   space, then Open3D's RANSAC on those matches, seeded and on one thread.
+   space, then Open3D's RANSAC on those matches, seeded and on one thread. Where that guess
+   puts less than GUESS_FIT of the source within 1.5 ``voxel`` of the target, a ``second``
+   guess, when one is given (the plans' 2D search, :mod:`pcmapq.align.plan_guess`), is asked
+   for, and the one that fits more of the source is refined.
 3. ICP (:mod:`pcmapq.align.refine3d`): small_gicp's point-to-plane ICP on one thread, three
    stages with correspondence distances 2, 1 and 0.5 ``voxel`` (the last on clouds downsampled
    at ``voxel / 2``).
@@ -23,6 +26,7 @@ Repeated runs give identical results. Cost grows with the clouds; on outdoor map
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import NamedTuple
 
 import numpy as np
@@ -37,6 +41,9 @@ __all__ = ["Registration3D", "align_3d"]
 
 #: Fewest points left after downsampling for features to mean anything.
 MIN_POINTS = 10
+#: Share of the source a global guess must put near the target (within 1.5 ``voxel``, as its
+#: RANSAC counts inliers) for no second guess to be asked for.
+GUESS_FIT = 0.5
 
 
 class Registration3D(NamedTuple):
@@ -49,13 +56,16 @@ class Registration3D(NamedTuple):
 
 
 def align_3d(source_xyz: np.ndarray, target_xyz: np.ndarray, *, voxel: float = 0.3,
-             init: np.ndarray | None = None, tolerance: float | None = None) -> Registration3D:
+             init: np.ndarray | None = None, tolerance: float | None = None,
+             second: Callable[[], np.ndarray | None] | None = None) -> Registration3D:
     """Register ``source_xyz`` (N, 3) to ``target_xyz`` (M, 3), metres: ``p_target = T p_source``.
 
     voxel: working resolution, metres (features, RANSAC and ICP distances scale with it).
     init: 4x4 initial guess; skips the global search (ICP still refines). tolerance: fitness
-    distance, metres (default ``voxel``). Points that are not finite, or exactly (0, 0, 0)
-    (a common no-return marker), are ignored. Deterministic.
+    distance, metres (default ``voxel``). second: another global guess (4x4, source ->
+    target; None: it has none), asked for only when the global search's fits less than
+    GUESS_FIT of the source; the better fitting of the two is refined. Points that are not
+    finite, or exactly (0, 0, 0) (a common no-return marker), are ignored. Deterministic.
     """
     if not voxel > 0:
         raise InputError(f"voxel must be positive, got {voxel}")
@@ -71,12 +81,37 @@ def align_3d(source_xyz: np.ndarray, target_xyz: np.ndarray, *, voxel: float = 0
         from pcmapq.align.features3d import global_registration  # Open3D: loaded when it runs
 
         guess = global_registration(src_down, tgt_down, voxel)
+        if second is not None:
+            guess = _better(guess, second, src_down, tgt_down, voxel, (src_shift, tgt_shift))
     else:
         guess = tgt_shift @ np.asarray(init, dtype=np.float64).reshape(4, 4) @ np.linalg.inv(
             src_shift)
     transform = refine(source, target, guess, voxel, (src_down, tgt_down))
     fitness, rmse = score(source, target, transform, tolerance or voxel, voxel / 2)
     return Registration3D(np.linalg.inv(tgt_shift) @ transform @ src_shift, fitness, rmse)
+
+
+def _better(guess: np.ndarray, second: Callable[[], np.ndarray | None], source: np.ndarray,
+            target: np.ndarray, voxel: float, shifts: tuple[np.ndarray, np.ndarray]) -> np.ndarray:
+    """``guess`` (4x4, between the centred clouds ``source`` and ``target``, both downsampled
+    at ``voxel``), or ``second()`` (in the input frames; ``shifts``: each cloud's centring) when
+    the first fits less than GUESS_FIT of the source and the second fits more."""
+    tree = cKDTree(target)
+
+    def fit(transform: np.ndarray) -> float:
+        dist, _ = tree.query(apply(transform, source), distance_upper_bound=1.5 * voxel,
+                             workers=-1)
+        return float(np.isfinite(dist).mean())
+
+    first = fit(guess)
+    if first >= GUESS_FIT:
+        return guess
+    other = second()
+    if other is None:
+        return guess
+    src_shift, tgt_shift = shifts
+    other = tgt_shift @ np.asarray(other, dtype=np.float64) @ np.linalg.inv(src_shift)
+    return other if fit(other) > first else guess
 
 
 def score(source: np.ndarray, target: np.ndarray, transform: np.ndarray, tolerance: float,

@@ -14,10 +14,11 @@ import numpy as np
 from pcmapq.align import Alignment, align
 from pcmapq.align.free_space import FreeSpace
 from pcmapq.align.parts import place_parts
+from pcmapq.align.plan_guess import guess_from_plans
 from pcmapq.align.planar import RigidTarget
 from pcmapq.align.rigid3d import Registration3D, align_3d, apply
 from pcmapq.core.bounds import bounds, radius
-from pcmapq.core.errors import EvaluationError, Refused, SettingsRefused
+from pcmapq.core.errors import EvaluationError, InputError, Refused, SettingsRefused
 from pcmapq.core.frames import Levelling
 from pcmapq.core.grid import MetricGrid
 from pcmapq.core.transform import Similarity2D
@@ -73,12 +74,12 @@ def place(source: OccupancyMap | PointMap, prepared: PreparedTruth, settings: Se
     progress("aligning")
     option, truth = settings.alignment, prepared.source
     given = source
-    source, registration = align_clouds_3d(source, truth, settings)
-    map_xy, map_level = plan_points(source, settings)
-    walls_found()
     target = prepared.aligner
     if target is None or not target.fits(option.params):
         target = RigidTarget(prepared.xy, option.params)
+    source, registration = align_clouds_3d(source, truth, settings, (prepared, target))
+    map_xy, map_level = plan_points(source, settings)
+    walls_found()
     alignment = align_plan(source, map_xy, prepared.xy, registration, settings, target,
                            free_space(source, prepared))
 
@@ -158,15 +159,31 @@ def map_raster(source: OccupancyMap | PointMap, map_xy: np.ndarray, transform: S
 
 
 def align_clouds_3d(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap,
-                    settings: Settings) -> tuple[OccupancyMap | PointMap, Registration3D | None]:
+                    settings: Settings,
+                    plan: tuple[PreparedTruth, RigidTarget] | None = None,
+                    ) -> tuple[OccupancyMap | PointMap, Registration3D | None]:
     """When both sides are 3D clouds (and no guess or --no-align says otherwise), register them
-    in 3D first; returns the map moved into the truth frame and the registration."""
+    in 3D first; returns the map moved into the truth frame and the registration. ``plan``: the
+    truth's plan and its points prepared for the 2D search, for the registration's second
+    guess (:mod:`pcmapq.align.plan_guess`) where its global search fits the map poorly."""
     both_3d = all(isinstance(s, PointMap) and s.is_3d for s in (source, truth))
     option = settings.alignment
     if not (both_3d and option.enabled and option.init is None and not option.scale):
         return source, None
+
+    def second() -> np.ndarray | None:
+        prepared, target = plan
+        try:  # a map with no wall band in its own frame (a camera's axes) has no plan guess
+            map_xy, map_level = plan_points(source, settings)
+            return guess_from_plans(map_xy, map_level, prepared.xy, prepared.level,
+                                    option.params, target)
+        except (InputError, EvaluationError):
+            return None
+
+    levelled = plan is not None and plan[0].level is not None
     try:
-        reg = align_3d(source.points, truth.points, voxel=option.voxel_3d)
+        reg = align_3d(source.points, truth.points, voxel=option.voxel_3d,
+                       second=second if levelled else None)
     except EvaluationError as error:
         voxel = "" if "voxel" in str(error) else f" at --voxel-3d {option.voxel_3d:g} m"
         raise EvaluationError(f"{source.path} against {truth.path}: {error}{voxel}"
