@@ -167,13 +167,13 @@ def fit(points: np.ndarray, label: np.ndarray, count: int
 def _scatter(points: np.ndarray, on: np.ndarray, lab: np.ndarray, centroid: np.ndarray,
              count: int) -> np.ndarray:
     """(count, 3, 3) each plane's sum of the outer products of its points ``points[on]``
-    (labels ``lab``) about its centroid, added in the points' order, ROWS at a time (each of
-    the six distinct entries by a 1-D ``np.add.at``)."""
-    sums = np.zeros((len(PAIRS), count))
+    (labels ``lab``) about its centroid, added in the points' order (each of the six distinct
+    entries by one ``np.bincount``: with a plane's points in runs, ``np.add.at`` takes ten
+    times as long for the same sums); the offsets from the centroids gathered ROWS at a time."""
+    d = np.empty((len(on), 3))
     for part in _rows(len(on)):
-        d = points[on[part]] - centroid[lab[part]]
-        for k, (a, b) in enumerate(PAIRS):
-            np.add.at(sums[k], lab[part], d[:, a] * d[:, b])
+        d[part] = points[on[part]] - centroid[lab[part]]
+    sums = [np.bincount(lab, weights=d[:, a] * d[:, b], minlength=count) for a, b in PAIRS]
     cov = np.empty((count, 3, 3))
     for k, (a, b) in enumerate(PAIRS):
         cov[:, a, b] = cov[:, b, a] = sums[k]
