@@ -1,5 +1,6 @@
 """Issue 57's bounds on a large pair of 3D clouds (:mod:`testkit.town3d`'s town, written once
-into the cache by :mod:`bench.large_3d`), as ratios of :mod:`bench.ratios` (``python -m bench --only large3d``):
+into the cache by :mod:`bench.large_3d`), as ratios of :mod:`bench.ratios`
+(``python -m bench --only large3d``):
 
 - ``large3d``: ``pcmapq eval map.ply truth.ply`` of the 10 M-point pair by default against the
   same run without the 3D figures of two clouds: ``--no-structures``, and AWD/SCS and the 3D
