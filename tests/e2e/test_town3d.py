@@ -13,6 +13,7 @@ import pytest
 from pcmapq.align.features3d import global_registration
 from pcmapq.core.voxels import voxel_centroids
 from testkit.command import run
+from testkit.paths import shared
 from testkit.poses import errors
 from testkit.town3d import map_to_truth, pair
 
@@ -51,3 +52,13 @@ def test_the_town_is_registered_and_scored(town: tuple[Path, Path], tmp_path: Pa
     shift, angle = errors(found, map_to_truth())
     assert shift < 0.1 and angle < 0.2
     assert doc["alignment_3d"]["fitness"] > 0.9
+
+
+def test_a_scan_of_another_place_is_still_refused(town: tuple[Path, Path]) -> None:
+    """A real LiDAR scan against the town: neither guess fits it, and the map is refused in
+    one line, not scored."""
+    scan = shared("registration", "source.ply")
+    got = run("eval", str(scan), str(town[1]), "--no-noref", "--no-structures")
+    assert got.returncode == 1
+    assert "does not seem to show the place of" in got.stderr
+    assert len(got.stderr.strip().splitlines()) == 1

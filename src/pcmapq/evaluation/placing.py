@@ -173,8 +173,11 @@ def align_clouds_3d(source: OccupancyMap | PointMap, truth: OccupancyMap | Point
 
     def second() -> np.ndarray | None:
         prepared, target = plan
-        try:  # a map with no wall band in its own frame (a camera's axes) has no plan guess
+        try:  # a map with no wall band in its own frame (a camera's axes) has no plan guess,
+            # nor one that looks too large for its truth (a unit mistake: the search would take
+            # minutes and gigabytes)
             map_xy, map_level = plan_points(source, settings)
+            check_size(source, map_xy, prepared.xy, settings)
             return guess_from_plans(map_xy, map_level, prepared.xy, prepared.level,
                                     option.params, target)
         except (InputError, EvaluationError):
