@@ -10,8 +10,9 @@ Modules: :mod:`~pcmapq.align.params` (:class:`AlignParams`, the tunables),
 :mod:`~pcmapq.align.coarse` (the global search), :mod:`~pcmapq.align.point_to_point`,
 :mod:`~pcmapq.align.point_to_line` and :mod:`~pcmapq.align.similarity_icp` (the ICP stages),
 :mod:`~pcmapq.align.rigid3d` (3D clouds; it loads Open3D on import, so it is not imported
-here). Importing this package loads no Open3D: it is imported where ICP runs. The planar
-alignment (SciPy, Numba) loads on first use of its names, so that the settings, which hold
+here) with :mod:`~pcmapq.align.plan_guess` (its second guess, from the two clouds' plans).
+Importing this package loads no Open3D: it is imported where ICP runs. The planar alignment
+(SciPy, Numba) loads on first use of its names, so that the settings, which hold
 :class:`AlignParams`, load none of it.
 """
 
