@@ -29,6 +29,7 @@ from scipy import ndimage
 from scipy.spatial import cKDTree
 
 from pcmapq.core.components import Components
+from pcmapq.core.covariance import PAIRS, symmetric
 from pcmapq.core.voxels import open3d_centroids
 
 #: Nearest neighbours of a point's normal and of its edges in the region graph.
@@ -42,8 +43,6 @@ NEIGHBOUR_ANGLE_DEG = 10.0
 GROWTH_ROUNDS = 2
 #: Points whose per-point work (neighbours, normals, pairs, products) is done at once.
 ROWS = 1 << 16
-#: The pairs of axes of a 3 x 3 covariance's six distinct entries.
-PAIRS = ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))
 
 
 @dataclass(frozen=True)
@@ -173,11 +172,8 @@ def _scatter(points: np.ndarray, on: np.ndarray, lab: np.ndarray, centroid: np.n
     d = np.empty((len(on), 3))
     for part in _rows(len(on)):
         d[part] = points[on[part]] - centroid[lab[part]]
-    sums = [np.bincount(lab, weights=d[:, a] * d[:, b], minlength=count) for a, b in PAIRS]
-    cov = np.empty((count, 3, 3))
-    for k, (a, b) in enumerate(PAIRS):
-        cov[:, a, b] = cov[:, b, a] = sums[k]
-    return cov
+    return symmetric([np.bincount(lab, weights=d[:, a] * d[:, b], minlength=count)
+                      for a, b in PAIRS])
 
 
 def grow(points: np.ndarray, near: np.ndarray, label: np.ndarray, normal: np.ndarray,

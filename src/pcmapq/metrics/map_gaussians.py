@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from pcmapq.core.bounds import bounds
+from pcmapq.core.covariance import PAIRS, symmetric
 from pcmapq.core.errors import InputError
 from pcmapq.core.voxels import index_keys, voxel_index, voxel_keys
 from pcmapq.metrics.defaults import AWD_MIN_POINTS, AWD_VOXEL, SCS_RADIUS
@@ -36,8 +37,6 @@ CHUNK = 1 << 19
 #: A cloud's voxels are every voxel of its box when the box holds at most this many (and at
 #: most DENSE_PER_POINT a point): their sums are then found without a pass to list them.
 DENSE_CELLS, DENSE_PER_POINT = 1 << 20, 4
-#: The pairs of axes of a covariance's six distinct entries.
-_PAIRS = ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))
 
 
 @dataclass(frozen=True)
@@ -99,17 +98,14 @@ def voxel_gaussians(points: np.ndarray, voxel: float, min_points: int = 2,
         for a in range(3):
             np.add.at(sums[a], at, chunk[:, a])
     means = sums / np.maximum(n, 1.0)
-    products = np.zeros((len(_PAIRS), len(keys)))
+    products = np.zeros((len(PAIRS), len(keys)))
     for chunk in _chunks(points, origin):
         at = rows(chunk)
         centred = [chunk[:, a] - np.take(means[a], at) for a in range(3)]
-        for k, (a, b) in enumerate(_PAIRS):
+        for k, (a, b) in enumerate(PAIRS):
             np.add.at(products[k], at, centred[a] * centred[b])
     kept = n >= max(min_points, 2)
-    cov = np.empty((int(np.count_nonzero(kept)), 3, 3))
-    for k, (a, b) in enumerate(_PAIRS):
-        cov[:, a, b] = cov[:, b, a] = products[k][kept] / (n[kept] - 1)
-    return keys[kept], means.T[kept], cov
+    return keys[kept], means.T[kept], symmetric(products[:, kept] / (n[kept] - 1))
 
 
 def _cells(points: np.ndarray, origin: np.ndarray, voxel: float
