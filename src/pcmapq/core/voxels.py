@@ -22,8 +22,8 @@ from pcmapq.core import voxel_table
 from pcmapq.core.bounds import bounds
 from pcmapq.core.errors import InputError
 
-__all__ = ["VoxelMap", "evenly", "index_keys", "open3d_centroids", "voxel_centroids",
-           "voxel_count", "voxel_groups"]
+__all__ = ["VoxelMap", "evenly", "index_keys", "open3d_centroids", "stripe_points",
+           "voxel_centroids", "voxel_count", "voxel_groups"]
 
 #: Grouping by counting is used when the points' box holds at most this many voxels per point
 #: and at most DENSE_CELLS voxels (8 bytes of memory each).
@@ -37,10 +37,14 @@ STREAM_FROM = 100_000
 #: Voxels from the grid's corner that the compiled table's keys reach along an axis (3D: 2**20
 #: less one): :func:`open3d_centroids` leaves a wider cloud to Open3D.
 REACH = (1 << 20) - 1
-#: A cloud of more points than this is reduced by :func:`open3d_centroids` in stripes of x of
-#: about STRIPE_WIDTH_POINTS points, a pass over its points each: the table holds one stripe's
-#: voxels at a time.
-STRIPE_POINTS, STRIPE_WIDTH_POINTS = 25_000_000, 8_000_000
+#: A cloud of more points than this is reduced in stripes of x (:func:`stripe_points`), one
+#: pass over its points each, so that the voxel table holds one stripe's voxels at a time, not
+#: a large cloud's whole table beside the evaluation (docs/benchmarks.md).
+STRIPE_POINTS = 25_000_000
+#: Such a cloud's stripes hold about this many points each: the table of one stripe's voxels and
+#: the centroids of the stripes before it stand beside the plan's global search, whose peak the
+#: stripes' width barely moves.
+STRIPE_WIDTH_POINTS = 8_000_000
 
 
 class VoxelMap:
@@ -188,6 +192,12 @@ def voxel_centroids(points: np.ndarray, voxel: float, scale: float = 1.0,
     return grid.points()
 
 
+def stripe_points(points: int) -> int | None:
+    """The ``stripe_points`` of a reduction of ``points`` points: None (one pass) up to
+    STRIPE_POINTS, else stripes of about STRIPE_WIDTH_POINTS points."""
+    return None if points <= STRIPE_POINTS else STRIPE_WIDTH_POINTS
+
+
 def open3d_centroids(points: np.ndarray, voxel: float) -> np.ndarray:
     """The centroids (M, 3) of the points (N, 3, metres, any float type) in each voxel of
     Open3D's ``voxel_down_sample``, bit for bit (its cubes start half a voxel below the
@@ -208,9 +218,8 @@ def open3d_centroids(points: np.ndarray, voxel: float) -> np.ndarray:
             np.asarray(points, dtype=np.float64)))
         out = np.asarray(cloud.voxel_down_sample(voxel).points)
     else:
-        out = voxel_table.streamed_centroids(points, voxel, origin=corner, stripe_points=None
-                                             if len(points) <= STRIPE_POINTS
-                                             else STRIPE_WIDTH_POINTS)
+        out = voxel_table.streamed_centroids(points, voxel, origin=corner,
+                                             stripe_points=stripe_points(len(points)))
     return out[np.lexsort(out.T[::-1])]
 
 

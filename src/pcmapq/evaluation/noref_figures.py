@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 
 from pcmapq.core.heap import release_free_memory
-from pcmapq.core.voxels import voxel_centroids
+from pcmapq.core.voxels import STRIPE_POINTS, stripe_points, voxel_centroids
 from pcmapq.evaluation.inputs import truth_raster
 from pcmapq.io import OccupancyMap, PointMap
 from pcmapq.metrics.inspection import noref_figures
@@ -40,24 +40,13 @@ def input_figures(source: OccupancyMap | PointMap, config: NoRefConfig = NoRefCo
     return {"cloud": None, "grid": occupancy_figures(source, scale, corners)}
 
 
-#: A cloud of more than this many points is reduced in stripes of x, one pass over its points
-#: each, so that the voxel table holds one stripe's voxels at a time, not a large cloud's whole
-#: table beside the evaluation (docs/benchmarks.md).
-STRIPE_POINTS = 25_000_000
-#: Such a cloud's stripes hold about this many points each: the table of one stripe's voxels and
-#: the centroids of the stripes before it stand beside the plan's global search, whose peak the
-#: stripes' width barely moves.
-STRIPE_WIDTH_POINTS = 8_000_000
-
-
 def reduced(points: np.ndarray, voxel: float, scale: float = 1.0) -> np.ndarray:
     """(M, 3) float64: ``points`` times ``scale``, metres, reduced to their centroid in each
     voxel of ``voxel`` metres (0: all of them); a large cloud mapped onto its file is read in
     chunks, never converted whole (:func:`~pcmapq.core.voxels.voxel_centroids`)."""
     if voxel <= 0:
         return np.asarray(points, dtype=np.float64) * scale
-    return voxel_centroids(points, voxel, scale, stripe_points=None
-                           if len(points) <= STRIPE_POINTS else STRIPE_WIDTH_POINTS)
+    return voxel_centroids(points, voxel, scale, stripe_points=stripe_points(len(points)))
 
 
 def occupancy_figures(source: OccupancyMap | PointMap, scale: float = 1.0,

@@ -114,12 +114,12 @@ def distances_3d(map_xyz: np.ndarray, truth_xyz: np.ndarray, voxel: float = 0.05
     every core), one call per direction: the distances SciPy's ``cKDTree`` gives, in about
     two thirds of its time (``bench/bench_clouds.py``). Each cloud's centroids are handed to
     Open3D once (a cloud of more than STRIPE_POINTS points reduced in stripes of x)."""
-    from pcmapq.core.voxels import STRIPE_POINTS, STRIPE_WIDTH_POINTS, voxel_centroids
+    from pcmapq.core.voxels import stripe_points, voxel_centroids
 
     basis = (f"in 3D: the map's and the truth's points voxel-downsampled to {voxel:g} m "
              "(centroids), each to the nearest of the other's")
-    m, t = (voxel_centroids(c, voxel, stripe_points=None if len(c) <= STRIPE_POINTS
-                            else STRIPE_WIDTH_POINTS) for c in (map_xyz, truth_xyz))
+    m, t = (voxel_centroids(c, voxel, stripe_points=stripe_points(len(c)))
+            for c in (map_xyz, truth_xyz))
     if len(m) == 0 or len(t) == 0:
         return _summary(np.full(len(m), np.inf), np.full(len(t), np.inf), taus, basis)
     clouds = [_open3d_cloud(m), _open3d_cloud(t)]
