@@ -24,18 +24,26 @@ VOXEL = 0.3
 
 
 @pytest.fixture(scope="module")
-def town(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
+def clouds() -> tuple[np.ndarray, np.ndarray]:
+    """The 3 x 3 town's map and truth, (POINTS, 3) float32 each."""
+    return pair(POINTS, 3, 3)
+
+
+@pytest.fixture(scope="module")
+def town(clouds: tuple[np.ndarray, np.ndarray],
+         tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
     out = tmp_path_factory.mktemp("town")
     paths = out / "map.ply", out / "truth.ply"
-    for path, points in zip(paths, pair(POINTS, 3, 3), strict=True):
+    for path, points in zip(paths, clouds, strict=True):
         cloud = o3d.geometry.PointCloud(o3d.utility.Vector3dVector(points.astype(np.float64)))
         o3d.io.write_point_cloud(str(path), cloud)
     return paths
 
 
-def test_the_features_alone_turn_the_town_upside_down() -> None:
+def test_the_features_alone_turn_the_town_upside_down(
+        clouds: tuple[np.ndarray, np.ndarray]) -> None:
     """What the second guess is for: the features' guess on this town is far from the truth."""
-    source, target = (voxel_centroids(c - c.mean(axis=0), VOXEL) for c in pair(POINTS, 3, 3))
+    source, target = (voxel_centroids(c - c.mean(axis=0), VOXEL) for c in clouds)
     guess = global_registration(source, target, VOXEL)
     assert guess[2, 2] < 0.0 or abs(np.degrees(np.arctan2(guess[1, 0], guess[0, 0])) + 25) > 5
 
