@@ -10,15 +10,26 @@ normals, each point's own, are built on every core: the same tree and normals, b
 
 small_gicp over Open3D's ICP: repeatable without holding Open3D to one thread, and closer to
 the reference poses (docs/benchmarks.md, "Choices behind the code").
+
+small_gicp holds Python's lock while it registers, so no other thread of the process runs
+meanwhile. Clouds of CHILD_POINTS or more are therefore refined in a child process (this
+module run as ``python -m pcmapq.align.refine3d``, the clouds passed on its standard input):
+the same steps on the same numbers, so the same transform bit for bit, while the evaluation's
+other threads (the truth's figures) go on beside it.
 """
 
 from __future__ import annotations
 
 import os
+import pickle
+import subprocess
+import sys
+from pathlib import Path
 
 import numpy as np
 import small_gicp
 
+from pcmapq.core.errors import EvaluationError
 from pcmapq.core.voxels import voxel_centroids
 
 __all__ = ["last_reach", "refine"]
@@ -34,6 +45,11 @@ NORMAL_NEIGHBOURS = 20
 #: Threads that build a target's KD-tree and normals: the registration holds Python's lock
 #: meanwhile, so the pipeline's other threads leave the cores to it.
 PREPARE_THREADS = os.cpu_count() or 1
+#: Source and target points, all ICP stages' clouds counted, from which the ICP runs in a child
+#: process (smaller clouds take less time to refine than a process takes to start).
+CHILD_POINTS = 200_000
+
+Levels = dict[float, tuple[np.ndarray, np.ndarray]]
 
 
 def refine(source: np.ndarray, target: np.ndarray, guess: np.ndarray, voxel: float,
@@ -43,14 +59,24 @@ def refine(source: np.ndarray, target: np.ndarray, guess: np.ndarray, voxel: flo
     source (N, 3), target (M, 3): the whole clouds, metres; coarse: both already downsampled
     at ``voxel`` (metres, the working resolution).
     """
-    levels = {1.0: _prepared(*coarse)}
-    transform = np.asarray(guess, dtype=np.float64)
+    levels: Levels = {1.0: coarse}
+    for _, units in ICP_STAGES:
+        if units not in levels:
+            levels[units] = (voxel_centroids(source, voxel * units),
+                             voxel_centroids(target, voxel * units))
+    guess = np.asarray(guess, dtype=np.float64)
+    if sum(len(src) + len(tgt) for src, tgt in levels.values()) >= CHILD_POINTS:
+        return _in_child(levels, guess, voxel)
+    return _stages(levels, guess, voxel)
+
+
+def _stages(levels: Levels, guess: np.ndarray, voxel: float) -> np.ndarray:
+    """The ICP stages from ``guess`` (4x4) on ``levels`` (source and target downsampled at each
+    stage's voxel, in units of ``voxel``, metres); 4x4."""
+    prepared = {units: _prepared(*clouds) for units, clouds in levels.items()}
+    transform = guess
     for distance_units, voxel_units in ICP_STAGES:
-        if voxel_units not in levels:
-            cell = voxel * voxel_units
-            levels[voxel_units] = _prepared(voxel_centroids(source, cell),
-                                            voxel_centroids(target, cell))
-        src, tgt, tree = levels[voxel_units]
+        src, tgt, tree = prepared[voxel_units]
         result = small_gicp.align(tgt, src, tree, init_T_target_source=transform,
                                   registration_type="PLANE_ICP",
                                   max_correspondence_distance=voxel * distance_units,
@@ -58,6 +84,22 @@ def refine(source: np.ndarray, target: np.ndarray, guess: np.ndarray, voxel: flo
                                   rotation_epsilon=CONVERGED, translation_epsilon=CONVERGED)
         transform = np.array(result.T_target_source, dtype=np.float64)
     return transform
+
+
+def _in_child(levels: Levels, guess: np.ndarray, voxel: float) -> np.ndarray:
+    """:func:`_stages` run by ``python -m pcmapq.align.refine3d``: its arguments pickled to the
+    child's standard input, the transform back from its standard output."""
+    package_root = str(Path(__file__).resolve().parents[2])  # the pcmapq this one is
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(
+        [package_root, *filter(None, [os.environ.get("PYTHONPATH")])]))
+    done = subprocess.run([sys.executable, "-m", __name__],
+                          input=pickle.dumps((levels, guess, voxel), protocol=5),
+                          capture_output=True, env=env, check=False)
+    if done.returncode != 0:
+        lines = done.stderr.decode(errors="replace").strip().splitlines()
+        raise EvaluationError("the 3D ICP's process failed (exit code "
+                              f"{done.returncode}){': ' + lines[-1] if lines else ''}")
+    return pickle.loads(done.stdout)
 
 
 def last_reach(voxel: float) -> float:
@@ -75,3 +117,7 @@ def _prepared(source: np.ndarray, target: np.ndarray
     small_gicp.estimate_normals(tgt, tree, num_neighbors=NORMAL_NEIGHBOURS,
                                 num_threads=PREPARE_THREADS)
     return src, tgt, tree
+
+
+if __name__ == "__main__":  # the child of _in_child: arguments on stdin, transform on stdout
+    sys.stdout.buffer.write(pickle.dumps(_stages(*pickle.load(sys.stdin.buffer)), protocol=5))
