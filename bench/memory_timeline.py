@@ -43,6 +43,8 @@ STAGES = [
     ("pcmapq.align.regions3d", "regions_3d"),
     ("pcmapq.metrics.map_gaussians", "map_gaussians"),
     ("pcmapq.evaluation.scoring", "structures_3d"),
+    ("pcmapq.evaluation.truth", "find_planes"),
+    ("pcmapq.match.structures", "find_planes"),
     ("pcmapq.evaluation.noref_figures", "input_figures"),
     ("pcmapq.features.registry", "SideBySide.features"),
 ]

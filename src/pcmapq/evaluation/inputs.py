@@ -80,6 +80,15 @@ def with_seen(source: OccupancyMap | PointMap) -> OccupancyMap | PointMap:
     return replace(source, seen=seen_of_scans(read_laser_scans(source.path), 2 * CLOSING))
 
 
+def registered_in_3d(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap,
+                     settings: Settings) -> bool:
+    """Whether the map is placed by a 3D registration: both sides are 3D clouds, and no guess,
+    ``--no-align`` or ``--scale auto`` says otherwise."""
+    option = settings.alignment
+    return all(isinstance(s, PointMap) and s.is_3d for s in (source, truth)) and \
+        option.enabled and option.init is None and not option.scale
+
+
 def load_pair(map_path: str | Path | PointMap, truth_path: str | Path, settings: Settings,
               memory_limit: int | None = None) -> tuple[OccupancyMap | PointMap,
                                                          OccupancyMap | PointMap]:

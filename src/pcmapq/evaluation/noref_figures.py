@@ -6,7 +6,6 @@ occupancy figures of :mod:`pcmapq.metrics.noref2d`. docs/metrics.md says what ea
 
 from __future__ import annotations
 
-import os
 import threading
 from dataclasses import asdict, replace
 from typing import Any
@@ -14,6 +13,7 @@ from typing import Any
 import numpy as np
 
 from pcmapq.core.heap import release_free_memory
+from pcmapq.core.priority import lower_priority
 from pcmapq.core.voxels import STRIPE_POINTS, stripe_points, voxel_centroids
 from pcmapq.evaluation.inputs import truth_raster
 from pcmapq.io import OccupancyMap, PointMap
@@ -69,11 +69,6 @@ def occupancy_figures(source: OccupancyMap | PointMap, scale: float = 1.0,
     return figures
 
 
-#: The figures' thread runs this much nicer than the evaluation (Linux schedules threads as
-#: tasks), so it takes the cores the evaluation leaves idle rather than sharing the busy ones.
-BACKGROUND_NICE = 10
-
-
 #: A map cloud of more than this many points, reduced in one pass (at most STRIPE_POINTS), has
 #: its figures wait for its plan points (:meth:`EarlyFigures.walls_found`): its wall band is
 #: shorter than the reduction beside it, and the band's end is the evaluation's first peak in
@@ -127,10 +122,7 @@ class EarlyFigures:
             self._thread.join()
 
     def _run(self, config: NoRefConfig) -> None:
-        try:
-            os.setpriority(os.PRIO_PROCESS, threading.get_native_id(), BACKGROUND_NICE)
-        except (AttributeError, OSError):  # not Linux: the thread keeps the process's priority
-            pass
+        lower_priority()
         self._go.wait()
         if self._cancelled:
             return

@@ -22,7 +22,7 @@ from pcmapq.core.errors import EvaluationError, InputError, Refused, SettingsRef
 from pcmapq.core.frames import Levelling
 from pcmapq.core.grid import MetricGrid
 from pcmapq.core.transform import Similarity2D
-from pcmapq.evaluation.inputs import MAP_CROP, TRUTH_CROP, min_hits, plan_points
+from pcmapq.evaluation.inputs import MAP_CROP, TRUTH_CROP, min_hits, plan_points, registered_in_3d
 from pcmapq.evaluation.same_place import OVERSIZE, overlap, refusal, verdict
 from pcmapq.evaluation.truth import PreparedTruth
 from pcmapq.features import Features
@@ -166,9 +166,8 @@ def align_clouds_3d(source: OccupancyMap | PointMap, truth: OccupancyMap | Point
     in 3D first; returns the map moved into the truth frame and the registration. ``plan``: the
     truth's plan and its points prepared for the 2D search, for the registration's second
     guess (:mod:`pcmapq.align.plan_guess`) where its global search fits the map poorly."""
-    both_3d = all(isinstance(s, PointMap) and s.is_3d for s in (source, truth))
     option = settings.alignment
-    if not (both_3d and option.enabled and option.init is None and not option.scale):
+    if not registered_in_3d(source, truth, settings):
         return source, None
 
     def second() -> np.ndarray | None:

@@ -6,7 +6,7 @@ AWD and SCS, and structures), gathered in a
 
 from __future__ import annotations
 
-from concurrent.futures import ThreadPoolExecutor
+from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import replace
 from pathlib import Path
 
@@ -20,9 +20,9 @@ from pcmapq.core.frames import Frames
 from pcmapq.core.grid import MetricGrid
 from pcmapq.evaluation.noref_figures import EarlyFigures, input_figures
 from pcmapq.evaluation.placing import Placed, Progress
-from pcmapq.evaluation.truth import FEATURE_THREADS, PreparedTruth
+from pcmapq.evaluation.truth import FEATURE_THREADS, PreparedTruth, plane_params
 from pcmapq.features import Features, SideBySide, default_params
-from pcmapq.features.planes3d import PlaneParams
+from pcmapq.features.planes3d import Planes
 from pcmapq.features.rooms import Params as RoomParams
 from pcmapq.features.rooms import drawn, share_inside
 from pcmapq.io import OccupancyMap, PointMap
@@ -73,7 +73,8 @@ def score(placed: Placed, prepared: PreparedTruth, settings: Settings,
             progress("3D structures")
             structures_job = pool.submit(structures_3d, truth.points, side.source.points,
                                          settings.structures,
-                                         last_reach(settings.alignment.voxel_3d))
+                                         last_reach(settings.alignment.voxel_3d),
+                                         prepared.planes)
         if placed.features is None:
             progress("drawing the walls' centre lines and detecting features")
             sides = SideBySide(settings.matching.detectors, settings.matching.params)
@@ -144,14 +145,16 @@ def recorded_settings(settings: Settings, map_3d: bool, structures: bool) -> dic
 
 
 def structures_3d(truth: np.ndarray, map_: np.ndarray, option: StructuresConfig,
-                  reach: float | None = None) -> Structures3D:
+                  reach: float | None = None,
+                  truth_planes: Future[Planes] | None = None) -> Structures3D:
     """The 3D structures of two clouds (N, 3), both in the truth frame, metres, found and
     matched with ``option`` (:func:`~pcmapq.match.structures.compare_structures`), the map's
     moved by the planes' own fit when it moves none more than ``reach`` metres (the 3D
-    registration's last ICP correspondence distance; None: whatever it moves)."""
-    return compare_structures(truth, map_, PlaneParams(option.voxel, option.min_points,
-                                                       option.min_area),
-                              option.line_margin, option.max_angle, option.max_offset, reach)
+    registration's last ICP correspondence distance; None: whatever it moves).
+    ``truth_planes``: the job finding the truth's planes with ``option`` (None: found here)."""
+    return compare_structures(truth, map_, plane_params(option), option.line_margin,
+                              option.max_angle, option.max_offset, reach,
+                              None if truth_planes is None else truth_planes.result())
 
 
 def inside(features: Features, area: np.ndarray, grid: MetricGrid,

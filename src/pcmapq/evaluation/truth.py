@@ -14,12 +14,21 @@ from pcmapq.align.planar import RigidTarget
 from pcmapq.core import memory
 from pcmapq.core.frames import Levelling
 from pcmapq.core.grid import MetricGrid
-from pcmapq.evaluation.inputs import MAP_CROP, TRUTH_CROP, plan_points, truth_cells, truth_grid
+from pcmapq.core.priority import lower_priority
+from pcmapq.evaluation.inputs import (
+    MAP_CROP,
+    TRUTH_CROP,
+    plan_points,
+    registered_in_3d,
+    truth_cells,
+    truth_grid,
+)
 from pcmapq.features import Features, SideBySide
+from pcmapq.features.planes3d import PlaneParams, Planes, find_planes
 from pcmapq.io import OccupancyMap, PointMap
 from pcmapq.io.extent import check_span, hint
 from pcmapq.metrics.distances import DistanceField, nearest_distance
-from pcmapq.settings import Settings
+from pcmapq.settings import Settings, StructuresConfig
 
 #: Threads that find a truth's features when nothing else runs beside them.
 FEATURE_THREADS = 2
@@ -33,7 +42,9 @@ class PreparedTruth:
     background thread), ``to_truth``: each cell's distance to the nearest truth wall, metres;
     ``aligner``: its points prepared for the rigid alignment; ``maps``: how many maps may be
     scored on its grid at once in the memory allowed; ``sides``: the detectors' runner (to
-    stop a background job whose map is refused)."""
+    stop a background job whose map is refused); ``planes``: the job finding a 3D cloud
+    truth's planes for the 3D structures (:func:`plane_params`), or None (found with the
+    map's)."""
 
     source: OccupancyMap | PointMap
     xy: np.ndarray
@@ -45,6 +56,7 @@ class PreparedTruth:
     aligner: RigidTarget | None = None
     maps: int = 1
     sides: SideBySide | None = None
+    planes: Future[Planes] | None = None
 
     @property
     def features(self) -> dict[str, Features]:
@@ -52,9 +64,12 @@ class PreparedTruth:
         return self.found.result() if isinstance(self.found, Future) else self.found
 
     def cancel(self) -> None:
-        """Stop the background feature job, if any (its map was refused or failed)."""
+        """Stop the background jobs, if any (their map was refused or failed): the features
+        between two detectors, the planes unless already started."""
         if self.sides is not None:
             self.sides.cancel()
+        if self.planes is not None:
+            self.planes.cancel()
 
 
 def prepare_truth(truth: OccupancyMap | PointMap, settings: Settings,
@@ -68,7 +83,10 @@ def prepare_truth(truth: OccupancyMap | PointMap, settings: Settings,
     default) is kept as ``PreparedTruth.maps``; InputError (one line) when none fits.
     loaded: inputs held in memory beside the truth (``eval``'s map), counted in the estimate.
     background: find the features on a thread of their own while the caller places its map
-    (:meth:`PreparedTruth.features` waits for them); otherwise here, on two threads."""
+    (:meth:`PreparedTruth.features` waits for them), and after them a 3D cloud truth's planes
+    when a 3D cloud map is to be registered to it with its structures found (the map's 3D
+    registration leaves a core free: :mod:`pcmapq.align.refine3d`); otherwise the features
+    here, on two threads."""
     check_span(truth, TRUTH_CROP)
     for source in loaded:
         check_span(source, MAP_CROP)
@@ -86,16 +104,26 @@ def prepare_truth(truth: OccupancyMap | PointMap, settings: Settings,
                  or memory_advice((*loaded, truth), grid, least, limit))
     occupied = truth_cells(truth, xy, grid, settings)
     sides = SideBySide(settings.matching.detectors, settings.matching.params)
+    option = settings.alignment
+    planes = None
     if background:
-        pool = ThreadPoolExecutor(1)
+        pool = ThreadPoolExecutor(1, initializer=lower_priority)
         found: dict[str, Features] | Future = pool.submit(sides.features, occupied, grid)
-        pool.shutdown(wait=False)  # its thread ends with the job
+        if settings.structures.enabled and \
+                any(registered_in_3d(source, truth, settings) for source in loaded):
+            planes = pool.submit(find_planes, truth.points, plane_params(settings.structures))
+        pool.shutdown(wait=False)  # its thread ends with the jobs
     else:
         found = sides.features(occupied, grid, threads=FEATURE_THREADS)
-    option = settings.alignment
     aligner = RigidTarget(xy, option.params) if option.enabled and not option.scale else None
     return PreparedTruth(truth, xy, level, grid, occupied, found, nearest_distance(occupied, grid),
-                         aligner, fits[0] if fits else least, sides)
+                         aligner, fits[0] if fits else least, sides, planes)
+
+
+def plane_params(option: StructuresConfig) -> PlaneParams:
+    """The parameters the 3D structures' planes are found with."""
+    return PlaneParams(option.voxel, option.min_points, option.min_area)
+
 
 
 def _sizes(inputs: Sequence[OccupancyMap | PointMap],

@@ -176,16 +176,21 @@ def match_structures(name: str, truth: Planes | Lines, map_: Planes | Lines,
 
 def compare_structures(truth_points: np.ndarray, map_points: np.ndarray, params: PlaneParams,
                        line_margin: float, max_angle: float, max_offset: float,
-                       reach: float | None = None) -> Structures3D:
+                       reach: float | None = None,
+                       truth_planes: Planes | None = None) -> Structures3D:
     """The planes and plane lines of two clouds (N, 3), both in the truth frame, metres,
     found with ``params`` (lines: extents touching within ``line_margin`` metres, at least as
     long as the side of the smallest plane, ``sqrt(params.min_area)``) and matched
     with ``max_angle`` degrees and ``max_offset`` metres, the map's planes moved first by the
     planes' own fit (:mod:`pcmapq.match.plane_fit`) to the planes matched so, when it moves
-    none more than ``reach`` metres (None: whatever it moves). The two clouds' planes are found
-    on two threads at once (NumPy and SciPy's work leaves Python's lock)."""
-    with ThreadPoolExecutor(2, thread_name_prefix="pcmapq-planes") as pool:
-        truth, found = pool.map(find_planes, (truth_points, map_points), (params, params))
+    none more than ``reach`` metres (None: whatever it moves). ``truth_planes``: the truth's
+    planes when already found with ``params`` (None: found here). The two clouds' planes are
+    found on two threads at once (NumPy and SciPy's work leaves Python's lock)."""
+    if truth_planes is not None:
+        truth, found = truth_planes, find_planes(map_points, params)
+    else:
+        with ThreadPoolExecutor(2, thread_name_prefix="pcmapq-planes") as pool:
+            truth, found = pool.map(find_planes, (truth_points, map_points), (params, params))
     first = match_structures("planes", truth, found, max_angle, max_offset)
     fit = plane_fit(truth, found, first.truth_idx, first.map_idx, reach)
     planes = [truth, moved(found, fit.matrix)]

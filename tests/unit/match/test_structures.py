@@ -114,3 +114,18 @@ def test_the_structures_are_the_same_from_run_to_run(truth):
         for field in ("truth_idx", "map_idx", "displacement", "angle"):
             np.testing.assert_array_equal(getattr(one.matching, field),
                                           getattr(two.matching, field))
+
+
+def test_the_truths_planes_found_beforehand_give_the_same_structures(truth):
+    """An evaluation finds a 3D truth's planes while its map registers: the same planes, so
+    the same matches, as when both clouds' planes are found together."""
+    moved = b.cloud(b.changed(b.faces(b_end=b.B_END + 0.3), {"A.floor": 0.05}), seed=2)
+    together = compared(truth, moved)
+    before = compare_structures(truth, moved, PlaneParams(), MARGIN, ANGLE, OFFSET,
+                                truth_planes=find_planes(truth, PlaneParams()))
+    for name in ("planes", "plane_lines"):
+        one, two = together.detectors[name], before.detectors[name]
+        assert len(one.truth) == len(two.truth) > 0
+        for field in ("truth_idx", "map_idx", "displacement", "angle"):
+            np.testing.assert_array_equal(getattr(one.matching, field),
+                                          getattr(two.matching, field))
