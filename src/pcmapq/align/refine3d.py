@@ -12,24 +12,19 @@ small_gicp over Open3D's ICP: repeatable without holding Open3D to one thread, a
 the reference poses (docs/benchmarks.md, "Choices behind the code").
 
 small_gicp holds Python's lock while it registers, so no other thread of the process runs
-meanwhile. Clouds of CHILD_POINTS or more are therefore refined in a child process (this
-module run as ``python -m pcmapq.align.refine3d``, the clouds passed on its standard input):
-the same steps on the same numbers, so the same transform bit for bit, while the evaluation's
-other threads (the truth's figures) go on beside it.
+meanwhile. Clouds of CHILD_POINTS or more (all stages' clouds counted) are therefore refined
+in a child process (:mod:`pcmapq.core.child`): the same transform bit for bit, while the
+evaluation's other threads (the truth's figures) go on beside it.
 """
 
 from __future__ import annotations
 
 import os
-import pickle
-import subprocess
-import sys
-from pathlib import Path
 
 import numpy as np
 import small_gicp
 
-from pcmapq.core.errors import EvaluationError
+from pcmapq.core.child import CHILD_POINTS, in_child
 from pcmapq.core.voxels import voxel_centroids
 
 __all__ = ["last_reach", "refine"]
@@ -45,10 +40,6 @@ NORMAL_NEIGHBOURS = 20
 #: Threads that build a target's KD-tree and normals: the registration holds Python's lock
 #: meanwhile, so the pipeline's other threads leave the cores to it.
 PREPARE_THREADS = os.cpu_count() or 1
-#: Source and target points, all ICP stages' clouds counted, from which the ICP runs in a child
-#: process (smaller clouds take less time to refine than a process takes to start).
-CHILD_POINTS = 200_000
-
 Levels = dict[float, tuple[np.ndarray, np.ndarray]]
 
 
@@ -66,7 +57,7 @@ def refine(source: np.ndarray, target: np.ndarray, guess: np.ndarray, voxel: flo
                              voxel_centroids(target, voxel * units))
     guess = np.asarray(guess, dtype=np.float64)
     if sum(len(src) + len(tgt) for src, tgt in levels.values()) >= CHILD_POINTS:
-        return _in_child(levels, guess, voxel)
+        return in_child("the 3D ICP", _stages, levels, guess, voxel)
     return _stages(levels, guess, voxel)
 
 
@@ -86,22 +77,6 @@ def _stages(levels: Levels, guess: np.ndarray, voxel: float) -> np.ndarray:
     return transform
 
 
-def _in_child(levels: Levels, guess: np.ndarray, voxel: float) -> np.ndarray:
-    """:func:`_stages` run by ``python -m pcmapq.align.refine3d``: its arguments pickled to the
-    child's standard input, the transform back from its standard output."""
-    package_root = str(Path(__file__).resolve().parents[2])  # the pcmapq this one is
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join(
-        [package_root, *filter(None, [os.environ.get("PYTHONPATH")])]))
-    done = subprocess.run([sys.executable, "-m", __name__],
-                          input=pickle.dumps((levels, guess, voxel), protocol=5),
-                          capture_output=True, env=env, check=False)
-    if done.returncode != 0:
-        lines = done.stderr.decode(errors="replace").strip().splitlines()
-        raise EvaluationError("the 3D ICP's process failed (exit code "
-                              f"{done.returncode}){': ' + lines[-1] if lines else ''}")
-    return pickle.loads(done.stdout)
-
-
 def last_reach(voxel: float) -> float:
     """How far apart a source and a target point may be to pair in the last ICP stage,
     metres, at the working resolution ``voxel`` (metres)."""
@@ -118,6 +93,3 @@ def _prepared(source: np.ndarray, target: np.ndarray
                                 num_threads=PREPARE_THREADS)
     return src, tgt, tree
 
-
-if __name__ == "__main__":  # the child of _in_child: arguments on stdin, transform on stdout
-    sys.stdout.buffer.write(pickle.dumps(_stages(*pickle.load(sys.stdin.buffer)), protocol=5))

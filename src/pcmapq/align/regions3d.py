@@ -7,8 +7,10 @@ shows what a plan cannot.
 Regions are square tiles of the truth's ground plane. Each region's own map points (at
 ``voxel``) are registered by small_gicp's point-to-plane ICP, seeded at identity (the global
 pose), on one thread, against the truth's points within the tile grown by the widest pairing
-distance on every side, coarse to fine. Frame: the truth cloud levelled as its plan is (x, y the
-truth's plan, the 2D consistency map's frame; z up), metres and degrees. ``offset`` is the map's
+distance on every side, coarse to fine; from CHILD_POINTS points (both clouds at ``voxel``) in a
+child process (:mod:`pcmapq.core.child`: small_gicp holds Python's lock while it registers).
+Frame: the truth cloud levelled as its plan is (x, y the truth's plan, the 2D consistency map's
+frame; z up), metres and degrees. ``offset`` is the map's
 error there: where the map (as the global registration placed it) has the region's centroid,
 from where the region fits the truth on its own (a map that sank has dz < 0); roll, pitch and
 yaw are the region's turn about x, y and z from its fit, the same way round.
@@ -29,6 +31,7 @@ import small_gicp
 from scipy.spatial import cKDTree
 from scipy.spatial.transform import Rotation
 
+from pcmapq.core.child import CHILD_POINTS, in_child
 from pcmapq.core.transform import affine
 from pcmapq.core.voxels import voxel_centroids
 
@@ -146,24 +149,11 @@ def _pinned(hessian: np.ndarray, half_side: float) -> float:
     return float(np.linalg.eigvalsh(hessian / np.outer(scale, scale))[0])
 
 
-def regions_3d(map_xyz: np.ndarray, truth_xyz: np.ndarray, *, tile_m: float = TILE_M,
-               voxel: float = 0.3, level: np.ndarray | None = None) -> Consistency3D:
-    """The regions of the map ``map_xyz`` (N, 3, already in the truth cloud's frame), each
-    registered on its own to ``truth_xyz`` (M, 3), metres.
-
-    tile_m: a tile's side, metres (grown so that the map spans at most MAX_TILES tiles).
-    voxel: both clouds are taken at this voxel (centroids), metres; the pairing distances
-    scale with it (STAGES) and a point fits within half of it. level: the truth's levelling
-    rotation (3x3), applied to both first, so that tiles lie on its ground and dz is
-    vertical; None: the truth frame as it is. Deterministic."""
+def _rows(placed: np.ndarray, truth: np.ndarray, tile_m: float, voxel: float) -> list[tuple]:
+    """One row per region of ``placed`` (N, 3, levelled truth frame, at ``voxel`` metres) in
+    tiles of ``tile_m`` metres, registered on its own to ``truth`` (M, 3, the same): its
+    centroid, offset, turn (degrees), points, fit before and after, and whether it is held."""
     tolerance = voxel / 2
-    # the centroids of a large cloud are streamed (any float type, a file mapped into memory
-    # read in chunks): no copy of all its points is made
-    placed = levelled(voxel_centroids(np.asarray(map_xyz), voxel), level)
-    truth = levelled(voxel_centroids(np.asarray(truth_xyz), voxel), level)
-    if len(placed) == 0 or len(truth) < NORMAL_NEIGHBOURS:
-        return Consistency3D.empty(tile_m, voxel, tolerance)
-    tile_m = max(tile_m, float(np.ptp(placed[:, :2], axis=0).max()) / MAX_TILES)
     keys = np.floor(placed[:, :2] / tile_m).astype(np.int64)
     tiles, inverse, counts = np.unique(keys, axis=0, return_inverse=True, return_counts=True)
     order = np.argsort(inverse.ravel(), kind="stable")
@@ -190,6 +180,30 @@ def regions_3d(map_xyz: np.ndarray, truth_xyz: np.ndarray, *, tile_m: float = TI
         held = _pinned(hessian, tile_m / 2) >= MIN_INFORMATION and fit_after >= MIN_FIT
         rows.append((*centre, *-move[:3, 3], *angles, len(own),
                      float(np.isfinite(before).mean()), fit_after, held))
+    return rows
+
+
+def regions_3d(map_xyz: np.ndarray, truth_xyz: np.ndarray, *, tile_m: float = TILE_M,
+               voxel: float = 0.3, level: np.ndarray | None = None) -> Consistency3D:
+    """The regions of the map ``map_xyz`` (N, 3, already in the truth cloud's frame), each
+    registered on its own to ``truth_xyz`` (M, 3), metres.
+
+    tile_m: a tile's side, metres (grown so that the map spans at most MAX_TILES tiles).
+    voxel: both clouds are taken at this voxel (centroids), metres; the pairing distances
+    scale with it (STAGES) and a point fits within half of it. level: the truth's levelling
+    rotation (3x3), applied to both first, so that tiles lie on its ground and dz is
+    vertical; None: the truth frame as it is. Deterministic."""
+    tolerance = voxel / 2
+    # the centroids of a large cloud are streamed (any float type, a file mapped into memory
+    # read in chunks): no copy of all its points is made
+    placed = levelled(voxel_centroids(np.asarray(map_xyz), voxel), level)
+    truth = levelled(voxel_centroids(np.asarray(truth_xyz), voxel), level)
+    if len(placed) == 0 or len(truth) < NORMAL_NEIGHBOURS:
+        return Consistency3D.empty(tile_m, voxel, tolerance)
+    tile_m = max(tile_m, float(np.ptp(placed[:, :2], axis=0).max()) / MAX_TILES)
+    work = (placed, truth, tile_m, voxel)
+    rows = in_child("the 3D consistency map", _rows, *work) \
+        if len(placed) + len(truth) >= CHILD_POINTS else _rows(*work)
     if not rows:
         return Consistency3D.empty(tile_m, voxel, tolerance)
     # to the micrometre (and 1e-6 of a share or degree), as results are saved: the figures

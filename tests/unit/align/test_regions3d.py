@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from pcmapq.align import regions3d
 from pcmapq.align.regions3d import Consistency3D, regions_3d
 from testkit.street import street, sunk, tilted
 
@@ -95,6 +96,20 @@ def test_repeatable(truth, scan, sank):
     a, b = sank, regions_3d(sunk(scan, 10.0, 0.3), truth, tile_m=TILE, voxel=VOXEL)
     for name in ("centre", "offset", "angles_deg", "fit_before", "fit_after", "held"):
         np.testing.assert_array_equal(getattr(a, name), getattr(b, name))
+
+
+def test_a_large_maps_regions_registered_in_a_child_process_are_the_same(
+        monkeypatch, truth, scan, sank):
+    """Clouds of CHILD_POINTS or more are registered in a child process: the same regions,
+    bit for bit."""
+    calls, real = [], regions3d.in_child
+    monkeypatch.setattr(regions3d, "CHILD_POINTS", 0)
+    monkeypatch.setattr(regions3d, "in_child",
+                        lambda what, *call: calls.append(what) or real(what, *call))
+    b = regions_3d(sunk(scan, 10.0, 0.3), truth, tile_m=TILE, voxel=VOXEL)
+    assert calls == ["the 3D consistency map"]
+    for name in ("centre", "offset", "angles_deg", "fit_before", "fit_after", "held"):
+        np.testing.assert_array_equal(getattr(sank, name), getattr(b, name))
 
 
 def test_a_long_map_gets_larger_tiles():
