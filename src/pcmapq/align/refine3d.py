@@ -25,7 +25,6 @@ import numpy as np
 import small_gicp
 
 from pcmapq.core.child import CHILD_POINTS, in_child
-from pcmapq.core.voxels import voxel_centroids
 
 __all__ = ["last_reach", "refine"]
 
@@ -40,6 +39,7 @@ NORMAL_NEIGHBOURS = 20
 #: Threads that build a target's KD-tree and normals: the registration holds Python's lock
 #: meanwhile, so the pipeline's other threads leave the cores to it.
 PREPARE_THREADS = os.cpu_count() or 1
+
 Levels = dict[float, tuple[np.ndarray, np.ndarray]]
 
 
@@ -50,6 +50,10 @@ def refine(source: np.ndarray, target: np.ndarray, guess: np.ndarray, voxel: flo
     source (N, 3), target (M, 3): the whole clouds, metres; coarse: both already downsampled
     at ``voxel`` (metres, the working resolution).
     """
+    # imported here: the child process that runs _stages imports this module, and starts
+    # sooner with NumPy and small_gicp alone (SciPy and Numba come with the voxels)
+    from pcmapq.core.voxels import voxel_centroids
+
     levels: Levels = {1.0: coarse}
     for _, units in ICP_STAGES:
         if units not in levels:
