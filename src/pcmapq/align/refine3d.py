@@ -96,4 +96,3 @@ def _prepared(source: np.ndarray, target: np.ndarray
     small_gicp.estimate_normals(tgt, tree, num_neighbors=NORMAL_NEIGHBOURS,
                                 num_threads=PREPARE_THREADS)
     return src, tgt, tree
-

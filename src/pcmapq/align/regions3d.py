@@ -10,10 +10,10 @@ pose), on one thread, against the truth's points within the tile grown by the wi
 distance on every side, coarse to fine; from CHILD_POINTS points (both clouds at ``voxel``) in a
 child process (:mod:`pcmapq.core.child`: small_gicp holds Python's lock while it registers).
 Frame: the truth cloud levelled as its plan is (x, y the truth's plan, the 2D consistency map's
-frame; z up), metres and degrees. ``offset`` is the map's
-error there: where the map (as the global registration placed it) has the region's centroid,
-from where the region fits the truth on its own (a map that sank has dz < 0); roll, pitch and
-yaw are the region's turn about x, y and z from its fit, the same way round.
+frame; z up), metres and degrees. ``offset`` is the map's error there: where the map (as the
+global registration placed it) has the region's centroid, from where the region fits the truth
+on its own (a map that sank has dz < 0); roll, pitch and yaw are the region's turn about x, y
+and z from its fit, the same way round.
 
 A region is held when the ICP's information pins all six of its degrees of freedom and it fits:
 the 6 x 6 Hessian of the point-to-plane cost at the fit, per pair and with its turns taken as

@@ -4,8 +4,8 @@ it. The function (defined at a module's top level) and its arguments are pickled
 ``python -m pcmapq.core.child``'s standard input, and its result or exception comes back on its
 standard output: the same code on the same numbers, so the same result bit for bit.
 
-Starting a child costs about half a second (its imports), so callers use one from
-CHILD_POINTS points of work.
+Starting a child costs 0.2-0.5 s (its imports: NumPy and small_gicp, SciPy too for the 3D
+consistency map), so callers use one from CHILD_POINTS points of work.
 """
 
 from __future__ import annotations
