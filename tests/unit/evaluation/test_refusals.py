@@ -14,11 +14,9 @@ import pytest
 from pcmapq.core import memory
 from pcmapq.core.errors import EvaluationError, InputError
 from pcmapq.evaluation.placing import align_clouds_3d
-from pcmapq.evaluation.truth import plane_params, prepare_truth
-from pcmapq.features.planes3d import find_planes
+from pcmapq.evaluation.truth import prepare_truth
 from pcmapq.io import PointMap
-from pcmapq.settings import AlignmentConfig, Settings, SourceConfig, StructuresConfig
-from testkit import building3d
+from pcmapq.settings import Settings, SourceConfig
 
 
 def terrain(seed: int, side: float, n: int = 20_000) -> np.ndarray:
@@ -92,26 +90,3 @@ def test_clouds_in_millimetres_that_do_not_register_are_named_with_their_unit():
     assert line.startswith("a_mm.npy against b_mm.npy: too few feature matches to register "
                            "the clouds at --voxel-3d 0.3 m; a_mm.npy: it spans 1.2e+04 x "
                            "8e+03 m: are its coordinates in millimetres or another unit?")
-
-
-@pytest.mark.parametrize(("change", "map_3d", "found"), [
-    ({}, True, True),
-    ({"structures": StructuresConfig(enabled=False)}, True, False),
-    ({"alignment": AlignmentConfig(enabled=False)}, True, False),
-    ({}, False, False),
-])
-def test_a_3d_truths_planes_are_found_beside_the_registration_only_when_wanted(
-        change, map_3d, found):
-    """The truth's planes start on the background thread only where a 3D map will be
-    registered and its structures found; they are the planes scoring would find."""
-    cloud = building3d.cloud(building3d.faces(), seed=1)
-    truth = PointMap(Path("b.npy"), cloud, True)
-    source = PointMap(Path("a.npy"), cloud if map_3d else cloud[:, :2].copy(), map_3d)
-    settings = replace(Settings(), **change)
-    prepared = prepare_truth(truth, settings, maps=(0,), loaded=(source,), background=True)
-    assert prepared.features  # the thread's first job
-    assert (prepared.planes is not None) == found
-    if found:
-        again = find_planes(cloud, plane_params(settings.structures))
-        assert len(again.normal) > 10
-        np.testing.assert_array_equal(prepared.planes.result().normal, again.normal)

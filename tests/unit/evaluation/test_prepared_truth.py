@@ -1,0 +1,38 @@
+"""The truth prepared once for any map: what it starts on its background thread."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from pcmapq.evaluation.truth import plane_params, prepare_truth
+from pcmapq.features.planes3d import find_planes
+from pcmapq.io import PointMap
+from pcmapq.settings import AlignmentConfig, Settings, StructuresConfig
+from testkit import building3d
+
+
+@pytest.mark.parametrize(("change", "map_3d", "found"), [
+    ({}, True, True),
+    ({"structures": StructuresConfig(enabled=False)}, True, False),
+    ({"alignment": AlignmentConfig(enabled=False)}, True, False),
+    ({}, False, False),
+])
+def test_a_3d_truths_planes_are_found_beside_the_registration_only_when_wanted(
+        change, map_3d, found):
+    """The truth's planes start on the background thread only where a 3D map will be
+    registered and its structures found; they are the planes scoring would find."""
+    cloud = building3d.cloud(building3d.faces(), seed=1)
+    truth = PointMap(Path("b.npy"), cloud, True)
+    source = PointMap(Path("a.npy"), cloud if map_3d else cloud[:, :2].copy(), map_3d)
+    settings = replace(Settings(), **change)
+    prepared = prepare_truth(truth, settings, maps=(0,), loaded=(source,), background=True)
+    assert prepared.features  # the thread's first job
+    assert (prepared.planes is not None) == found
+    if found:
+        again = find_planes(cloud, plane_params(settings.structures))
+        assert len(again.normal) > 10
+        np.testing.assert_array_equal(prepared.planes.result().normal, again.normal)
