@@ -8,9 +8,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from pcmapq.core.unused import leave_out_unused
 from testkit import synth
 from testkit.files import write_image_map
 from testkit.paths import SAMPLE
+
+leave_out_unused()  # the test processes as the command's: Open3D without IPython
 
 
 @pytest.fixture(autouse=True)

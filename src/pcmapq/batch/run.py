@@ -17,6 +17,7 @@ from pathlib import Path
 from pcmapq.batch.manifest import Row
 from pcmapq.batch.row import RECORDS, Outcome, Task, failed, run_row
 from pcmapq.core.errors import InputError
+from pcmapq.core.unused import leave_out_unused
 from pcmapq.io.writers import one_line
 from pcmapq.report.summary import write_summary
 from pcmapq.results import gates
@@ -33,7 +34,8 @@ LOCAL_ROUNDS = 2
 def run_local(tasks: list[Task], workers: int,
               done: Callable[[Outcome], None] = lambda o: None,
               rules: tuple[Gate, ...] | list[Gate] = ()) -> list[Outcome]:
-    """Run the tasks on ``workers`` local processes (spawned); the outcomes in task order.
+    """Run the tasks on ``workers`` local processes (spawned, without the modules pcmapq never
+    uses: :mod:`~pcmapq.core.unused`); the outcomes in task order.
     When a worker process dies (killed, out of memory), the unfinished rows run again in a
     new pool, :data:`LOCAL_ROUNDS` times at most, then are recorded as failed (exit 1)."""
     outcomes: list[Outcome | None] = [None] * len(tasks)
@@ -41,8 +43,8 @@ def run_local(tasks: list[Task], workers: int,
     context = multiprocessing.get_context("spawn")
     for _ in range(LOCAL_ROUNDS):
         broken: list[int] = []
-        with ProcessPoolExecutor(max(1, min(workers, len(pending))),
-                                 mp_context=context) as pool:
+        with ProcessPoolExecutor(max(1, min(workers, len(pending))), mp_context=context,
+                                 initializer=leave_out_unused) as pool:
             futures = {pool.submit(run_row, tasks[i]): i for i in pending}
             try:
                 for future in as_completed(futures):

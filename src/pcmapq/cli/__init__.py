@@ -17,6 +17,8 @@ import os
 import sys
 from typing import Any
 
+from pcmapq.core.unused import leave_out_unused
+
 __all__ = ["MODULES", "app", "main"]
 
 #: Arguments answered by :func:`~pcmapq.cli.base.listing_app` alone.
@@ -25,11 +27,6 @@ LISTING = ([], ["--help"], ["-h"], ["--version"])
 #: normal equations, batched 2 x 2 and 3 x 3 fits), where more threads only spin beside the
 #: pipeline's own threads (docs/benchmarks.md). Set before NumPy loads; the user's value wins.
 BLAS_THREADS = "1"
-#: Modules the command never uses that a library it loads would import when installed, marked
-#: absent for the command's process: Open3D loads Dash, whose notebook support loads IPython,
-#: a noticeable part of a short run's start (Dash carries on without it). The library, imported
-#: in the user's own process, is left alone.
-UNUSED = ("IPython",)
 #: Each command's module in pcmapq.cli, in the order ``pcmapq --help`` lists them
 #: (:data:`~pcmapq.cli.base.HELP`).
 MODULES = {"eval": "evaluate", "map": "map_scans", "inspect": "inspect", "compare": "compare",
@@ -54,8 +51,7 @@ def main() -> None:
     its own imports only); anything else: the whole application."""
     args = sys.argv[1:]
     os.environ.setdefault("OPENBLAS_NUM_THREADS", BLAS_THREADS)
-    for name in UNUSED:
-        sys.modules.setdefault(name, None)  # type: ignore[arg-type]  # import raises ImportError
+    leave_out_unused()  # modules the command never uses (IPython, which Open3D's Dash loads)
     try:
         if args in LISTING:
             from pcmapq.cli.base import listing_app
