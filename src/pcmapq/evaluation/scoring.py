@@ -151,10 +151,14 @@ def structures_3d(truth: np.ndarray, map_: np.ndarray, option: StructuresConfig,
     matched with ``option`` (:func:`~pcmapq.match.structures.compare_structures`), the map's
     moved by the planes' own fit when it moves none more than ``reach`` metres (the 3D
     registration's last ICP correspondence distance; None: whatever it moves).
-    ``truth_planes``: the job finding the truth's planes with ``option`` (None: found here)."""
+    ``truth_planes``: the job finding the truth's planes with ``option`` (None: found here);
+    a job that has not started (its thread still on the truth's features) is cancelled and the
+    planes found here, beside the map's, rather than waited for."""
+    early = None
+    if truth_planes is not None and not truth_planes.cancel():  # running or done
+        early = truth_planes.result()
     return compare_structures(truth, map_, plane_params(option), option.line_margin,
-                              option.max_angle, option.max_offset, reach,
-                              None if truth_planes is None else truth_planes.result())
+                              option.max_angle, option.max_offset, reach, early)
 
 
 def inside(features: Features, area: np.ndarray, grid: MetricGrid,

@@ -36,3 +36,35 @@ def test_a_3d_truths_planes_are_found_beside_the_registration_only_when_wanted(
         again = find_planes(cloud, plane_params(settings.structures))
         assert len(again.normal) > 10
         np.testing.assert_array_equal(prepared.planes.result().normal, again.normal)
+
+
+def test_truth_planes_not_yet_started_are_found_by_scoring_not_waited_for():
+    """Scoring reached before the truth's thread starts its planes (still on the truth's
+    features) cancels that job and finds the planes beside the map's: the same structures as
+    with the planes found beforehand, and no wait for a job that would start later."""
+    from concurrent.futures import Future, ThreadPoolExecutor
+
+    from pcmapq.evaluation.scoring import structures_3d
+
+    truth = building3d.cloud(building3d.faces(), seed=1)
+    moved = building3d.moved_map()
+    option = StructuresConfig()
+    done: Future = Future()
+    done.set_result(find_planes(truth, plane_params(option)))
+    pending: Future = Future()  # never started: waiting for it would never end
+    pool = ThreadPoolExecutor(1)
+    job = pool.submit(structures_3d, truth, moved, option, None, pending)
+    try:
+        late = job.result(timeout=60)
+    finally:
+        if not pending.done():  # the job is waiting for it: let it end
+            pending.set_result(done.result())
+        pool.shutdown()
+    assert pending.cancelled()
+    early = structures_3d(truth, moved, option, None, done)
+    for name in ("planes", "plane_lines"):
+        one, two = late.detectors[name], early.detectors[name]
+        assert len(one.truth) == len(two.truth) > 0
+        for field in ("truth_idx", "map_idx", "displacement", "angle"):
+            np.testing.assert_array_equal(getattr(one.matching, field),
+                                          getattr(two.matching, field))
