@@ -173,6 +173,31 @@ def test_an_evaluation_loads_open3d_but_not_ipython(tmp_path):
     assert json.loads((tmp_path / "r.json").read_text())["detectors"]
 
 
+#: In a fresh process: the unused modules left out, then Open3D loaded and used.
+UNUSED_LEFT_OUT = """
+import sys
+from pcmapq.core.unused import leave_out_unused
+leave_out_unused()
+import open3d
+print(open3d.geometry.PointCloud().is_empty(), sorted(n for n in {names!r} if sys.modules.get(n)))
+"""
+
+
+def test_open3d_loads_without_the_unused_modules():
+    """What the command, its batch workers and the test processes do
+    (:func:`~pcmapq.core.unused.leave_out_unused`): Open3D loads and works without them."""
+    from importlib.machinery import PathFinder
+
+    from pcmapq.core.unused import UNUSED
+
+    if not any(PathFinder.find_spec(name) for name in UNUSED):
+        pytest.skip("none of the unused modules is installed here: there is nothing to leave out")
+    got = subprocess.run([sys.executable, "-c", UNUSED_LEFT_OUT.format(names=UNUSED)],
+                         capture_output=True, text=True, timeout=120)
+    assert got.returncode == 0, got.stderr
+    assert got.stdout.split() == ["True", "[]"], got.stdout
+
+
 #: Asks the OpenBLAS that NumPy loaded how many threads it runs, in a process that ran a command.
 BLAS_THREADS = """
 import ctypes, os, re, sys
