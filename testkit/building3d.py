@@ -212,3 +212,14 @@ def known_structures():
     from pcmapq.settings import StructuresConfig
 
     return structures_3d(cloud(faces(), seed=1), moved_map(), StructuresConfig())
+
+
+def assert_same_matches(one, two) -> None:
+    """Two :class:`~pcmapq.match.structures.Structures3D` with truth structures whose planes and
+    plane lines match alike, field by field."""
+    for name in ("planes", "plane_lines"):
+        first, second = one.detectors[name], two.detectors[name]
+        assert len(first.truth) == len(second.truth) > 0
+        for field in ("truth_idx", "map_idx", "displacement", "angle"):
+            np.testing.assert_array_equal(getattr(first.matching, field),
+                                          getattr(second.matching, field))

@@ -61,10 +61,4 @@ def test_truth_planes_not_yet_started_are_found_by_scoring_not_waited_for():
             pending.set_result(done.result())
         pool.shutdown()
     assert pending.cancelled()
-    early = structures_3d(truth, moved, option, None, done)
-    for name in ("planes", "plane_lines"):
-        one, two = late.detectors[name], early.detectors[name]
-        assert len(one.truth) == len(two.truth) > 0
-        for field in ("truth_idx", "map_idx", "displacement", "angle"):
-            np.testing.assert_array_equal(getattr(one.matching, field),
-                                          getattr(two.matching, field))
+    building3d.assert_same_matches(late, structures_3d(truth, moved, option, None, done))

@@ -108,12 +108,7 @@ def test_a_truth_without_structures_has_nothing_to_find(truth):
 
 def test_the_structures_are_the_same_from_run_to_run(truth):
     moved = b.cloud(b.changed(b.faces(b_end=b.B_END + 0.3), {"A.floor": 0.05}), seed=2)
-    first, again = compared(truth, moved), compared(truth, moved)
-    for name in ("planes", "plane_lines"):
-        one, two = first.detectors[name], again.detectors[name]
-        for field in ("truth_idx", "map_idx", "displacement", "angle"):
-            np.testing.assert_array_equal(getattr(one.matching, field),
-                                          getattr(two.matching, field))
+    b.assert_same_matches(compared(truth, moved), compared(truth, moved))
 
 
 def test_the_truths_planes_found_beforehand_give_the_same_structures(truth):
@@ -123,9 +118,4 @@ def test_the_truths_planes_found_beforehand_give_the_same_structures(truth):
     together = compared(truth, moved)
     before = compare_structures(truth, moved, PlaneParams(), MARGIN, ANGLE, OFFSET,
                                 truth_planes=find_planes(truth, PlaneParams()))
-    for name in ("planes", "plane_lines"):
-        one, two = together.detectors[name], before.detectors[name]
-        assert len(one.truth) == len(two.truth) > 0
-        for field in ("truth_idx", "map_idx", "displacement", "angle"):
-            np.testing.assert_array_equal(getattr(one.matching, field),
-                                          getattr(two.matching, field))
+    b.assert_same_matches(together, before)
