@@ -104,6 +104,33 @@ def test_a_large_cloud_s_figures_wait_for_its_walls(tmp_path, monkeypatch):
     assert not stopped._thread.is_alive() and not stopped._figures
 
 
+def test_the_sides_the_thread_has_not_started_are_found_by_the_caller(tmp_path, monkeypatch):
+    """Scoring, free before the figures' thread has started a side, finds that side itself
+    (:meth:`EarlyFigures.help`): each side found once, the figures those found at once."""
+    import threading
+
+    held = threading.Event()
+    monkeypatch.setattr(early_figures, "lower_priority", held.wait)  # the thread waits here
+    calls: list[str] = []
+    found = early_figures.input_figures
+
+    def counted(source, config):
+        calls.append(threading.current_thread().name)
+        return found(source, config)
+
+    monkeypatch.setattr(early_figures, "input_figures", counted)
+    sides = {"map": PointMap(tmp_path / "a.ply", _box_room(8, 20_000), True),
+             "truth": PointMap(tmp_path / "b.ply", _box_room(9, 20_000), True)}
+    settings = Settings()
+    early = EarlyFigures(sides, settings)
+    early.help()
+    assert calls == [threading.current_thread().name] * 2  # both here, the thread still held
+    held.set()
+    for side, cloud in sides.items():
+        assert early.get(side) == found(cloud, settings.noref)
+    assert len(calls) == 2  # the thread, released, found nothing left to do
+
+
 def test_a_small_cloud_s_figures_start_at_once(tmp_path):
     cloud = PointMap(tmp_path / "room.ply", _box_room(8, 20_000), True)
     early = EarlyFigures({"map": cloud}, Settings())

@@ -87,23 +87,25 @@ class EarlyFigures:
     truth (whose corners the truth's own Harris features give) are left to
     :func:`input_figures` after the alignment. With a map cloud of DEFER_FROM to
     STRIPE_POINTS points the thread starts its work once :meth:`walls_found` is called (or
-    the figures are wanted)."""
+    the figures are wanted). A side the thread has not started when the caller is free
+    (:meth:`help`) is found on the caller's thread."""
 
     def __init__(self, sides: dict[str, OccupancyMap | PointMap], settings: Settings) -> None:
-        config = settings.noref
+        self._config = config = settings.noref
         self._sources = {} if not config.enabled else {
             side: source for side, source in sides.items()
             if not (side == "map" and settings.alignment.scale)
             and ((isinstance(source, PointMap) and source.is_3d)
                  or (side == "map" and isinstance(source, OccupancyMap)))}
         self._figures: dict[str, dict[str, Any]] = {}
+        self._left = list(self._sources)  # the sides no thread has started, in order
+        self._taking = threading.Lock()
         self._error: BaseException | None = None
         self._go, self._cancelled = threading.Event(), False
         cloud = sides.get("map")
         if not (isinstance(cloud, PointMap) and DEFER_FROM < len(cloud.points) <= STRIPE_POINTS):
             self._go.set()
-        self._thread = threading.Thread(target=self._run, args=(config,), daemon=True,
-                                        name="pcmapq-noref")
+        self._thread = threading.Thread(target=self._run, daemon=True, name="pcmapq-noref")
         if self._sources:
             self._thread.start()
 
@@ -121,16 +123,28 @@ class EarlyFigures:
         if self._thread.is_alive():
             self._thread.join()
 
-    def _run(self, config: NoRefConfig) -> None:
+    def help(self) -> None:
+        """Find here, on the calling thread, the figures of every side the thread has not
+        started (scoring, its own work done, waits for the rest: the figures of both sides of a
+        large pair then take two cores rather than one); the same figures, whichever thread
+        finds them."""
+        self._go.set()
+        self._work()
+
+    def _run(self) -> None:
         lower_priority()
         self._go.wait()
-        if self._cancelled:
-            return
+        self._work()
+
+    def _work(self) -> None:
+        """Find the figures of the sides left, one at a time, until none is left."""
         try:
-            for side, source in self._sources.items():
-                if self._cancelled:
-                    return
-                self._figures[side] = input_figures(source, config)
+            while not self._cancelled:
+                with self._taking:
+                    if not self._left:
+                        break
+                    side = self._left.pop(0)
+                self._figures[side] = input_figures(self._sources[side], self._config)
             release_free_memory()  # the reduction's table and chunks, freed into the heap
         except BaseException as exc:  # handed to the caller by get()
             self._error = exc

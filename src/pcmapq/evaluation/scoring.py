@@ -80,6 +80,8 @@ def score(placed: Placed, prepared: PreparedTruth, settings: Settings,
             sides = SideBySide(settings.matching.detectors, settings.matching.params)
             side = replace(placed, features=sides.features(placed.occupied, prepared.grid,
                                                            threads=FEATURE_THREADS))
+        if early is not None:  # this thread is free until the jobs end: a side's
+            early.help()  # no-reference figures their thread has not started, found here
         consistency = None if consistency_job is None else consistency_job.result()
         cloud_distances = None if cloud_job is None else cloud_job.result()
         gaussians = None if gaussians_job is None else gaussians_job.result()
