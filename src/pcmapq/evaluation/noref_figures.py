@@ -127,27 +127,30 @@ class EarlyFigures:
         """Find here, on the calling thread, the figures of every side the thread has not
         started (scoring, its own work done, waits for the rest: the figures of both sides of a
         large pair then take two cores rather than one); the same figures, whichever thread
-        finds them."""
+        finds them. An error is raised here."""
         self._go.set()
         self._work()
 
     def _run(self) -> None:
         lower_priority()
         self._go.wait()
-        self._work()
+        try:
+            self._work()
+        except BaseException as exc:  # handed to the caller by get()
+            self._error = exc
 
     def _work(self) -> None:
         """Find the figures of the sides left, one at a time, until none is left."""
-        try:
-            while not self._cancelled:
-                with self._taking:
-                    if not self._left:
-                        break
-                    side = self._left.pop(0)
-                self._figures[side] = input_figures(self._sources[side], self._config)
+        found = False
+        while not self._cancelled:
+            with self._taking:
+                if not self._left:
+                    break
+                side = self._left.pop(0)
+            self._figures[side] = input_figures(self._sources[side], self._config)
+            found = True
+        if found:
             release_free_memory()  # the reduction's table and chunks, freed into the heap
-        except BaseException as exc:  # handed to the caller by get()
-            self._error = exc
 
     def get(self, side: str) -> dict[str, Any] | None:
         """The figures of ``side`` ("map" or "truth") when found here, waiting for them; None
