@@ -4,6 +4,7 @@ of the whole cloud's, and MOM's planes come from the cloud at a third of the rad
 
 from __future__ import annotations
 
+import threading
 import time
 
 import numpy as np
@@ -107,8 +108,6 @@ def test_a_large_cloud_s_figures_wait_for_its_walls(tmp_path, monkeypatch):
 def test_the_sides_the_thread_has_not_started_are_found_by_the_caller(tmp_path, monkeypatch):
     """Scoring, free before the figures' thread has started a side, finds that side itself
     (:meth:`EarlyFigures.help`): each side found once, the figures those found at once."""
-    import threading
-
     held = threading.Event()
     monkeypatch.setattr(early_figures, "lower_priority", held.wait)  # the thread waits here
     calls: list[str] = []

@@ -156,8 +156,6 @@ def map_raster(source: OccupancyMap | PointMap, map_xy: np.ndarray, transform: S
     return occupied, footprint
 
 
-
-
 def align_clouds_3d(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap,
                     settings: Settings,
                     plan: tuple[PreparedTruth, RigidTarget] | None = None,

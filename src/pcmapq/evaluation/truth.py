@@ -125,7 +125,6 @@ def plane_params(option: StructuresConfig) -> PlaneParams:
     return PlaneParams(option.voxel, option.min_points, option.min_area)
 
 
-
 def _sizes(inputs: Sequence[OccupancyMap | PointMap],
            grid: MetricGrid) -> tuple[int, int, float, int]:
     """Image cells, grid cells, the grid's area (m^2) and cloud points of scoring on ``grid``."""

@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
+from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 import pytest
 
+from pcmapq.evaluation.scoring import structures_3d
 from pcmapq.evaluation.truth import plane_params, prepare_truth
 from pcmapq.features.planes3d import find_planes
 from pcmapq.io import PointMap
@@ -42,10 +44,6 @@ def test_truth_planes_not_yet_started_are_found_by_scoring_not_waited_for():
     """Scoring reached before the truth's thread starts its planes (still on the truth's
     features) cancels that job and finds the planes beside the map's: the same structures as
     with the planes found beforehand, and no wait for a job that would start later."""
-    from concurrent.futures import Future, ThreadPoolExecutor
-
-    from pcmapq.evaluation.scoring import structures_3d
-
     truth = building3d.cloud(building3d.faces(), seed=1)
     moved = building3d.moved_map()
     option = StructuresConfig()
