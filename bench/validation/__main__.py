@@ -1,7 +1,7 @@
 """Measure the validation on ../shared/data: print its sections, write docs/validation.md, or
 compare every case with its stored reference.
 
-    python -m bench.validation [--only SECTION] [--data DIR] [--check] [--write]
+    python -m bench.validation [--only SECTION]... [--data DIR] [--check] [--write]
         [--save-references]
 """
 
@@ -21,7 +21,8 @@ from .document import DOC, SECTIONS, write, write_one
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m bench.validation",
                                      description=__doc__.split("\n\n")[0])
-    parser.add_argument("--only", choices=SECTIONS, help="this section only")
+    parser.add_argument("--only", choices=SECTIONS, action="append",
+                        help="this section only; repeated, these sections, in this order")
     parser.add_argument("--data", type=Path, default=DATA,
                         help="the shared data folder (default: %(default)s)")
     parser.add_argument("--check", action="store_true",
@@ -38,14 +39,15 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     record: Record = {}
     sections = []
-    for name in [args.only] if args.only else SECTIONS:
+    for name in args.only or SECTIONS:
         start = time.perf_counter()
         sections.append(SECTIONS[name].section(args.data, record))
         print(f"{name}: {time.perf_counter() - start:.0f} s", file=sys.stderr, flush=True)
         if not (args.write or args.check):  # each section as soon as it is measured
             print(("\n" if len(sections) > 1 else "") + sections[-1].text, flush=True)
     if args.write and args.only:
-        write_one(args.only, sections[0])
+        for name, section in zip(args.only, sections, strict=True):
+            write_one(name, section)
     elif args.write:
         write(sections)
     if args.save_references:

@@ -70,7 +70,8 @@ def opening() -> str:
         "cores; times and memory vary with the machine and its load. "
         f"`{COMMAND}` measures and writes it "
         "again; `python -m bench.validation --only SECTION` prints one section (" + only
-        + "); `--check` runs every case and compares its figures with its stored reference "
+        + "; `--only` repeated, several); `--check` runs every case and compares its figures "
+        "with its stored reference "
         "(`tests/reference/validation/<case>.json`, numbers within 1e-6), and "
         "`tests/realdata/test_validation.py` does so for the cheap ones. How results differ "
         "from those of earlier code: [CHANGELOG.md](../CHANGELOG.md).",
