@@ -41,10 +41,13 @@ class LineTarget:
         :func:`line_normals`; none is computed twice. Needs at least 3 truth points. Safe
         from several threads at once."""
         with self._computing:
-            missing = np.unique(index[np.isnan(self._normals[index, 0])])
-            if len(missing):
+            got = self._normals[index]
+            gap = np.isnan(got[:, 0])
+            if gap.any():
+                missing = np.unique(index[gap])
                 self._normals[missing] = line_normals(self.tree, missing)
-            return self._normals[index]
+                got = self._normals[index]
+            return got
 
 
 def refine_point_to_line(map_xy: np.ndarray, target: LineTarget, init: Similarity2D,
@@ -74,7 +77,7 @@ def refine_point_to_line(map_xy: np.ndarray, target: LineTarget, init: Similarit
         jac = np.column_stack([n[:, 0], n[:, 1], n[:, 1] * p[:, 0] - n[:, 0] * p[:, 1]])
         if with_scale:
             jac = np.column_stack([jac, np.einsum("ni,ni->n", n, p)])
-        scale = max(1.4826 * float(np.median(np.abs(r))), 1e-3)
+        scale = max(1.4826 * _median(np.abs(r)), 1e-3)
         w = np.clip(1.0 - (r / (4.685 * scale)) ** 2, 0.0, None) ** 2
         step = np.linalg.lstsq(jac.T @ (jac * w[:, None]), -jac.T @ (w * r), rcond=None)[0]
         if with_scale:
@@ -86,3 +89,13 @@ def refine_point_to_line(map_xy: np.ndarray, target: LineTarget, init: Similarit
         if np.abs(step[:2]).max() < settled and np.abs(step[2:]).max() < 0.1 * settled:
             break
     return tf
+
+
+def _median(values: np.ndarray) -> float:
+    """``np.median`` of finite ``values`` (K >= 1,), the same number, without its checks (it
+    runs once per ICP step)."""
+    half = len(values) // 2
+    if len(values) % 2:
+        return float(np.partition(values, half)[half])
+    low, high = np.partition(values, (half - 1, half))[half - 1:half + 1]
+    return float((low + high) / 2)
