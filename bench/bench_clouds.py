@@ -12,7 +12,7 @@ below the sensor), written as binary little-endian float32 x, y, z PLY (12 bytes
 temporary folder and deleted after. The truth is the campus's plan drawn at 0.05 m (PNG + YAML).
 
 Every run is a fresh process (``python -m pcmapq eval ... --json``, or the floor's few lines),
-its peak GB the child's peak RSS (``os.wait4``). pcmapq s is the whole process's wall time
+its peak GB the child's peak memory (:func:`measured`). pcmapq s is the whole process's wall time
 (interpreter, imports, every step); floor s is Open3D's read + voxel alone, timed inside its
 process (its whole process, imports included, is "floor process s": importing Open3D alone
 takes seconds). ratio = pcmapq s / floor s, the stricter of the two ratios. ``--before SRC``
@@ -42,6 +42,7 @@ from pathlib import Path
 
 import numpy as np
 
+from bench.tree_memory import TreeMemory
 from pcmapq.core.transform import Similarity2D
 from pcmapq.io.writers import write_ros_map
 from testkit import synth
@@ -181,20 +182,24 @@ def write_case(out: Path, points: int) -> tuple[Path, Path]:
 
 def measured(cmd: list[str], src: str | None = None) -> tuple[float, float, str]:
     """Run ``cmd`` in a fresh process (with ``PYTHONPATH=src`` if given): wall seconds, peak
-    RSS in GB, its stdout."""
+    memory in GB, its stdout. The peak is the larger of the process's own peak RSS and the
+    largest sum of its and its child processes' resident sets, sampled
+    (:class:`bench.tree_memory.TreeMemory`)."""
     env = dict(os.environ, PYTHONPATH=src) if src else None
     with tempfile.TemporaryFile() as out, tempfile.TemporaryFile() as err:
         start = time.perf_counter()
         proc = subprocess.Popen(cmd, stdout=out, stderr=err, env=env)
+        tree = TreeMemory(proc.pid)
         _, status, usage = os.wait4(proc.pid, 0)
         seconds = time.perf_counter() - start
+        tree_gb = tree.stop() / 1024**3
         proc.returncode = os.waitstatus_to_exitcode(status)
         out.seek(0)
         err.seek(0)
         text = out.read().decode()
         if proc.returncode != 0:
             raise RuntimeError(f"{cmd[:4]} exited {proc.returncode}: {err.read().decode()[-2000:]}")
-    return seconds, usage.ru_maxrss / 1024**2, text
+    return seconds, max(usage.ru_maxrss / 1024**2, tree_gb), text
 
 
 def pcmapq_run(cloud: Path, truth: Path, src: str | None = None) -> dict:

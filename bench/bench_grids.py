@@ -7,9 +7,9 @@ truth's walls (the least any comparison of two grids does), measured in the same
 Each case is :mod:`bench.large_grid`'s: a campus of copies of one building, ``size`` x ``size``
 cells of 0.05 m for the truth and for the map (turned -12 degrees, moved, walls from points with
 3 cm noise), written into a temporary folder and deleted after. Every run is a fresh process,
-its peak GB the child's peak RSS (``os.wait4``); pcmapq s is the whole process's wall time,
-floor s the floor's work timed inside its process. The pose error is against the known
-transform.
+its peak GB the child's peak memory (:func:`bench.bench_clouds.measured`); pcmapq s is the
+whole process's wall time, floor s the floor's work timed inside its process. The pose error
+is against the known transform.
 """
 
 from __future__ import annotations

@@ -10,7 +10,8 @@ into the cache by :mod:`bench.large_3d`), as ratios of :mod:`bench.ratios`
 - ``large3d50`` (opt-in, not run by default: a run takes many minutes): the 50 M-point pair by
   default, its peak memory over 8 GB (at most 1), and its wall seconds beside it.
 
-Each run is a fresh process; wall seconds and the child's peak RSS (``os.wait4``).
+Each run is a fresh process; wall seconds and its peak memory, the processes it starts
+counted (:func:`bench.bench_clouds.measured`).
 """
 
 from __future__ import annotations

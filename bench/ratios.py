@@ -1,8 +1,9 @@
 """pcmapq's speed and memory as ratios to a floor or a peer measured in the same run, so that a
 busy machine slows both sides alike and cannot hide a regression (``python -m bench``).
 
-Each case runs its commands in fresh processes (wall seconds and peak RSS of the child, by
-``os.wait4``), alternating the two sides and keeping each side's best of ``repeat`` runs:
+Each case runs its commands in fresh processes (wall seconds and peak memory of the child, the
+processes it starts counted: :func:`bench.bench_clouds.measured`), alternating the two sides
+and keeping each side's best of ``repeat`` runs:
 
 - ``noref``: ``pcmapq eval`` by default against ``--no-noref`` (the price of the default
   no-reference block) on the shipped sample, KITTI 00's 20-scan pair and a 10 M-point cloud;
