@@ -92,8 +92,8 @@ def refine_point_to_line(map_xy: np.ndarray, target: LineTarget, init: Similarit
 
 
 def _median(values: np.ndarray) -> float:
-    """``np.median`` of finite ``values`` (K >= 1,), the same number, without its checks (it
-    runs once per ICP step)."""
+    """``np.median`` of finite ``values`` (K,), K >= 1: the same number, without numpy's
+    checks (it runs once per ICP step)."""
     half = len(values) // 2
     if len(values) % 2:
         return float(np.partition(values, half)[half])
