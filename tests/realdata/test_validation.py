@@ -122,6 +122,14 @@ def test_gazebo_slam_map_mean_accuracy_under_8_cm(gazebo_run):
         assert det.matching.quality >= 0.8 and det.matching.precision >= 0.8, name
 
 
+def test_the_floor_plans_cases_are_those_compared_here():
+    """The floor plans' section of the validation is its cases here: each compared with its
+    reference above, and no stored reference without one."""
+    cases = sorted(plan.case for plan in floorplans.FLOORPLANS)
+    assert cases == sorted(name for name in CHEAP if name.startswith("floorplans-"))
+    assert cases == sorted(p.stem for p in reference.FOLDER.glob("floorplans-*.json"))
+
+
 @pytest.mark.parametrize("plan", floorplans.FLOORPLANS, ids=lambda p: p.case)
 def test_slam_map_aligns_to_its_plan(plan):
     """SLAM map vs hand-drawn plan: yaw within 5 degrees of the expected one (Intel's plan is
