@@ -42,7 +42,7 @@ from pathlib import Path
 
 import numpy as np
 
-from bench.tree_memory import TreeMemory
+from bench.tree_memory import waited
 from pcmapq.core.transform import Similarity2D
 from pcmapq.io.writers import write_ros_map
 from testkit import synth
@@ -182,24 +182,21 @@ def write_case(out: Path, points: int) -> tuple[Path, Path]:
 
 def measured(cmd: list[str], src: str | None = None) -> tuple[float, float, str]:
     """Run ``cmd`` in a fresh process (with ``PYTHONPATH=src`` if given): wall seconds, peak
-    memory in GB, its stdout. The peak is the larger of the process's own peak RSS and the
-    largest sum of its and its child processes' resident sets, sampled
-    (:class:`bench.tree_memory.TreeMemory`)."""
+    memory in GB (its child processes' counted: :func:`bench.tree_memory.waited`), its
+    stdout."""
     env = dict(os.environ, PYTHONPATH=src) if src else None
     with tempfile.TemporaryFile() as out, tempfile.TemporaryFile() as err:
         start = time.perf_counter()
         proc = subprocess.Popen(cmd, stdout=out, stderr=err, env=env)
-        tree = TreeMemory(proc.pid)
-        _, status, usage = os.wait4(proc.pid, 0)
+        status, _, gb = waited(proc)
         seconds = time.perf_counter() - start
-        tree_gb = tree.stop() / 1024**3
         proc.returncode = os.waitstatus_to_exitcode(status)
         out.seek(0)
         err.seek(0)
         text = out.read().decode()
         if proc.returncode != 0:
             raise RuntimeError(f"{cmd[:4]} exited {proc.returncode}: {err.read().decode()[-2000:]}")
-    return seconds, max(usage.ru_maxrss / 1024**2, tree_gb), text
+    return seconds, gb, text
 
 
 def pcmapq_run(cloud: Path, truth: Path, src: str | None = None) -> dict:

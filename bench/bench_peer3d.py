@@ -41,7 +41,7 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
-from bench.tree_memory import TreeMemory
+from bench.tree_memory import waited
 from testkit.paths import SHARED_DATA
 
 #: Pitch drift of the map, degrees a scan (scan k turned by k times it).
@@ -69,15 +69,12 @@ def run(cmd: list[str]) -> Run:
     with tempfile.TemporaryFile() as err:
         start = time.perf_counter()
         proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=err)
-        tree = TreeMemory(proc.pid)
-        _, status, usage = os.wait4(proc.pid, 0)
+        status, usage, gb = waited(proc)
         seconds = time.perf_counter() - start
-        tree_gb = tree.stop() / 1024**3
         if os.waitstatus_to_exitcode(status) != 0:
             err.seek(0)
             raise RuntimeError(f"{' '.join(cmd[:4])} failed: {err.read().decode()[-2000:]}")
-    return Run(seconds, max(usage.ru_maxrss / 1024**2, tree_gb),
-               usage.ru_utime + usage.ru_stime)
+    return Run(seconds, gb, usage.ru_utime + usage.ru_stime)
 
 
 def kitti_pitched_pair(cache: Path) -> tuple[Path, Path] | None:

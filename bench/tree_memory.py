@@ -5,11 +5,14 @@ single process's)."""
 
 from __future__ import annotations
 
+import os
+import resource
+import subprocess
 import threading
 
 import psutil
 
-__all__ = ["TreeMemory"]
+__all__ = ["TreeMemory", "waited"]
 
 #: Seconds between two samples.
 EVERY = 0.05
@@ -49,3 +52,12 @@ class TreeMemory:
         self._done.set()
         self._thread.join()
         return self._peak
+
+
+def waited(proc: subprocess.Popen) -> tuple[int, resource.struct_rusage, float]:
+    """Wait for ``proc`` (``os.wait4``): its wait status, its resource usage, and its peak
+    memory in GB, the larger of its own peak RSS and the largest sum of its and its
+    descendants' resident sets sampled meanwhile (:class:`TreeMemory`)."""
+    tree = TreeMemory(proc.pid)
+    _, status, usage = os.wait4(proc.pid, 0)
+    return status, usage, max(usage.ru_maxrss / 1024**2, tree.stop() / 1024**3)
