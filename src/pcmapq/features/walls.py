@@ -153,10 +153,13 @@ def cores(objects: np.ndarray, width_px: float) -> np.ndarray:
     crop = objects[np.ix_(rows, cols)]
     _, label = cv2.connectedComponents(crop.astype(np.uint8), connectivity=8)
     depth = distance_to(np.pad(~crop, 1, constant_values=True))[1:-1, 1:-1]
+    v, u = np.nonzero(crop)  # the object cells: all that is compared, not the whole crop
+    own, deep = label[v, u], depth[v, u]
     deepest = np.zeros(label.max() + 1, dtype=np.float32)
-    np.maximum.at(deepest, label[crop], depth[crop])
+    np.maximum.at(deepest, own, deep)
+    keep = deep >= deepest[own] - 0.5 * width_px
     core = np.zeros_like(objects)
-    core[np.ix_(rows, cols)] = crop & (depth >= deepest[label] - 0.5 * width_px)
+    core[rows[v[keep]], cols[u[keep]]] = True
     return core
 
 
