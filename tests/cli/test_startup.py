@@ -198,6 +198,33 @@ def test_open3d_loads_without_the_unused_modules():
     assert got.stdout.split() == ["True", "[]"], got.stdout
 
 
+#: In a fresh process: the stand-ins put in place, then Open3D loaded and used, its Plotly
+#: drawing called.
+STAND_INS_IN_PLACE = """
+import sys
+from pcmapq.core.unused import leave_out_unused
+leave_out_unused()
+import open3d
+print(open3d.geometry.PointCloud().is_empty(), 'plotly' in sys.modules, 'dash' in sys.modules)
+try:
+    open3d.visualization.draw_plotly([])
+except ImportError as error:
+    print(error)
+"""
+
+
+def test_open3d_loads_without_its_plotly_drawing():
+    """Open3D's package imports its Plotly drawing, which loads Plotly and Dash (about 0.2 s of
+    every process that loads Open3D); pcmapq's processes put a stand-in in its place. Open3D
+    loads and works without them, and the drawing, called, says it was left out."""
+    got = subprocess.run([sys.executable, "-c", STAND_INS_IN_PLACE], capture_output=True,
+                         text=True, timeout=120)
+    assert got.returncode == 0, got.stderr
+    assert got.stdout.splitlines() == [
+        "True False False",
+        "open3d.visualization.draw_plotly.draw_plotly is left out of pcmapq's processes"]
+
+
 #: Asks the OpenBLAS that NumPy loaded how many threads it runs, in a process that ran a command.
 BLAS_THREADS = """
 import ctypes, os, re, sys
