@@ -7,7 +7,7 @@ The evaluation runs in this process (``pcmapq.evaluation.pipeline.evaluate``, de
 settings) with the libraries' own thread pools held to one thread (OpenMP, OpenCV, Open3D), so
 that a step's work is all on the thread that calls it: its CPU is that thread's CPU time
 (``time.thread_time``) over the call, less the steps it calls itself, plus the CPU of the child
-process it waits for (the 3D ICP, the 3D consistency map). The pipeline's own threads still
+process it waits for (the 3D consistency map). The pipeline's own threads still
 run side by side; a step's seconds are its own however they overlap. The rest of the process's
 CPU (``resource.getrusage``, children included) is what no step listed holds: importing the
 libraries, the threads' and processes' start, the command's own glue. The wall time of this
@@ -33,7 +33,7 @@ STEPS = [
     ("pcmapq.evaluation.truth", "prepare_truth", "the truth's raster"),
     ("pcmapq.align.rigid3d", "align_3d", "the 3D registration: the clouds' voxels"),
     ("pcmapq.align.features3d", "global_registration", "the 3D registration: global search"),
-    ("pcmapq.align.refine3d", "refine", "the 3D registration: ICP (child process)"),
+    ("pcmapq.align.refine3d", "refine", "the 3D registration: ICP"),
     ("pcmapq.align.rigid3d", "score", "the 3D registration: its fitness"),
     ("pcmapq.raster.slice", "wall_band", "the wall bands of the clouds"),
     ("pcmapq.evaluation.placing", "align_plan", "the plan's alignment"),
@@ -50,7 +50,7 @@ STEPS = [
     ("pcmapq.evaluation.scoring", "score", "scoring: features matched, distances, the result"),
 ]
 #: Steps that wait for a child process: its CPU is theirs.
-IN_CHILD = {"refine", "regions_3d"}
+IN_CHILD = {"regions_3d"}
 
 
 class Ledger:

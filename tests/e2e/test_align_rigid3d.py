@@ -8,7 +8,6 @@ import pytest
 from pcmapq.align import refine3d
 from pcmapq.align.features3d import feature_matches, keypoints
 from pcmapq.align.rigid3d import align_3d
-from pcmapq.core import child
 from pcmapq.core.errors import EvaluationError, InputError
 from testkit.poses import apply, errors, rigid
 
@@ -93,25 +92,6 @@ def test_the_target_prepared_on_every_core_gives_the_same_registration(monkeypat
         monkeypatch.setattr(refine3d, "PREPARE_THREADS", threads)
         got.append(align_3d(source, target, voxel=0.2, init=np.eye(4)).transform)
     assert np.array_equal(got[0], got[1])
-
-
-def test_large_clouds_are_refined_in_a_child_process_to_the_same_transform(monkeypatch) -> None:
-    """The ICP run in a child process (as clouds of CHILD_POINTS or more are) gives the
-    transform of the ICP run in this process, bit for bit."""
-    target = room(0)
-    source = apply(np.linalg.inv(rigid((0.0, 0.0, 3.0), (0.2, -0.1, 0.0))), room(1))
-    got = []
-    for least in (10**9, 0):
-        monkeypatch.setattr(refine3d, "CHILD_POINTS", least)
-        got.append(align_3d(source, target, voxel=0.2, init=np.eye(4)).transform)
-    assert np.array_equal(got[0], got[1])
-
-
-def test_a_failed_child_process_is_one_evaluation_error(monkeypatch) -> None:
-    monkeypatch.setattr(refine3d, "CHILD_POINTS", 0)
-    monkeypatch.setattr(child.sys, "executable", "false")
-    with pytest.raises(EvaluationError, match="the 3D ICP's process failed .exit code 1."):
-        align_3d(room(1), room(0), voxel=0.2, init=np.eye(4))
 
 
 def test_keypoints_and_matches_are_small_and_mutual() -> None:
