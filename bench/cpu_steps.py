@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import argparse
 import functools
-import importlib
 import os
 import resource
 import sys
@@ -26,6 +25,8 @@ import threading
 import time
 from collections import defaultdict
 from collections.abc import Callable
+
+from bench.memory_timeline import instrument
 
 #: (module, function, label) of each step measured; a detector's label names the detector.
 STEPS = [
@@ -86,19 +87,6 @@ class Ledger:
         return inner
 
 
-def instrument(ledger: Ledger) -> None:
-    """Wrap every step of STEPS where it is defined and wherever pcmapq imported it."""
-    wrapped = {}
-    for module, name, label in STEPS:
-        fn = getattr(importlib.import_module(module), name)
-        wrapped.setdefault(id(fn), (fn, ledger.timed(fn, name, label)))
-    for module in list(sys.modules.values()):  # the step's own module too
-        if getattr(module, "__name__", "").startswith("pcmapq"):
-            for attr, value in list(vars(module).items()):
-                if id(value) in wrapped and value is wrapped[id(value)][0]:
-                    setattr(module, attr, wrapped[id(value)][1])
-
-
 def one_thread_pools() -> None:
     """The libraries' own thread pools held to one thread, in this process and its children."""
     os.environ["OMP_NUM_THREADS"] = "1"
@@ -122,7 +110,9 @@ def main() -> int:
     refine3d.PREPARE_THREADS = 1
     walls._DRAWING = threading.BoundedSemaphore(1)
     ledger = Ledger()
-    instrument(ledger)
+    labels = {(module, name): label for module, name, label in STEPS}
+    instrument(lambda fn, module, name: ledger.timed(fn, name, labels[module, name]),
+               list(labels))
     start = time.perf_counter()
     evaluate(args.map, args.truth)
     wall = time.perf_counter() - start

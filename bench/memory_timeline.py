@@ -95,19 +95,21 @@ class Timeline:
         return out
 
 
-def instrument(line: Timeline) -> None:
-    """Wrap every stage of STAGES where it is defined and wherever it was imported."""
+def instrument(wrap: Callable[[Callable, str, str], Callable],
+               stages: list[tuple[str, str]] = STAGES) -> None:
+    """Replace every stage of ``stages`` (module, function or Class.method) by ``wrap(fn,
+    module, name)`` where it is defined and wherever pcmapq imported it."""
     wrapped = {}
-    for module, name in STAGES:
+    for module, name in stages:
         owner = importlib.import_module(module)
         if "." in name:  # a method: wrapped on its class
             owner = getattr(owner, name.split(".")[0])
         attr = name.split(".")[-1]
         fn = getattr(owner, attr)
         if owner is not sys.modules.get(module):
-            setattr(owner, attr, line.timed(fn, name))
+            setattr(owner, attr, wrap(fn, module, name))
             continue
-        wrapped.setdefault(id(fn), (fn, line.timed(fn, name)))
+        wrapped.setdefault(id(fn), (fn, wrap(fn, module, name)))
     for module in list(sys.modules.values()):
         if getattr(module, "__name__", "").startswith("pcmapq"):
             for attr, value in list(vars(module).items()):
@@ -133,7 +135,7 @@ def main() -> int:
         scoring.regions_3d = lambda *a, **k: None
         settings = replace(settings, structures=replace(settings.structures, enabled=False))
     line = Timeline()
-    instrument(line)
+    instrument(lambda fn, _, name: line.timed(fn, name))
     done = threading.Event()
 
     def sample() -> None:
