@@ -125,7 +125,8 @@ def local_shape(points: np.ndarray, k: int = NEIGHBOURS
         near[part] = found = found.reshape(-1, k)
         centred = points[found]
         centred -= centred.mean(axis=1, keepdims=True)
-        values, vectors = np.linalg.eigh(np.einsum("nki,nkj->nij", centred, centred) / k)
+        values, vectors = np.linalg.eigh(np.einsum("nki,nkj->nij", centred, centred,
+                                                   optimize=True) / k)
         variation[part] = values[:, 0] / np.maximum(values.sum(axis=1), 1e-18)
         normal[part] = vectors[:, :, 0]
     return near, normal, variation
@@ -183,7 +184,7 @@ def grow(points: np.ndarray, near: np.ndarray, label: np.ndarray, normal: np.nda
     round's choices made on the labels the round starts with."""
     label = label.copy()
     for _ in range(GROWTH_ROUNDS):
-        free = np.flatnonzero(label < 0)
+        free = _next_to_plane(label, near)
         if not len(free):
             break
         taken = np.full(len(free), -1, dtype=label.dtype)
@@ -198,6 +199,15 @@ def grow(points: np.ndarray, near: np.ndarray, label: np.ndarray, normal: np.nda
             taken[part][ok] = cand[ok, best[ok]]
         label[free] = taken
     return label
+
+
+def _next_to_plane(label: np.ndarray, near: np.ndarray) -> np.ndarray:
+    """The points with no plane (``label`` -1) that have a neighbour (``near``) on one."""
+    free = np.flatnonzero(label < 0)
+    keep = np.empty(len(free), dtype=bool)
+    for part in _rows(len(free)):
+        keep[part] = (label[near[free[part]]] >= 0).any(axis=1)
+    return free[keep]
 
 
 def rectangles(points: np.ndarray, label: np.ndarray, normal: np.ndarray,
