@@ -97,8 +97,7 @@ class Consistency:
 
 
 def _fitness(points: np.ndarray, target: LineTarget, tolerance: float) -> float:
-    dist, _ = target.tree.query(points, distance_upper_bound=tolerance, workers=1)
-    return float(np.isfinite(dist).mean())
+    return float((target.nearest(points, tolerance) >= 0).mean())
 
 
 def _held(points: np.ndarray, target: LineTarget, tolerance: float) -> bool:
@@ -106,8 +105,8 @@ def _held(points: np.ndarray, target: LineTarget, tolerance: float) -> bool:
     within ``tolerance``) that face two ways enough to hold a translation: the smaller
     eigenvalue of the sum of their normals' outer products is at least MIN_SPREAD of the
     larger."""
-    dist, j = target.tree.query(points, distance_upper_bound=tolerance, workers=1)
-    ok = np.isfinite(dist)
+    j = target.nearest(points, tolerance)
+    ok = j >= 0
     if ok.sum() < max(3, MIN_FIT * len(points)):
         return False
     n = target.normals(j[ok])
