@@ -21,12 +21,14 @@ points in the plane, along their principal axes. Metres, in the cloud's frame.
 
 from __future__ import annotations
 
+import os
 from collections.abc import Iterator
 from dataclasses import dataclass
 
+import numba
 import numpy as np
+import small_gicp
 from scipy import ndimage
-from scipy.spatial import cKDTree
 
 from pcmapq.core.components import Components
 from pcmapq.core.covariance import PAIRS, symmetric
@@ -41,6 +43,8 @@ MAX_VARIATION = 0.03
 NEIGHBOUR_ANGLE_DEG = 10.0
 #: Rounds of growth: points next to a region and near its plane join it, once per round.
 GROWTH_ROUNDS = 2
+#: Threads that search the neighbours.
+THREADS = os.cpu_count() or 1
 #: Points whose per-point work (neighbours, normals, pairs, products) is done at once.
 ROWS = 1 << 16
 
@@ -115,21 +119,50 @@ def _rows(n: int) -> Iterator[slice]:
 def local_shape(points: np.ndarray, k: int = NEIGHBOURS
                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Each point's k nearest neighbours (N, k) indices (itself first; int32 below 2**31
-    points), its unit normal (N, 3) and its surface variation (N,), from their covariance."""
+    points), its unit normal (N, 3) and its surface variation (N,), from their covariance.
+    The neighbours are small_gicp's KD-tree's, on every core (SciPy's, in about half the
+    time)."""
     n, k = len(points), min(k, len(points))
-    tree = cKDTree(points)
+    points = np.ascontiguousarray(points, dtype=np.float64)
+    tree = small_gicp.KdTree(points, num_threads=THREADS)
     near = np.empty((n, k), dtype=np.int32 if n < 2**31 else np.int64)
     normal, variation = np.empty((n, 3)), np.empty(n)
     for part in _rows(n):
-        _, found = tree.query(points[part], k=k, workers=-1)
-        near[part] = found = found.reshape(-1, k)
-        centred = points[found]
-        centred -= centred.mean(axis=1, keepdims=True)
-        values, vectors = np.linalg.eigh(np.einsum("nki,nkj->nij", centred, centred,
-                                                   optimize=True) / k)
+        near[part] = tree.batch_knn_search(points[part], k, num_threads=THREADS)[0]
+        values, vectors = np.linalg.eigh(_covariances(points, near[part]))
         variation[part] = values[:, 0] / np.maximum(values.sum(axis=1), 1e-18)
         normal[part] = vectors[:, :, 0]
     return near, normal, variation
+
+
+@numba.njit(cache=True, nogil=True)
+def _covariances(points: np.ndarray, near: np.ndarray) -> np.ndarray:
+    """(K, 3, 3) the covariance of each row of ``near``'s (K, k) points, about their mean."""
+    count, k = near.shape
+    out = np.empty((count, 3, 3))
+    for i in range(count):
+        mx = my = mz = 0.0
+        for a in range(k):
+            j = near[i, a]
+            mx += points[j, 0]
+            my += points[j, 1]
+            mz += points[j, 2]
+        mx, my, mz = mx / k, my / k, mz / k
+        xx = xy = xz = yy = yz = zz = 0.0
+        for a in range(k):
+            j = near[i, a]
+            dx, dy, dz = points[j, 0] - mx, points[j, 1] - my, points[j, 2] - mz
+            xx += dx * dx
+            xy += dx * dy
+            xz += dx * dz
+            yy += dy * dy
+            yz += dy * dz
+            zz += dz * dz
+        out[i, 0, 0], out[i, 1, 1], out[i, 2, 2] = xx / k, yy / k, zz / k
+        out[i, 0, 1] = out[i, 1, 0] = xy / k
+        out[i, 0, 2] = out[i, 2, 0] = xz / k
+        out[i, 1, 2] = out[i, 2, 1] = yz / k
+    return out
 
 
 def regions(points: np.ndarray, near: np.ndarray, normal: np.ndarray, flat: np.ndarray,
