@@ -71,9 +71,12 @@ def _linearize(source: np.ndarray, target: np.ndarray, normals: np.ndarray, pair
             jac[5] = -nk * rotation[k, 2]
             for a in range(6):
                 gradient[a] += jac[a] * err
-                for c in range(6):
+                for c in range(a, 6):  # the upper triangle; the lower is the same products
                     hessian[a, c] += jac[a] * jac[c]
             cost += 0.5 * err * err
+    for a in range(6):
+        for c in range(a):
+            hessian[a, c] = hessian[c, a]
     return hessian, gradient, cost
 
 
