@@ -104,10 +104,11 @@ def main() -> int:
     args = parser.parse_args()
     one_thread_pools()
     import pcmapq.align.refine3d as refine3d
+    import pcmapq.features.planes3d as planes3d
     import pcmapq.features.walls as walls
     from pcmapq.evaluation.pipeline import evaluate
 
-    refine3d.PREPARE_THREADS = 1
+    refine3d.PREPARE_THREADS = planes3d.THREADS = 1  # small_gicp's searches, on the caller
     walls._DRAWING = threading.BoundedSemaphore(1)
     ledger = Ledger()
     labels = {(module, name): label for module, name, label in STEPS}
