@@ -1,17 +1,16 @@
-"""Where one ``pcmapq eval``'s CPU goes: each step's CPU seconds, whichever thread or child
-process runs it; a markdown table.
+"""Where one ``pcmapq eval``'s CPU goes: each step's CPU seconds, whichever thread runs it; a
+markdown table.
 
     python -m bench.cpu_steps MAP TRUTH
 
 The evaluation runs in this process (``pcmapq.evaluation.pipeline.evaluate``, default
 settings) with the libraries' own thread pools held to one thread (OpenMP, OpenCV, Open3D), so
 that a step's work is all on the thread that calls it: its CPU is that thread's CPU time
-(``time.thread_time``) over the call, less the steps it calls itself, plus the CPU of the child
-process it waits for (the 3D consistency map). The pipeline's own threads still
-run side by side; a step's seconds are its own however they overlap. The rest of the process's
-CPU (``resource.getrusage``, children included) is what no step listed holds: importing the
-libraries, the threads' and processes' start, the command's own glue. The wall time of this
-run is not the command's: the libraries' pools run on one thread here.
+(``time.thread_time``) over the call, less the steps it calls itself. The pipeline's own
+threads still run side by side; a step's seconds are its own however they overlap. The rest of
+the process's CPU (``resource.getrusage``) is what no step listed holds: importing the
+libraries, the threads' start, the command's own glue. The wall time of this run is not the
+command's: the libraries' pools run on one thread here.
 """
 
 from __future__ import annotations
@@ -44,14 +43,12 @@ STEPS = [
     ("pcmapq.features.planes3d", "find_planes", "the 3D structures: planes, both clouds"),
     ("pcmapq.match.structures", "compare_structures", "the 3D structures: lines, matching"),
     ("pcmapq.align.regions", "regions", "the 2D consistency map"),
-    ("pcmapq.align.regions3d", "regions_3d", "the 3D consistency map (child process)"),
+    ("pcmapq.align.regions3d", "regions_3d", "the 3D consistency map"),
     ("pcmapq.metrics.distances", "distances_3d", "the 3D distances"),
     ("pcmapq.metrics.map_gaussians", "map_gaussians", "AWD and SCS"),
     ("pcmapq.evaluation.noref_figures", "input_figures", "the no-reference figures, both clouds"),
     ("pcmapq.evaluation.scoring", "score", "scoring: features matched, distances, the result"),
 ]
-#: Steps that wait for a child process: its CPU is theirs.
-IN_CHILD = {"regions_3d"}
 
 
 class Ledger:
@@ -69,17 +66,12 @@ class Ledger:
             stack = self.local.__dict__.setdefault("stack", [])
             stack.append(0.0)
             start = time.thread_time()
-            children = resource.getrusage(resource.RUSAGE_CHILDREN) if name in IN_CHILD else None
             try:
                 return fn(*args, **kwargs)
             finally:
                 spent = time.thread_time() - start
                 inner_steps = stack.pop()
                 own = spent - inner_steps
-                if children is not None:
-                    after = resource.getrusage(resource.RUSAGE_CHILDREN)
-                    own += (after.ru_utime + after.ru_stime) - (children.ru_utime +
-                                                                children.ru_stime)
                 if stack:
                     stack[-1] += spent
                 with self.lock:

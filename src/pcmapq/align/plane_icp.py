@@ -128,10 +128,13 @@ def _kept(source: np.ndarray, rotation: np.ndarray, shift: np.ndarray, target: n
 
 class Fit(NamedTuple):
     """transform: 4x4 source -> target. steps: the index of the last step (small_gicp's
-    ``iterations``)."""
+    ``iterations``). hessian: the 6 x 6 Hessian of the last linearisation (turns first;
+    small_gicp's ``H``), inliers: the pairs it counted (small_gicp's ``num_inliers``)."""
 
     transform: np.ndarray
     steps: int
+    hessian: np.ndarray
+    inliers: int
 
 
 class Nearest:
@@ -175,6 +178,7 @@ def plane_icp(nearest: Nearest, normals: np.ndarray, guess: np.ndarray, max_dist
     transform = np.array(guess, dtype=np.float64)
     inlier = np.zeros(len(source), np.bool_)
     damping, last = INIT_LAMBDA, 0
+    hessian = np.zeros((6, 6))
     for step in range(iterations):
         last = step
         rotation, shift = np.ascontiguousarray(transform[:3, :3]), transform[:3, 3].copy()
@@ -194,7 +198,7 @@ def plane_icp(nearest: Nearest, normals: np.ndarray, guess: np.ndarray, max_dist
             damping *= LAMBDA_FACTOR
         if not kept or converged:
             break
-    return Fit(transform, last)
+    return Fit(transform, last, hessian, int(np.count_nonzero(inlier)))
 
 
 def se3_exp(delta: np.ndarray) -> np.ndarray:

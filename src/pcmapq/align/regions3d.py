@@ -5,10 +5,11 @@ regions moved by offsets that grow where it bends, and the vertical part of thos
 shows what a plan cannot.
 
 Regions are square tiles of the truth's ground plane. Each region's own map points (at
-``voxel``) are registered by small_gicp's point-to-plane ICP, seeded at identity (the global
-pose), on one thread, against the truth's points within the tile grown by the widest pairing
-distance on every side, coarse to fine; from CHILD_POINTS points (both clouds at ``voxel``) in a
-child process (:mod:`pcmapq.core.child`: small_gicp holds Python's lock while it registers).
+``voxel``) are registered by small_gicp's point-to-plane ICP (as :mod:`pcmapq.align.plane_icp`
+computes it: its loops leave Python's lock to the evaluation's other threads), seeded at
+identity (the global pose), on one thread, against the truth's points within the tile grown by
+the widest pairing distance on every side (their normals and KD-tree small_gicp's), coarse to
+fine.
 Frame: the truth cloud levelled as its plan is (x, y the truth's plan, the 2D consistency map's
 frame; z up), metres and degrees. ``offset`` is the map's error there: where the map (as the
 global registration placed it) has the region's centroid, from where the region fits the truth
@@ -31,7 +32,7 @@ import small_gicp
 from scipy.spatial import cKDTree
 from scipy.spatial.transform import Rotation
 
-from pcmapq.core.child import CHILD_POINTS, in_child
+from pcmapq.align.plane_icp import Nearest, plane_icp
 from pcmapq.core.transform import affine
 from pcmapq.core.voxels import voxel_centroids
 
@@ -126,18 +127,16 @@ def _register(own: np.ndarray, window: np.ndarray, voxel: float
     """Point-to-plane ICP of ``own`` (N, 3) onto ``window`` (M, 3), both centred on ``own``'s
     centroid, from identity, coarse to fine: the 4x4 move and the last stage's 6 x 6 Hessian
     (turns about x, y, z, then x, y, z translations) per pair."""
-    src, tgt = small_gicp.PointCloud(own), small_gicp.PointCloud(window)
+    tgt = small_gicp.PointCloud(window)
     tree = small_gicp.KdTree(tgt, num_threads=1)
     small_gicp.estimate_normals(tgt, tree, num_neighbors=NORMAL_NEIGHBOURS, num_threads=1)
+    nearest = Nearest(np.ascontiguousarray(own, dtype=np.float64),
+                      np.ascontiguousarray(tgt.points()[:, :3]), tree)
+    normals = np.ascontiguousarray(tgt.normals()[:, :3])
     move, hessian = np.eye(4), np.zeros((6, 6))
     for units in STAGES:
-        result = small_gicp.align(tgt, src, tree, init_T_target_source=move,
-                                  registration_type="PLANE_ICP",
-                                  max_correspondence_distance=units * voxel, num_threads=1,
-                                  max_iterations=ITERATIONS, rotation_epsilon=SETTLED,
-                                  translation_epsilon=SETTLED)
-        move = np.array(result.T_target_source, dtype=np.float64)
-        hessian = np.array(result.H, dtype=np.float64) / max(int(result.num_inliers), 1)
+        fit = plane_icp(nearest, normals, move, units * voxel, ITERATIONS, SETTLED, SETTLED)
+        move, hessian = fit.transform, fit.hessian / max(fit.inliers, 1)
     return move, hessian
 
 
@@ -201,9 +200,7 @@ def regions_3d(map_xyz: np.ndarray, truth_xyz: np.ndarray, *, tile_m: float = TI
     if len(placed) == 0 or len(truth) < NORMAL_NEIGHBOURS:
         return Consistency3D.empty(tile_m, voxel, tolerance)
     tile_m = max(tile_m, float(np.ptp(placed[:, :2], axis=0).max()) / MAX_TILES)
-    work = (placed, truth, tile_m, voxel)
-    rows = in_child("the 3D consistency map", _rows, *work) \
-        if len(placed) + len(truth) >= CHILD_POINTS else _rows(*work)
+    rows = _rows(placed, truth, tile_m, voxel)
     if not rows:
         return Consistency3D.empty(tile_m, voxel, tolerance)
     # to the micrometre (and 1e-6 of a share or degree), as results are saved: the figures

@@ -98,16 +98,44 @@ def test_repeatable(truth, scan, sank):
         np.testing.assert_array_equal(getattr(a, name), getattr(b, name))
 
 
-def test_a_large_maps_regions_registered_in_a_child_process_are_the_same(
-        monkeypatch, truth, scan, sank):
-    """Clouds of CHILD_POINTS or more are registered in a child process: the same regions,
-    bit for bit."""
-    calls, real = [], regions3d.in_child
-    monkeypatch.setattr(regions3d, "CHILD_POINTS", 0)
-    monkeypatch.setattr(regions3d, "in_child",
-                        lambda what, *call: calls.append(what) or real(what, *call))
+def _small_gicps_fit(own, window, voxel):
+    """A region's ICP as small_gicp's own ``align`` gives it: move and Hessian per pair."""
+    import small_gicp
+
+    tgt, src = small_gicp.PointCloud(window), small_gicp.PointCloud(own)
+    tree = small_gicp.KdTree(tgt, num_threads=1)
+    small_gicp.estimate_normals(tgt, tree, num_neighbors=regions3d.NORMAL_NEIGHBOURS,
+                                num_threads=1)
+    move, hessian = np.eye(4), np.zeros((6, 6))
+    for units in regions3d.STAGES:
+        result = small_gicp.align(tgt, src, tree, init_T_target_source=move,
+                                  registration_type="PLANE_ICP",
+                                  max_correspondence_distance=units * voxel, num_threads=1,
+                                  max_iterations=regions3d.ITERATIONS,
+                                  rotation_epsilon=regions3d.SETTLED,
+                                  translation_epsilon=regions3d.SETTLED)
+        move = np.array(result.T_target_source, dtype=np.float64)
+        hessian = np.array(result.H, dtype=np.float64) / max(int(result.num_inliers), 1)
+    return move, hessian
+
+
+def test_the_regions_are_small_gicps(monkeypatch, truth, scan, sank):
+    """Each region's ICP, computed by pcmapq, gives the regions that small_gicp's own
+    ``align`` gives (to the micrometre and 1e-6 degree the regions are kept at), and the
+    same Hessian per pair to 1e-9."""
+    hessians = []
+    real = regions3d._register
+
+    def both(own, window, voxel):
+        ours, theirs = real(own, window, voxel), _small_gicps_fit(own, window, voxel)
+        hessians.append((ours[1], theirs[1]))
+        return theirs
+
+    monkeypatch.setattr(regions3d, "_register", both)
     b = regions_3d(sunk(scan, 10.0, 0.3), truth, tile_m=TILE, voxel=VOXEL)
-    assert calls == ["the 3D consistency map"]
+    assert len(hessians) == len(b.points) > 0
+    for ours, theirs in hessians:
+        np.testing.assert_allclose(ours, theirs, rtol=1e-9, atol=1e-12)
     for name in ("centre", "offset", "angles_deg", "fit_before", "fit_after", "held"):
         np.testing.assert_array_equal(getattr(sank, name), getattr(b, name))
 
