@@ -39,23 +39,24 @@ PREPARE_THREADS = os.cpu_count() or 1
 
 
 def refine(source: np.ndarray, target: np.ndarray, guess: np.ndarray, voxel: float,
-           coarse: tuple[np.ndarray, np.ndarray]) -> np.ndarray:
+           levels: dict[float, tuple[np.ndarray, np.ndarray]]) -> np.ndarray:
     """Point-to-plane ICP from ``guess`` (4x4 source -> target), coarse to fine; 4x4.
 
-    source (N, 3), target (M, 3): the whole clouds, metres; coarse: both already downsampled
-    at ``voxel`` (metres, the working resolution).
+    source (N, 3), target (M, 3): the whole clouds, metres. levels: both clouds downsampled,
+    by voxel in units of ``voxel`` (metres, the working resolution): at least ``1.0``'s; the
+    stages' others are added to it.
     """
     # Numba's loops: loaded when two clouds are registered
     from pcmapq.align.plane_icp import Nearest, plane_icp
     from pcmapq.core.voxels import voxel_centroids
 
-    levels = {1.0: coarse}
     for _, units in ICP_STAGES:
         if units not in levels:
             levels[units] = (voxel_centroids(source, voxel * units),
                              voxel_centroids(target, voxel * units))
     nearest, normals = {}, {}
-    for units, (src, tgt) in levels.items():
+    for units in dict.fromkeys(units for _, units in ICP_STAGES):
+        src, tgt = levels[units]
         cloud, tree = _prepared(tgt)
         nearest[units] = Nearest(np.ascontiguousarray(src, dtype=np.float64),
                                  np.ascontiguousarray(cloud.points()[:, :3]), tree,

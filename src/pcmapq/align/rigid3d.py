@@ -86,8 +86,10 @@ def align_3d(source_xyz: np.ndarray, target_xyz: np.ndarray, *, voxel: float = 0
     else:
         guess = tgt_shift @ np.asarray(init, dtype=np.float64).reshape(4, 4) @ np.linalg.inv(
             src_shift)
-    transform = refine(source, target, guess, voxel, (src_down, tgt_down))
-    fitness, rmse = score(source, target, transform, tolerance or voxel, voxel / 2)
+    levels = {1.0: (src_down, tgt_down)}
+    transform = refine(source, target, guess, voxel, levels)
+    half = levels.get(0.5, (None, None))[0]  # the last ICP stage's source, when at voxel / 2
+    fitness, rmse = score(source, target, transform, tolerance or voxel, voxel / 2, half)
     return Registration3D(np.linalg.inv(tgt_shift) @ transform @ src_shift, fitness, rmse)
 
 
@@ -115,11 +117,12 @@ def _better(guess: np.ndarray, second: Callable[[], np.ndarray | None], source: 
 
 
 def score(source: np.ndarray, target: np.ndarray, transform: np.ndarray, tolerance: float,
-          voxel: float) -> tuple[float, float]:
-    """(fitness, rmse): share of the source (downsampled at ``voxel``) moved by ``transform``
-    within ``tolerance`` metres of the target (downsampled at ``voxel / 2``), and the RMSE of
-    those distances, metres."""
-    moved = apply(transform, voxel_centroids(source, voxel))
+          voxel: float, source_down: np.ndarray | None = None) -> tuple[float, float]:
+    """(fitness, rmse): share of the source (downsampled at ``voxel``; ``source_down``: already
+    so) moved by ``transform`` within ``tolerance`` metres of the target (downsampled at
+    ``voxel / 2``), and the RMSE of those distances, metres."""
+    down = voxel_centroids(source, voxel) if source_down is None else source_down
+    moved = apply(transform, down)
     tree = cKDTree(voxel_centroids(target, voxel / 2))
     dist, _ = tree.query(moved, distance_upper_bound=tolerance, workers=-1)
     inliers = dist[np.isfinite(dist)]
