@@ -244,7 +244,7 @@ OPTIONS: tuple[Option, ...] = (
            flag="--structures/--no-structures"),
     Option("structures_voxel", "structures.voxel", FLOAT,
            "3D structures: each cloud is reduced to one point per voxel of this side before "
-           "its planes are found, metres (0.3 for outdoor LiDAR maps).", 0.01),
+           "its planes are found, metres (coarser: fewer, larger planes, sooner).", 0.01),
     Option("plane_min_points", "structures.min_points", INT,
            "3D structures: the fewest reduced points of a plane.", 3),
     Option("plane_min_area", "structures.min_area", FLOAT,
