@@ -33,7 +33,7 @@ import numba
 import numpy as np
 import small_gicp
 
-__all__ = ["Fit", "Nearest", "plane_icp"]
+__all__ = ["Fit", "Nearest", "plane_icp", "prepared"]
 
 #: Nearest target points kept per source point.
 CANDIDATES = 4
@@ -168,6 +168,21 @@ class Nearest:
             self.seen_at[again], self.pair[again] = moved, found[:, 0]
             self.searched += count
         return self.pair
+
+
+def prepared(source: np.ndarray, target: np.ndarray, neighbours: int, threads: int = 1
+             ) -> tuple[Nearest, np.ndarray]:
+    """What :func:`plane_icp` needs of a source (N, 3) and a target (M, 3), metres: the
+    source's kept nearest target points (:class:`Nearest`) in small_gicp's KD-tree of the
+    target, and the target's unit normals (M, 3) from each point's ``neighbours`` nearest
+    (small_gicp's). Tree, normals and searches on ``threads`` threads, each point's its own:
+    the same whatever the threads."""
+    cloud = small_gicp.PointCloud(target)
+    tree = small_gicp.KdTree(cloud, num_threads=threads)
+    small_gicp.estimate_normals(cloud, tree, num_neighbors=neighbours, num_threads=threads)
+    nearest = Nearest(np.ascontiguousarray(source, dtype=np.float64),
+                      np.ascontiguousarray(cloud.points()[:, :3]), tree, threads=threads)
+    return nearest, np.ascontiguousarray(cloud.normals()[:, :3])
 
 
 def plane_icp(nearest: Nearest, normals: np.ndarray, guess: np.ndarray, max_distance: float,

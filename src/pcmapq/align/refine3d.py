@@ -22,7 +22,6 @@ from __future__ import annotations
 import os
 
 import numpy as np
-import small_gicp
 
 __all__ = ["last_reach", "refine"]
 
@@ -47,7 +46,7 @@ def refine(source: np.ndarray, target: np.ndarray, guess: np.ndarray, voxel: flo
     stages' others are added to it.
     """
     # Numba's loops: loaded when two clouds are registered
-    from pcmapq.align.plane_icp import Nearest, plane_icp
+    from pcmapq.align.plane_icp import plane_icp, prepared
     from pcmapq.core.voxels import voxel_centroids
 
     for _, units in ICP_STAGES:
@@ -56,12 +55,8 @@ def refine(source: np.ndarray, target: np.ndarray, guess: np.ndarray, voxel: flo
                              voxel_centroids(target, voxel * units))
     nearest, normals = {}, {}
     for units in dict.fromkeys(units for _, units in ICP_STAGES):
-        src, tgt = levels[units]
-        cloud, tree = _prepared(tgt)
-        nearest[units] = Nearest(np.ascontiguousarray(src, dtype=np.float64),
-                                 np.ascontiguousarray(cloud.points()[:, :3]), tree,
-                                 threads=PREPARE_THREADS)
-        normals[units] = np.ascontiguousarray(cloud.normals()[:, :3])
+        nearest[units], normals[units] = prepared(*levels[units], NORMAL_NEIGHBOURS,
+                                                  PREPARE_THREADS)
     transform = np.asarray(guess, dtype=np.float64)
     for distance_units, voxel_units in ICP_STAGES:
         transform = plane_icp(nearest[voxel_units], normals[voxel_units], transform,
@@ -75,11 +70,3 @@ def last_reach(voxel: float) -> float:
     metres, at the working resolution ``voxel`` (metres)."""
     return ICP_STAGES[-1][0] * voxel
 
-
-def _prepared(target: np.ndarray) -> tuple[small_gicp.PointCloud, small_gicp.KdTree]:
-    """small_gicp's cloud of ``target`` (M, 3), metres, with its normals, and its KD-tree."""
-    cloud = small_gicp.PointCloud(target)
-    tree = small_gicp.KdTree(cloud, num_threads=PREPARE_THREADS)
-    small_gicp.estimate_normals(cloud, tree, num_neighbors=NORMAL_NEIGHBOURS,
-                                num_threads=PREPARE_THREADS)
-    return cloud, tree

@@ -28,11 +28,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-import small_gicp
 from scipy.spatial import cKDTree
 from scipy.spatial.transform import Rotation
 
-from pcmapq.align.plane_icp import Nearest, plane_icp
+from pcmapq.align.plane_icp import plane_icp, prepared
 from pcmapq.core.transform import affine
 from pcmapq.core.voxels import voxel_centroids
 
@@ -127,12 +126,7 @@ def _register(own: np.ndarray, window: np.ndarray, voxel: float
     """Point-to-plane ICP of ``own`` (N, 3) onto ``window`` (M, 3), both centred on ``own``'s
     centroid, from identity, coarse to fine: the 4x4 move and the last stage's 6 x 6 Hessian
     (turns about x, y, z, then x, y, z translations) per pair."""
-    tgt = small_gicp.PointCloud(window)
-    tree = small_gicp.KdTree(tgt, num_threads=1)
-    small_gicp.estimate_normals(tgt, tree, num_neighbors=NORMAL_NEIGHBOURS, num_threads=1)
-    nearest = Nearest(np.ascontiguousarray(own, dtype=np.float64),
-                      np.ascontiguousarray(tgt.points()[:, :3]), tree)
-    normals = np.ascontiguousarray(tgt.normals()[:, :3])
+    nearest, normals = prepared(own, window, NORMAL_NEIGHBOURS)
     move, hessian = np.eye(4), np.zeros((6, 6))
     for units in STAGES:
         fit = plane_icp(nearest, normals, move, units * voxel, ITERATIONS, SETTLED, SETTLED)
