@@ -21,7 +21,10 @@ them was: at a later pose, the nearest of the candidates is the nearest of all t
 while it is nearer than that radius less the distance the point has moved since (any other
 target point was at least the radius away then). Points for which that cannot be shown are
 searched again (small_gicp's KD-tree, on ``threads`` threads: each point's search is its own,
-so the result does not depend on them). The pairs are those small_gicp finds, but for two
+so the result does not depend on them), but for points shown to be farther than the stage's
+``max_distance`` from every target point (the nearer of their nearest candidate and that radius
+less the distance moved): they pair with no target point whichever is nearest, so their
+nearest candidate stands in. The pairs that count are those small_gicp finds, but for two
 target points at exactly the same distance.
 """
 
@@ -47,37 +50,63 @@ def _linearize(source: np.ndarray, target: np.ndarray, normals: np.ndarray, pair
                inlier: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
     """H (6x6), b (6,) and the cost of the pairs within ``max_sq`` (squared metres) at the pose
     (``rotation``, ``shift``); ``inlier`` (N,) set to which pairs count. Turns first, then
-    translations, as small_gicp orders them."""
-    hessian, gradient, cost = np.zeros((6, 6)), np.zeros(6), 0.0
-    jac, residual = np.empty(6), np.empty(3)
+    translations, as small_gicp orders them. The sums are kept in scalars (the upper triangle
+    of H; the lower is the same products), each added in the points' and axes' order."""
+    h00 = h01 = h02 = h03 = h04 = h05 = h11 = h12 = h13 = h14 = h15 = 0.0
+    h22 = h23 = h24 = h25 = h33 = h34 = h35 = h44 = h45 = h55 = 0.0
+    g0 = g1 = g2 = g3 = g4 = g5 = cost = 0.0
     for i in range(source.shape[0]):
         j = pair[i]
         p0, p1, p2 = source[i, 0], source[i, 1], source[i, 2]
-        for k in range(3):
-            residual[k] = target[j, k] - (rotation[k, 0] * p0 + rotation[k, 1] * p1
-                                          + rotation[k, 2] * p2 + shift[k])
-        if residual[0] ** 2 + residual[1] ** 2 + residual[2] ** 2 > max_sq:
+        e0 = target[j, 0] - (rotation[0, 0] * p0 + rotation[0, 1] * p1 + rotation[0, 2] * p2
+                             + shift[0])
+        e1 = target[j, 1] - (rotation[1, 0] * p0 + rotation[1, 1] * p1 + rotation[1, 2] * p2
+                             + shift[1])
+        e2 = target[j, 2] - (rotation[2, 0] * p0 + rotation[2, 1] * p1 + rotation[2, 2] * p2
+                             + shift[2])
+        if e0 ** 2 + e1 ** 2 + e2 ** 2 > max_sq:
             inlier[i] = False
             continue
         inlier[i] = True
         for k in range(3):
             nk = normals[j, k]
-            err = nk * residual[k]
-            jac[0] = nk * (rotation[k, 1] * p2 - rotation[k, 2] * p1)
-            jac[1] = nk * (rotation[k, 2] * p0 - rotation[k, 0] * p2)
-            jac[2] = nk * (rotation[k, 0] * p1 - rotation[k, 1] * p0)
-            jac[3] = -nk * rotation[k, 0]
-            jac[4] = -nk * rotation[k, 1]
-            jac[5] = -nk * rotation[k, 2]
-            for a in range(6):
-                gradient[a] += jac[a] * err
-                for c in range(a, 6):  # the upper triangle; the lower is the same products
-                    hessian[a, c] += jac[a] * jac[c]
+            err = nk * (e0 if k == 0 else e1 if k == 1 else e2)
+            ra, rb, rc = rotation[k, 0], rotation[k, 1], rotation[k, 2]
+            a0, a1 = nk * (rb * p2 - rc * p1), nk * (rc * p0 - ra * p2)
+            a2 = nk * (ra * p1 - rb * p0)
+            a3, a4, a5 = -nk * ra, -nk * rb, -nk * rc
+            g0 += a0 * err
+            g1 += a1 * err
+            g2 += a2 * err
+            g3 += a3 * err
+            g4 += a4 * err
+            g5 += a5 * err
+            h00 += a0 * a0
+            h01 += a0 * a1
+            h02 += a0 * a2
+            h03 += a0 * a3
+            h04 += a0 * a4
+            h05 += a0 * a5
+            h11 += a1 * a1
+            h12 += a1 * a2
+            h13 += a1 * a3
+            h14 += a1 * a4
+            h15 += a1 * a5
+            h22 += a2 * a2
+            h23 += a2 * a3
+            h24 += a2 * a4
+            h25 += a2 * a5
+            h33 += a3 * a3
+            h34 += a3 * a4
+            h35 += a3 * a5
+            h44 += a4 * a4
+            h45 += a4 * a5
+            h55 += a5 * a5
             cost += 0.5 * err * err
-    for a in range(6):
-        for c in range(a):
-            hessian[a, c] = hessian[c, a]
-    return hessian, gradient, cost
+    hessian = np.array([[h00, h01, h02, h03, h04, h05], [h01, h11, h12, h13, h14, h15],
+                        [h02, h12, h22, h23, h24, h25], [h03, h13, h23, h33, h34, h35],
+                        [h04, h14, h24, h34, h44, h45], [h05, h15, h25, h35, h45, h55]])
+    return hessian, np.array([g0, g1, g2, g3, g4, g5]), cost
 
 
 @numba.njit(cache=True, nogil=True)
@@ -100,10 +129,11 @@ def _cost(source: np.ndarray, target: np.ndarray, normals: np.ndarray, pair: np.
 @numba.njit(cache=True, nogil=True)
 def _kept(source: np.ndarray, rotation: np.ndarray, shift: np.ndarray, target: np.ndarray,
           near: np.ndarray, reach: np.ndarray, seen_at: np.ndarray, pair: np.ndarray,
-          again: np.ndarray) -> int:
+          again: np.ndarray, max_distance: float) -> int:
     """Each source point's nearest target point among its candidates ``near`` (N, K) into
-    ``pair`` where it is provably the nearest of all (module docstring); the other points'
-    indices into ``again``; returns how many."""
+    ``pair`` where it is provably the nearest of all, or where every target point is provably
+    farther than ``max_distance`` metres (module docstring); the other points' indices into
+    ``again``; returns how many."""
     count = 0
     for i in range(source.shape[0]):
         p0, p1, p2 = source[i, 0], source[i, 1], source[i, 2]
@@ -118,7 +148,8 @@ def _kept(source: np.ndarray, rotation: np.ndarray, shift: np.ndarray, target: n
             sq = (target[j, 0] - x0) ** 2 + (target[j, 1] - x1) ** 2 + (target[j, 2] - x2) ** 2
             if sq < best_sq:
                 best, best_sq = j, sq
-        if np.sqrt(best_sq) < reach[i] - moved:
+        best_d, bound = np.sqrt(best_sq), reach[i] - moved  # bound: the others' least
+        if best_d < bound or (best_d > max_distance and bound > max_distance):
             pair[i] = best
         else:
             again[count] = i
@@ -155,10 +186,12 @@ class Nearest:
         self._again = np.empty(n, np.int64)
         self.searched = 0
 
-    def at(self, rotation: np.ndarray, shift: np.ndarray) -> np.ndarray:
-        """(N,) index of each source point's nearest target point at the pose."""
+    def at(self, rotation: np.ndarray, shift: np.ndarray,
+           max_distance: float = np.inf) -> np.ndarray:
+        """(N,) index of each source point's nearest target point at the pose; of a point
+        farther than ``max_distance`` metres from every target point, one of its candidates."""
         count = _kept(self.source, rotation, shift, self.target, self.near, self.reach,
-                      self.seen_at, self.pair, self._again)
+                      self.seen_at, self.pair, self._again, max_distance)
         if count:
             again = self._again[:count].copy()
             moved = self.source[again] @ rotation.T + shift
@@ -197,7 +230,7 @@ def plane_icp(nearest: Nearest, normals: np.ndarray, guess: np.ndarray, max_dist
     for step in range(iterations):
         last = step
         rotation, shift = np.ascontiguousarray(transform[:3, :3]), transform[:3, 3].copy()
-        pair = nearest.at(rotation, shift)
+        pair = nearest.at(rotation, shift, max_distance)
         hessian, gradient, cost = _linearize(source, target, normals, pair, rotation, shift,
                                              max_distance * max_distance, inlier)
         kept, converged = False, False

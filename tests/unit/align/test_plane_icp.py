@@ -80,6 +80,35 @@ def test_the_nearest_target_points_are_the_kd_trees():
     assert kept[0].searched == kept[1].searched < 12 * len(source) / 2
 
 
+def test_points_beyond_the_reach_are_not_searched_again():
+    """Source points that no target point is near (a doubled floor 0.3 m above the target's,
+    its nearest target points all about as far) are not searched again as the pose moves: within
+    ``max_distance`` the pairs are still the KD-tree's, and beyond it the pair stays beyond it,
+    so the fit counts the same pairs."""
+    rng = np.random.default_rng(4)
+    grid = np.stack(np.meshgrid(np.arange(0, 10, 0.05), np.arange(0, 10, 0.05)), -1)
+    target = np.column_stack([grid.reshape(-1, 2), np.zeros(grid[..., 0].size)])
+    source = rng.uniform([1, 1, 0], [9, 9, 0], size=(20000, 3))
+    source[10000:, 2] = 0.3
+    cloud, tree = prepared(target)
+    points = np.ascontiguousarray(cloud.points()[:, :3])
+    reach = 0.1
+    kept, every = Nearest(source, points, tree), Nearest(source, points, tree)
+    pose = np.eye(4)
+    for _ in range(12):
+        pose = pose @ se3_exp(np.concatenate([rng.normal(scale=1e-4, size=3),
+                                              rng.normal(scale=2e-3, size=3)]))
+        rotation, shift = np.ascontiguousarray(pose[:3, :3]), pose[:3, 3].copy()
+        moved = source @ rotation.T + shift
+        near = np.linalg.norm(points[every.at(rotation, shift)] - moved, axis=1) <= reach
+        pair = kept.at(rotation, shift, reach)
+        assert np.array_equal(pair[near], every.pair[near])
+        assert (np.linalg.norm(points[pair[~near]] - moved[~near], axis=1) > reach).all()
+    again, again_kept = every.searched - len(source), kept.searched - len(source)
+    assert again > 3 * 10000  # the raised floor, searched at most steps without the reach
+    assert again_kept < again / 20
+
+
 def test_se3_exp_is_the_exponential_of_the_twist():
     from scipy.linalg import expm
 
