@@ -25,7 +25,6 @@ import os
 from collections.abc import Iterator
 from dataclasses import dataclass
 
-import numba
 import numpy as np
 import small_gicp
 from scipy import ndimage
@@ -33,6 +32,7 @@ from scipy import ndimage
 from pcmapq.core.components import Components
 from pcmapq.core.covariance import PAIRS, symmetric
 from pcmapq.core.voxels import open3d_centroids
+from pcmapq.features.local_shape import normals_and_variation
 
 #: Nearest neighbours of a point's normal and of its edges in the region graph.
 NEIGHBOURS = 12
@@ -119,7 +119,8 @@ def _rows(n: int) -> Iterator[slice]:
 def local_shape(points: np.ndarray, k: int = NEIGHBOURS
                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Each point's k nearest neighbours (N, k) indices (itself first; int32 below 2**31
-    points), its unit normal (N, 3) and its surface variation (N,), from their covariance.
+    points), its unit normal (N, 3) and its surface variation (N,), from their covariance
+    (:mod:`pcmapq.features.local_shape`).
     The neighbours are small_gicp's KD-tree's, on every core (SciPy's, in about half the
     time)."""
     n, k = len(points), min(k, len(points))
@@ -129,40 +130,8 @@ def local_shape(points: np.ndarray, k: int = NEIGHBOURS
     normal, variation = np.empty((n, 3)), np.empty(n)
     for part in _rows(n):
         near[part] = tree.batch_knn_search(points[part], k, num_threads=THREADS)[0]
-        values, vectors = np.linalg.eigh(_covariances(points, near[part]))
-        variation[part] = values[:, 0] / np.maximum(values.sum(axis=1), 1e-18)
-        normal[part] = vectors[:, :, 0]
+        normal[part], variation[part] = normals_and_variation(points, near[part])
     return near, normal, variation
-
-
-@numba.njit(cache=True, nogil=True)
-def _covariances(points: np.ndarray, near: np.ndarray) -> np.ndarray:
-    """(K, 3, 3) the covariance of each row of ``near``'s (K, k) points, about their mean."""
-    count, k = near.shape
-    out = np.empty((count, 3, 3))
-    for i in range(count):
-        mx = my = mz = 0.0
-        for a in range(k):
-            j = near[i, a]
-            mx += points[j, 0]
-            my += points[j, 1]
-            mz += points[j, 2]
-        mx, my, mz = mx / k, my / k, mz / k
-        xx = xy = xz = yy = yz = zz = 0.0
-        for a in range(k):
-            j = near[i, a]
-            dx, dy, dz = points[j, 0] - mx, points[j, 1] - my, points[j, 2] - mz
-            xx += dx * dx
-            xy += dx * dy
-            xz += dx * dz
-            yy += dy * dy
-            yz += dy * dz
-            zz += dz * dz
-        out[i, 0, 0], out[i, 1, 1], out[i, 2, 2] = xx / k, yy / k, zz / k
-        out[i, 0, 1] = out[i, 1, 0] = xy / k
-        out[i, 0, 2] = out[i, 2, 0] = xz / k
-        out[i, 1, 2] = out[i, 2, 1] = yz / k
-    return out
 
 
 def regions(points: np.ndarray, near: np.ndarray, normal: np.ndarray, flat: np.ndarray,
