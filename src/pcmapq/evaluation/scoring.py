@@ -77,7 +77,9 @@ def score(placed: Placed, prepared: PreparedTruth, settings: Settings,
                                          prepared.planes)
         if placed.features is None:
             progress("drawing the walls' centre lines and detecting features")
-            sides = SideBySide(settings.matching.detectors, settings.matching.params)
+            names, params = settings.matching.detectors, settings.matching.params
+            sides = prepared.sides if prepared.sides is not None and \
+                prepared.sides.serves(names, params) else SideBySide(names, params)
             side = replace(placed, features=sides.features(placed.occupied, prepared.grid,
                                                            threads=FEATURE_THREADS))
         if early is not None:  # this thread is free until the jobs end: a side's

@@ -41,10 +41,10 @@ class PreparedTruth:
     ``occupied`` cells, its :attr:`features` by detector (``found``: them, or their job on a
     background thread), ``to_truth``: each cell's distance to the nearest truth wall, metres;
     ``aligner``: its points prepared for the rigid alignment; ``maps``: how many maps may be
-    scored on its grid at once in the memory allowed; ``sides``: the detectors' runner (to
-    stop a background job whose map is refused); ``planes``: the job finding a 3D cloud
-    truth's planes for the 3D structures (:func:`plane_params`), or None (found with the
-    map's)."""
+    scored on its grid at once in the memory allowed; ``sides``: the detectors' runner (the
+    maps' sides join it; it stops a background job whose map is refused); ``planes``: the job
+    finding a 3D cloud truth's planes for the 3D structures (:func:`plane_params`), or None
+    (found with the map's)."""
 
     source: OccupancyMap | PointMap
     xy: np.ndarray

@@ -10,7 +10,7 @@ import importlib
 import os
 from collections.abc import Mapping, Sequence
 from concurrent.futures import ThreadPoolExecutor
-from threading import BoundedSemaphore, Event, Lock
+from threading import BoundedSemaphore, Condition, Event
 from typing import Any
 
 import numpy as np
@@ -85,19 +85,39 @@ def detect_in(name: str, walls: WallImage, params: Any = None) -> Features:
         return found.detect(walls, found.checked(params))
 
 
+#: The order a side takes its detectors in: the costliest first (SIFT's scale space, then the
+#: rooms' segmentation), so that the last detectors of a run, whichever thread takes them, are
+#: short. Others after them, in the order asked.
+COSTLIEST_FIRST = ("sift", "rooms", "hough", "harris")
+
+
+class _Side:
+    """One side's detectors in :class:`SideBySide`: its walls, the detectors no thread has
+    taken, how many taken are still running, what they found (or the first error)."""
+
+    def __init__(self, walls: WallImage, names: Sequence[str]) -> None:
+        rank = {name: k for k, name in enumerate(COSTLIEST_FIRST)}
+        self.walls, self.running = walls, 0
+        self.left = sorted(names, key=lambda name: rank.get(name, len(rank)))  # stable
+        self.found: dict[str, Features] = {}
+        self.error: BaseException | None = None
+
+
 class SideBySide:
-    """The truth's and the map's features, each side on its own thread (:meth:`features`):
+    """The truth's and the maps' features, each side on threads of its own (:meth:`features`):
     the truth's start as soon as its raster exists, while the map is still being aligned.
 
-    One side at a time runs a given detector, and a side takes the next of its detectors that
-    the other side is not running (waiting only when all that are left are busy): the two
-    sides' largest temporaries (SIFT's scale space) never coincide, neither side idles while
-    there is work the other does not hold, and one side's Python-bound steps (Hough's merging)
-    overlap the other's OpenCV and NumPy work, which runs without the interpreter lock. No more
-    detectors run at once in the process than it has cores (at least 2; :func:`detect_in`),
-    whichever side or caller runs them. Each result depends on its own input only, whichever
-    thread computes it and in whatever order.
-    :meth:`cancel` stops a side at its next detector (a refused map needs no truth features)."""
+    A side's thread takes the first of its detectors (:data:`COSTLIEST_FIRST`) that no other
+    side is running (the sides' largest temporaries, SIFT's scale spaces, then rarely coincide;
+    one side's Python-bound steps, Hough's merging, overlap the other's OpenCV and NumPy work,
+    which runs without the interpreter lock), else the first left. A thread whose side has none
+    left takes one another side has not started, and runs it for that side: the truth's thread
+    runs at a lower priority (while the map is placed), and the last detectors of the side that
+    started first need not end the run on one core. No more detectors run at once in the
+    process than it has cores (at least 2; :func:`detect_in`), whichever side or caller runs
+    them. Each result depends on its own input only, whichever thread computes it and in
+    whatever order. :meth:`cancel` stops every side at its next detector (a refused map needs
+    no truth features)."""
 
     def __init__(self, names: Sequence[str], params: Mapping[str, Any]) -> None:
         """names: the detectors (keys of :data:`DETECTORS`, unknown ones fail here); params:
@@ -105,40 +125,72 @@ class SideBySide:
         self.names, self.params = list(names), params
         for name in self.names:
             detector(name)
-        self._busy = {name: Lock() for name in self.names}
+        self._sides: list[_Side] = []
+        self._running = {name: 0 for name in self.names}  # sides running each detector
+        self._changed = Condition()
         self._stop = Event()
 
     def features(self, occupied: np.ndarray, grid: MetricGrid,
                  threads: int = 1) -> dict[str, Features]:
         """Every detector's features on one side's occupied cells (bool on ``grid``), on up to
-        ``threads`` threads of this side (this one included); only those found before a
-        :meth:`cancel`."""
-        walls = walls_of(occupied, grid)
-        found: dict[str, Features] = {}
-        left, taking = list(self.names), Lock()
+        ``threads`` threads of this side (this one included) and those of other sides with
+        none of their own left; only those found before a :meth:`cancel`."""
+        side = _Side(walls_of(occupied, grid), self.names)
+        with self._changed:
+            self._sides.append(side)
+        try:
+            with ThreadPoolExecutor(max(threads - 1, 1)) as more:
+                others = [more.submit(self._work, side) for _ in range(threads - 1)]
+                self._work(side)
+                for other in others:
+                    other.result()
+            with self._changed:  # the detectors other sides' threads took from this one
+                self._changed.wait_for(lambda: side.running == 0)
+        finally:
+            with self._changed:
+                self._sides.remove(side)
+        if side.error is not None:
+            raise side.error
+        return {name: side.found[name] for name in self.names if name in side.found}
 
-        def work() -> None:
-            while not self._stop.is_set():
-                with taking:  # the first detector left that is free, else the first left
-                    if not left:
-                        return
-                    free = next((n for n in left if self._busy[n].acquire(blocking=False)),
-                                None)
-                    name = left[0] if free is None else free
-                    left.remove(name)
-                if free is None:
-                    self._busy[name].acquire()
-                try:
-                    found[name] = detect_in(name, walls, self.params.get(name))
-                finally:
-                    self._busy[name].release()
+    def _work(self, own: _Side) -> None:
+        """Run detectors, this side's first, then those other sides have not started."""
+        while (job := self._take(own)) is not None:
+            side, name = job
+            try:
+                found = detect_in(name, side.walls, self.params.get(name))
+            except BaseException as error:  # raised by the side's own call
+                found = None
+                side.error = side.error or error
+            with self._changed:
+                if found is not None:
+                    side.found[name] = found
+                side.running -= 1
+                self._running[name] -= 1
+                self._changed.notify_all()
 
-        with ThreadPoolExecutor(max(threads - 1, 1)) as more:
-            others = [more.submit(work) for _ in range(threads - 1)]
-            work()
-            for other in others:
-                other.result()
-        return found
+    def _take(self, own: _Side) -> tuple[_Side, str] | None:
+        """The next (side, detector) for a thread of ``own`` (class docstring), marked as
+        running; None when there is none or the sides are stopped."""
+        with self._changed:
+            if self._stop.is_set() or own.error is not None:
+                return None
+            if own.left:
+                side = own
+                name = next((n for n in own.left if not self._running[n]), own.left[0])
+            else:
+                side = next((s for s in self._sides if s.left and s.error is None), None)
+                if side is None:
+                    return None
+                name = side.left[0]
+            side.left.remove(name)
+            side.running += 1
+            self._running[name] += 1
+            return side, name
+
+    def serves(self, names: Sequence[str], params: Mapping[str, Any]) -> bool:
+        """Whether these are its detectors and parameters (another side may join it)."""
+        return self.names == list(names) and self.params == params
 
     def cancel(self) -> None:
         """Stop every side at its next detector."""

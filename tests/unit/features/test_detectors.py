@@ -203,3 +203,82 @@ def test_no_more_detectors_run_at_once_than_the_process_allows(monkeypatch):
     for job in jobs:
         job.join()
     assert most == 1
+
+
+def _cross(size: int, at: int) -> np.ndarray:
+    occupied = np.zeros((size, size), bool)
+    occupied[at, 5:size - 5] = occupied[5:size - 5, at] = True
+    return occupied
+
+
+def test_a_side_with_none_left_runs_the_other_sides_detectors(monkeypatch):
+    """Two sides on one SideBySide, the first started early on one thread: the second's
+    thread, its own detectors done, runs those of the first it has not started, for the first.
+    Each side gets every detector's features, the ones a detector finds alone, in the order
+    asked; an error in a detector taken over reaches the side it belongs to."""
+    import threading
+    import time
+    from dataclasses import replace
+
+    import pcmapq.features as features
+    from pcmapq.features import registry
+
+    names = ["harris", "hough", "sift", "rooms"]
+    grid = MetricGrid(0.05, (0.0, 0.0, 0.0), (60, 60))
+    first, second = _cross(60, 20), _cross(60, 40)
+    ran: dict[tuple[str, int], str] = {}
+    real = {name: features.detector(name) for name in names}
+    started = threading.Event()
+
+    def slow(name):
+        def run(walls, params):
+            side = 0 if walls.image[:, 20].sum() > walls.image[:, 40].sum() else 1
+            ran[name, side] = threading.current_thread().name
+            started.set()
+            if side == 0:
+                time.sleep(0.5)  # the first side's detectors are slow
+            return real[name].detect(walls, params)
+        return replace(real[name], detect=run)
+
+    monkeypatch.setattr(registry, "detector", lambda name: slow(name))
+    sides = features.SideBySide(names, {})
+    got = {}
+    one = threading.Thread(target=lambda: got.update(first=sides.features(first, grid)),
+                           name="first")
+    one.start()
+    started.wait()
+    got["second"] = sides.features(second, grid)
+    one.join()
+    assert list(got["first"]) == list(got["second"]) == names
+    helped = [name for name in names if ran[name, 0] != "first"]
+    assert helped and all(ran[name, 0] == threading.current_thread().name for name in helped)
+    for side, occupied in (("first", first), ("second", second)):
+        for name in names:
+            alone = real[name].detect(registry.walls_of(occupied, grid), real[name].params())
+            assert np.array_equal(got[side][name].xy, alone.xy), (side, name)
+
+    def broken(name):
+        def run(walls, params):
+            if walls.image[:, 20].sum() > walls.image[:, 40].sum():
+                time.sleep(0.2)
+                if threading.current_thread().name != "first":
+                    raise ValueError("taken over and broken")
+            return real[name].detect(walls, params)
+        return replace(real[name], detect=run)
+
+    monkeypatch.setattr(registry, "detector", lambda name: broken(name))
+    sides = features.SideBySide(names, {})
+    errors = []
+
+    def first_side():
+        try:
+            sides.features(first, grid)
+        except ValueError as error:
+            errors.append(error)
+
+    one = threading.Thread(target=first_side, name="first")
+    one.start()
+    time.sleep(0.05)
+    assert list(sides.features(second, grid)) == names  # the thief's own side is whole
+    one.join()
+    assert len(errors) == 1
