@@ -157,17 +157,21 @@ class SideBySide:
         """Run detectors, this side's first, then those other sides have not started."""
         while (job := self._take(own)) is not None:
             side, name = job
+            found = failed = None
             try:
                 found = detect_in(name, side.walls, self.params.get(name))
             except BaseException as error:  # raised by the side's own call
-                found = None
-                side.error = side.error or error
-            with self._changed:
-                if found is not None:
-                    side.found[name] = found
-                side.running -= 1
-                self._running[name] -= 1
-                self._changed.notify_all()
+                failed = error
+                if not isinstance(error, Exception):  # an interrupt stops this thread too
+                    raise
+            finally:
+                with self._changed:
+                    if found is not None:
+                        side.found[name] = found
+                    side.error = side.error or failed
+                    side.running -= 1
+                    self._running[name] -= 1
+                    self._changed.notify_all()
 
     def _take(self, own: _Side) -> tuple[_Side, str] | None:
         """The next (side, detector) for a thread of ``own`` (class docstring), marked as
