@@ -77,9 +77,8 @@ def score(placed: Placed, prepared: PreparedTruth, settings: Settings,
                                          prepared.planes)
         if placed.features is None:
             progress("drawing the walls' centre lines and detecting features")
-            names, params = settings.matching.detectors, settings.matching.params
-            sides = prepared.sides if prepared.sides is not None and \
-                prepared.sides.serves(names, params) else SideBySide(names, params)
+            sides = prepared.sides or SideBySide(settings.matching.detectors,
+                                                 settings.matching.params)
             side = replace(placed, features=sides.features(placed.occupied, prepared.grid,
                                                            threads=FEATURE_THREADS))
         if early is not None:  # this thread is free until the jobs end: a side's

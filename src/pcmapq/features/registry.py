@@ -89,6 +89,7 @@ def detect_in(name: str, walls: WallImage, params: Any = None) -> Features:
 #: rooms' segmentation), so that the last detectors of a run, whichever thread takes them, are
 #: short. Others after them, in the order asked.
 COSTLIEST_FIRST = ("sift", "rooms", "hough", "harris")
+_RANK = {name: k for k, name in enumerate(COSTLIEST_FIRST)}
 
 
 class _Side:
@@ -96,9 +97,8 @@ class _Side:
     taken, how many taken are still running, what they found (or the first error)."""
 
     def __init__(self, walls: WallImage, names: Sequence[str]) -> None:
-        rank = {name: k for k, name in enumerate(COSTLIEST_FIRST)}
         self.walls, self.running = walls, 0
-        self.left = sorted(names, key=lambda name: rank.get(name, len(rank)))  # stable
+        self.left = sorted(names, key=lambda name: _RANK.get(name, len(_RANK)))  # stable
         self.found: dict[str, Features] = {}
         self.error: BaseException | None = None
 
@@ -191,10 +191,6 @@ class SideBySide:
             side.running += 1
             self._running[name] += 1
             return side, name
-
-    def serves(self, names: Sequence[str], params: Mapping[str, Any]) -> bool:
-        """Whether these are its detectors and parameters (another side may join it)."""
-        return self.names == list(names) and self.params == params
 
     def cancel(self) -> None:
         """Stop every side at its next detector."""
