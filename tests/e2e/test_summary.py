@@ -16,7 +16,8 @@ from pcmapq.core.errors import InputError
 from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.report import summary
 from pcmapq.report.summary import summary_figure, table_csv, table_md, write_summary
-from pcmapq.results.figures import FIGURES, columns, failed_row, head, table_row
+from pcmapq.results.figures import FIGURES
+from pcmapq.results.rows import columns, failed_row, head, table_row
 from pcmapq.settings import DEFAULT_DETECTORS, DETECTOR_NAMES, MatchingConfig, Settings
 from testkit import synth
 from testkit.files import write_image_map

@@ -21,7 +21,7 @@ from pcmapq.evaluation.pipeline import evaluate
 from pcmapq.io.digest import sha256_file
 from pcmapq.io.targets import input_files
 from pcmapq.io.writers import OutputSet, one_line, write_atomic
-from pcmapq.results.figures import failed_row, table_row
+from pcmapq.results.rows import failed_row, table_row
 
 #: The folder of DIR where each row's record (its inputs' checksums, settings, outputs) is
 #: kept; hidden, so ``DIR/*.json`` holds the results only.
@@ -58,7 +58,7 @@ class Task:
 class Outcome:
     """How a row ended: status 'computed', 'skipped' (a valid saved result) or 'failed';
     exit_code 0 or the error's (2 bad input, 1 evaluation failed or any other error); its
-    table row (:func:`~pcmapq.results.figures.table_row` or ``failed_row``); pcmapq's
+    table row (:func:`~pcmapq.results.rows.table_row` or ``failed_row``); pcmapq's
     warnings while it ran."""
 
     name: str

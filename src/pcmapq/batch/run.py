@@ -21,8 +21,8 @@ from pcmapq.core.unused import leave_out_unused
 from pcmapq.io.writers import one_line
 from pcmapq.report.summary import write_summary
 from pcmapq.results import gates
-from pcmapq.results.figures import table_row
 from pcmapq.results.gates import Gate
+from pcmapq.results.rows import table_row
 
 #: Dask reruns a task that raised this many times (the task itself never raises; a worker
 #: lost mid-task is rescheduled by the scheduler, up to its ``allowed-failures``).

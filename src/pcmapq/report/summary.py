@@ -15,8 +15,9 @@ import numpy as np
 from pcmapq.core.errors import InputError
 from pcmapq.io.writers import OutputSet, one_line, write_atomic
 from pcmapq.report.style import DETECTOR_COLOURS
-from pcmapq.results.figures import SCORES, TAIL, by_name, columns, header, ranked
+from pcmapq.results.figures import SCORES, by_name
 from pcmapq.results.result import DECIMALS
+from pcmapq.results.rows import TAIL, columns, header, ranked
 from pcmapq.settings import DEFAULT_DETECTORS, DETECTOR_NAMES
 
 #: Decimals of the markdown table: scale 4, degrees 2, everything else 3 (as the terminal).
@@ -25,7 +26,7 @@ MD_DECIMALS = {"scale": 4, "yaw_deg": 2}
 
 def table_csv(rows: Sequence[dict[str, object]]) -> str:
     """The rows as CSV, one per map in the order given with its rank
-    (:func:`~pcmapq.results.figures.ranked`), :func:`columns` order: floats with
+    (:func:`~pcmapq.results.rows.ranked`), :func:`columns` order: floats with
     :data:`~pcmapq.results.result.DECIMALS` decimals, an empty cell for None."""
     import csv
     import io
@@ -42,7 +43,7 @@ def table_csv(rows: Sequence[dict[str, object]]) -> str:
 def table_md(rows: Sequence[dict[str, object]]) -> str:
     """The rows as a markdown table (units in the headers): scores 'n/a' when undefined,
     other figures '-' when there is none, blank in a failed row, whose status says its exit
-    code and error; each row's rank (:func:`~pcmapq.results.figures.ranked`) beside its
+    code and error; each row's rank (:func:`~pcmapq.results.rows.ranked`) beside its
     name."""
     rows = ranked(list(rows))
     cols = [c for c in columns(rows) if c not in TAIL]

@@ -17,7 +17,7 @@ from pydantic import ValidationError
 from pcmapq.core.errors import InputError
 from pcmapq.core.words import count
 from pcmapq.io.writers import one_line
-from pcmapq.results.figures import table_row
+from pcmapq.results.rows import table_row
 from pcmapq.results.schema import ResultDocument, problem
 
 #: What makes two truths the same, beside their path: the truth grid's keys in the JSON.

@@ -39,8 +39,8 @@ from pcmapq.evaluation.placing import Placed
 from pcmapq.evaluation.truth import PreparedTruth
 from pcmapq.io import PointMap
 from pcmapq.metrics.trajectory import ape, rpe
-from pcmapq.results.figures import step_columns, table_row
 from pcmapq.results.result import Result
+from pcmapq.results.rows import step_columns, table_row
 from pcmapq.settings import Settings
 from pcmapq.track.runs import Run
 from pcmapq.track.steps import travelled
@@ -74,7 +74,7 @@ class Step:
     """One step: the map of the first ``scans`` scans; ``time_s`` at its last scan, seconds
     from a recording's start or from a log's first scan (None without timestamps), and
     ``distance_m`` travelled by then; ``figures`` the flat columns of
-    :func:`~pcmapq.results.figures.table_row` plus ``slide_m``, ``local_offset_m`` and the
+    :func:`~pcmapq.results.rows.table_row` plus ``slide_m``, ``local_offset_m`` and the
     trajectory errors (None when undefined); ``note`` why a step was not scored ("" when it
     was);
     ``start`` the pose its ICP started from (None: the global search); ``frames`` the frames
@@ -119,8 +119,8 @@ def pose_errors(estimate: np.ndarray, reference: np.ndarray,
 
 
 def figures_of(result: Result) -> dict[str, float | None]:
-    """A result's flat figures: :func:`~pcmapq.results.figures.table_row` without the inputs and
-    outcome, then :func:`~pcmapq.results.figures.step_columns` (the detectors' mean precision,
+    """A result's flat figures: :func:`~pcmapq.results.rows.table_row` without the inputs and
+    outcome, then :func:`~pcmapq.results.rows.step_columns` (the detectors' mean precision,
     the wall precision at each tau)."""
     doc = result.to_dict(features=False)
     row = table_row("", doc)

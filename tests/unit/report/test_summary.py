@@ -10,7 +10,7 @@ from matplotlib.colors import to_rgb
 
 from pcmapq.report.style import DETECTOR_COLOURS
 from pcmapq.report.summary import summary_figure, table_csv
-from pcmapq.results.figures import columns, failed_row, head
+from pcmapq.results.rows import columns, failed_row, head
 from pcmapq.settings import DETECTOR_NAMES
 
 
@@ -31,7 +31,7 @@ def test_csv_columns_are_the_union_of_taus_in_order():
 
 
 def test_gates_verdict_in_a_word():
-    from pcmapq.results.figures import gates_verdict
+    from pcmapq.results.rows import gates_verdict
     assert gates_verdict(None) == ""
     assert gates_verdict([{"key": "coverage", "passed": True}]) == "pass"
     assert gates_verdict([{"key": "harris.quality", "passed": False},
@@ -45,7 +45,7 @@ def test_rank_puts_refused_and_failed_maps_last():
     place (refused, or forced: by f1 too), then a map that failed otherwise; the rows keep
     their order."""
     from pcmapq.report.summary import table_md
-    from pcmapq.results.figures import ranked
+    from pcmapq.results.rows import ranked
 
     def scored(name, f1, verdict="same place"):
         return {**failed_row(name, name, "t", 0, ""), "verdict": verdict, "exit_code": 0,

@@ -8,6 +8,7 @@ import pytest
 from pcmapq.report.docs_tables import figures_table
 from pcmapq.report.summary import table_csv, table_md
 from pcmapq.results import figures as table
+from pcmapq.results import rows
 from pcmapq.results.gates import check, parse_rules, short_names
 from pcmapq.track.timeline import figures_of
 
@@ -23,7 +24,7 @@ from pcmapq.track.timeline import figures_of
 def test_a_column_and_its_header_follow_from_the_path(name, column, header):
     figure = table.by_name()[name]
     assert figure.column_name == column and figure.header == header
-    assert table.header(column) == header
+    assert rows.header(column) == header
 
 
 def test_a_figure_added_to_the_table_reaches_every_output(monkeypatch, sample_result):
@@ -38,7 +39,7 @@ def test_a_figure_added_to_the_table_reaches_every_output(monkeypatch, sample_re
     assert "harris.matched" in short_names()
     (outcome,) = check(parse_rules(f"harris.matched={matched}", None), doc)
     assert outcome.path == "detectors.harris.matched" and outcome.passed
-    row = table.table_row("sample", doc)
+    row = rows.table_row("sample", doc)
     assert row["harris_matched"] == matched
     assert "harris_matched" in table_csv([row]).splitlines()[0].split(",")
     assert "| harris matched |" in table_md([row])

@@ -9,8 +9,9 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from pcmapq.results.figures import by_name, head
+from pcmapq.results.figures import by_name
 from pcmapq.results.result import Result
+from pcmapq.results.rows import head
 from pcmapq.results.schema import ResultDocument
 from testkit.building3d import known_structures
 
