@@ -22,8 +22,8 @@ from pcmapq.core import voxel_table
 from pcmapq.core.bounds import bounds
 from pcmapq.core.errors import InputError
 
-__all__ = ["VoxelMap", "evenly", "index_keys", "open3d_centroids", "stripe_points",
-           "voxel_centroids", "voxel_count", "voxel_groups"]
+__all__ = ["VoxelMap", "evenly", "index_keys", "open3d_centroids", "open3d_voxels",
+           "stripe_points", "voxel_centroids", "voxel_count", "voxel_groups"]
 
 #: Grouping by counting is used when the points' box holds at most this many voxels per point
 #: and at most DENSE_CELLS voxels (8 bytes of memory each).
@@ -199,27 +199,33 @@ def stripe_points(points: int) -> int | None:
 
 
 def open3d_centroids(points: np.ndarray, voxel: float) -> np.ndarray:
+    """The centroids (M, 3) of :func:`open3d_voxels`, in lexicographic order (x, then y, then
+    z)."""
+    out = open3d_voxels(points, voxel)
+    return out[np.lexsort(out.T[::-1])]
+
+
+def open3d_voxels(points: np.ndarray, voxel: float) -> np.ndarray:
     """The centroids (M, 3) of the points (N, 3, metres, any float type) in each voxel of
     Open3D's ``voxel_down_sample``, bit for bit (its cubes start half a voxel below the
-    cloud's least corner; each voxel's points are summed in their order), in lexicographic
-    order (x, then y, then z), so that the order of the input does not matter. Read in chunks
-    by the compiled table (a file mapped into memory is never converted whole; more than
-    STRIPE_POINTS points in stripes of x); Open3D itself reduces a cloud wider than the
-    table's keys reach (a float64 copy of it)."""
+    cloud's least corner; each voxel's points are summed in their order), in the voxels' index
+    order (x, then y, then z), not Open3D's, which follows the order of the input. Read in
+    chunks by the compiled table (a file mapped into memory is never converted whole; more
+    than STRIPE_POINTS points in stripes of x); Open3D itself reduces a cloud wider than the
+    table's keys reach (a float64 copy of it), its centroids then in lexicographic order."""
     points = np.asarray(points)
     if len(points) == 0:
         return np.zeros((0, 3))
     lo, hi = (b.astype(np.float64) for b in bounds(points))
     corner = lo - voxel * 0.5
-    if float(np.max((hi - corner) / voxel)) >= REACH:
-        import open3d as o3d  # only here: Open3D loads in seconds
+    if float(np.max((hi - corner) / voxel)) < REACH:
+        return voxel_table.streamed_centroids(points, voxel, origin=corner,
+                                              stripe_points=stripe_points(len(points)))
+    import open3d as o3d  # only here: Open3D loads in seconds
 
-        cloud = o3d.geometry.PointCloud(o3d.utility.Vector3dVector(
-            np.asarray(points, dtype=np.float64)))
-        out = np.asarray(cloud.voxel_down_sample(voxel).points)
-    else:
-        out = voxel_table.streamed_centroids(points, voxel, origin=corner,
-                                             stripe_points=stripe_points(len(points)))
+    cloud = o3d.geometry.PointCloud(o3d.utility.Vector3dVector(
+        np.asarray(points, dtype=np.float64)))
+    out = np.asarray(cloud.voxel_down_sample(voxel).points)
     return out[np.lexsort(out.T[::-1])]
 
 

@@ -132,3 +132,21 @@ def test_open3d_centroids_are_open3ds_bit_for_bit(dtype, shift, monkeypatch):
     monkeypatch.setattr(voxels, "STRIPE_WIDTH_POINTS", 15_000)
     assert np.array_equal(voxels.open3d_centroids(points, 0.1), expected)
     assert voxels.open3d_centroids(points[:0], 0.1).shape == (0, 3)
+
+
+def test_open3d_voxels_come_in_their_index_order_whatever_the_points_order():
+    """Open3D's voxels (the same centroids as its voxel_down_sample), in the order of their
+    index (x, then y, then z) rather than Open3D's, which follows the points' order: the
+    same cloud with its points shuffled gives the same voxels in the same order."""
+    from pcmapq.core import voxels
+
+    rng = np.random.default_rng(4)
+    points = rng.normal(0, 3, (40_000, 3))
+    out = voxels.open3d_voxels(points, 0.1)
+    assert np.array_equal(out[np.lexsort(out.T[::-1])], voxels.open3d_centroids(points, 0.1))
+    index = np.floor((out - (points.min(axis=0) - 0.05)) / 0.1).astype(np.int64)
+    step = np.diff(index, axis=0)  # each voxel after the last: the first axis that differs grows
+    first = step[np.arange(len(step)), np.argmax(step != 0, axis=1)]
+    assert np.all(first > 0)
+    shuffled = voxels.open3d_voxels(points[rng.permutation(len(points))], 0.1)
+    np.testing.assert_allclose(shuffled, out, rtol=0, atol=1e-12)
