@@ -7,7 +7,8 @@ import pytest
 from scipy.spatial import cKDTree
 
 from pcmapq.raster import slice as slice_module
-from pcmapq.raster.slice import floor_height, level_rotation, wall_band
+from pcmapq.raster.levelling import level_rotation
+from pcmapq.raster.slice import floor_height, wall_band
 from testkit import synth
 
 FLOOR_Z = 1.7
@@ -182,7 +183,7 @@ def test_levelling_a_cloud_on_one_line_finds_no_plane_and_warns_nothing() -> Non
     whose normalising divided 0 by 0 (a NumPy RuntimeWarning on stderr before the error)."""
     import warnings
 
-    from pcmapq.raster.slice import level_rotation
+    from pcmapq.raster.levelling import level_rotation
 
     t = np.linspace(0.0, 30.0, 540)[:, None]
     points = np.array([0.2, 0.5, -0.5]) + t * np.array([-0.8, 0.35, -0.13])
