@@ -27,7 +27,7 @@ from typer.testing import CliRunner
 from pcmapq.cli import app
 from pcmapq.core.transform import Similarity2D
 from pcmapq.evaluation.pipeline import evaluate
-from pcmapq.io.writers import write_ros_map
+from pcmapq.io.writers import write_cloud, write_ros_map
 from pcmapq.results.result import Result
 from testkit import building3d, synth
 from testkit.paths import REPO, SAMPLE
@@ -322,14 +322,13 @@ def test_two_3d_clouds_with_their_points_in_another_order_score_the_same(tmp_pat
     with their points shuffled, as another tool may write the same clouds: the same result,
     every figure (within 1e-6: a voxel's points are summed in another order). The levelling
     drew its RANSAC sample in the order Open3D's voxels came out, which follows the points'."""
-    from pcmapq.io.writers import write_cloud
-
+    clouds = {"map": building3d.moved_map(),
+              "truth": building3d.cloud(building3d.faces(), seed=1)}
     rng = np.random.default_rng(5)
     docs = []
     for name, order in (("as-built", None), ("shuffled", rng.permutation)):
         paths = []
-        for side, points in (("map", building3d.moved_map()),
-                             ("truth", building3d.cloud(building3d.faces(), seed=1))):
+        for side, points in clouds.items():
             path = tmp_path / f"{name}-{side}.ply"
             write_cloud(path, points if order is None else points[order(len(points))])
             paths.append(path)
