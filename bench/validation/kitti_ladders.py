@@ -54,14 +54,16 @@ def _metres(value: float | None) -> str:
 def _table(kind: str, rungs: list[Rung]) -> list[str]:
     """One ladder's table, and its line of rank correlations."""
     lines = [header([f"level ({UNIT[kind]})", "at the end (m / deg)", "verdict", "3D fitness",
-                     "Chamfer 3D (m)", "AWD (m)", "SCS", "planes f1", "plane lines f1",
+                     "Chamfer 3D (m)", "AWD (m)", "SCS", "SCS, MapEval's code", "planes f1",
+                     "plane lines f1",
                      "largest region |dz| (m)", "largest region offset (m)", "held / regions"])]
     for g in rungs:
         f, r = g.figures, g.run.result
         lines.append(row([
             _level(kind, g.level), f"{g.injected.offset_m:.2f} / {g.injected.turn_deg:.1f}",
             r.overlap.verdict, f"{r.registration_3d.fitness:.3f}", _metres(f["chamfer_3d_m"]),
-            _metres(f["awd_m"]), score(f["scs"], 3), score(f["planes_f1"], 2),
+            _metres(f["awd_m"]), score(f["scs"], 3), score(f["scs_as_coded"], 3),
+            score(f["planes_f1"], 2),
             score(f["plane_lines_f1"], 2), _metres(f["largest_dz_m"]),
             _metres(f["largest_offset_m"]), f"{f['held']} / {f['regions']}"]))
     levels = [g.level for g in rungs]
@@ -74,6 +76,10 @@ def _table(kind: str, rungs: list[Rung]) -> list[str]:
         elif not meets(name, value):
             text += " (**not met**)"
         parts.append(text)
+        if name == "scs":
+            coded = rho(levels, [g.figures["scs_as_coded"] for g in rungs])
+            shown = "-" if coded is None else f"{coded:.2f}"
+            parts.append(f"SCS as MapEval's code computes it {shown}")
     lines += ["", f"Spearman's rho with the level: {', '.join(parts)}."]
     return lines
 
@@ -193,7 +199,10 @@ def _findings(by_kind: dict[str, list[Rung]]) -> list[str]:
         "pitch moves every far point, so its error spreads more evenly as it grows, and SCS "
         "falls). MapEval meant the two so: AWD for the global accuracy, SCS for the local "
         "consistency, which a drift leaves whole. pcmapq's SCS is MapEval's definition: not "
-        "its fault.",
+        "its fault. MapEval's own code, its arithmetic as docs/metrics.md reads it (each "
+        "covariance divided by (n - 1) three times, a Cholesky factor for the square root; "
+        "`testkit.mapeval.mapeval_as_coded`), run on the same placed maps, gives an SCS that "
+        f"does not move one way either (rho {listed('scs_as_coded')}).",
         "",
         f"The vertical drift's largest reported |dz| is within the bound at {sum(bends)} of "
         f"{len(bends)} levels and in the far region at {sum(same)} of {len(same)}. At full "

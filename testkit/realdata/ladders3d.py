@@ -53,6 +53,7 @@ from pcmapq.metrics.map_gaussians import MapGaussians, map_gaussians
 from pcmapq.results.result import Result
 from pcmapq.settings import NoRefConfig, Settings
 from testkit.kitti import curved, stretched, tr_00
+from testkit.mapeval import mapeval_as_coded
 from testkit.realdata.bends3d import WITHIN_M, WITHIN_SHARE, placed_errors, region_dz
 from testkit.runs import Run, timed_evaluate
 
@@ -142,18 +143,20 @@ class Bend:
 @dataclass(frozen=True)
 class Rung:
     """One drifted map scored: its kind and level, the drift at the run's end, the
-    evaluation, its 3D figures (:func:`figures_3d`) and, for the vertical ladder, the check of
-    its 3D consistency map."""
+    evaluation, its 3D figures (:func:`figures_3d`), SCS as MapEval's code computes it on the
+    map as the evaluation placed it (:func:`coded_scs`) and, for the vertical ladder, the check
+    of its 3D consistency map."""
 
     kind: str
     level: float
     injected: Injected
     run: Run
+    scs_as_coded: float | None
     bend: Bend | None
 
     @property
     def figures(self) -> dict[str, float | None]:
-        return figures_3d(self.run.result)
+        return {**figures_3d(self.run.result), "scs_as_coded": self.scs_as_coded}
 
     def summary(self) -> dict:
         out = self.run.summary()
@@ -234,8 +237,18 @@ def direct_figures(folder: Path, kind: str, level: float, transform: np.ndarray
                                  last_reach(settings.alignment.voxel_3d))
         figures = figures_of(chamfer.result().chamfer_m, gaussians.result(),
                              structures.result(), regions.result())
+    figures["scs_as_coded"] = coded_scs(placed, target)
     return figures, (bend(folder, kind, level, regions.result(), transform, level_of)
                      if kind == "vertical" else None)
+
+
+def coded_scs(placed: np.ndarray, truth: np.ndarray) -> float | None:
+    """SCS of the map ``placed`` (N, 3, in the truth's frame) against ``truth`` (M, 3) as
+    MapEval's code computes it (:func:`testkit.mapeval.mapeval_as_coded`, its defaults: 3 m
+    voxels, 100 points, a neighbourhood of 5 voxels), rounded to 1e-6 as results are saved."""
+    scs = mapeval_as_coded(np.asarray(placed, dtype=np.float64),
+                           np.asarray(truth, dtype=np.float64))[1]
+    return None if scs is None else round(scs, 6)
 
 
 def rho(levels: list[float], values: list[float | None]) -> float | None:
@@ -285,7 +298,10 @@ def measure(folder: Path, kind: str, level: float) -> Rung:
         write_cloud(truth, ladder_map(folder))
         write_cloud(cloud, ladder_map(folder, kind, level))
         run = timed_evaluate(cloud, truth, SETTINGS)
+        source, target = load_pair(cloud, truth, SETTINGS)
     r = run.result
+    placed = apply(np.asarray(r.registration_3d.transform, dtype=np.float64), source.points)
     return Rung(kind, level, injected(folder, kind, level), run,
+                coded_scs(placed, target.points),
                 bend(folder, kind, level, r.consistency_3d, r.registration_3d.transform,
                      r.frames.truth_levelling) if kind == "vertical" else None)
