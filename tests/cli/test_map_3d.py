@@ -1,6 +1,7 @@
 """MapEval's AWD and SCS through ``pcmapq eval`` on two 3D clouds: in the frame given
 (``--no-align``) they are the plain reference's on the files' points; after a 3D registration,
-those of the map in the truth's frame."""
+those of the map in the truth's frame, whether the registration searched or started where
+``--init-3d`` says."""
 
 from __future__ import annotations
 
@@ -10,6 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from pcmapq.io.export import write_matrix
 from testkit import synth
 from testkit.command import run
 from testkit.mapeval import reference_awd_scs
@@ -74,3 +76,42 @@ def test_after_a_3d_registration_the_figures_are_the_maps_in_the_truths_frame(cl
     assert doc["map_3d"]["voxels"] == pytest.approx(voxels, abs=2)
     assert doc["gates"] == [{"key": "awd_3d", "path": "map_3d.awd_m", "option": "--fail-over",
                              "bound": 1.0, "value": doc["map_3d"]["awd_m"], "passed": True}]
+
+
+def test_a_3d_start_is_where_the_registration_begins(clouds):
+    """``--init-3d``: the map turned 30 degrees and moved, started 2 degrees and 0.2 m off
+    its pose (a file as ``--transform`` writes it) or at the identity, is registered where
+    the global search registers it, with every 3D figure; started 90 degrees off, its ICP
+    stays in another pose (no global search ran): fitness under 0.2."""
+    folder, cloud, _ = clouds
+    pose = np.eye(4)
+    pose[:3, :3], pose[:3, 3] = rotation_about([0, 0, 1], 30.0), [2.0, -1.0, 0.0]
+    np.save(folder / "turned.npy", cloud @ pose[:3, :3].T + pose[:3, 3])
+    back = np.linalg.inv(pose)
+    near, far = np.eye(4), np.eye(4)
+    near[:3, :3], near[:3, 3] = rotation_about([0, 0, 1], 2.0), [0.2, -0.1, 0.05]
+    far[:3, :3] = rotation_about([0, 0, 1], 90.0)
+    write_matrix(folder / "near.txt", near @ back)
+    write_matrix(folder / "far.txt", far @ back)
+    searched, _ = evaluate(folder, "turned.npy", "--no-noref")
+    want = np.array(searched["alignment_3d"]["matrix"])
+    assert np.abs(want[:3, 3] - back[:3, 3]).max() < 0.01
+    for start in (str(folder / "near.txt"), "identity"):
+        doc, stdout = evaluate(folder, "turned.npy", "--no-noref", "--init-3d", start)
+        np.testing.assert_allclose(doc["alignment_3d"]["matrix"], want, atol=1e-4)
+        assert doc["map_3d"]["awd_m"] == pytest.approx(searched["map_3d"]["awd_m"], abs=1e-3)
+        assert doc["structures_3d"]["planes"]["f1"] == searched["structures_3d"]["planes"]["f1"]
+        assert len(doc["settings"]["alignment"]["init_3d"]) == 16
+    doc, _ = evaluate(folder, "turned.npy", "--no-noref", "--init-3d", str(folder / "far.txt"))
+    assert doc["alignment_3d"]["fitness"] < 0.2 < searched["alignment_3d"]["fitness"]
+
+
+def test_a_3d_start_with_a_plan_is_refused_in_one_line(clouds, tmp_path):
+    """An image or a 2D cloud on either side has no 3D registration to start: exit 2, one line
+    naming the side."""
+    folder, _, truth = clouds
+    flat = tmp_path / "flat.npy"
+    np.save(flat, truth[:, :2])
+    proc = run("eval", str(flat), str(folder / "truth.npy"), "--init-3d", "identity")
+    assert proc.returncode == 2 and proc.stderr.count("\n") == 1, proc.stderr
+    assert f"{flat} is not a 3D cloud" in proc.stderr and "Traceback" not in proc.stderr

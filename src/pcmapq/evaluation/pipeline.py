@@ -11,7 +11,13 @@ from pathlib import Path
 
 from pcmapq.evaluation.inputs import load_pair
 from pcmapq.evaluation.noref_figures import EarlyFigures
-from pcmapq.evaluation.placing import Placed, Progress, check_footprint_rule, place
+from pcmapq.evaluation.placing import (
+    Placed,
+    Progress,
+    check_footprint_rule,
+    check_init_3d,
+    place,
+)
 from pcmapq.evaluation.scoring import score
 from pcmapq.evaluation.truth import PreparedTruth, prepare_truth
 from pcmapq.io import OccupancyMap, PointMap
@@ -33,6 +39,7 @@ def evaluate(map_path: str | Path | PointMap, truth_path: str | Path,
     progress("loading")
     source, truth = load_pair(map_path, truth_path, settings, memory_limit)
     check_footprint_rule(source, settings)  # before the truth is prepared: a refusal costs nothing
+    check_init_3d(source, truth, settings)
     prepared = prepare_truth(truth, settings, memory_limit, maps=(0,), loaded=(source,),
                              background=True)
     try:

@@ -70,6 +70,7 @@ def place(source: OccupancyMap | PointMap, prepared: PreparedTruth, settings: Se
     unless ``settings.alignment.force``. ``walls_found`` is called once the map's plan points
     are found (a cloud's wall band, the first large step)."""
     check_span(source, MAP_CROP)
+    check_init_3d(source, prepared.source, settings)
     rule = map_footprint_rule(source, settings)
     progress("aligning")
     option, truth = settings.alignment, prepared.source
@@ -113,6 +114,17 @@ def check_footprint_rule(source: OccupancyMap | PointMap, settings: Settings) ->
                    views=isinstance(source, PointMap) and source.seen is not None)
     except ValueError as err:
         raise SettingsRefused(f"{source.path}: {err}") from None
+
+
+def check_init_3d(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMap,
+                  settings: Settings) -> None:
+    """SettingsRefused (one line, naming the map) when ``--init-3d`` is given and a side is
+    not a 3D cloud: it starts a 3D registration. Found before any work."""
+    flat = [s for s in (source, truth) if not (isinstance(s, PointMap) and s.is_3d)]
+    if settings.alignment.init_3d is not None and flat:
+        raise SettingsRefused(f"{source.path}: --init-3d starts the 3D registration of two 3D "
+                              f"clouds; {flat[0].path} is not a 3D cloud (--init x,y,yaw "
+                              "places a plan)")
 
 
 def map_footprint_rule(source: OccupancyMap | PointMap, settings: Settings) -> str:
@@ -181,8 +193,9 @@ def align_clouds_3d(source: OccupancyMap | PointMap, truth: OccupancyMap | Point
             return None
 
     levelled = plan is not None and plan[0].level is not None
+    start = None if option.init_3d is None else np.reshape(option.init_3d, (4, 4))
     try:
-        reg = align_3d(source.points, truth.points, voxel=option.voxel_3d,
+        reg = align_3d(source.points, truth.points, voxel=option.voxel_3d, init=start,
                        second=second if levelled else None)
     except EvaluationError as error:
         voxel = "" if "voxel" in str(error) else f" at --voxel-3d {option.voxel_3d:g} m"

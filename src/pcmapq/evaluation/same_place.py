@@ -138,9 +138,9 @@ def refusal(source: OccupancyMap | PointMap, truth_path: Path, alignment: Alignm
     far = far_points(source, MAP_CROP)
     if far:
         cause = far
-    elif option.init is not None or not option.enabled:
-        cause = ("the given frame: a wrong --init guess or --no-align; drop them for a "
-                 "global search")
+    elif option.init is not None or option.init_3d is not None or not option.enabled:
+        cause = ("the given frame: a wrong --init or --init-3d start, or --no-align; drop them "
+                 "for a global search")
     elif not option.scale and size > OVERSIZE:
         cause = (f"a scale that differs: the map spans {size:.1f} times the truth; try "
                  "--scale auto")

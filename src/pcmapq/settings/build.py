@@ -89,9 +89,17 @@ def apply(settings: Settings, option: Option, value: Any) -> Settings:
 
 def check(settings: Settings) -> None:
     """Refuse settings that cannot work together (InputError, one line)."""
-    if not settings.alignment.enabled and settings.alignment.scale:
+    option = settings.alignment
+    if not option.enabled and option.scale:
         raise InputError("--no-align and --scale auto (or --map-resolution auto) cannot go "
                          "together: estimating the scale is part of the alignment")
+    if option.init_3d is None:
+        return
+    other = ("--init" if option.init is not None else "--no-align" if not option.enabled else
+             "--scale auto (or --map-resolution auto)" if option.scale else None)
+    if other is not None:
+        raise InputError(f"--init-3d and {other} cannot go together: --init-3d starts the "
+                         "rigid 3D registration of two 3D clouds")
 
 
 def option_words(values: dict[str, Any], command: str) -> list[str]:

@@ -88,6 +88,8 @@ class AlignmentConfig:
 
     enabled: False trusts the map's frame (``--no-align``): no global step, no ICP.
     init: initial guess of the map -> truth transform; skips the global step.
+    init_3d: two 3D clouds: the 3D registration's start, a rigid 4x4 map -> truth transform
+        (row-major, 16 numbers, metres; ``--init-3d``): no global search, its ICP starts there.
     scale: estimate the map's scale too (a similarity); for maps whose resolution is unknown
         or wrong. A map image without resolution then starts from the truth's.
     voxel_3d: working voxel of the 3D registration when both sides are 3D clouds, metres
@@ -101,6 +103,7 @@ class AlignmentConfig:
 
     enabled: bool = True
     init: Similarity2D | None = None
+    init_3d: tuple[float, ...] | None = None
     scale: bool = False
     voxel_3d: float = 0.3
     min_confidence: float = 0.5
@@ -276,6 +279,7 @@ class Settings:
             raster=RasterConfig(**doc["raster"]),
             alignment=AlignmentConfig(**{
                 **a, "init": None if init is None else Similarity2D.from_dict(init),
+                "init_3d": None if a.get("init_3d") is None else tuple(a["init_3d"]),
                 "params": AlignParams(**{**a["params"], "scale_range": tuple(
                     a["params"]["scale_range"])})}),
             footprint=FootprintConfig(**doc["footprint"]),

@@ -84,14 +84,18 @@ def read_settings(path: str | Path, base: Settings | None = None) -> Settings:
 
 def _read_words(doc: dict, path: str | Path) -> dict:
     """``doc`` with each word option given as text (``scale: auto``, ``resolution: auto``,
-    ``init: "1,2,30"``, ``detectors: harris,hough``) read by its option's parser, as the
-    command line reads it, and the settings that value implies (``also``) set too."""
+    ``init: "1,2,30"``, ``detectors: harris,hough``; ``init_3d`` also as the list of 16 numbers
+    a result saves) read by its option's parser, as the command line reads it, and the
+    settings that value implies (``also``) set too."""
     out = copy.deepcopy(doc)
     for option in options_of():
         if option.kind != TEXT:
             continue
         *groups, key = option.path.split(".")
         group = _group(out, groups)
+        if group is not None and option.path == "alignment.init_3d" and \
+                isinstance(group.get(key), list):  # a matrix as a saved result lists it
+            group[key] = ",".join(str(v) for v in group[key])
         if group is None or not isinstance(group.get(key), str):
             continue
         try:

@@ -37,6 +37,58 @@ def show_init(tf: Similarity2D | None) -> str | None:
     return None if tf is None else f"{tf.tx:g},{tf.ty:g},{np.degrees(tf.yaw):g}"
 
 
+#: How far a given 3D start's 3x3 part may be from a rotation (largest entry of R^T R - I,
+#: and |det R - 1|): the rounding of a matrix written with a few decimals.
+ROTATION_TOLERANCE = 1e-4
+#: The rigid start ``--init-3d identity`` gives.
+IDENTITY_3D = tuple(float(v) for v in np.eye(4).ravel())
+
+
+def parse_init_3d(text: str) -> tuple[float, ...]:
+    """A 4x4 rigid map -> truth transform, row-major (16 floats, metres), from ``identity``,
+    16 comma-separated numbers (CloudAnalyzer's ``--initial-matrix``) or the path of a text
+    file of its rows (as ``--transform`` writes it, CloudCompare's transformation file); 12
+    numbers are its first three rows (a KITTI pose). Its 3x3 part, a rotation to within
+    ROTATION_TOLERANCE, is made one exactly (through its quaternion, scipy's)."""
+    if text.strip() == "identity":
+        return IDENTITY_3D
+    given = "," in text
+    if given:
+        values, what = text.split(","), f"got {text!r}"
+    else:
+        try:
+            with open(text, encoding="utf-8") as f:
+                values, what = f.read().split(), f"{text} holds something else"
+        except (OSError, UnicodeDecodeError) as err:
+            reason = getattr(err, "strerror", None) or "not a text file"
+            raise OptionError(f"{text}: {reason.lower()}; expected identity, 16 comma-separated "
+                              "numbers or a file of a 4x4 matrix", "--init-3d") from None
+    try:
+        numbers = np.array([float(v) for v in values])
+        if len(numbers) not in (12, 16) or not np.isfinite(numbers).all():
+            raise ValueError(text)
+    except ValueError:
+        raise OptionError("expected a 4x4 rigid transform, row by row: 16 finite numbers (or "
+                          f"the 12 of its first three rows); {what}", "--init-3d") from None
+    matrix = np.vstack([numbers.reshape(-1, 4), [0.0, 0.0, 0.0, 1.0]])[:4]
+    rotation = matrix[:3, :3]
+    off = max(float(np.abs(rotation.T @ rotation - np.eye(3)).max()),
+              abs(float(np.linalg.det(rotation)) - 1.0))
+    if off > ROTATION_TOLERANCE or not np.array_equal(matrix[3], [0.0, 0.0, 0.0, 1.0]):
+        raise OptionError(f"{'the matrix' if given else text}: not a rigid transform (its 3x3 "
+                          "part is no rotation, or its last row is not 0 0 0 1)", "--init-3d")
+    from scipy.spatial.transform import Rotation  # loaded when a 3D start is given
+
+    matrix[:3, :3] = Rotation.from_matrix(rotation).as_matrix()  # element by element: the same
+    return tuple(float(v) + 0.0 for v in matrix.ravel())  # bits wherever the array lies
+
+
+def show_init_3d(matrix: tuple[float, ...] | None) -> str | None:
+    if matrix is None:
+        return None
+    return "identity" if tuple(matrix) == IDENTITY_3D else ",".join(repr(v) for v in matrix)
+
+
 def parse_box(text: str, option: str) -> tuple[float, float, float, float]:
     """A box ``x0,y0,x1,y1`` (metres, finite, x0 < x1, y0 < y1)."""
     try:

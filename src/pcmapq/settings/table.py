@@ -29,10 +29,12 @@ from pcmapq.settings.parsers import (
     parse_detectors,
     parse_footprint,
     parse_init,
+    parse_init_3d,
     parse_map_resolution,
     parse_scale,
     parse_taus,
     show_init,
+    show_init_3d,
     show_list,
 )
 
@@ -154,6 +156,12 @@ OPTIONS: tuple[Option, ...] = (
            read=parse_init, show=show_init, commands=(EVAL, BATCH, TRACK),
            helps={TRACK: "Initial guess x,y,yaw (m, m, deg), map -> truth, of the first "
                          "step; skips the global search."}),
+    Option("init_3d", "alignment.init_3d", TEXT,
+           "Two 3D clouds: start the 3D registration from this rigid map -> truth transform "
+           "('identity' for clouds in one frame, 16 comma-separated numbers row by row, or a "
+           "file of its 4x4 matrix as --transform writes it); skips the global search (ICP "
+           "still refines).", metavar="<identity|matrix|path>",
+           read=parse_init_3d, show=show_init_3d, commands=(EVAL, BATCH)),
     Option("no_align", "alignment.enabled", SWITCH, "Trust the map's frame: no alignment at all.",
            flag="--no-align/--align", read=lambda off: not off, show=lambda on: not on,
            commands=(EVAL, BATCH, TRACK),

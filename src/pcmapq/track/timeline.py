@@ -152,8 +152,9 @@ def place_step(source, prepared: PreparedTruth, settings: Settings,
 
 
 def settings_from(settings: Settings, start: Similarity2D | None) -> Settings:
-    """The settings a step was scored with: ICP from ``start`` (None: as given)."""
-    if start is None or not settings.alignment.enabled:
+    """The settings a step was scored with: ICP from ``start`` (None: as given; and with a
+    3D start given, every step's registration starts there)."""
+    if start is None or not settings.alignment.enabled or settings.alignment.init_3d is not None:
         return settings
     return replace(settings, alignment=replace(settings.alignment, init=start))
 

@@ -32,7 +32,8 @@ from testkit.paths import REPO
 #: A value other than the default for each text option, as typed.
 TEXTS = {"scale": "auto", "map_resolution": "0.1", "map_crop": "-5,-5,5,5",
          "truth_crop": "-6,-6,6,6", "init": "1,2,3", "detectors": "sift", "tau": "0.3,0.4",
-         "footprint": "walls", "map_topic": "/slam/map", "truth_topic": "/truth_map"}
+         "footprint": "walls", "map_topic": "/slam/map", "truth_topic": "/truth_map",
+         "init_3d": "0,-1,0,1,1,0,0,2,0,0,1,0.5,0,0,0,1"}
 
 
 def sample(option: Option, command: str) -> object:
