@@ -49,7 +49,7 @@ def parse_init_3d(text: str) -> tuple[float, ...]:
     16 comma-separated numbers (CloudAnalyzer's ``--initial-matrix``) or the path of a text
     file of its rows (as ``--transform`` writes it, CloudCompare's transformation file); 12
     numbers are its first three rows (a KITTI pose). Its 3x3 part, a rotation to within
-    ROTATION_TOLERANCE, is made one exactly (through its quaternion, scipy's)."""
+    ROTATION_TOLERANCE, is made one exactly (:func:`_orthonormal`)."""
     if text.strip() == "identity":
         return IDENTITY_3D
     given = "," in text
@@ -77,10 +77,23 @@ def parse_init_3d(text: str) -> tuple[float, ...]:
     if off > ROTATION_TOLERANCE or not np.array_equal(matrix[3], [0.0, 0.0, 0.0, 1.0]):
         raise OptionError(f"{'the matrix' if given else text}: not a rigid transform (its 3x3 "
                           "part is no rotation, or its last row is not 0 0 0 1)", "--init-3d")
-    from scipy.spatial.transform import Rotation  # loaded when a 3D start is given
+    matrix[:3, :3] = _orthonormal(rotation.tolist())
+    return tuple(float(v) + 0.0 for v in matrix.ravel())
 
-    matrix[:3, :3] = Rotation.from_matrix(rotation).as_matrix()  # element by element: the same
-    return tuple(float(v) + 0.0 for v in matrix.ravel())  # bits wherever the array lies
+
+def _orthonormal(rows: list[list[float]]) -> list[list[float]]:
+    """A rotation made of a 3x3 matrix near one: its first row normalised, its second made
+    orthogonal to it and normalised (Gram-Schmidt), the third their cross product; in Python
+    floats, so the same bits whatever the machine and wherever its arrays lie."""
+    x, y = rows[0], rows[1]
+    length = math.sqrt(sum(v * v for v in x))
+    x = [v / length for v in x]
+    along = sum(a * b for a, b in zip(x, y, strict=True))
+    y = [b - along * a for a, b in zip(x, y, strict=True)]
+    length = math.sqrt(sum(v * v for v in y))
+    y = [v / length for v in y]
+    return [x, y, [x[1] * y[2] - x[2] * y[1], x[2] * y[0] - x[0] * y[2],
+                   x[0] * y[1] - x[1] * y[0]]]
 
 
 def show_init_3d(matrix: tuple[float, ...] | None) -> str | None:
