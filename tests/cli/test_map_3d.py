@@ -102,6 +102,8 @@ def test_a_3d_start_is_where_the_registration_begins(clouds):
         assert doc["map_3d"]["awd_m"] == pytest.approx(searched["map_3d"]["awd_m"], abs=1e-3)
         assert doc["structures_3d"]["planes"]["f1"] == searched["structures_3d"]["planes"]["f1"]
         assert len(doc["settings"]["alignment"]["init_3d"]) == 16
+        assert doc["alignment"]["method"] == "3d+init" != searched["alignment"]["method"]
+        assert "registered in 3D from --init-3d" in " ".join(stdout.split())
     doc, _ = evaluate(folder, "turned.npy", "--no-noref", "--init-3d", str(folder / "far.txt"))
     assert doc["alignment_3d"]["fitness"] < 0.2 < searched["alignment_3d"]["fitness"]
 

@@ -51,8 +51,10 @@ class Alignment:
     transform: map frame -> truth frame. fitness: share of (voxel-downsampled) map points within
     ``tolerance_m`` of a truth point after alignment, [0, 1]. rmse_m: RMSE of those inlier
     distances, metres. method: "coarse+icp", "similarity+icp" (global search over scale too),
-    "init+icp", "init" or "none". distinctiveness: how far the final pose's score in the global
-    search stands above the best score elsewhere, [0, 1] (see
+    "init+icp", "init" or "none"; after a 3D registration (:mod:`pcmapq.evaluation.placing`)
+    "3d", or "3d+init" when it started where ``--init-3d`` said. distinctiveness: how far
+    the final pose's score in the global search stands above the best score elsewhere, [0, 1]
+    (see
     :func:`~pcmapq.align.coarse.distinctiveness`); None when there was no global search.
     contradiction: share of the map's free cells (those farther than
     :data:`~pcmapq.align.free_space.CLEAR_M` from its walls) on the truth's known cells that

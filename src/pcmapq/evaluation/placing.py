@@ -297,4 +297,4 @@ def align_plan(source: OccupancyMap | PointMap, map_xy: np.ndarray, truth_xy: np
         return align(map_xy, truth_xy, option.params, init=option.init, refine=option.enabled,
                      scale=option.scale, target=target, free=free)
     return replace(align(map_xy, truth_xy, option.params, init=Similarity2D(), refine=False),
-                   method="3d")
+                   method="3d" if option.init_3d is None else "3d+init")

@@ -60,6 +60,8 @@ def alignment_words(result: Result) -> str:
         placed = "placed at --init"
     elif method == "init+icp":
         placed = "aligned from --init"
+    elif method == "3d+init":
+        placed = "registered in 3D from --init-3d"
     elif method.startswith("similarity"):
         placed = f"aligned at an estimated scale of {result.transform.scale:.4f}"
     else:
