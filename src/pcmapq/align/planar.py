@@ -54,8 +54,7 @@ class Alignment:
     "init+icp", "init" or "none"; after a 3D registration (:mod:`pcmapq.evaluation.placing`)
     "3d", or "3d+init" when it started where ``--init-3d`` said. distinctiveness: how far
     the final pose's score in the global search stands above the best score elsewhere, [0, 1]
-    (see
-    :func:`~pcmapq.align.coarse.distinctiveness`); None when there was no global search.
+    (see :func:`~pcmapq.align.coarse.distinctiveness`); None when there was no global search.
     contradiction: share of the map's free cells (those farther than
     :data:`~pcmapq.align.free_space.CLEAR_M` from its walls) on the truth's known cells that
     the pose puts on a truth wall or solid block, [0, 1]; None for a map without free space.
