@@ -109,6 +109,23 @@ def test_track_with_calib_reports_pose_errors_in_the_lidar_frame(kitti) -> None:
         assert step["rpe_rmse_m"] > 5 * rpe_rmse(kitti["estimate"][:n], kitti["lidar"][:n])
 
 
+def test_every_step_of_a_3d_run_is_registered_in_3d(kitti) -> None:
+    """Aligned (no --no-align), each step after the first starts its ICP from the step
+    before's 3D registration, as the first is registered: every step has the 3D figures (AWD,
+    the 3D consistency map's largest offset), not the first step alone."""
+    tmp = kitti["folder"]
+    out = tmp / "aligned_3d"
+    got = CliRunner().invoke(app, [
+        "track", str(tmp / "velodyne"), str(tmp / "ref.ply"), "--poses", str(tmp / "estimate.txt"),
+        "--every", str(EVERY), "--out", str(out), "--quiet"])
+    assert got.exit_code == 0, got.stderr
+    steps = json.loads((out / "track.json").read_text())["steps"]
+    assert [step["scans"] for step in steps] == list(range(EVERY, SCANS + 1, EVERY))
+    for step in steps:
+        assert step["awd_m"] is not None and step["largest_offset_3d_m"] is not None, step
+        assert step["awd_m"] < 0.5
+
+
 def test_a_log_scored_against_itself_ends_at_one(tmp_path) -> None:
     """The FHW run of docs/commands/track.md against itself (docs/metrics.md, 'A run scored
     against itself'): at the last step the map is the truth, every quality and precision 1;

@@ -19,7 +19,14 @@ from pcmapq.io.bag_grids import grids
 from pcmapq.io.occupancy import OccupancyMap
 from pcmapq.results.result import Result
 from pcmapq.settings import Settings
-from pcmapq.track.timeline import KEEP_BYTES, Step, figures_of, place_step, settings_from
+from pcmapq.track.timeline import (
+    KEEP_BYTES,
+    Step,
+    figures_of,
+    next_start,
+    place_step,
+    settings_from,
+)
 
 
 @dataclass(frozen=True)
@@ -73,7 +80,7 @@ def score_grids(recording: Recording, truth: PreparedTruth, settings: Settings,
             steps.append(Step(*at, {"slide_m": None, "local_offset_m": None}, str(err), start))
             continue
         if settings.alignment.enabled:
-            start = underway.placed.alignment.transform
+            start = next_start(underway.placed)
         if held is not None:
             held += result.map_occupied.nbytes + result.overlap.footprint.nbytes
             held = held if held <= KEEP_BYTES else None

@@ -2,8 +2,10 @@
 
 Each step scores the map of the scans so far inside its footprint (the partial-map rules), with
 the settings of ``pcmapq eval``. The first step searches for the map's pose in the truth (or
-starts from ``--init``); every later one starts ICP from the pose the step before found, and
-searches again only when that pose no longer fits (a confidence below the minimum). A step the
+starts from ``--init``); every later one starts ICP from the pose the step before found (a 3D
+run against a 3D truth: its 3D registration, so that every step is registered in 3D and has
+the 3D figures), and searches again only when that pose no longer fits (a confidence below the
+minimum). A step the
 method cannot score (too few walls yet, a place it does not recognise) is kept, with no
 figures and the reason.
 
@@ -57,6 +59,9 @@ FEATURE_THREADS = 2
 #: The steps' full results are kept while their map rasters and footprints take at most this
 #: many bytes in all (the truth's raster is shared); beyond it none is.
 KEEP_BYTES = 512 * 2**20
+#: Where a step's ICP starts: a plan pose (``--init``'s), or the 16 numbers of a rigid 4x4
+#: map -> truth transform, row by row (``--init-3d``'s: two 3D clouds registered in 3D).
+Start = Similarity2D | tuple[float, ...]
 
 
 @dataclass(frozen=True)
@@ -77,7 +82,8 @@ class Step:
     :func:`~pcmapq.results.rows.table_row` plus ``slide_m``, ``local_offset_m`` and the
     trajectory errors (None when undefined); ``note`` why a step was not scored ("" when it
     was);
-    ``start`` the pose its ICP started from (None: the global search); ``frames`` the frames
+    ``start`` the pose its ICP started from (:data:`Start`; None: the global search); ``frames``
+    the frames
     its result put the map and truth in (None when not scored); ``result`` its full result,
     while the steps' rasters fit in :data:`KEEP_BYTES` (None otherwise: :func:`result_at`
     scores it again)."""
@@ -88,7 +94,7 @@ class Step:
     distance_m: float
     figures: dict[str, float | None]
     note: str = ""
-    start: Similarity2D | None = None
+    start: Start | None = None
     frames: Frames | None = field(default=None, compare=False, repr=False)
     result: Result | None = field(default=None, compare=False, repr=False)
 
@@ -130,7 +136,7 @@ def figures_of(result: Result) -> dict[str, float | None]:
 
 
 def place_step(source, prepared: PreparedTruth, settings: Settings,
-               start: Similarity2D | None) -> tuple[Underway, Similarity2D | None]:
+               start: Start | None) -> tuple[Underway, Start | None]:
     """One step's map checked, aligned and drawn, the first half of its evaluation
     (:func:`~pcmapq.evaluation.pipeline.start_evaluation`), ICP from ``start`` (None: the
     global search); a start whose pose is refused is followed by a global search. The
@@ -142,7 +148,7 @@ def place_step(source, prepared: PreparedTruth, settings: Settings,
                               "within their range limits)")
     option = settings.alignment
     if start is None or not option.enabled:
-        return start_evaluation(source, prepared, settings), option.init
+        return start_evaluation(source, prepared, settings), option.init_3d or option.init
     try:
         return start_evaluation(source, prepared, settings_from(settings, start)), start
     except EvaluationError:
@@ -151,12 +157,23 @@ def place_step(source, prepared: PreparedTruth, settings: Settings,
         return start_evaluation(source, prepared, settings), None
 
 
-def settings_from(settings: Settings, start: Similarity2D | None) -> Settings:
-    """The settings a step was scored with: ICP from ``start`` (None: as given; and with a
-    3D start given, every step's registration starts there)."""
-    if start is None or not settings.alignment.enabled or settings.alignment.init_3d is not None:
+def settings_from(settings: Settings, start: Start | None) -> Settings:
+    """The settings a step was scored with: ICP from ``start`` (None: as given), a plan pose
+    as ``--init`` gives it, a 3D one as ``--init-3d`` does."""
+    if start is None or not settings.alignment.enabled:
         return settings
-    return replace(settings, alignment=replace(settings.alignment, init=start))
+    if isinstance(start, Similarity2D):
+        return replace(settings, alignment=replace(settings.alignment, init=start, init_3d=None))
+    return replace(settings, alignment=replace(settings.alignment, init=None, init_3d=start))
+
+
+def next_start(placed: Placed) -> Start:
+    """Where the next step's ICP starts: the pose this step's map was placed at, its 3D
+    registration when it had one (so that every step of two 3D clouds is registered in 3D),
+    else its plan's alignment."""
+    if placed.registration is not None:
+        return tuple(float(v) for v in np.asarray(placed.registration.transform).ravel())
+    return placed.alignment.transform
 
 
 def track(run: Run, prepared: PreparedTruth, settings: Settings, ends: np.ndarray,
@@ -213,7 +230,7 @@ def track(run: Run, prepared: PreparedTruth, settings: Settings, ends: np.ndarra
                                     str(err), start)
                 continue
             if settings.alignment.enabled:
-                start = underway.placed.alignment.transform
+                start = next_start(underway.placed)
             pending.append((index, scorers.submit(_finish, at, recent, underway, used, extra)))
             collect(scoring)
         collect(0)
@@ -243,7 +260,7 @@ def local_offset(recent: np.ndarray, side: Placed, prepared: PreparedTruth,
     return float(np.sqrt(np.mean(np.sum(moved**2, axis=1))))
 
 
-def _finish(at: tuple, recent: np.ndarray, underway: Underway, used: Similarity2D | None,
+def _finish(at: tuple, recent: np.ndarray, underway: Underway, used: Start | None,
             extra: dict) -> Step:
     """A placed step's evaluation finished (its features matched and scored,
     :func:`~pcmapq.evaluation.pipeline.finish_evaluation`), and the offset of its ``recent``
