@@ -5,9 +5,8 @@ the settings of ``pcmapq eval``. The first step searches for the map's pose in t
 starts from ``--init``); every later one starts ICP from the pose the step before found (a 3D
 run against a 3D truth: its 3D registration, so that every step is registered in 3D and has
 the 3D figures), and searches again only when that pose no longer fits (a confidence below the
-minimum). A step the
-method cannot score (too few walls yet, a place it does not recognise) is kept, with no
-figures and the reason.
+minimum). A step the method cannot score (too few walls yet, a place it does not recognise) is
+kept, with no figures and the reason.
 
 Besides the figures of ``pcmapq eval`` a step holds ``slide_m``: how far the alignment moved
 the positions of the first scored step's scans since that step, RMS metres (a map that drifts
@@ -82,11 +81,10 @@ class Step:
     :func:`~pcmapq.results.rows.table_row` plus ``slide_m``, ``local_offset_m`` and the
     trajectory errors (None when undefined); ``note`` why a step was not scored ("" when it
     was);
-    ``start`` the pose its ICP started from (:data:`Start`; None: the global search); ``frames``
-    the frames
-    its result put the map and truth in (None when not scored); ``result`` its full result,
-    while the steps' rasters fit in :data:`KEEP_BYTES` (None otherwise: :func:`result_at`
-    scores it again)."""
+    ``start`` the pose its ICP started from (:data:`Start`; None: the global search);
+    ``frames`` the frames its result put the map and truth in (None when not scored);
+    ``result`` its full result, while the steps' rasters fit in :data:`KEEP_BYTES` (None
+    otherwise: :func:`result_at` scores it again)."""
 
     step: int
     scans: int
