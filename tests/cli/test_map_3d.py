@@ -104,6 +104,9 @@ def test_a_3d_start_is_where_the_registration_begins(clouds):
         assert len(doc["settings"]["alignment"]["init_3d"]) == 16
         assert doc["alignment"]["method"] == "3d+init" != searched["alignment"]["method"]
         assert "registered in 3D from --init-3d" in " ".join(stdout.split())
+    again, _ = evaluate(folder, "turned.npy", "--no-noref", "--init-3d", str(folder / "near.txt"))
+    first, _ = evaluate(folder, "turned.npy", "--no-noref", "--init-3d", str(folder / "near.txt"))
+    assert json.dumps(again) == json.dumps(first)  # the same command, the same result
     doc, _ = evaluate(folder, "turned.npy", "--no-noref", "--init-3d", str(folder / "far.txt"))
     assert doc["alignment_3d"]["fitness"] < 0.2 < searched["alignment_3d"]["fitness"]
 
