@@ -20,7 +20,7 @@ from pcmapq.core.frames import Frames
 from pcmapq.core.grid import MetricGrid
 from pcmapq.evaluation.noref_figures import EarlyFigures, input_figures
 from pcmapq.evaluation.placing import Placed, Progress
-from pcmapq.evaluation.truth import FEATURE_THREADS, PreparedTruth, plane_params
+from pcmapq.evaluation.truth import FEATURE_THREADS, PlanesOnce, PreparedTruth, plane_params
 from pcmapq.features import Features, SideBySide, default_params
 from pcmapq.features.planes3d import Planes
 from pcmapq.features.rooms import Params as RoomParams
@@ -149,12 +149,13 @@ def recorded_settings(settings: Settings, map_3d: bool, structures: bool) -> dic
 
 def structures_3d(truth: np.ndarray, map_: np.ndarray, option: StructuresConfig,
                   reach: float | None = None,
-                  truth_planes: Future[Planes] | None = None) -> Structures3D:
+                  truth_planes: Future[Planes] | PlanesOnce | None = None) -> Structures3D:
     """The 3D structures of two clouds (N, 3), both in the truth frame, metres, found and
     matched with ``option`` (:func:`~pcmapq.match.structures.compare_structures`), the map's
     moved by the planes' own fit when it moves none more than ``reach`` metres (the 3D
     registration's last ICP correspondence distance; None: whatever it moves).
-    ``truth_planes``: the job finding the truth's planes with ``option`` (None: found here);
+    ``truth_planes``: the job finding the truth's planes with ``option``, or the planes found
+    once for every map (:class:`~pcmapq.evaluation.truth.PlanesOnce`; None: found here);
     a job that has not started (its thread still on the truth's features) is cancelled and the
     planes found here, beside the map's, rather than waited for."""
     early = None

@@ -7,6 +7,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass
+from threading import Lock
 
 import numpy as np
 
@@ -34,6 +35,27 @@ from pcmapq.settings import Settings, StructuresConfig
 FEATURE_THREADS = 2
 
 
+class PlanesOnce:
+    """A 3D cloud truth's planes, found the first time a score asks for them and kept for
+    every later one (the steps of ``pcmapq track``): a job as
+    :func:`~pcmapq.evaluation.scoring.structures_3d` takes one, that cannot be cancelled.
+    Safe from several threads at once: the first finds them, the others wait."""
+
+    def __init__(self, points: np.ndarray, params: PlaneParams) -> None:
+        self._points, self._params = points, params
+        self._planes: Planes | None = None
+        self._finding = Lock()
+
+    def cancel(self) -> bool:
+        return False
+
+    def result(self) -> Planes:
+        with self._finding:
+            if self._planes is None:
+                self._planes = find_planes(self._points, self._params)
+            return self._planes
+
+
 @dataclass(frozen=True)
 class PreparedTruth:
     """The truth as every score against it needs it, whatever the map: its plan points ``xy``
@@ -43,8 +65,8 @@ class PreparedTruth:
     ``aligner``: its points prepared for the rigid alignment; ``maps``: how many maps may be
     scored on its grid at once in the memory allowed; ``sides``: the detectors' runner (the
     maps' sides join it; it stops a background job whose map is refused); ``planes``: the job
-    finding a 3D cloud truth's planes for the 3D structures (:func:`plane_params`), or None
-    (found with the map's)."""
+    finding a 3D cloud truth's planes for the 3D structures (:func:`plane_params`; for every
+    map scored against it, a :class:`PlanesOnce`), or None (found with the map's)."""
 
     source: OccupancyMap | PointMap
     xy: np.ndarray
@@ -56,7 +78,7 @@ class PreparedTruth:
     aligner: RigidTarget | None = None
     maps: int = 1
     sides: SideBySide | None = None
-    planes: Future[Planes] | None = None
+    planes: Future[Planes] | PlanesOnce | None = None
 
     @property
     def features(self) -> dict[str, Features]:
@@ -86,7 +108,7 @@ def prepare_truth(truth: OccupancyMap | PointMap, settings: Settings,
     (:meth:`PreparedTruth.features` waits for them), and after them a 3D cloud truth's planes
     when a 3D cloud map is to be registered to it with its structures found (the map's 3D
     registration leaves a core free: :mod:`pcmapq.align.refine3d`); otherwise the features
-    here, on two threads."""
+    here, on two threads, and a 3D cloud truth's planes once the first map asks for them."""
     check_span(truth, TRUTH_CROP)
     for source in loaded:
         check_span(source, MAP_CROP)
@@ -115,6 +137,8 @@ def prepare_truth(truth: OccupancyMap | PointMap, settings: Settings,
         pool.shutdown(wait=False)  # its thread ends with the jobs
     else:
         found = sides.features(occupied, grid, threads=FEATURE_THREADS)
+        if settings.structures.enabled and isinstance(truth, PointMap) and truth.is_3d:
+            planes = PlanesOnce(truth.points, plane_params(settings.structures))
     aligner = RigidTarget(xy, option.params) if option.enabled and not option.scale else None
     return PreparedTruth(truth, xy, level, grid, occupied, found, nearest_distance(occupied, grid),
                          aligner, fits[0] if fits else least, sides, planes)

@@ -60,3 +60,29 @@ def test_truth_planes_not_yet_started_are_found_by_scoring_not_waited_for():
         pool.shutdown()
     assert pending.cancelled()
     building3d.assert_same_matches(late, structures_3d(truth, moved, option, None, done))
+
+
+def test_a_truth_prepared_for_many_maps_finds_its_planes_once(monkeypatch):
+    """Prepared for several maps (``pcmapq track``'s steps), a 3D cloud truth's planes are
+    found once, when the first score asks, by one of the threads that ask at once; every
+    score then gets the same structures as with the planes found beside it."""
+    import pcmapq.evaluation.truth as truth_module
+
+    cloud = building3d.cloud(building3d.faces(), seed=1)
+    moved = building3d.moved_map()
+    settings = Settings()
+    calls = []
+
+    def counted(points, params):
+        calls.append(len(points))
+        return find_planes(points, params)
+
+    monkeypatch.setattr(truth_module, "find_planes", counted)
+    prepared = prepare_truth(PointMap(Path("b.npy"), cloud, True), settings)
+    assert calls == []  # none asked yet: a 2D run's steps never pay for them
+    with ThreadPoolExecutor(3) as pool:
+        scored = list(pool.map(lambda _: structures_3d(cloud, moved, settings.structures,
+                                                       None, prepared.planes), range(3)))
+    assert calls == [len(cloud)]
+    for each in scored:
+        building3d.assert_same_matches(each, structures_3d(cloud, moved, settings.structures))
