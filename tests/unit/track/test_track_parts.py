@@ -244,3 +244,18 @@ def test_the_report_of_a_run_without_a_drop_says_so():
     assert "no lasting drop of precision (none of at least 0.05)" in page
     assert "not scored: degenerate map" in page
     assert "<td>poses</td><td>est.txt</td>" in page
+
+
+def test_the_3d_figures_of_a_3d_run_get_panels_of_their_own():
+    """A run of two 3D clouds draws its planes' f1 and its AWD and largest 3D offset, each in
+    a panel of its own; a 2D run's rows have no such column and no such panel."""
+    from pcmapq.report.timeline import timeline_figure
+
+    flat = [{"distance_m": float(d), "harris_quality": 0.5 + 0.1 * d} for d in range(3)]
+    solid = [{**row, "planes_f1": 0.4, "plane_lines_f1": 0.2, "awd_m": 0.3 - 0.05 * d,
+              "largest_offset_3d_m": 0.1 * d} for d, row in enumerate(flat)]
+    titles = {name: [ax.get_title(loc="left") for ax in timeline_figure(rows, None).axes]
+              for name, rows in (("flat", flat), ("solid", solid))}
+    assert not any("3D" in t for t in titles["flat"])
+    assert titles["solid"] == [*titles["flat"], *(t for t in titles["solid"] if "3D" in t)]
+    assert len(titles["solid"]) == len(titles["flat"]) + 2
