@@ -120,8 +120,10 @@ def check_init_3d(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMa
                   settings: Settings) -> None:
     """SettingsRefused (one line, naming the map) when ``--init-3d`` is given and a side is
     not a 3D cloud: it starts a 3D registration. Found before any work."""
+    if settings.alignment.init_3d is None:
+        return
     flat = [s for s in (source, truth) if not (isinstance(s, PointMap) and s.is_3d)]
-    if settings.alignment.init_3d is not None and flat:
+    if flat:
         raise SettingsRefused(f"{source.path}: --init-3d starts the 3D registration of two 3D "
                               f"clouds; {flat[0].path} is not a 3D cloud (--init x,y,yaw "
                               "places a plan)")

@@ -70,7 +70,9 @@ def parse_init_3d(text: str) -> tuple[float, ...]:
     except ValueError:
         raise OptionError("expected a 4x4 rigid transform, row by row: 16 finite numbers (or "
                           f"the 12 of its first three rows); {what}", "--init-3d") from None
-    matrix = np.vstack([numbers.reshape(-1, 4), [0.0, 0.0, 0.0, 1.0]])[:4]
+    if len(numbers) == 12:  # the first three rows
+        numbers = np.append(numbers, [0.0, 0.0, 0.0, 1.0])
+    matrix = numbers.reshape(4, 4)
     rotation = matrix[:3, :3]
     off = max(float(np.abs(rotation.T @ rotation - np.eye(3)).max()),
               abs(float(np.linalg.det(rotation)) - 1.0))
