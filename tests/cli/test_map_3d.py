@@ -82,7 +82,8 @@ def test_a_3d_start_is_where_the_registration_begins(clouds):
     """``--init-3d``: the map turned 30 degrees and moved, started 2 degrees and 0.2 m off
     its pose (a file as ``--transform`` writes it) or at the identity, is registered where
     the global search registers it, with every 3D figure; started 90 degrees off, its ICP
-    stays in another pose (no global search ran): fitness under 0.2."""
+    stays in another pose (no global search ran) that hangs off the truth: refused in one line
+    naming the start, and forced, fitness under 0.2."""
     folder, cloud, _ = clouds
     pose = np.eye(4)
     pose[:3, :3], pose[:3, 3] = rotation_about([0, 0, 1], 30.0), [2.0, -1.0, 0.0]
@@ -107,8 +108,14 @@ def test_a_3d_start_is_where_the_registration_begins(clouds):
     again, _ = evaluate(folder, "turned.npy", "--no-noref", "--init-3d", str(folder / "near.txt"))
     first, _ = evaluate(folder, "turned.npy", "--no-noref", "--init-3d", str(folder / "near.txt"))
     assert json.dumps(again) == json.dumps(first)  # the same command, the same result
-    doc, _ = evaluate(folder, "turned.npy", "--no-noref", "--init-3d", str(folder / "far.txt"))
+    refused = run("eval", str(folder / "turned.npy"), str(folder / "truth.npy"), "--no-noref",
+                  "--init-3d", str(folder / "far.txt"))
+    assert refused.returncode == 1 and refused.stderr.count("\n") == 1, refused.stderr
+    assert "the given frame" in refused.stderr and "--init-3d" in refused.stderr
+    doc, _ = evaluate(folder, "turned.npy", "--no-noref", "--force", "--init-3d",
+                      str(folder / "far.txt"))
     assert doc["alignment_3d"]["fitness"] < 0.2 < searched["alignment_3d"]["fitness"]
+    assert doc["alignment"]["verdict"] == "another place"
 
 
 def test_a_3d_start_with_a_plan_is_refused_in_one_line(clouds, tmp_path):

@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import json
 
+import numpy as np
+import open3d as o3d
 import pytest
 
 from testkit import synth
@@ -64,3 +66,25 @@ def test_threshold_options_reach_their_side(side, tmp_path):
     lines = proc.stderr.strip().splitlines()
     assert proc.returncode == 2 and len(lines) == 1, proc.stderr
     assert f"{side}.png: no occupied cells" in lines[0]
+
+
+def test_a_map_hung_off_its_truth_by_the_given_frame_is_refused(tmp_path):
+    """The sample placed 14 m off its plan by a wrong --init: its outer wall still lies on the
+    plan's, where the two meet, but it covers 19 % of the plan and 12 % of it lies on the plan:
+    exit 1, one line naming those shares and the given frame; its right pose, partial or
+    whole, is the same place."""
+    truth, scan = str(SAMPLE / "truth.png"), str(SAMPLE / "scan.ply")
+    off = run("eval", scan, truth, "--init", "6,-6,37", "--detectors", "harris")
+    lines = off.stderr.strip().splitlines()
+    assert off.returncode == 1 and len(lines) == 1 and "Traceback" not in off.stderr
+    assert "it covers 19% of the truth and 12% of it lies on the truth's walls" in lines[0]
+    assert "the given frame" in lines[0] and "--init" in lines[0]
+    points = np.asarray(o3d.io.read_point_cloud(scan).points)
+    left = points[:, 0] < np.quantile(points[:, 0], 0.2)
+    np.save(tmp_path / "part.npy", points[left])
+    for cloud, covers in ((scan, 0.9), (str(tmp_path / "part.npy"), 0.05)):
+        right = run("eval", cloud, truth, "--init", "6,8,37", "--detectors", "harris",
+                    "--json", "-")
+        assert right.returncode == 0, right.stderr
+        doc = json.loads(right.stdout)
+        assert doc["alignment"]["confidence"] == 1.0 and doc["coverage"] > covers

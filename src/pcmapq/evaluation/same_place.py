@@ -28,6 +28,13 @@ from pcmapq.settings import Settings
 FULL_DISTINCT = 0.2
 RECALL_NONE, RECALL_FULL = 0.4, 0.8
 AGREE_NONE, AGREE_FULL = 0.7, 0.9
+#: The larger of coverage and fitness worth none and full confidence. A map lies on its truth's
+#: place one way or the other: a partial map lies on the truth (high fitness), a map larger
+#: than its truth covers it (high coverage). A map that hangs off the truth (a wrong --init or
+#: --init-3d, --no-align on a map in another frame) has a sliver of each on the other, where
+#: its walls may agree however well. Maps of their own place in docs/validation.md reach 0.40
+#: and more; the sample hung 14-19 m off its plan by --init 0.14-0.21.
+SHARE_NONE, SHARE_FULL = 0.2, 0.4
 #: A map whose radius exceeds the truth's by this factor cannot be a part of it (a scale).
 OVERSIZE = 1.5
 #: A map below the minimum confidence still shows the truth's place when at least this many of
@@ -77,18 +84,22 @@ def verdict(confidence: float, min_confidence: float, parts: Sequence[Part],
     return OTHER
 
 
-def confidence(distinct: float | None, recall: float, agreement: float = 0.0) -> float:
-    """That the map shows the truth's place, [0, 1]: the smaller of distinct / FULL_DISTINCT
-    and (recall - RECALL_NONE) / (RECALL_FULL - RECALL_NONE), clipped. ``distinct``: the global
-    search's distinctiveness of the final pose (None without a search: ``--init``,
-    ``--no-align``, a 3D registration; then the recall term alone); ``recall``: share of the
-    covered truth walls near the map. 0.5 is distinctiveness 0.1 and recall 0.6.
+def confidence(distinct: float | None, recall: float, agreement: float = 0.0,
+               share: float = 1.0) -> float:
+    """That the map shows the truth's place, [0, 1]: the smallest of distinct / FULL_DISTINCT,
+    (recall - RECALL_NONE) / (RECALL_FULL - RECALL_NONE) and (share - SHARE_NONE) /
+    (SHARE_FULL - SHARE_NONE), clipped. ``distinct``: the global search's distinctiveness of the
+    final pose (None without a search: ``--init``, ``--no-align``, a 3D registration; then the
+    other terms alone); ``recall``: share of the covered truth walls near the map; ``share``:
+    the larger of the coverage and the fitness. 0.5 is distinctiveness 0.1, recall 0.6 or
+    share 0.3.
 
     A map that lies on the truth both ways is the truth's place even when the place is
     symmetric (a round room, a square hall: the pose is ambiguous, the scores are not), so
     ``agreement`` (fitness x recall) gives confidence on its own:
     (agreement - AGREE_NONE) / (AGREE_FULL - AGREE_NONE), 0.5 at 0.8; the larger one counts."""
-    terms = [(recall - RECALL_NONE) / (RECALL_FULL - RECALL_NONE)]
+    terms = [(recall - RECALL_NONE) / (RECALL_FULL - RECALL_NONE),
+             (share - SHARE_NONE) / (SHARE_FULL - SHARE_NONE)]
     if distinct is not None:
         terms.append(distinct / FULL_DISTINCT)
     agreed = (agreement - AGREE_NONE) / (AGREE_FULL - AGREE_NONE)
@@ -115,7 +126,8 @@ def overlap(truth_occ: np.ndarray, to_map: DistanceField, footprint: np.ndarray,
         through = float((free[faces] & (near > CLEAR_M)).mean()) if faces.any() else 0.0
     agreement = alignment.fitness * recall
     return Overlap(footprint, coverage, recall, agreement,
-                   confidence(alignment.distinctiveness, recall, agreement),
+                   confidence(alignment.distinctiveness, recall, agreement,
+                              max(coverage, alignment.fitness)),
                    seen_through=through)
 
 
@@ -125,7 +137,10 @@ def refusal(source: OccupancyMap | PointMap, truth_path: Path, alignment: Alignm
     option that addresses it."""
     map_path = source.path
     distinct = alignment.distinctiveness
-    why = (f"{cover.truth_recall:.0%} of the truth it covers lies near the map" +
+    share = ("" if max(cover.coverage, alignment.fitness) >= SHARE_FULL else
+             f"it covers {cover.coverage:.0%} of the truth and {alignment.fitness:.0%} of it "
+             "lies on the truth's walls, ")
+    why = (share + f"{cover.truth_recall:.0%} of the truth it covers lies near the map" +
            ("" if cover.seen_through is None else
             f", it saw through {cover.seen_through:.0%} of the truth's walls there") +
            ("" if distinct is None else

@@ -12,13 +12,24 @@ from pcmapq.evaluation.same_place import confidence
 
 
 def test_confidence_is_the_smaller_term():
-    """min(distinct / 0.2, (recall - 0.4) / 0.4), clipped; no search: the recall term."""
+    """min(distinct / 0.2, (recall - 0.4) / 0.4), clipped; no search: the recall term (and the
+    share, full by default)."""
     assert confidence(0.1, 0.6) == pytest.approx(0.5)
     assert confidence(0.05, 0.8) == pytest.approx(0.25)
     assert confidence(0.3, 0.7) == pytest.approx(0.75)
     assert confidence(None, 0.7) == pytest.approx(0.75)
     assert confidence(0.5, 1.0) == 1.0 and confidence(0.0, 1.0) == 0.0
     assert confidence(None, 0.2) == 0.0
+
+
+def test_a_map_with_a_sliver_on_the_truth_has_no_confidence():
+    """The larger of coverage and fitness: (share - 0.2) / 0.2, the smallest term; a partial
+    map (low coverage, high fitness) or one larger than its truth (the reverse) keeps the
+    other terms' confidence."""
+    assert confidence(None, 0.82, share=0.19) == 0.0  # the sample 14 m off its plan
+    assert confidence(None, 1.0, share=0.3) == pytest.approx(0.5)
+    assert confidence(0.5, 0.8, share=0.25) == pytest.approx(0.25)
+    assert confidence(None, 0.7, share=0.9) == confidence(None, 0.7) == pytest.approx(0.75)
 
 
 def test_distinctiveness_of_known_scores():
