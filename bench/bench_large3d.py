@@ -21,7 +21,7 @@ from pathlib import Path
 
 from bench import large_3d
 from bench.bench_clouds import measured
-from bench.ratios import Ratio, eval_cmd, paired, written
+from bench.timing import Ratio, eval_cmd, paired, written
 
 #: The 50 M case's bound, GB as :func:`bench.bench_clouds.measured` gives them (issue 57).
 BOUND_GB = 8.0

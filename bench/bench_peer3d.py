@@ -100,7 +100,7 @@ def kitti_pitched_pair(cache: Path) -> tuple[Path, Path] | None:
         write_cloud(folder / "map.ply", build_map_from_poses(
             data / "velodyne", pitched(poses, PITCH_DEG), max_scans=SCANS))
 
-    from bench.ratios import written
+    from bench.timing import written
 
     folder = written(cache / f"kitti{SCANS}_pitch{PITCH_DEG:g}", write)
     return folder / "map.ply", folder / "truth.ply"
@@ -169,7 +169,7 @@ def table(runs: dict[str, list[Run]]) -> str:
 
 def case(cache: Path, repeat: int) -> list:
     """The ratios of :mod:`bench.ratios`: time (target 1.0) and memory."""
-    from bench.ratios import Ratio
+    from bench.timing import Ratio
 
     runs = measure(cache, repeat, log=lambda line: print(line, file=sys.stderr, flush=True))
     if runs is None:

@@ -15,8 +15,8 @@ from matplotlib.figure import Figure
 from pcmapq.core.morphology import distance_to
 from pcmapq.raster.pool import max_pool, min_pool
 from pcmapq.report.canvas import extent, frame, pooling, size_m, window
-from pcmapq.report.plot import WIDTH_IN, plt  # Agg backend
-from pcmapq.report.style import TEXT_PT, TITLE_PT
+from pcmapq.report.plot import plt  # Agg backend
+from pcmapq.report.style import TEXT_PT, TITLE_PT, WIDTH_IN
 from pcmapq.results.result import Result
 
 #: Grey of the walls under a heatmap's coloured cells.

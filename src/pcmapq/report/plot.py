@@ -62,7 +62,6 @@ from pcmapq.report.rooms_layer import draw_rooms, rooms_legend  # noqa: E402
 from pcmapq.report.style import (  # noqa: E402
     DPI,
     EXTRA,
-    FIGURE_WIDTH_PX,
     FOOTPRINT,
     MAP_LIGHT,
     MATCHED,
@@ -72,12 +71,10 @@ from pcmapq.report.style import (  # noqa: E402
     THIN_PX_DENSITY,
     TITLE_PT,
     TRUTH_DARK,
+    WIDTH_IN,
 )
 from pcmapq.report.text import score  # noqa: E402
 from pcmapq.results.result import DetectorResult, Result  # noqa: E402
-
-#: Figure width, inches: the report's figure width at DPI.
-WIDTH_IN = FIGURE_WIDTH_PX / DPI
 
 
 def _nice(value: float) -> float:

@@ -16,7 +16,7 @@ from matplotlib.collections import PatchCollection
 from matplotlib.colors import Normalize
 from matplotlib.patches import Rectangle
 
-from pcmapq.report.style import TEXT_PT, TITLE_PT
+from pcmapq.report.style import TEXT_PT, TITLE_PT, WIDTH_IN
 from pcmapq.results.result import Result
 
 if TYPE_CHECKING:
@@ -133,13 +133,15 @@ def relief_figure(result: Result) -> Figure:
     """The two pictures side by side, for the report: the top view over the map's density on
     the part of the truth grid a picture shows (:func:`~pcmapq.report.canvas.window`), and the
     side profile."""
+    from matplotlib.figure import Figure
+
     from pcmapq.report.canvas import extent, frame, pooling, shade, size_m, window
-    from pcmapq.report.plot import WIDTH_IN, plt  # Agg backend; plot draws these panels too
 
     shown = window(result)
     width, height = size_m(result, shown)
     panel_h = float(np.clip(WIDTH_IN / 2 * height / max(width, 1e-9), 2.5, 9.0)) + 1.2
-    fig, (top, side) = plt.subplots(1, 2, figsize=(WIDTH_IN, panel_h), layout="constrained")
+    fig = Figure(figsize=(WIDTH_IN, panel_h), layout="constrained")
+    top, side = fig.subplots(1, 2)
     colours = relief_panels(fig, top, side, result)
     frame(top, result, shown)
     factor, _ = pooling(fig, [top], result.map_occupied[shown].shape)

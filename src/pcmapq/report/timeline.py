@@ -12,8 +12,8 @@ from matplotlib.figure import Figure
 
 from pcmapq.core.words import count
 from pcmapq.report.html import STYLE, _img, _table
-from pcmapq.report.plot import WIDTH_IN, png_bytes, vectorial_figure
-from pcmapq.report.style import DETECTOR_COLOURS, OTHER_COLOURS
+from pcmapq.report.plot import png_bytes, vectorial_figure
+from pcmapq.report.style import DETECTOR_COLOURS, OTHER_COLOURS, WIDTH_IN
 from pcmapq.report.text import number
 from pcmapq.results.result import Result
 
