@@ -32,8 +32,9 @@ AGREE_NONE, AGREE_FULL = 0.7, 0.9
 #: place one way or the other: a partial map lies on the truth (high fitness), a map larger
 #: than its truth covers it (high coverage). A map that hangs off the truth (a wrong --init or
 #: --init-3d, --no-align on a map in another frame) has a sliver of each on the other, where
-#: its walls may agree however well. Maps of their own place in docs/validation.md reach 0.40
-#: and more; the sample hung 14-19 m off its plan by --init 0.14-0.21.
+#: its walls may agree however well. Maps of their own place in docs/validation.md reach 0.37
+#: and more (a Halmstad map against its furniture-free layout); the sample hung 14-19 m off
+#: its plan by --init 0.14-0.21, the 3D building turned 90 degrees by --init-3d 0.09.
 SHARE_NONE, SHARE_FULL = 0.2, 0.4
 #: A map whose radius exceeds the truth's by this factor cannot be a part of it (a scale).
 OVERSIZE = 1.5
