@@ -60,8 +60,6 @@ print(json.dumps({"seconds": time.perf_counter() - start}))
 """
 
 
-
-
 def kitti_pair(cache: Path) -> tuple[Path, Path] | None:
     """KITTI 00's first 20 scans: the KISS-ICP map and the map of the reference poses, as
     ``pcmapq map`` builds them, written once into ``cache``; None without the data."""

@@ -46,6 +46,7 @@ def paired(first: list[str], second: list[str], repeat: int
 
 
 def eval_cmd(map_path: Path, truth: Path, out: Path, *extra: str) -> list[str]:
+    """``pcmapq eval`` of ``map_path`` against ``truth`` in a fresh Python, its JSON to ``out``."""
     return [sys.executable, "-m", "pcmapq", "eval", str(map_path), str(truth), "--json",
             str(out), *extra]
 

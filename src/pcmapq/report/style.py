@@ -16,7 +16,7 @@ ARROW_SHARE, MAX_ARROW_SCALE = 0.12, 100.0
 #: Dots per inch of the PNGs; rasters are pooled to the pixels their panel has at this
 #: resolution (saved at fewer dpi, matplotlib skips some of their rows again).
 DPI = 130
-#: Widest figure, pixels at DPI: the width the HTML report gives a figure; inches.
+#: Widest figure: pixels at DPI (the width the HTML report gives a figure), and inches.
 FIGURE_WIDTH_PX = 1350
 WIDTH_IN = FIGURE_WIDTH_PX / DPI
 #: Font sizes, points: titles, everything else (tick labels, legend, colour bar).
