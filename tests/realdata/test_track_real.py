@@ -141,3 +141,21 @@ def test_a_log_scored_against_itself_ends_at_one(tmp_path) -> None:
         for name in ("harris", "hough", "sift"):
             assert last[f"{name}_quality"] == last[f"{name}_precision"] == 1.0, (name, last)
         assert coverage[0] <= last["coverage"] <= coverage[1], last["coverage"]
+
+
+def test_the_first_steps_of_a_small_map_are_placed_at_their_pose() -> None:
+    """ACES's first 20 and 40 scans (5 and 25 m of corridor) against the map of the whole
+    corrected log, in one frame: the global search weighs a pose by the map's free space only
+    where enough of it is clear of the map's walls at the search's coarse cell, so such a small
+    map is placed where it is (within 1 cm and 0.1 degree), not half a building away."""
+    from pcmapq.settings import Settings
+    from pcmapq.track import open_run, track_run
+
+    log = shared("carmen", "aces-corrected.log.gz")
+    run = open_run(log)
+    steps = track_run(run, log, Settings(), np.array([20, 40])).steps
+    for step in steps:
+        figures = step.figures
+        assert step.scored and figures["verdict"] == "same place", (step.step, step.note)
+        assert abs(figures["x_m"]) < 0.01 and abs(figures["y_m"]) < 0.01, figures
+        assert abs(figures["yaw_deg"]) < 0.1, figures

@@ -65,6 +65,13 @@ class Search:
 #: Poses within these of the final one are "near" it (see :func:`distinctiveness`): yaw,
 #: degrees; position, share of the (scaled) map's radius; scale, ratio.
 NEAR_DEG, NEAR_RADIUS, NEAR_SCALE = 15.0, 0.2, 1.15
+#: Fewest free points (half a search cell apart, clear of the map's walls) that weigh the
+#: search's poses: on a raster of the search's cell a wall is a cell thick, so a few of a
+#: small map's free points land on the truth's walls even at its pose, and a share of a few
+#: dozen points weighs that by tenfold or more (the first 20 scans of CARMEN's ACES log: 28
+#: points, its pose dropped from the search). The poses the search keeps are still weighed by
+#: the free space at the truth's own cell (:mod:`pcmapq.align.finalists`).
+MIN_CLEAR = 100
 
 
 def distinctiveness(search: Search, tf: Similarity2D) -> float:
@@ -179,6 +186,8 @@ def coarse_search(map_xy: np.ndarray, truth_xy: np.ndarray, *,
     if angle_step_deg is None:
         angle_step_deg = float(np.clip(np.degrees(sigma / max(radius, 1e-6)), 0.5, 3.0))
     clear = _clear(free, map_xy, resolution) - centre
+    if len(clear) < MIN_CLEAR:
+        clear = clear[:0]
     half = int(np.ceil(max(radius, _radius(clear) if len(clear) else 0.0) / resolution)) + 1
     tgrid = _template_grid(half, resolution)
     fgrid = MetricGrid.covering(truth_xy, resolution, margin=(half + 1) * resolution + overhang)
