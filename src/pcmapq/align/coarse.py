@@ -67,8 +67,8 @@ class Search:
 NEAR_DEG, NEAR_RADIUS, NEAR_SCALE = 15.0, 0.2, 1.15
 #: Fewest free points (half a search cell apart, clear of the map's walls) that weigh the
 #: search's poses: on a raster of the search's cell a wall is a cell thick, so a few of a
-#: small map's free points land on the truth's walls even at its pose, and a share of a few
-#: dozen points weighs that by tenfold or more (the first 20 scans of CARMEN's ACES log: 28
+#: small map's free points land on the truth's walls even at its pose, and among a few dozen
+#: points they cost that pose most of its score (the first 20 scans of CARMEN's ACES log: 28
 #: points, its pose dropped from the search). The poses the search keeps are still weighed by
 #: the free space at the truth's own cell (:mod:`pcmapq.align.finalists`).
 MIN_CLEAR = 100
@@ -172,8 +172,9 @@ def coarse_search(map_xy: np.ndarray, truth_xy: np.ndarray, *,
     the angle that moves the map's farthest point by sigma, clipped to [0.5, 3]). overhang: how
     far, metres, the map's centroid may lie outside the truth's bounding box. per_angle: peaks
     kept from each yaw's response.
-    free: the map's free space and the truth's solid and known cells; given, each pose's
-    score is multiplied by exp(-PENALTY x the cost of the map's free space there)
+    free: the map's free space and the truth's solid and known cells; given, and with at least
+    MIN_CLEAR of its points clear of the map's walls at ``resolution``, each pose's score is
+    multiplied by exp(-PENALTY x the cost of the map's free space there)
     (:func:`~pcmapq.align.free_space.cost`).
     Candidates come best first; yaws within three steps and positions within 4 cells of a better one
     are dropped, so near-symmetric alternatives survive to be settled by refinement.
