@@ -22,7 +22,7 @@ import cv2
 import numpy as np
 
 from pcmapq.align import free_space
-from pcmapq.align.free_space import CLEAR_M, FreeSpace
+from pcmapq.align.free_space import FreeSpace
 from pcmapq.core.bounds import bounds
 from pcmapq.core.grid import MetricGrid
 from pcmapq.core.morphology import distance_to
@@ -65,13 +65,6 @@ class Search:
 #: Poses within these of the final one are "near" it (see :func:`distinctiveness`): yaw,
 #: degrees; position, share of the (scaled) map's radius; scale, ratio.
 NEAR_DEG, NEAR_RADIUS, NEAR_SCALE = 15.0, 0.2, 1.15
-#: Fewest free points (half a search cell apart, clear of the map's walls) that weigh the
-#: search's poses: on a raster of the search's cell a wall is a cell thick, so a few of a
-#: small map's free points land on the truth's walls even at its pose, and among a few dozen
-#: points they cost that pose most of its score (the first 20 scans of CARMEN's ACES log: 28
-#: points, its pose dropped from the search). The poses the search keeps are still weighed by
-#: the free space at the truth's own cell (:mod:`pcmapq.align.finalists`).
-MIN_CLEAR = 100
 
 
 def distinctiveness(search: Search, tf: Similarity2D) -> float:
@@ -172,9 +165,10 @@ def coarse_search(map_xy: np.ndarray, truth_xy: np.ndarray, *,
     the angle that moves the map's farthest point by sigma, clipped to [0.5, 3]). overhang: how
     far, metres, the map's centroid may lie outside the truth's bounding box. per_angle: peaks
     kept from each yaw's response.
-    free: the map's free space and the truth's solid and known cells; given, and with at least
-    MIN_CLEAR of its points clear of the map's walls at ``resolution``, each pose's score is
-    multiplied by exp(-PENALTY x the cost of the map's free space there)
+    free: the map's free space and the truth's solid and known cells; given, and with enough
+    of its points evidence at ``resolution``
+    (:meth:`~pcmapq.align.free_space.FreeSpace.evidence`), each pose's score is multiplied by
+    exp(-PENALTY x the cost of the map's free space there)
     (:func:`~pcmapq.align.free_space.cost`).
     Candidates come best first; yaws within three steps and positions within 4 cells of a better one
     are dropped, so near-symmetric alternatives survive to be settled by refinement.
@@ -186,9 +180,7 @@ def coarse_search(map_xy: np.ndarray, truth_xy: np.ndarray, *,
     radius = _radius(centred)
     if angle_step_deg is None:
         angle_step_deg = float(np.clip(np.degrees(sigma / max(radius, 1e-6)), 0.5, 3.0))
-    clear = _clear(free, map_xy, resolution) - centre
-    if len(clear) < MIN_CLEAR:
-        clear = clear[:0]
+    clear = (np.zeros((0, 2)) if free is None else free.evidence(map_xy, resolution)) - centre
     half = int(np.ceil(max(radius, _radius(clear) if len(clear) else 0.0) / resolution)) + 1
     tgrid = _template_grid(half, resolution)
     fgrid = MetricGrid.covering(truth_xy, resolution, margin=(half + 1) * resolution + overhang)
@@ -224,15 +216,6 @@ def coarse_search(map_xy: np.ndarray, truth_xy: np.ndarray, *,
     return Search([Candidate(_pose(yaw, xy, centre), float(score)) for score, yaw, *xy in best],
                   poses, centre, radius, resolution, float(np.radians(angle_step_deg)),
                   np.vstack(plain) if plain else None)
-
-
-def _clear(free: FreeSpace | None, map_xy: np.ndarray, cell: float) -> np.ndarray:
-    """The map's free points (map frame, metres) that are evidence on a raster of ``cell``
-    metres: thinned to half a cell, farther than CLEAR_M and 1.5 cells from its walls
-    ``map_xy``; none without ``free``."""
-    if free is None:
-        return np.zeros((0, 2))
-    return free.clear(map_xy, 0.5 * cell, max(CLEAR_M, 1.5 * cell))
 
 
 def _pose(yaw: float, centre_truth: np.ndarray, centre_map: np.ndarray,

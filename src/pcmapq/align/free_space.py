@@ -44,6 +44,13 @@ OFF_TRUTH, OFF_ALLOWED = 0.3, 0.2
 FFT_BYTES = 64e6
 #: Free points a final pose is checked with: a share is sure to about 1 % with this many.
 CHECK_POINTS = 20_000
+#: Fewest free points that are evidence on a raster coarser than the truth's (the global
+#: search's, :meth:`FreeSpace.evidence`): there a wall is a cell thick, so a few of a small
+#: map's free points land on the truth's walls even at its pose, and among a few dozen points
+#: they cost that pose most of its score (the first 20 scans of CARMEN's ACES log: 28 points,
+#: its pose dropped from the search). The poses the search keeps are still weighed by the free
+#: space at the truth's own cell (:mod:`pcmapq.align.finalists`).
+MIN_CLEAR = 100
 
 
 @dataclass(frozen=True)
@@ -70,6 +77,13 @@ class FreeSpace:
             return free
         dist, _ = cKDTree(walls_xy).query(free, distance_upper_bound=margin, workers=1)
         return free[~np.isfinite(dist)]
+
+    def evidence(self, walls_xy: np.ndarray, cell: float) -> np.ndarray:
+        """The free points (map frame, metres) that are evidence on a raster of ``cell``
+        metres: thinned to half a cell, farther than CLEAR_M and 1.5 cells from the map's walls
+        ``walls_xy`` (N, 2, map frame); none when fewer than MIN_CLEAR are left."""
+        clear = self.clear(walls_xy, 0.5 * cell, max(CLEAR_M, 1.5 * cell))
+        return clear if len(clear) >= MIN_CLEAR else clear[:0]
 
     def solid_xy(self) -> np.ndarray:
         """Centres of the truth's solid cells, (M, 2) metres, truth frame."""
