@@ -98,7 +98,7 @@ def kitti_pitched_pair(cache: Path) -> tuple[Path, Path] | None:
         truth, poses = reference_map(data, SCANS)
         write_cloud(folder / "truth.ply", truth)
         write_cloud(folder / "map.ply", build_map_from_poses(
-            data / "velodyne", pitched(poses, PITCH_DEG), max_scans=SCANS))
+            data / "velodyne", pitched(poses, PITCH_DEG), max_scans=SCANS).points)
 
     from bench.timing import written
 

@@ -35,8 +35,8 @@ def pitch_ladder(steps_deg: tuple[float, ...], voxel: float = 0.1
 
     folder = shared("kitti00")
     poses = lidar_poses_from_camera(read_kitti_poses(folder / "poses.txt"), tr_00())
-    truth = build_map_from_poses(folder, poses, voxel=voxel)
-    drifted = {step: build_map_from_poses(folder, pitched(poses, step), voxel=voxel)
+    truth = build_map_from_poses(folder, poses, voxel=voxel).points
+    drifted = {step: build_map_from_poses(folder, pitched(poses, step), voxel=voxel).points
                for step in steps_deg}
     return truth, drifted
 

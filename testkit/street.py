@@ -63,3 +63,17 @@ def tilted(cloud: np.ndarray, degrees_per_metre: float) -> np.ndarray:
     x = np.maximum(out[:, 0], 0.0)
     out[:, 2] -= np.tan(np.radians(degrees_per_metre)) * x**2 / 2
     return out
+
+
+def street_run(cloud: np.ndarray, scans: int, step: float = 1.0, reach: float = 8.0,
+               start: float = 0.0) -> tuple[list[np.ndarray], np.ndarray]:
+    """A car's run along the street ``cloud`` (N, 3): scan k taken at x = ``start`` + k *
+    ``step``, 1.5 m above the ground, holding the street's points within ``reach`` metres of
+    it. The scans' points in the scanner's frame (each (n, 3)) and the scanner's poses (K, 4,
+    4, scanner -> street: a shift)."""
+    poses = np.repeat(np.eye(4)[None], scans, axis=0)
+    poses[:, 0, 3] = start + step * np.arange(scans)
+    poses[:, 2, 3] = 1.5
+    seen = [cloud[np.linalg.norm(cloud - pose[:3, 3], axis=1) <= reach] - pose[:3, 3]
+            for pose in poses]
+    return seen, poses

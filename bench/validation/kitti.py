@@ -48,7 +48,8 @@ class Maps:
 def kiss_map(folder: Path, scans: int = SCANS) -> tuple[np.ndarray, np.ndarray]:
     """KISS-ICP's map (N, 3 metres) of the first ``scans`` scans of ``folder/velodyne`` and its
     poses (K, 4, 4), as ``pcmapq map`` builds them."""
-    return build_map_kiss(folder / "velodyne", max_scans=scans)
+    built, poses = build_map_kiss(folder / "velodyne", max_scans=scans)
+    return built.points, poses
 
 
 def reference_map(folder: Path, scans: int = SCANS) -> tuple[np.ndarray, np.ndarray]:
@@ -56,7 +57,7 @@ def reference_map(folder: Path, scans: int = SCANS) -> tuple[np.ndarray, np.ndar
     first LiDAR frame, and those poses (K, 4, 4), as ``pcmapq map --poses --calib`` builds it."""
     poses = lidar_poses_from_camera(read_kitti_poses(folder / "poses.txt"),
                                     np.vstack([TR, [0, 0, 0, 1]]))[:scans]
-    return build_map_from_poses(folder / "velodyne", poses, max_scans=scans), poses
+    return build_map_from_poses(folder / "velodyne", poses, max_scans=scans).points, poses
 
 
 def measure(folder: Path, scans: int = SCANS) -> Maps:

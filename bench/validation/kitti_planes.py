@@ -57,7 +57,7 @@ def measure(folder: Path, level: float, timed: bool = False) -> Rung:
     truth, poses = _reference(folder)
     cloud = truth if level == 0 else build_map_from_poses(folder / "velodyne",
                                                           pitched(poses, level),
-                                                          max_scans=SCANS)
+                                                          max_scans=SCANS).points
     with tempfile.TemporaryDirectory(prefix="pcmapq_kitti_planes_") as tmp:
         write_cloud(Path(tmp) / "truth.ply", truth)
         write_cloud(Path(tmp) / "map.ply", cloud)

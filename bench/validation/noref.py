@@ -220,7 +220,7 @@ def cloud_ladder(folder: Path, base: str) -> CloudLadder:
     with tempfile.TemporaryDirectory(prefix="pcmapq_noref_") as tmp:
         truth = Path(tmp) / "truth.ply"
         for label, level, poses in runs:
-            cloud = build_map_from_poses(velodyne, poses, max_scans=SCANS)
+            cloud = build_map_from_poses(velodyne, poses, max_scans=SCANS).points
             path = truth if level == 0 else Path(tmp) / "map.ply"
             write_cloud(path, cloud)
             figures = noref_figures(voxel_centroids(cloud, VOXEL), RADIUS, MIN_KNN, MAX_NN,

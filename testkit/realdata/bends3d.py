@@ -123,6 +123,19 @@ def region_dz(placed: np.ndarray, dz: np.ndarray, centre: np.ndarray, tile: floa
     return np.array([mean_dz[np.all(tile_of == t, axis=1)].mean() for t in wanted])
 
 
+def stretch_dz(placed: np.ndarray, dz: np.ndarray, stretch_of: np.ndarray,
+               wanted: np.ndarray, voxel: float) -> np.ndarray:
+    """Each stretch's mean vertical error (K,), metres: the points' (N, 3, placed) errors
+    ``dz`` (N,) averaged over each voxel of a stretch's points (``stretch_of`` (N,) each
+    point's stretch), then over the stretch's voxels, for the stretches ``wanted`` (K,)."""
+    out = []
+    for k in wanted:
+        mine = stretch_of == k
+        _, voxel_of = voxel_groups(placed[mine], voxel)
+        out.append(float(np.mean(np.bincount(voxel_of, dz[mine]) / np.bincount(voxel_of))))
+    return np.array(out)
+
+
 def measure(folder: Path, kind: str, level: float) -> Rung:
     """The reference map and the drifted one, scored; the rung's figures."""
     truth = lidar_poses_from_camera(read_kitti_poses(folder / "poses.txt"), tr_00())[:SCANS]
@@ -132,7 +145,7 @@ def measure(folder: Path, kind: str, level: float) -> Rung:
     with tempfile.TemporaryDirectory(prefix="pcmapq_bends_") as tmp:
         for name, poses in (("truth", truth), ("map", drift)):
             write_cloud(Path(tmp) / f"{name}.ply", build_map_from_poses(
-                folder / "velodyne", poses, max_scans=SCANS, max_range=RANGE_M))
+                folder / "velodyne", poses, max_scans=SCANS, max_range=RANGE_M).points)
         run = timed_evaluate(Path(tmp) / "map.ply", Path(tmp) / "truth.ply", SETTINGS)
     r = run.result
     c, level_of = r.consistency_3d, r.frames.truth_levelling

@@ -9,8 +9,9 @@ error integrated along the run, at five levels of three kinds:
   :func:`testkit.kitti.stretched`).
 
 All built as ``pcmapq map --poses`` builds them (:func:`pcmapq.mapping.build_map_from_poses`:
-full range, 0.1 m voxels; each map once per process) and scored as ``pcmapq eval map.ply
-truth.ply --no-noref`` scores two 3D clouds.
+full range, 0.1 m voxels, each point with its scan, so that the 3D consistency map's regions are
+stretches of the run; each map once per process) and scored as ``pcmapq eval map.ply truth.ply
+--no-noref`` scores two 3D clouds.
 
 The levels, measured (KITTI's car moves 0.86 m a scan, 16 m over the run): a heading or pitch
 drift of 0.025 degrees a scan leaves the run's end 0.07 m and 0.5 degrees off, AWD 0.06 m, the
@@ -42,10 +43,17 @@ from pcmapq.align.refine3d import last_reach
 from pcmapq.align.regions3d import Consistency3D, regions_3d
 from pcmapq.align.rigid3d import apply
 from pcmapq.core.frames import Levelling
+from pcmapq.core.transform import affine
+from pcmapq.core.voxels import voxel_groups
 from pcmapq.evaluation.inputs import load_pair, plan_points
 from pcmapq.evaluation.scoring import structures_3d
 from pcmapq.io.writers import write_cloud
-from pcmapq.mapping import build_map_from_poses, lidar_poses_from_camera, read_kitti_poses
+from pcmapq.mapping import (
+    ScanMap,
+    build_map_from_poses,
+    lidar_poses_from_camera,
+    read_kitti_poses,
+)
 from pcmapq.mapping.reference import scans_for_poses
 from pcmapq.match.structures import Structures3D
 from pcmapq.metrics.distances import distances_3d
@@ -54,7 +62,13 @@ from pcmapq.results.result import Result
 from pcmapq.settings import NoRefConfig, Settings
 from testkit.kitti import curved, stretched, tr_00
 from testkit.mapeval import mapeval_as_coded
-from testkit.realdata.bends3d import WITHIN_M, WITHIN_SHARE, placed_errors, region_dz
+from testkit.realdata.bends3d import (
+    WITHIN_M,
+    WITHIN_SHARE,
+    placed_errors,
+    region_dz,
+    stretch_dz,
+)
 from testkit.runs import Run, timed_evaluate
 
 #: Scans of the maps (the first ones of kitti00/velodyne).
@@ -69,6 +83,8 @@ LEVELS: dict[str, tuple[float, ...]] = {
 SETTINGS = Settings(noref=NoRefConfig(enabled=False))
 #: The scans' range in the maps (build_map_from_poses' default, as ``pcmapq map``), metres.
 MAX_RANGE_M = 100.0
+#: The maps' voxel (build_map_from_poses' default, as ``pcmapq map``), metres.
+MAP_VOXEL_M = 0.1
 #: The issue's bound on a figure's rank correlation with the level.
 RHO = 0.9
 
@@ -88,14 +104,20 @@ def reference_poses(folder: Path) -> np.ndarray:
 
 
 @cache
-def ladder_map(folder: Path, kind: str | None = None, level: float = 0.0) -> np.ndarray:
-    """The map (N, 3) metres of the first scans, as ``pcmapq map --poses`` builds it: at the
-    reference poses (``kind`` None: the truth) or drifted; built once per process."""
+def ladder_map(folder: Path, kind: str | None = None, level: float = 0.0) -> ScanMap:
+    """The map of the first scans (points (N, 3) metres, each one's scan), as ``pcmapq map
+    --poses`` builds it: at the reference poses (``kind`` None: the truth) or drifted; built
+    once per process."""
     poses = reference_poses(folder)
     if kind is not None:
         poses = drifted(poses, kind, level)
     return build_map_from_poses(folder / "velodyne", poses, max_scans=SCANS,
-                                max_range=MAX_RANGE_M)
+                                max_range=MAX_RANGE_M, voxel=MAP_VOXEL_M)
+
+
+def write_ladder_map(path: Path, built: ScanMap) -> None:
+    """A ladder's map written as ``pcmapq map`` writes it: its points and their scans."""
+    write_cloud(path, built.points, scan=built.scan)
 
 
 @dataclass(frozen=True)
@@ -124,7 +146,9 @@ class Bend:
     |dz| (its centroid x, y; the 5th and 95th percentiles of its points' vertical errors, m:
     how far apart the scans put its surfaces; its expected and reported dz, m), the largest
     reported dz (signed, m) and whether it is that region, and the median and largest
-    |reported - expected| over the held regions (m)."""
+    |reported - expected| over the held regions (m); for stretches of the run, the far
+    region's first and last scan and the expected dz of the region with the largest reported
+    |dz| (m)."""
 
     far_at: tuple[float, float]
     spread_m: tuple[float, float]
@@ -134,6 +158,8 @@ class Bend:
     same_region: bool
     median_error_m: float
     max_error_m: float
+    far_scans: tuple[int, int] | None = None
+    largest_expected_m: float | None = None
 
     def within(self, injected_m: float) -> bool:
         """Reported within WITHIN_M plus WITHIN_SHARE of the injected offset of expected."""
@@ -220,8 +246,8 @@ def direct_figures(folder: Path, kind: str, level: float, transform: np.ndarray
     settings, m3 = SETTINGS, SETTINGS.map_3d
     with tempfile.TemporaryDirectory(prefix="pcmapq_ladders3d_") as tmp:
         truth_path, map_path = Path(tmp) / "truth.ply", Path(tmp) / "map.ply"
-        write_cloud(truth_path, ladder_map(folder))
-        write_cloud(map_path, ladder_map(folder, kind, level))
+        write_ladder_map(truth_path, ladder_map(folder))
+        write_ladder_map(map_path, ladder_map(folder, kind, level))
         source, truth = load_pair(map_path, truth_path, settings)
     level_of = plan_points(truth, settings)[1]
     placed, target = apply(np.asarray(transform, dtype=np.float64), source.points), truth.points
@@ -230,7 +256,8 @@ def direct_figures(folder: Path, kind: str, level: float, transform: np.ndarray
                               settings.distances.taus)
         regions = pool.submit(regions_3d, placed, target, tile_m=m3.tile,
                               voxel=settings.alignment.voxel_3d,
-                              level=None if level_of is None else level_of.rotation)
+                              level=None if level_of is None else level_of.rotation,
+                              scan=source.scan)
         gaussians = pool.submit(map_gaussians, placed, target, m3.voxel, m3.min_points,
                                 m3.radius)
         structures = pool.submit(structures_3d, target, placed, settings.structures,
@@ -275,19 +302,39 @@ def bend(folder: Path, kind: str, level: float, consistency: Consistency3D | Non
     c = consistency
     if c is None or not c.held.any():
         raise RuntimeError(f"{kind} {level}: no held region of a 3D consistency map")
-    truth = reference_poses(folder)
-    placed, error = placed_errors(list(scans(folder)), truth, drifted(truth, kind, level),
-                                  transform, None if level_of is None else level_of.rotation)
-    expected = region_dz(placed, error[:, 2], c.centre, c.tile_m, c.voxel_m)
+    truth, points = reference_poses(folder), list(scans(folder))
+    drift = drifted(truth, kind, level)
+    placed, error = placed_errors(points, truth, drift, transform,
+                                  None if level_of is None else level_of.rotation)
+    if c.scans is None:  # tiles: a point is in the region whose tile holds it
+        expected = region_dz(placed, error[:, 2], c.centre, c.tile_m, c.voxel_m)
+        point_of = np.floor(placed[:, :2] / c.tile_m).astype(np.int64)
+        region_of = np.floor(c.centre[:, :2] / c.tile_m).astype(np.int64)
+    else:  # stretches: in the one holding its scan
+        point_of = point_stretches(points, drift, c.stretch)[:, None]
+        region_of = c.scans[:, :1] // c.stretch
+        expected = stretch_dz(placed, error[:, 2], point_of[:, 0], region_of[:, 0], c.voxel_m)
     far = int(np.flatnonzero(c.held)[np.argmax(np.abs(expected[c.held]))])
     largest = c.largest_dz()
     gap = np.abs(c.offset[c.held, 2] - expected[c.held])
-    tile = np.floor(placed[:, :2] / c.tile_m) == np.floor(c.centre[far, :2] / c.tile_m)
-    spread = np.percentile(error[np.all(tile, axis=1), 2], [5, 95])
+    spread = np.percentile(error[np.all(point_of == region_of[far], axis=1), 2], [5, 95])
     return Bend(tuple(np.round(c.centre[far, :2], 1).tolist()),
                 tuple(np.round(spread, 6).tolist()), round(float(expected[far]), 6),
                 float(c.offset[far, 2]), float(c.offset[largest, 2]), largest == far,
-                round(float(np.median(gap)), 6), round(float(gap.max()), 6))
+                round(float(np.median(gap)), 6), round(float(gap.max()), 6),
+                None if c.scans is None else tuple(c.scans[far].tolist()),
+                None if c.scans is None else round(float(expected[largest]), 6))
+
+
+def point_stretches(points: list[np.ndarray], poses: np.ndarray, stretch: int) -> np.ndarray:
+    """The stretch of the run (N,) each of the scans' ``points`` (scanner frame) falls in, as
+    the map placed at ``poses`` records it: its map voxel's mean scan index (MAP_VOXEL_M, the
+    map's frame), divided by the ``stretch`` scans a stretch holds."""
+    in_map = np.vstack([affine(p, pose) for p, pose in zip(points, poses, strict=True)])
+    scan_of = np.repeat(np.arange(len(points)), [len(p) for p in points])
+    _, voxel_of = voxel_groups(in_map, MAP_VOXEL_M)
+    mean = np.bincount(voxel_of, scan_of) / np.bincount(voxel_of)
+    return np.floor(mean[voxel_of] / stretch).astype(np.int64)
 
 
 def measure(folder: Path, kind: str, level: float) -> Rung:
@@ -295,8 +342,8 @@ def measure(folder: Path, kind: str, level: float) -> Rung:
     SETTINGS scores them; the vertical ladder's consistency map checked."""
     with tempfile.TemporaryDirectory(prefix="pcmapq_ladders3d_") as tmp:
         truth, cloud = Path(tmp) / "truth.ply", Path(tmp) / "map.ply"
-        write_cloud(truth, ladder_map(folder))
-        write_cloud(cloud, ladder_map(folder, kind, level))
+        write_ladder_map(truth, ladder_map(folder))
+        write_ladder_map(cloud, ladder_map(folder, kind, level))
         run = timed_evaluate(cloud, truth, SETTINGS)
         source, target = load_pair(cloud, truth, SETTINGS)
     r = run.result

@@ -1,6 +1,7 @@
 """Two 3D clouds of a street whose map sank by 0.3 m beyond x = 10, through ``pcmapq eval``:
 the 3D consistency map in the JSON, its CSV, its figures and gates, its terminal line, its
-pictures, and a result read back; a 2D result has none of it."""
+pictures, and a result read back; a 2D result has none of it. A map of a run along the street
+built by ``pcmapq map``, its last scans placed too low: its regions are stretches of the run."""
 
 from __future__ import annotations
 
@@ -18,7 +19,7 @@ from pcmapq.results.result import Result
 from testkit.command import run
 from testkit.files import read_cloud
 from testkit.paths import SAMPLE
-from testkit.street import street, sunk
+from testkit.street import street, street_run, sunk
 
 #: The street runs from x = -30 to 20 m: most of it in place, so that the 3D registration
 #: fits that part, and the last 10 m sunk.
@@ -115,3 +116,56 @@ def test_a_2d_result_has_no_3d_consistency(tmp_path):
     assert "consistency_3d" not in doc and "map_3d" not in doc["settings"]
     assert (tmp_path / "r3.csv").read_text().count("\n") == 1
     assert "pcmapq: warning:" in proc.stderr and "needs two 3D clouds" in proc.stderr
+
+
+@pytest.fixture(scope="module")
+def run_mapped(tmp_path_factory) -> Path:
+    """A car's 30 scans of the street from x = -29 m (a scan every 2 m), its poses from the
+    24th on (x = 19 m) 0.3 m too low, mapped by ``pcmapq map --poses``; the truth the street
+    itself."""
+    tmp = tmp_path_factory.mktemp("run")
+    truth = street(-30.0, 30.0, spacing=0.15, seed=0)
+    seen, poses = street_run(truth + np.random.default_rng(7).normal(0.0, 0.005, truth.shape),
+                             30, step=2.0, start=-29.0)
+    (tmp / "scans").mkdir()
+    for index, points in enumerate(seen):
+        np.save(tmp / "scans" / f"{index:03d}.npy", points)
+    poses[24:, 2, 3] -= DEPTH
+    np.savetxt(tmp / "poses.txt", poses[:, :3, :].reshape(len(poses), 12))
+    write_cloud(tmp / "truth.ply", truth)
+    proc = run("map", str(tmp / "scans"), "--poses", str(tmp / "poses.txt"), "--out",
+               str(tmp / "map.ply"), "-q")
+    assert proc.returncode == 0, proc.stderr
+    return tmp
+
+
+def test_a_map_built_from_scans_is_cut_into_stretches_of_its_run(run_mapped):
+    """``pcmapq map`` writes each point's scan; ``pcmapq eval`` cuts such a map into stretches
+    of 4 scans: those of scans 24 on lie 0.3 m low, the others in place, every whole one
+    held; the JSON, the CSV and the terminal name the scans; ``--stretch-3d 0`` cuts it into
+    tiles."""
+    tmp = run_mapped
+    scan = read_cloud(tmp / "map.ply")["scan"]  # a voxel's mean scan
+    assert scan.min() >= 0 and 28 <= scan.max() <= 29
+    proc = run("eval", str(tmp / "map.ply"), str(tmp / "truth.ply"), "--no-noref",
+               "--detectors", "harris", "--json", str(tmp / "r.json"), "--regions-3d",
+               str(tmp / "r3.csv"))
+    assert proc.returncode == 0, proc.stderr
+    block = json.loads((tmp / "r.json").read_text())["consistency_3d"]
+    assert block["tile_m"] is None and block["stretch_scans"] == 4
+    regions = block["regions"]
+    assert [(r["first_scan"], r["last_scan"]) for r in regions] == \
+        [(k, min(k + 3, 29)) for k in range(0, 30, 4)]
+    assert all(r["held"] for r in regions[:-1])
+    assert all(abs(r["dz_m"] + DEPTH) < 0.05 for r in regions if r["first_scan"] >= 24)
+    assert all(abs(r["dz_m"]) < 0.05 for r in regions if r["last_scan"] < 24)
+    with (tmp / "r3.csv").open() as f:
+        rows = list(csv.DictReader(f))
+    assert [int(r["first_scan"]) for r in rows] == [r["first_scan"] for r in regions]
+    assert re.search(r"largest dz -0\.[23]\d\d m \(too low\) at .*scans 2[48]-", proc.stdout)
+    assert Result.from_json(tmp / "r.json").to_dict()["consistency_3d"] == block
+    tiles = run("eval", str(tmp / "map.ply"), str(tmp / "truth.ply"), "--no-noref",
+                "--detectors", "harris", "--stretch-3d", "0", "--json", "-", "-q")
+    assert tiles.returncode == 0, tiles.stderr
+    block = json.loads(tiles.stdout)["consistency_3d"]
+    assert block["tile_m"] == 8.0 and "stretch_scans" not in block

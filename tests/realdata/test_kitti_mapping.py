@@ -39,8 +39,9 @@ def kitti_maps() -> dict[str, np.ndarray]:
     calls: list[tuple[int, int]] = []
     kiss_map, kiss_poses = build_map_kiss(kitti, max_scans=scans, voxel=0.1,
                                           progress=lambda d, t: calls.append((d, t)))
+    kiss_map = kiss_map.points
     truth_poses = lidar_poses_from_camera(camera_poses[:scans], tr_00())
-    truth_map = build_map_from_poses(kitti, truth_poses, None, voxel=0.1)
+    truth_map = build_map_from_poses(kitti, truth_poses, None, voxel=0.1).points
     return {"kiss_map": kiss_map, "kiss_poses": kiss_poses, "truth_map": truth_map,
             "truth_poses": truth_poses, "calls": np.array(calls)}
 

@@ -72,7 +72,7 @@ def kitti(tmp_path_factory) -> dict[str, Path | np.ndarray]:
     write_kitti_poses(tmp / "reference.txt", camera)
     write_kitti_poses(tmp / "estimate.txt", estimate)
     np.savetxt(tmp / "Tr.txt", TR.reshape(3, 4))
-    write_cloud(tmp / "ref.ply", build_map_from_poses(open_scans(scans), lidar, voxel=0.2))
+    write_cloud(tmp / "ref.ply", build_map_from_poses(open_scans(scans), lidar, voxel=0.2).points)
     return {"folder": tmp, "camera": camera, "lidar": lidar, "estimate": estimate}
 
 

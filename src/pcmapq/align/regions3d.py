@@ -4,12 +4,16 @@ consistent map needs no region to move; a map that sinks, tilts or drifts along 
 regions moved by offsets that grow where it bends, and the vertical part of those offsets (dz)
 shows what a plan cannot.
 
-Regions are square tiles of the truth's ground plane. Each region's own map points (at
+Regions are square tiles of the truth's ground plane, or, for a map that carries the scan each
+point came from (a map ``pcmapq map`` built, :mod:`pcmapq.mapping.scan_map`), stretches of the
+run: consecutive scans, their points wherever they lie. A drift builds up along the run, so a
+stretch holds points placed with nearly one error, where a tile of a long-range scanner's map
+holds points of every scan that saw it, each put elsewhere. Each region's own map points (at
 ``voxel``) are registered by small_gicp's point-to-plane ICP (as :mod:`pcmapq.align.plane_icp`
 computes it: its loops leave Python's lock to the evaluation's other threads), seeded at
-identity (the global pose), on one thread, against the truth's points within the tile grown by
-the widest pairing distance on every side (their normals and KD-tree small_gicp's), coarse to
-fine.
+identity (the global pose), on one thread, against the truth's points within the region's box
+(a tile, a stretch's points' extent) grown by the widest pairing distance on every side (their
+normals and KD-tree small_gicp's), coarse to fine.
 Frame: the truth cloud levelled as its plan is (x, y the truth's plan, the 2D consistency map's
 frame; z up), metres and degrees. ``offset`` is the map's error there: where the map (as the
 global registration placed it) has the region's centroid, from where the region fits the truth
@@ -18,7 +22,8 @@ and z from its fit, the same way round.
 
 A region is held when the ICP's information pins all six of its degrees of freedom and it fits:
 the 6 x 6 Hessian of the point-to-plane cost at the fit, per pair and with its turns taken as
-the movement of a point at the region's half side, has its smallest eigenvalue at least
+the movement of a point at the region's half side (a tile's; a stretch's points' wider extent
+in the plan), has its smallest eigenvalue at least
 MIN_INFORMATION (a ground alone leaves x, y and yaw free; a straight facade on it, x), and at
 least MIN_FIT of the region's points lie within the tolerance of a truth point once it is
 registered."""
@@ -42,7 +47,11 @@ TILE_M = 8.0
 #: Regions at most this many tiles across the map's larger side (a larger map gets larger
 #: tiles: the cost stays that of a map of this many tiles).
 MAX_TILES = 32
-#: A tile holding fewer map points than this (at the working voxel) is no region.
+#: A stretch of the run holds at least this many scans; the run is cut into at most
+#: MAX_STRETCHES stretches, each of the same number of scans.
+STRETCH_SCANS = 4
+MAX_STRETCHES = 32
+#: A tile or stretch holding fewer map points than this (at the working voxel) is no region.
 MIN_POINTS = 200
 #: ICP stages: the largest pairing distance of each, in units of the working voxel (wide first:
 #: at the 0.3 m default, offsets of up to about a metre are caught).
@@ -65,15 +74,17 @@ class Consistency3D:
     """The regions of one registered 3D map, as arrays (K regions), in the truth's levelled
     frame (module docstring), metres and degrees.
 
-    tile_m: a tile's side. voxel_m: the working voxel the points are taken at. tolerance_m: the
-    distance within which a point fits a truth point. centre: (K, 3) centroid of each region's
-    map points. offset: (K, 3) dx, dy, dz, the map's error: its region from where the region
-    fits the truth. angles_deg: (K, 3) roll, pitch, yaw, likewise. points: (K,) the region's
-    map points. fit_before, fit_after: (K,) share of them within the tolerance of a truth point
-    at the global pose and once the region is registered on its own. held: (K,) whether its
-    fit is pinned in every direction and fits (module docstring)."""
+    tile_m: a tile's side (regions cut by scans: None). voxel_m: the working voxel the points
+    are taken at. tolerance_m: the distance within which a point fits a truth point. centre:
+    (K, 3) centroid of each region's map points. offset: (K, 3) dx, dy, dz, the map's error:
+    its region from where the region fits the truth. angles_deg: (K, 3) roll, pitch, yaw,
+    likewise. points: (K,) the region's map points. fit_before, fit_after: (K,) share of them
+    within the tolerance of a truth point at the global pose and once the region is registered
+    on its own. held: (K,) whether its fit is pinned in every direction and fits (module
+    docstring). scans: for regions cut by scans, (K, 2) int the first and last scan of each
+    stretch; None for tiles. stretch: the scans a stretch holds (0 for tiles)."""
 
-    tile_m: float
+    tile_m: float | None
     voxel_m: float
     tolerance_m: float
     centre: np.ndarray
@@ -83,13 +94,17 @@ class Consistency3D:
     fit_before: np.ndarray
     fit_after: np.ndarray
     held: np.ndarray
+    scans: np.ndarray | None = None
+    stretch: int = 0
 
     @classmethod
-    def empty(cls, tile_m: float, voxel_m: float, tolerance_m: float) -> Consistency3D:
+    def empty(cls, tile_m: float | None, voxel_m: float, tolerance_m: float,
+              stretch: int = 0) -> Consistency3D:
         """A consistency map with no region."""
         none = np.zeros((0, 3))
         return cls(tile_m, voxel_m, tolerance_m, none, none, none, np.zeros(0, int),
-                   np.zeros(0), np.zeros(0), np.zeros(0, bool))
+                   np.zeros(0), np.zeros(0), np.zeros(0, bool),
+                   np.zeros((0, 2), int) if stretch else None, stretch)
 
     @property
     def offset_m(self) -> np.ndarray:
@@ -103,6 +118,15 @@ class Consistency3D:
     def largest_dz(self) -> int | None:
         """Index of the held region with the largest vertical offset |dz|; None without one."""
         return self._most(np.abs(self.offset[:, 2]))
+
+    def cut(self) -> str:
+        """How the map is cut into regions, in words: ``8 m tiles``, ``stretches of 4 scans``."""
+        return (f"{self.tile_m:g} m tiles" if self.scans is None else
+                f"stretches of {self.stretch} scans")
+
+    def scan_span(self, k: int) -> str:
+        """Region ``k``'s scans in words (``scans 4-7``); "" for a tile."""
+        return "" if self.scans is None else f"scans {self.scans[k, 0]}-{self.scans[k, 1]}"
 
     def _most(self, values: np.ndarray) -> int | None:
         held = np.flatnonzero(self.held)
@@ -142,45 +166,95 @@ def _pinned(hessian: np.ndarray, half_side: float) -> float:
     return float(np.linalg.eigvalsh(hessian / np.outer(scale, scale))[0])
 
 
-def _rows(placed: np.ndarray, truth: np.ndarray, tile_m: float, voxel: float) -> list[tuple]:
+class _Truth:
+    """The truth's points (M, 3, levelled, at the working voxel) as each region needs them:
+    sorted by x for the window of a box, and a KD-tree for the fit."""
+
+    def __init__(self, truth: np.ndarray) -> None:
+        self.sorted = truth[np.argsort(truth[:, 0], kind="stable")]
+        self.tree = cKDTree(truth)
+
+
+def _row(own: np.ndarray, truth: _Truth, lo: np.ndarray, hi: np.ndarray, half_side: float,
+         voxel: float) -> tuple | None:
+    """The row of one region, its map points ``own`` (N, 3, levelled truth frame, at ``voxel``
+    metres) in the box ``lo``-``hi`` (x, y, metres), registered on its own to the truth's
+    points in that box grown by the widest pairing distance: its centroid, offset, turn
+    (degrees), points, fit before and after, and whether it is held (its turns scaled by
+    ``half_side`` metres); None when the truth has too few points there."""
+    tolerance, margin = voxel / 2, STAGES[0] * voxel
+    window = truth.sorted[_in_box(truth.sorted[:, :2], lo - margin, hi + margin)]
+    if len(window) < NORMAL_NEIGHBOURS:
+        return None
+    centre = own.mean(axis=0)
+    move, hessian = _register(own - centre, window - centre, voxel)
+    before = truth.tree.query(own, distance_upper_bound=tolerance, workers=1)[0]
+    fitted = affine(own - centre, move) + centre
+    after = truth.tree.query(fitted, distance_upper_bound=tolerance, workers=1)[0]
+    fit_after = float(np.isfinite(after).mean())
+    # the map's error: its region's centroid from where the fit puts it, and its turn
+    angles = Rotation.from_matrix(move[:3, :3].T).as_euler("xyz", degrees=True)
+    held = _pinned(hessian, half_side) >= MIN_INFORMATION and fit_after >= MIN_FIT
+    return (*centre, *-move[:3, 3], *angles, len(own), float(np.isfinite(before).mean()),
+            fit_after, held)
+
+
+def _tile_rows(placed: np.ndarray, truth: _Truth, tile_m: float, voxel: float) -> list[tuple]:
     """One row per region of ``placed`` (N, 3, levelled truth frame, at ``voxel`` metres) in
-    tiles of ``tile_m`` metres, registered on its own to ``truth`` (M, 3, the same): its
-    centroid, offset, turn (degrees), points, fit before and after, and whether it is held."""
-    tolerance = voxel / 2
+    tiles of ``tile_m`` metres (:func:`_row`)."""
     keys = np.floor(placed[:, :2] / tile_m).astype(np.int64)
     tiles, inverse, counts = np.unique(keys, axis=0, return_inverse=True, return_counts=True)
     order = np.argsort(inverse.ravel(), kind="stable")
     bounds_at = np.concatenate([[0], np.cumsum(counts)])
-    by_x = np.argsort(truth[:, 0], kind="stable")
-    truth_sorted = truth[by_x]
-    tree = cKDTree(truth)
-    margin = STAGES[0] * voxel
     rows = []
     for k in np.flatnonzero(counts >= MIN_POINTS):
-        own = placed[order[bounds_at[k]:bounds_at[k + 1]]]
-        window = truth_sorted[_in_box(truth_sorted[:, :2], tiles[k] * tile_m - margin,
-                                      (tiles[k] + 1) * tile_m + margin)]
-        if len(window) < NORMAL_NEIGHBOURS:
-            continue
-        centre = own.mean(axis=0)
-        move, hessian = _register(own - centre, window - centre, voxel)
-        before = tree.query(own, distance_upper_bound=tolerance, workers=1)[0]
-        fitted = affine(own - centre, move) + centre
-        after = tree.query(fitted, distance_upper_bound=tolerance, workers=1)[0]
-        fit_after = float(np.isfinite(after).mean())
-        # the map's error: its region's centroid from where the fit puts it, and its turn
-        angles = Rotation.from_matrix(move[:3, :3].T).as_euler("xyz", degrees=True)
-        held = _pinned(hessian, tile_m / 2) >= MIN_INFORMATION and fit_after >= MIN_FIT
-        rows.append((*centre, *-move[:3, 3], *angles, len(own),
-                     float(np.isfinite(before).mean()), fit_after, held))
+        row = _row(placed[order[bounds_at[k]:bounds_at[k + 1]]], truth, tiles[k] * tile_m,
+                   (tiles[k] + 1) * tile_m, tile_m / 2, voxel)
+        if row is not None:
+            rows.append(row)
     return rows
 
 
+def stretch_scans(last_scan: float) -> int:
+    """The scans a stretch of a run holds whose points' scans reach ``last_scan`` (the first
+    is 0): at least STRETCH_SCANS, and as many as cut the run into at most MAX_STRETCHES."""
+    scans = int(np.ceil(last_scan)) + 1
+    return max(STRETCH_SCANS, -(-scans // MAX_STRETCHES))
+
+
+def _stretch_rows(map_xyz: np.ndarray, scan: np.ndarray, stretch: int | None, truth: _Truth,
+                  voxel: float, level: np.ndarray | None
+                  ) -> tuple[list[tuple], list[tuple[int, int]], int]:
+    """One row per stretch of ``stretch`` scans (None: :func:`stretch_scans`) of the run of
+    the map ``map_xyz`` (N, 3, truth frame; ``scan`` (N,) each point's scan): each stretch's
+    points at ``voxel`` metres, levelled by ``level``, registered on their own (:func:`_row`);
+    with each row's first and last scan, and the scans a stretch holds."""
+    scan = np.asarray(scan)
+    last = int(np.ceil(scan.max()))  # a voxel's scan is a mean: the last scan, rounded up
+    stretch = stretch or stretch_scans(last)
+    of = np.floor(scan / stretch).astype(np.int64)
+    rows, spans = [], []
+    for k in np.unique(of):
+        own = levelled(voxel_centroids(np.asarray(map_xyz)[of == k], voxel), level)
+        if len(own) < MIN_POINTS:
+            continue
+        lo, hi = own[:, :2].min(axis=0), own[:, :2].max(axis=0)
+        row = _row(own, truth, lo, hi, float(np.max(hi - lo)) / 2, voxel)
+        if row is not None:
+            rows.append(row)
+            spans.append((int(k) * stretch, min(int(k) * stretch + stretch - 1, last)))
+    return rows, spans, stretch
+
+
 def regions_3d(map_xyz: np.ndarray, truth_xyz: np.ndarray, *, tile_m: float = TILE_M,
-               voxel: float = 0.3, level: np.ndarray | None = None) -> Consistency3D:
+               voxel: float = 0.3, level: np.ndarray | None = None,
+               scan: np.ndarray | None = None, stretch: int | None = None) -> Consistency3D:
     """The regions of the map ``map_xyz`` (N, 3, already in the truth cloud's frame), each
     registered on its own to ``truth_xyz`` (M, 3), metres.
 
+    scan: (N,) each map point's scan (:mod:`pcmapq.mapping.scan_map`): regions are then
+    stretches of the run of ``stretch`` scans each (None: :func:`stretch_scans`; 0: tiles);
+    None: tiles.
     tile_m: a tile's side, metres (grown so that the map spans at most MAX_TILES tiles).
     voxel: both clouds are taken at this voxel (centroids), metres; the pairing distances
     scale with it (STAGES) and a point fits within half of it. level: the truth's levelling
@@ -189,16 +263,24 @@ def regions_3d(map_xyz: np.ndarray, truth_xyz: np.ndarray, *, tile_m: float = TI
     tolerance = voxel / 2
     # the centroids of a large cloud are streamed (any float type, a file mapped into memory
     # read in chunks): no copy of all its points is made
-    placed = levelled(voxel_centroids(np.asarray(map_xyz), voxel), level)
     truth = levelled(voxel_centroids(np.asarray(truth_xyz), voxel), level)
-    if len(placed) == 0 or len(truth) < NORMAL_NEIGHBOURS:
-        return Consistency3D.empty(tile_m, voxel, tolerance)
-    tile_m = max(tile_m, float(np.ptp(placed[:, :2], axis=0).max()) / MAX_TILES)
-    rows = _rows(placed, truth, tile_m, voxel)
+    spans = None
+    if scan is not None and stretch != 0 and len(map_xyz) and len(truth) >= NORMAL_NEIGHBOURS:
+        tile = None
+        rows, spans, stretch = _stretch_rows(map_xyz, scan, stretch, _Truth(truth), voxel,
+                                             level)
+    else:
+        placed = levelled(voxel_centroids(np.asarray(map_xyz), voxel), level)
+        if len(placed) == 0 or len(truth) < NORMAL_NEIGHBOURS:
+            return Consistency3D.empty(tile_m, voxel, tolerance)
+        tile = max(tile_m, float(np.ptp(placed[:, :2], axis=0).max()) / MAX_TILES)
+        rows, stretch = _tile_rows(placed, _Truth(truth), tile, voxel), 0
     if not rows:
-        return Consistency3D.empty(tile_m, voxel, tolerance)
+        return Consistency3D.empty(tile, voxel, tolerance, stretch)
     # to the micrometre (and 1e-6 of a share or degree), as results are saved: the figures
     # made from them are then the same read back from JSON
     table = np.round(np.array(rows, dtype=np.float64), 6) + 0.0
-    return Consistency3D(tile_m, voxel, tolerance, table[:, :3], table[:, 3:6], table[:, 6:9],
-                         table[:, 9].astype(int), table[:, 10], table[:, 11], table[:, 12] > 0)
+    return Consistency3D(tile, voxel, tolerance, table[:, :3], table[:, 3:6], table[:, 6:9],
+                         table[:, 9].astype(int), table[:, 10], table[:, 11], table[:, 12] > 0,
+                         None if spans is None else np.array(spans, dtype=int).reshape(-1, 2),
+                         stretch)

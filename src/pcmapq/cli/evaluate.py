@@ -131,8 +131,9 @@ def eval_command(
             map_path: Path | PointMap = paths[0]
         else:
             progress("mapping the scans with KISS-ICP")
-            points, _ = build_map_kiss(scans, max_scans=max_scans, topic=scan_topic)
-            map_path = PointMap(scans, points, not flat(points), kind="scans")
+            built, _ = build_map_kiss(scans, max_scans=max_scans, topic=scan_topic)
+            map_path = PointMap(scans, built.points, not flat(built.points), kind="scans",
+                                scan=built.scan)
         limit = memory_limit(max_memory)
         result = replace(evaluate(map_path, truth_path, settings, progress, limit),
                          command=options.command_line(ctx))

@@ -86,8 +86,8 @@ def map_command(
                                     files=every.files[:max_scans])
                     err.print(f"mapping {describe_scans(first, len(every))}", markup=False,
                               highlight=False, soft_wrap=True)
-                points, trajectory = build_map_kiss(source, max_scans=max_scans, voxel=voxel,
-                                                    progress=tick, topic=scan_topic)
+                built, trajectory = build_map_kiss(source, max_scans=max_scans, voxel=voxel,
+                                                   progress=tick, topic=scan_topic)
             else:
                 trajectory = (scanner_poses(poses, calib) if poses is not None else
                               recorded_poses(source, scan_topic, pose_topic, calib, frame))
@@ -98,13 +98,13 @@ def map_command(
                     err.print(f"mapping {describe_scans(scans, len(every))}", markup=False,
                               highlight=False, soft_wrap=True)
                 trajectory = trajectory[:len(scans)]
-                points = build_map_from_poses(scans, trajectory, voxel=voxel, progress=tick)
-        if not len(points):
+                built = build_map_from_poses(scans, trajectory, voxel=voxel, progress=tick)
+        if not len(built):
             raise InputError(f"{source}: the scans hold no point to map (no return within "
                              "their range limits)")
         with OutputSet() as outputs:  # the map and its poses: all or none
-            write_cloud(out, points, outputs)
-            wrote = [f"wrote {out}: {count(len(points), 'point')} from "
+            write_cloud(out, built.points, outputs, scan=built.scan)
+            wrote = [f"wrote {out}: {count(len(built), 'point')} from "
                      f"{count(len(trajectory), 'scan')}"]
             if poses_out is not None:
                 write_kitti_poses(poses_out, trajectory, outputs)

@@ -51,16 +51,19 @@ class VoxelMap:
     """Voxel-hash accumulator of world-frame points (metres).
 
     voxel: cell edge, metres. min_flush: buffered points that always trigger a merge.
-    dims: coordinates per point (3; 2 for planar points).
+    dims: coordinates per point (3; 2 for planar points). carried: values per point after its
+    coordinates that each voxel averages too without being keyed by them (a scan's index).
     """
 
-    def __init__(self, voxel: float, min_flush: int = 1_000_000, dims: int = 3) -> None:
+    def __init__(self, voxel: float, min_flush: int = 1_000_000, dims: int = 3,
+                 carried: int = 0) -> None:
         if not voxel > 0:
             raise InputError(f"voxel must be positive, got {voxel}")
         self.voxel = float(voxel)
         self.min_flush = int(min_flush)
+        self.dims = int(dims)
         self._keys = np.empty(0, dtype=np.int64)
-        self._sums = np.empty((0, dims), dtype=np.float64)
+        self._sums = np.empty((0, dims + carried), dtype=np.float64)
         self._counts = np.empty(0, dtype=np.int64)
         self._buffer: list[np.ndarray] = []
         self._buffered = 0
@@ -71,7 +74,8 @@ class VoxelMap:
         return len(self._keys)
 
     def add(self, points: np.ndarray) -> None:
-        """Add world-frame points (N, dims), metres; merges when the buffer is large enough."""
+        """Add world-frame points (N, dims + carried), metres then the carried values; merges
+        when the buffer is large enough."""
         points = np.asarray(points, dtype=np.float64).reshape(-1, self._sums.shape[1])
         if len(points) == 0:
             return
@@ -81,7 +85,8 @@ class VoxelMap:
             self._merge()
 
     def points(self) -> np.ndarray:
-        """The map: (M, dims) float64 voxel centroids, metres, sorted by voxel index."""
+        """The map: (M, dims + carried) float64 voxel centroids, metres (then each voxel's mean
+        carried values), sorted by voxel index."""
         self._merge()
         return self._sums / self._counts[:, None]
 
@@ -90,7 +95,7 @@ class VoxelMap:
             return
         new = np.concatenate(self._buffer)
         self._buffer, self._buffered = [], 0
-        index = voxel_index(new, self.voxel)
+        index = voxel_index(new[:, :self.dims], self.voxel)
         dense = _dense_groups(index) if len(self._keys) == 0 else None
         if dense is not None:
             self._keys, inverse = dense

@@ -63,7 +63,8 @@ def score(placed: Placed, prepared: PreparedTruth, settings: Settings,
             consistency_3d_job = pool.submit(
                 regions_3d, side.source.points, truth.points, tile_m=settings.map_3d.tile,
                 voxel=settings.alignment.voxel_3d,
-                level=None if prepared.level is None else prepared.level.rotation)
+                level=None if prepared.level is None else prepared.level.rotation,
+                scan=side.source.scan, stretch=settings.map_3d.stretch)
         if in_one_frame_3d(side, truth, settings):
             m3 = settings.map_3d
             gaussians_job = pool.submit(map_gaussians, side.source.points, truth.points,

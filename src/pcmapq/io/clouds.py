@@ -31,7 +31,7 @@ from pcmapq.io import pcd, ply
 from pcmapq.io.ply import CHUNK, VertexBlock, vertex_block
 from pcmapq.io.stderr import stderr_captured
 from pcmapq.io.survey import read_e57, read_las
-from pcmapq.io.writers import one_line
+from pcmapq.io.writers import SCAN, one_line
 
 #: A PCD's coordinate fields (PCL's names).
 XYZ = ("x", "y", "z")
@@ -68,6 +68,8 @@ class PointMap:
     is_3d: False when z is constant (a 2D cloud).
     seen: for a map made of scans with known poses, the area its scans saw (the union of
         their views, see :mod:`pcmapq.raster.seen`); None otherwise.
+    scan: for a map built from scans (``pcmapq map``), each point's scan (N,), the mean index
+        of the scans it came from (:mod:`pcmapq.mapping.scan_map`); None otherwise.
     """
 
     path: Path
@@ -75,6 +77,7 @@ class PointMap:
     is_3d: bool
     kind: str = "cloud"
     seen: SeenCells | None = None
+    scan: np.ndarray | None = None
 
 
 def flat(points: np.ndarray) -> bool:
@@ -96,28 +99,62 @@ def load_cloud(path: Path, memory_limit: int | None = None) -> PointMap:
         ".las": lambda p: read_las(p, memory_limit), ".laz": lambda p: read_las(p, memory_limit),
         ".e57": lambda p: read_e57(p, memory_limit),
     }
+    scan = None
     try:
         block = vertex_block(path) if path.suffix.lower() == ".ply" else None
         if block is not None:
+            scan = _scan(path, block.values(SCAN))
             mapped = _mapped_3d(block) if block.count > MAP_POINTS else None
             if mapped is not None:
-                return PointMap(path, mapped, True)
+                return PointMap(path, mapped, True, scan=scan)
             check_points(path, block.count, memory_limit)
             points = np.empty((block.count, 3), dtype=np.float64)
             for start in range(0, block.count, CHUNK):
                 points[start:start + CHUNK] = block.read(start, start + CHUNK)
         else:
             points = with_z(path, readers[path.suffix.lower()](path))
+            if path.suffix.lower() == ".pcd":
+                scan = _scan(path, pcd_scan(path))
     except OSError as exc:
         raise InputError(f"{path}: cannot read: {one_line(exc)}") from None
     if not np.isfinite(points).all():
-        points = points[np.isfinite(points).all(axis=1)]
+        finite = np.isfinite(points).all(axis=1)
+        points, scan = points[finite], None if scan is None else scan[finite]
     if len(points) == 0:
         raise InputError(f"{path}: no points")
     is_3d = not flat(points)
     if not is_3d:
         points[:, 2] = 0.0
-    return PointMap(path, points, is_3d)
+    return PointMap(path, points, is_3d, scan=None if scan is None else np.array(scan))
+
+
+def pcd_scan(path: Path) -> np.ndarray | None:
+    """The ``scan`` field of a binary PCD (each point's, as stored); None without one, or for
+    an ASCII or compressed PCD."""
+    header = pcd.read_header(path)
+    if SCAN not in header.fields:
+        return None
+    table = pcd.read_fields(path, [SCAN], header)
+    return None if table is None else table[SCAN]
+
+
+def _scan(path: Path, values: np.ndarray | None) -> np.ndarray | None:
+    """A cloud's ``scan`` values (each point's scan, :mod:`pcmapq.mapping.scan_map`) when
+    every one is a finite number of at least 0, else None, with a warning naming the file for
+    values that are not (the map's regions are then tiles)."""
+    if values is None:
+        return None
+    ok = len(values) > 0 and np.issubdtype(values.dtype, np.number)
+    for start in range(0, len(values), CHUNK) if ok else ():
+        chunk = values[start:start + CHUNK]
+        if not (np.isfinite(chunk).all() and chunk.min() >= 0):
+            ok = False
+            break
+    if not ok:
+        warnings.warn(f"{path}: its '{SCAN}' values are not all numbers of at least 0: they "
+                      "are not read as the scans its points came from", stacklevel=2)
+        return None
+    return values
 
 
 def _mapped_3d(block: VertexBlock) -> np.ndarray | None:

@@ -168,7 +168,8 @@ def crop(source: OccupancyMap | PointMap, box: Box, option: str) -> OccupancyMap
         if not inside.any():
             raise InputError(f"{source.path}: {option} {_box_text(box)} keeps none of its points")
         return replace(source, points=np.ascontiguousarray(source.points[inside],
-                                                           dtype=np.float64))
+                                                           dtype=np.float64),
+                       scan=None if source.scan is None else np.asarray(source.scan)[inside])
     grid = source.grid
     corners = grid.xy_to_pixels(np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]]))
     rows, cols = grid.shape

@@ -63,6 +63,15 @@ class VertexBlock:
         for start in range(0, self.count, size):
             yield self.read(start, start + size)
 
+    def values(self, name: str) -> np.ndarray | None:
+        """The scalar property ``name`` of every vertex, as a read-only array of its stored type
+        mapped onto the file (nothing is read until used); None without that property."""
+        if name not in (self.dtype.names or ()) or self.count == 0:
+            return None
+        records = np.memmap(self.path, dtype=self.dtype, mode="r", offset=self.offset,
+                            shape=(self.count,))
+        return records[name]
+
     def mapped(self) -> np.ndarray | None:
         """The vertices' x, y, z as a read-only (count, 3) array mapped onto the file (nothing is
         read until used), of the coordinates' own type; None unless x, y, z are one type and

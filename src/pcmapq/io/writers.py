@@ -13,6 +13,10 @@ import numpy as np
 
 from pcmapq.core.errors import InputError
 
+#: The property (PLY) or field (PCD) of a cloud file that holds each point's scan: the mean
+#: index of the scans it came from (:mod:`pcmapq.mapping.scan_map`).
+SCAN = "scan"
+
 
 class OutputSet:
     """The output files of one run, all or nothing. A file written with ``outputs=`` this set
@@ -134,14 +138,18 @@ def _target_mode(path: Path) -> int:
         return 0o666 & ~umask
 
 
-def write_cloud(path: Path, points: np.ndarray, outputs: OutputSet | None = None) -> None:
+def write_cloud(path: Path, points: np.ndarray, outputs: OutputSet | None = None,
+                scan: np.ndarray | None = None) -> None:
     """Write points (N, 3, metres) as .ply or .pcd (binary float32), whole or not at all (with
-    ``outputs``: when that set is committed); a symlink is written through."""
+    ``outputs``: when that set is committed); a symlink is written through. scan: (N,) each
+    point's scan (:mod:`pcmapq.mapping.scan_map`), written as the float property ``scan``."""
     import open3d as o3d
 
     if path.suffix.lower() not in (".ply", ".pcd"):
         raise InputError(f"{path}: a map is written as .ply or .pcd")
     cloud = o3d.t.geometry.PointCloud(o3d.core.Tensor(np.asarray(points, dtype=np.float32)))
+    if scan is not None:
+        cloud.point[SCAN] = o3d.core.Tensor(np.asarray(scan, dtype=np.float32).reshape(-1, 1))
     target = Path(os.path.realpath(path))
     tmp = target.with_name(f".{target.stem}.{os.getpid()}.tmp{target.suffix}")
     staged = False

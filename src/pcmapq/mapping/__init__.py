@@ -2,6 +2,7 @@
 
 - :func:`build_map_kiss`: KISS-ICP odometry over the scans, deskewed scans accumulated.
 - :func:`build_map_from_poses`: the scans placed with known poses (a reference map).
+- :class:`ScanMap`: a built map's points and the scans each came from.
 - :func:`posed_map`: the scans placed relative to the first pose, as map-metrics places them.
 - :mod:`pcmapq.mapping.poses`: KITTI / TUM pose files and calibrations.
 
@@ -31,9 +32,12 @@ from pcmapq.mapping.reference import (
     posed_map,
     scans_for_poses,
 )
+from pcmapq.mapping.scan_map import ScanGrid, ScanMap
 from pcmapq.mapping.scans import ScanSequence, open_scans
 
 __all__ = [
+    "ScanGrid",
+    "ScanMap",
     "ScanSequence",
     "VoxelMap",
     "build_map_from_poses",

@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from pcmapq.core.errors import InputError
-from pcmapq.core.voxels import VoxelMap
+from pcmapq.mapping.scan_map import ScanGrid, ScanMap
 from pcmapq.mapping.scans import open_scans
 
 if TYPE_CHECKING:
@@ -51,7 +51,7 @@ def kiss_config(*, max_range: float = 100.0, min_range: float = 0.0, deskew: boo
 
 def build_map_kiss(source: str | Path, *, max_scans: int | None = None, voxel: float = 0.1,
                    progress: Progress | None = None, config: KISSConfig | None = None,
-                   topic: str | None = None) -> tuple[np.ndarray, np.ndarray]:
+                   topic: str | None = None) -> tuple[ScanMap, np.ndarray]:
     """Run KISS-ICP over a scan sequence and accumulate its deskewed scans into one map.
 
     source: a scan folder, ROS bag or MCAP file (see :mod:`pcmapq.mapping.scans`).
@@ -59,15 +59,16 @@ def build_map_kiss(source: str | Path, *, max_scans: int | None = None, voxel: f
     cell). progress: called as ``progress(done, total)`` after each scan. config: KISS-ICP
     settings (default :func:`kiss_config`). topic: the PointCloud2 topic of a bag.
 
-    Returns ``(points, poses)``: points (N, 3) float64 and poses (K, 4, 4) float64 (sensor at
-    scan k -> world), both in the first scan's sensor frame, metres. Repeatable to ~1e-12 m
+    Returns ``(map, poses)``: the map's points (N, 3) float64 with each one's scan
+    (:mod:`pcmapq.mapping.scan_map`) and poses (K, 4, 4) float64 (sensor at scan k -> world),
+    both in the first scan's sensor frame, metres. Repeatable to ~1e-12 m
     (see :func:`kiss_config`).
     """
     from kiss_icp.kiss_icp import KissICP
 
     scans = open_scans(source, max_scans=max_scans, topic=topic)
     odometry = KissICP(config=config or kiss_config())
-    grid = VoxelMap(voxel)
+    grid = ScanGrid(voxel)
     poses: list[np.ndarray] = []
     for index, (points, stamps) in enumerate(scans):
         if len(points) == 0:
@@ -75,9 +76,9 @@ def build_map_kiss(source: str | Path, *, max_scans: int | None = None, voxel: f
         deskewed, _ = odometry.register_frame(points, stamps)
         pose = np.array(odometry.last_pose, dtype=np.float64)
         poses.append(pose)
-        grid.add(np.asarray(deskewed) @ pose[:3, :3].T + pose[:3, 3])
+        grid.add(np.asarray(deskewed) @ pose[:3, :3].T + pose[:3, 3], index)
         if progress is not None:
             progress(index + 1, len(scans))
     if not poses:
         raise InputError(f"{scans.path}: no scans")
-    return grid.points(), np.stack(poses)
+    return grid.map(), np.stack(poses)

@@ -19,8 +19,8 @@ import numpy as np
 
 from pcmapq.core.errors import InputError
 from pcmapq.core.transform import affine
-from pcmapq.core.voxels import VoxelMap
 from pcmapq.core.words import count
+from pcmapq.mapping.scan_map import ScanGrid, ScanMap
 from pcmapq.mapping.scans import ScanSequence, open_scans
 from pcmapq.metrics.posed import place
 
@@ -63,7 +63,7 @@ def build_map_from_poses(source: str | Path | ScanSequence, poses: np.ndarray,
                          calib: np.ndarray | None = None, *, max_scans: int | None = None,
                          voxel: float = 0.1, progress: Callable[[int, int], None] | None = None,
                          min_range: float = 0.0, max_range: float = 100.0,
-                         topic: str | None = None) -> np.ndarray:
+                         topic: str | None = None) -> ScanMap:
     """Accumulate scan k placed by ``poses[k] @ calib`` into one map.
 
     source: a scan folder, ROS bag or MCAP file, or a sequence opened already. poses: (K, 4,
@@ -72,22 +72,23 @@ def build_map_from_poses(source: str | Path | ScanSequence, poses: np.ndarray,
     scanner -> pose frame, or None. voxel: output cell, metres. progress: ``progress(done,
     total)`` after each scan.
 
-    Returns the map (N, 3) float64, metres, in the poses' world frame. Deterministic.
+    Returns the map: its points (N, 3) float64, metres, in the poses' world frame, and each
+    one's scan (:mod:`pcmapq.mapping.scan_map`). Deterministic.
     """
     poses = np.asarray(poses, dtype=np.float64)
     if poses.ndim != 3 or poses.shape[1:] != (4, 4) or len(poses) == 0:
         raise InputError(f"poses: expected K x 4 x 4, got shape {poses.shape}")
     scans = scans_for_poses(source, len(poses), max_scans=max_scans, topic=topic)
     mount = np.eye(4) if calib is None else np.asarray(calib, dtype=np.float64).reshape(4, 4)
-    grid = VoxelMap(voxel)
+    grid = ScanGrid(voxel)
     for index, (points, _) in enumerate(scans):
         ranges = np.linalg.norm(points, axis=1)
         points = points[(ranges >= min_range) & (ranges <= max_range)]
         place = poses[index] @ mount
-        grid.add(affine(points, place))
+        grid.add(affine(points, place), index)
         if progress is not None:
             progress(index + 1, len(scans))
-    return grid.points()
+    return grid.map()
 
 
 def posed_map(source: str | Path | ScanSequence, poses: np.ndarray, *,

@@ -121,14 +121,18 @@ def _run(result: Result) -> str:
 def _relief(result: Result) -> str:
     """Two 3D clouds: the 3D consistency map's section (its figures in words, the top view of
     each region's vertical offset and the side profile); '' otherwise."""
-    if result.consistency_3d is None:
+    c = result.consistency_3d
+    if c is None:
         return ""
     figure = _img(png_bytes(relief_figure(result)),
                   "each region's vertical offset dz: top view and side profile") \
         if has_relief(result) else ""
+    cut = ("tiles of the ground" if c.scans is None else
+           f"stretches of the run ({c.cut()}: the points each stretch's scans put in the map, "
+           "wherever they lie)")
     return (f"<h2>Where the map bends in 3D</h2><p>{html.escape('; '.join(relief_parts(result)))}"
             f"</p>{figure}<p class=\"note\">The map, as the 3D registration placed it, cut into "
-            "tiles of the ground, each registered to the truth on its own in 3D. dz: where the "
+            f"{html.escape(cut)}, each registered to the truth on its own in 3D. dz: where the "
             "map has a region, from where it fits the truth (below 0: the map lies too low "
             "there). Held: its geometry pins the fit in every direction and it fits; the "
             "others are hatched (their offset is not sure). Truth frame levelled, metres.</p>")

@@ -1,7 +1,9 @@
 """The 3D consistency map's pictures (two 3D clouds, :mod:`pcmapq.align.regions3d`): where a map
 sinks or rises. A top view of the map's tiles, each coloured by its region's vertical offset dz
 (diverging, white at 0, a colour bar in metres) over the map's density in grey, and a side
-profile: each region's dz against its distance along the map's main axis. dz is the map's
+profile: each region's dz against its distance along the map's main axis. Regions that are
+stretches of the run are drawn as their centroids, joined in the run's order and labelled by
+their scans, and profiled against the run (each stretch's middle scan). dz is the map's
 error: below 0 the map has the region too low (blue), above too high (red). Truth frame
 levelled (x, y the truth's plan), metres; regions that are not held are drawn faint and
 hatched (their offset is not sure)."""
@@ -71,7 +73,8 @@ def relief_panels(fig: Figure, top: Axes, side: Axes, result: Result) -> ScalarM
     c = result.consistency_3d
     colours = relief_colours(result)
     top.set_title(f"3D: each region's vertical offset dz ({c.tile_m:g} m tiles; hatched: not "
-                  "held)", fontsize=TITLE_PT)
+                  "held)" if c.scans is None else f"3D: the vertical offset dz of each stretch "
+                  f"of {c.stretch} scans (hollow: not held)", fontsize=TITLE_PT)
     bar = fig.colorbar(colours, ax=top, location="bottom", shrink=0.8, aspect=30)
     bar.set_label("dz [m], the map's region from its fit to the truth (< 0: too low)",
                   fontsize=TEXT_PT)
@@ -81,10 +84,16 @@ def relief_panels(fig: Figure, top: Axes, side: Axes, result: Result) -> ScalarM
 
 
 def _profile(ax: Axes, c: Consistency3D, colours: ScalarMappable) -> None:
-    """Each region's dz (metres) against its distance along the map's main axis."""
-    mean, axis = main_axis(c)
-    along = (c.centre[:, :2] - mean) @ axis
-    mean = np.round(mean, 1) + 0.0  # as the label writes it, never "-0.0"
+    """Each region's dz (metres) against its distance along the map's main axis, or a
+    stretch's against its middle scan."""
+    if c.scans is None:
+        mean, axis = main_axis(c)
+        along = (c.centre[:, :2] - mean) @ axis
+        mean = np.round(mean, 1) + 0.0  # as the label writes it, never "-0.0"
+        label = (f"along the map's main axis ({axis[0]:.2f}, {axis[1]:.2f}) from "
+                 f"({mean[0]:.1f}, {mean[1]:.1f}) [m]")
+    else:
+        along, label = c.scans.mean(axis=1), "along the run: each stretch's middle scan"
     dz = c.offset[:, 2]
     ax.axhline(0.0, color="0.6", lw=0.8, zorder=1)
     loose = ~c.held
@@ -98,9 +107,9 @@ def _profile(ax: Axes, c: Consistency3D, colours: ScalarMappable) -> None:
     span = colours.norm.vmax
     low, high = min(-span, dz.min(initial=0.0)), max(span, dz.max(initial=0.0))
     ax.set_ylim(low - 0.1 * (high - low), high + 0.1 * (high - low))
-    ax.set_title("3D: side profile, dz along the map", fontsize=TITLE_PT)
-    ax.set_xlabel(f"along the map's main axis ({axis[0]:.2f}, {axis[1]:.2f}) from "
-                  f"({mean[0]:.1f}, {mean[1]:.1f}) [m]", fontsize=TEXT_PT)
+    ax.set_title(f"3D: side profile, dz along the {'map' if c.scans is None else 'run'}",
+                 fontsize=TITLE_PT)
+    ax.set_xlabel(label, fontsize=TEXT_PT)
     ax.set_ylabel("dz [m] (< 0: the map too low)", fontsize=TEXT_PT)
     ax.tick_params(labelsize=TEXT_PT)
     ax.legend(fontsize=TEXT_PT, frameon=False, loc="best")
@@ -108,11 +117,38 @@ def _profile(ax: Axes, c: Consistency3D, colours: ScalarMappable) -> None:
 
 def draw_top_view(ax: Axes, result: Result, box: tuple[float, float, float, float],
                   image: np.ndarray, colours: ScalarMappable) -> None:
-    """The map's tiles coloured by dz over ``image`` (the pooled RGB picture of the ``box``,
-    metres, shown in grey), the region with the largest |dz| ringed at its centroid."""
+    """The map's tiles (or stretches) coloured by dz over ``image`` (the pooled RGB picture of
+    the ``box``, metres, shown in grey), the region with the largest |dz| ringed at its
+    centroid."""
     c = result.consistency_3d
     grey = np.repeat(image.mean(axis=2, keepdims=True), 3, axis=2)
     ax.imshow(grey, extent=box, origin="upper", interpolation="nearest")
+    if c.scans is None:
+        _tiles(ax, c, colours)
+    else:
+        _stretches(ax, c, colours)
+    if (k := c.largest_dz()) is not None:
+        ax.scatter(*c.centre[k, :2], s=110, facecolors="none", edgecolors="black", lw=1.2,
+                   zorder=5)
+
+
+def _stretches(ax: Axes, c: Consistency3D, colours: ScalarMappable) -> None:
+    """Each stretch of the run at its centroid, joined in the run's order, coloured by dz
+    (hollow: not held); the first and the last labelled by their scans."""
+    ax.plot(c.centre[:, 0], c.centre[:, 1], color="0.35", lw=0.8, zorder=3)
+    rgba = colours.to_rgba(c.offset[:, 2])
+    loose = ~c.held
+    ax.scatter(*c.centre[loose, :2].T, s=60, facecolors="none", edgecolors="0.45", zorder=4)
+    ax.scatter(*c.centre[c.held, :2].T, s=70, c=rgba[c.held], edgecolors="black",
+               linewidths=0.5, zorder=4)
+    for k, side in {0: -1, len(c.points) - 1: 1}.items():
+        ax.annotate(f"scans {c.scans[k, 0]}-{c.scans[k, 1]}", tuple(c.centre[k, :2]),
+                    xytext=(6 * side, 6), textcoords="offset points", fontsize=TEXT_PT - 1,
+                    ha="left" if side > 0 else "right", zorder=6)
+
+
+def _tiles(ax: Axes, c: Consistency3D, colours: ScalarMappable) -> None:
+    """Each tile coloured by dz (faint and hatched: not held)."""
     corners = np.floor(c.centre[:, :2] / c.tile_m) * c.tile_m
     rgba = colours.to_rgba(c.offset[:, 2])
     for held, alpha, hatch in ((True, HELD_ALPHA, None), (False, LOOSE_ALPHA, "///")):
@@ -124,9 +160,6 @@ def draw_top_view(ax: Axes, result: Result, box: tuple[float, float, float, floa
         face[:, 3] = alpha
         ax.add_collection(PatchCollection(tiles, facecolors=face, edgecolors="0.5",
                                           linewidths=0.3, hatch=hatch, zorder=3))
-    if (k := c.largest_dz()) is not None:
-        ax.scatter(*c.centre[k, :2], s=110, facecolors="none", edgecolors="black", lw=1.2,
-                   zorder=5)
 
 
 def relief_figure(result: Result) -> Figure:

@@ -107,20 +107,24 @@ def breaks(result: Result) -> str:
 def relief_parts(result: Result) -> list[str]:
     """Two 3D clouds' 3D consistency map (:mod:`pcmapq.align.regions3d`) in short parts: the
     held regions' longest offset and largest vertical offset and where (truth frame levelled,
-    metres), and how many regions are held; [] without one."""
+    metres; a stretch of the run's scans), and how many regions are held; [] without one."""
     c = result.consistency_3d
     if c is None:
         return []
+    def at(k: int) -> str:
+        span = c.scan_span(k)
+        return (f"({c.centre[k, 0]:.1f}, {c.centre[k, 1]:.1f}, {c.centre[k, 2]:.1f}) m"
+                + (f", {span}" if span else ""))
+
     parts = []
     if (k := c.largest()) is not None:
-        parts.append(f"largest offset {c.offset_m[k]:.3f} m at ({c.centre[k, 0]:.1f}, "
-                     f"{c.centre[k, 1]:.1f}, {c.centre[k, 2]:.1f}) m")
+        parts.append(f"largest offset {c.offset_m[k]:.3f} m at {at(k)}")
     if (k := c.largest_dz()) is not None:
         dz = c.offset[k, 2]
         parts.append(f"largest dz {dz:+.3f} m ({'too low' if dz < 0 else 'too high'}) at "
-                     f"({c.centre[k, 0]:.1f}, {c.centre[k, 1]:.1f}, {c.centre[k, 2]:.1f}) m")
+                     f"{at(k)}")
     return [*parts, f"{int(c.held.sum())} of {count(len(c.points), 'region')} of "
-                    f"{c.tile_m:g} m held"]
+                    f"{c.cut()} held"]
 
 
 def verdict(result: Result) -> str:

@@ -8,7 +8,7 @@ import io
 import numpy as np
 
 from pcmapq.results.blocks import DECIMALS, Findings
-from pcmapq.results.blocks3d import REGION_3D_COLUMNS, consistency_3d_block
+from pcmapq.results.blocks3d import REGION_3D_COLUMNS, SCAN_COLUMNS, consistency_3d_block
 from pcmapq.results.document import REGION_COLUMNS, consistency_block
 
 
@@ -42,10 +42,13 @@ def regions_3d_csv(result: Findings) -> str:
     """One row per region of the 3D consistency map (the JSON's ``consistency_3d.regions``):
     where the region is, the map's error there (dx, dy, dz and roll, pitch, yaw: where the map
     has it from where it fits the truth on its own), its points, its fitness before and after
-    and whether it is held, in the truth's levelled frame, metres and degrees. The header
-    alone when there is none (not two 3D clouds)."""
+    and whether it is held, in the truth's levelled frame, metres and degrees; a stretch of
+    the run's first and last scan when the regions are stretches. The header alone when there
+    is none (not two 3D clouds)."""
     c = result.consistency_3d
-    return _rows(REGION_3D_COLUMNS, [] if c is None else consistency_3d_block(c).regions)
+    columns = REGION_3D_COLUMNS if c is not None and c.scans is not None else tuple(
+        key for key in REGION_3D_COLUMNS if key not in SCAN_COLUMNS)
+    return _rows(columns, [] if c is None else consistency_3d_block(c).regions)
 
 
 def _rows(columns: tuple[str, ...], regions: list) -> str:

@@ -200,13 +200,16 @@ class Map3DConfig:
     voxel: the voxels' side, metres. min_points: the points a voxel needs in each cloud to be
     compared. radius: SCS's neighbourhood, in voxels along each axis. tile: side of the tiles
     of the 3D consistency map (each tile of the map registered to the truth on its own,
-    :mod:`pcmapq.align.regions3d`), metres.
+    :mod:`pcmapq.align.regions3d`), metres. stretch: for a map that carries its points' scans,
+    the scans a stretch of the run holds, its 3D consistency map's regions instead of tiles;
+    None: as many as cut the run into at most 32 stretches, at least 4; 0: tiles.
     """
 
     voxel: float = AWD_VOXEL
     min_points: int = AWD_MIN_POINTS
     radius: int = SCS_RADIUS
     tile: float = 8.0
+    stretch: int | None = None
 
 
 @dataclass(frozen=True)

@@ -199,6 +199,10 @@ OPTIONS: tuple[Option, ...] = (
     Option("tile_3d", "map_3d.tile", FLOAT,
            "Side of the tiles of the 3D consistency map of two 3D clouds (each tile of the map "
            "registered to the truth on its own), metres.", 1.0, flag="--tile-3d"),
+    Option("stretch_3d", "map_3d.stretch", INT,
+           "A 3D map that carries its points' scans ('pcmapq map' writes them): scans per "
+           "stretch of the run, the regions of its 3D consistency map (default: at least 4, "
+           "at most 32 stretches); 0: tiles of --tile-3d instead.", 0, flag="--stretch-3d"),
     Option("tau", "distances.taus", TEXT,
            "Distance thresholds of the F-score, metres, comma-separated.", metavar="<M,M,...>",
            read=parse_taus, show=show_list, commands=(EVAL, BATCH, TRACK),

@@ -43,6 +43,7 @@ from pcmapq.io.carmen import (
 )
 from pcmapq.io.clouds import flat
 from pcmapq.mapping import (
+    ScanGrid,
     ScanSequence,
     VoxelMap,
     build_map_kiss,
@@ -154,14 +155,14 @@ class ScanRun:
         """For each of ``ends`` (increasing): the 3D map of the first ``end`` scans, and the
         scans since the step before (N, 3; their own voxel map's points). Each scan is placed
         and added to the voxel maps once."""
-        grid, wanted, views, seen = VoxelMap(self.voxel), list(ends), [], NO_VIEW
+        grid, wanted, views, seen = ScanGrid(self.voxel), list(ends), [], NO_VIEW
         recent = VoxelMap(self.voxel)
         for index, (points, _) in enumerate(self.sequence):
             ranges = np.linalg.norm(points, axis=1)
             points = points[(ranges >= MIN_RANGE) & (ranges <= MAX_RANGE)]
             pose = self.poses[index]
             placed = affine(points, pose)
-            grid.add(placed)
+            grid.add(placed, index)
             recent.add(placed)
             views.append(view_outlines(pose[None, :2, 3], placed[:, :2],
                                        np.zeros(len(placed), dtype=np.int64))[0])
@@ -169,9 +170,9 @@ class ScanRun:
             if wanted and index + 1 == wanted[0]:
                 wanted.pop(0)
                 seen, views = add_views(seen, np.stack(views)), []
-                points = grid.points()
-                yield (PointMap(self.path, points, is_3d=not flat(points), kind="scans",
-                                seen=seen),
+                built = grid.map()
+                yield (PointMap(self.path, built.points, is_3d=not flat(built.points),
+                                kind="scans", seen=seen, scan=built.scan),
                        recent.points())
                 recent = VoxelMap(self.voxel)
             if not wanted:

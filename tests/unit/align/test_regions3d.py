@@ -8,7 +8,8 @@ import pytest
 
 from pcmapq.align import regions3d
 from pcmapq.align.regions3d import Consistency3D, regions_3d
-from testkit.street import street, sunk, tilted
+from pcmapq.mapping.scan_map import ScanGrid
+from testkit.street import street, street_run, sunk, tilted
 
 #: The tests' working voxel and tile, metres (a tile edge lies on x = 10).
 VOXEL, TILE = 0.2, 10.0
@@ -169,3 +170,30 @@ def test_a_large_cloud_is_streamed_not_copied(monkeypatch, scan):
     for name in ("centre", "offset", "angles_deg", "fit_before", "fit_after", "held"):
         np.testing.assert_array_equal(getattr(got, name), getattr(expected, name))
     assert peak < 2 * dense.nbytes
+
+
+def test_a_run_whose_last_scans_sank_is_cut_into_stretches():
+    """A car's 30-scan run along the street (a scan a metre, 8 m of reach), mapped with its
+    scans from the 20th on placed 0.3 m too low, each map point carrying its scan: the regions
+    are stretches of 4 scans; those of scans 20 on lie 0.3 m low (within 5 cm), those before
+    16 in place, every one held, and the largest |dz| is a sunk stretch's."""
+    truth = street(-10.0, 40.0, spacing=0.15, seed=0)
+    drawn = truth + np.random.default_rng(7).normal(0.0, 0.005, truth.shape)
+    seen, poses = street_run(drawn, 30)
+    poses[20:, 2, 3] -= 0.3
+    grid = ScanGrid(0.1)
+    for index, (points, pose) in enumerate(zip(seen, poses, strict=True)):
+        grid.add(points + pose[:3, 3], index)
+    built = grid.map()
+    c = regions_3d(built.points, truth, voxel=VOXEL, scan=built.scan)
+    assert c.tile_m is None and c.stretch == 4 and c.cut() == "stretches of 4 scans"
+    assert c.scans.tolist() == [[k, min(k + 3, 29)] for k in range(0, 30, 4)]
+    assert c.held.all()
+    sunk_ = c.scans[:, 0] >= 20
+    np.testing.assert_allclose(c.offset[sunk_, 2], -0.3, atol=0.05)
+    assert np.all(np.abs(c.offset[c.scans[:, 1] < 16, 2]) < 0.05)
+    assert c.scans[c.largest_dz(), 0] >= 20 and c.scan_span(c.largest_dz()).startswith("scans")
+    # asked for tiles, the same map is cut into tiles; asked for 10 scans, 3 stretches
+    assert regions_3d(built.points, truth, voxel=VOXEL, scan=built.scan, stretch=0).scans is None
+    assert regions_3d(built.points, truth, voxel=VOXEL, scan=built.scan,
+                      stretch=10).scans.tolist() == [[0, 9], [10, 19], [20, 29]]

@@ -115,3 +115,19 @@ def test_nonzero_window_is_the_grown_box_of_nonzero_cells(image, margin):
     expected = np.zeros_like(image)
     expected[lo:hi, left:right] = True
     np.testing.assert_array_equal(expected, grown)
+
+
+def test_a_carried_value_is_averaged_per_voxel_not_keyed() -> None:
+    """Carried values (a scan's index) average over each voxel's points, whatever the merges;
+    the voxels are those of the coordinates alone."""
+    rng = np.random.default_rng(5)
+    points = rng.uniform(0.0, 2.0, (3000, 3))
+    scan = rng.integers(0, 9, 3000).astype(float)
+    grid = VoxelMap(0.5, min_flush=700, carried=1)
+    for part in np.array_split(np.column_stack([points, scan]), 5):
+        grid.add(part)
+    table = grid.points()
+    np.testing.assert_allclose(table[:, :3], by_sorting(points, 0.5), atol=1e-12)
+    _, inverse = np.unique(voxel_keys(points, 0.5), return_inverse=True)
+    np.testing.assert_allclose(table[:, 3], np.bincount(inverse, scan) / np.bincount(inverse),
+                               atol=1e-12)

@@ -97,6 +97,14 @@ def test_crop_of_a_cloud_and_a_crop_that_keeps_nothing(scan_points):
         crop(cloud, (100.0, 100.0, 101.0, 101.0), "--map-crop")
 
 
+def test_crop_of_a_cloud_keeps_the_scans_of_the_points_it_keeps(scan_points):
+    scan = np.arange(len(scan_points), dtype=float)
+    cut = crop(PointMap(Path("s.ply"), scan_points, True, scan=scan), (0.0, 0.0, 5.0, 5.0),
+               "--map-crop")
+    kept = np.all((scan_points[:, :2] >= 0) & (scan_points[:, :2] <= 5), axis=1)
+    np.testing.assert_array_equal(cut.scan, scan[kept])
+
+
 def test_one_straight_wall_has_nothing_to_align_and_an_l_has():
     x = np.linspace(0.0, 10.0, 2000)
     wall = np.column_stack([x, 0.02 * np.sin(x)])

@@ -166,3 +166,48 @@ def test_large_cloud_with_bad_rows_or_flat_is_read(tmp_path: Path, small_map_lim
         np.testing.assert_array_equal(m.points, np.delete(xyz, 17, axis=0))
     else:
         assert not m.is_3d and np.all(m.points[:, 2] == 0.0)
+
+
+# --- the scan each point came from -----------------------------------------------------------
+
+
+@pytest.mark.parametrize("suffix", [".ply", ".pcd"])
+def test_a_maps_scans_are_written_and_read_back(tmp_path: Path, suffix: str) -> None:
+    """``write_cloud(..., scan=)`` stores each point's scan; a PLY or binary PCD reads it back
+    beside its points, rows with a non-finite coordinate dropped from both; a cloud without
+    one has none."""
+    from pcmapq.io.writers import write_cloud
+
+    xyz = np.random.default_rng(0).normal(size=(40, 3))
+    scan = np.repeat(np.arange(8) + 0.5, 5)
+    write_cloud(tmp_path / f"m{suffix}", xyz, scan=scan)
+    m = load_map(tmp_path / f"m{suffix}")
+    np.testing.assert_array_equal(m.scan, scan.astype(np.float32))
+    write_cloud(tmp_path / f"plain{suffix}", xyz)
+    assert load_map(tmp_path / f"plain{suffix}").scan is None
+    xyz[3, 0] = np.nan
+    write_cloud(tmp_path / f"nan{suffix}", xyz, scan=scan)
+    m = load_map(tmp_path / f"nan{suffix}")
+    assert len(m.points) == len(m.scan) == 39 and m.scan[3] == scan[4]
+
+
+def test_a_large_maps_scans_are_mapped_too(tmp_path: Path, small_map_limit: int) -> None:
+    from pcmapq.io.writers import write_cloud
+
+    xyz = np.random.default_rng(0).normal(size=(25, 3))
+    write_cloud(tmp_path / "big.ply", xyz, scan=np.arange(25))
+    m = load_map(tmp_path / "big.ply")
+    assert not m.points.flags.owndata
+    np.testing.assert_array_equal(m.scan, np.arange(25))
+
+
+def test_scans_that_are_not_numbers_of_at_least_0_are_not_read(tmp_path: Path) -> None:
+    """Another program's ``scan`` property with a negative value: the cloud is read, its
+    scans are not, with a warning naming the file."""
+    from pcmapq.io.writers import write_cloud
+
+    xyz = np.random.default_rng(0).normal(size=(10, 3))
+    write_cloud(tmp_path / "m.ply", xyz, scan=np.arange(10) - 1.0)
+    with pytest.warns(UserWarning, match=r"m\.ply: its 'scan' values are not all numbers"):
+        m = load_map(tmp_path / "m.ply")
+    assert m.scan is None and len(m.points) == 10

@@ -100,8 +100,9 @@ def test_a_map_from_recorded_scans_and_odometry_is_the_files_map(layout, tmp_pat
         " ".join(f"{v:.17g}" for v in pose[:3].ravel()) + "\n" for _, pose in poses))
     bag = write_recording(tmp_path / name_of(layout), [], layout, scans=clouds,
                           scan_topic="/points", poses=poses)
-    from_bag = build_map_from_poses(open_scans(bag), recorded_poses(bag, None, "/odom"))
-    from_files = build_map_from_poses(open_scans(folder), scanner_poses(tmp_path / "poses.txt"))
+    from_bag = build_map_from_poses(open_scans(bag), recorded_poses(bag, None, "/odom")).points
+    from_files = build_map_from_poses(open_scans(folder),
+                                      scanner_poses(tmp_path / "poses.txt")).points
     assert from_bag.shape == from_files.shape
     assert np.abs(from_bag - from_files).max() < 1e-9
 
@@ -140,7 +141,7 @@ def test_a_map_of_laser_scans_is_a_2d_cloud(tmp_path):
         scans.append(Scan(1.0 + k, np.full(91, 4.0), float(angles[0]), step))
         poses.append((1.0 + k, pose))
     path = write_recording(tmp_path / "run.mcap", [], "mcap", scans=scans, poses=poses)
-    points = build_map_from_poses(open_scans(path), recorded_poses(path, None, "/odom"))
+    points = build_map_from_poses(open_scans(path), recorded_poses(path, None, "/odom")).points
     assert len(points) > 0 and flat(points)
 
 

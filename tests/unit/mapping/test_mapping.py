@@ -159,10 +159,11 @@ def test_build_map_from_poses_places_scans(tmp_path: Path) -> None:
     calib = np.eye(4)
     calib[:3, 3] = [0.0, 0.0, 1.0]
     calls: list[tuple[int, int]] = []
-    points = build_map_from_poses(folder, poses, calib, voxel=0.01,
-                                  progress=lambda done, total: calls.append((done, total)))
+    built = build_map_from_poses(folder, poses, calib, voxel=0.01,
+                                 progress=lambda done, total: calls.append((done, total)))
     expected = np.array([[0, 2, 1], [1, 0, 1], [10, 2, 1], [11, 0, 1]], dtype=np.float64)
-    assert np.allclose(points, expected)
+    assert np.allclose(built.points, expected)
+    assert built.scan.tolist() == [0, 0, 1, 1]  # each point's scan
     assert calls == [(1, 2), (2, 2)]
     with pytest.raises(InputError, match="2 poses for 1 scan in"):
         build_map_from_poses(write_scans(tmp_path / "one", [scan]), poses)

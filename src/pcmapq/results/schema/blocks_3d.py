@@ -26,14 +26,22 @@ class Region3D(Block):
     fitness_after: float
     held: bool
     """Its geometry pins the fit in all six directions and it fits (its offset is sure)."""
+    first_scan: int | None = None
+    """A stretch of the run: its first scan (0: the run's first); null for a tile."""
+    last_scan: int | None = None
+    """A stretch of the run: its last scan; null for a tile."""
 
 
 class ConsistencyMap3D(Block):
-    """Two 3D clouds: the map, as the 3D registration placed it, cut into tiles of the ground,
-    each registered to the truth on its own in 3D; in the truth's levelled frame (x, y its
-    plan, z up), metres and degrees. Largest: of the held regions; null without one."""
+    """Two 3D clouds: the map, as the 3D registration placed it, cut into tiles of the ground
+    (or, for a map that carries its points' scans, stretches of the run), each registered to
+    the truth on its own in 3D; in the truth's levelled frame (x, y its plan, z up), metres and
+    degrees. Largest: of the held regions; null without one."""
 
-    tile_m: float
+    tile_m: float | None
+    """A tile's side; null when the regions are stretches of the run."""
+    stretch_scans: int | None = None
+    """The scans a stretch of the run holds; null when the regions are tiles."""
     voxel_m: float
     tolerance_m: float
     """A point within this of a truth point fits (fitness)."""
