@@ -4,7 +4,8 @@ drift put there?
 
 KITTI 00's first 20 scans (about 16 m of road), each cut to 12 m of range, placed at the
 reference poses (the truth) and at poses that drift vertically (the map), both built as
-``pcmapq map --poses`` builds them, and scored as ``pcmapq eval map.ply truth.ply``:
+``pcmapq map --poses`` builds them but written without their points' scans (so that the
+regions are tiles), and scored as ``pcmapq eval map.ply truth.ply``:
 
 - pitch: each step's motion turned about the car's lateral axis by a further ``level``
   degrees, as a pitch drift integrates (scan k pitched by k x level, the run bending down);
@@ -49,7 +50,8 @@ def section(data: Path, record: Record) -> Section:
         "each step's motion turned about the car's lateral axis by a further *level* degrees "
         "(scan k pitched by k x level, the run bending down, as a pitch drift integrates); "
         "*lower*: scan k lowered by k x *level* metres. Both built as `pcmapq map --poses` "
-        "builds them and scored as `pcmapq eval map.ply truth.ply` (`--force`, no detectors, "
+        "builds them but written without their points' scans, so that the regions are tiles, "
+        "and scored as `pcmapq eval map.ply truth.ply` (`--force`, no detectors, "
         "no no-reference figures), with the 3D consistency map's defaults (8 m tiles, the "
         "3D registration's 0.3 m voxel; `consistency_3d` in the JSON, `--regions-3d`). "
         "Each map point's true place is known (the same beam at the reference pose), so each "

@@ -1,6 +1,7 @@
 """KITTI 00 drifting vertically, for the 3D consistency map (:mod:`pcmapq.align.regions3d`):
 the first scans, each cut to a short range, at the reference poses (the truth) and at poses
-that drift (a pitch that integrates along the run, or scans lowered one by one), scored as
+that drift (a pitch that integrates along the run, or scans lowered one by one), written
+without their points' scans (the regions are tiles) and scored as
 ``pcmapq eval map.ply truth.ply``; each region's expected dz from the known true place of
 every point. docs/validation.md's section (``bench/validation/consistency_3d.py``) and
 tests/realdata/test_consistency_3d_kitti.py use it."""

@@ -18,7 +18,7 @@ drift of 0.025 degrees a scan leaves the run's end 0.07 m and 0.5 degrees off, A
 3D registration's fitness 1.00: barely off. Doubling at each level, 0.4 degrees a scan leaves
 it 1.15 m and 7.6 degrees off, fitness 0.6-0.7, the planes' f1 0.10-0.50: a clearly bad map.
 0.8 would go past what the 3D consistency map can measure: its regions' ICP catches offsets of
-about a metre (four 0.3 m voxels), and only 9 of about 105 regions are held there. A stretch
+about a metre (four 0.3 m voxels). A stretch
 moves no point more than the run's end, so it takes a larger share to spoil the map as much:
 1 % (0.16 m at the end, AWD 0.04 m, fitness 1.00) is barely off, 16 % (2.6 m, AWD 0.37 m,
 fitness 0.79) clearly bad.

@@ -66,9 +66,10 @@ def eval_command(
         "points, its fitness before and after, and whether its walls hold it (held).")] = None,
     regions_3d: Annotated[Path | None, typer.Option(
         "--regions-3d", help="Two 3D clouds: write the 3D consistency map as CSV, one row per "
-        "tile of the ground (truth frame levelled, metres): where the map has the region from "
-        "where it fits the truth on its own (dx, dy, dz; roll, pitch, yaw in degrees), its "
-        "points, its fitness before and after, and whether it is held.")] = None,
+        "tile of the ground, or per stretch of the run for a map that carries its points' "
+        "scans (truth frame levelled, metres): where the map has the region from where it "
+        "fits the truth on its own (dx, dy, dz; roll, pitch, yaw in degrees), its points, its "
+        "fitness before and after, and whether it is held.")] = None,
     plot: Annotated[Path | None, typer.Option(
         help="Draw the vectorial map, one panel per detector: PNG, SVG or PDF by the file's "
         "extension.")] = None,
