@@ -22,10 +22,6 @@ from pcmapq.core.errors import InputError
 CHUNK = 1 << 18
 #: The table grows (doubles) when this share of its slots is used.
 LOAD = 0.6
-#: The table starts with room for as many voxels as the points it reads (a cloud of one point
-#: per voxel, a map written as voxel centroids, never grows it), at most 2**START_BITS slots
-#: (84 MB in 3D) and at least 2**16: it grows by doubling beyond, each time moving every voxel.
-START_BITS = 21
 EMPTY = -1
 GOLDEN = np.uint64(11400714819323198485)
 
@@ -149,8 +145,7 @@ def _stripe(points: np.ndarray, voxel: float, scale: float,
             hi: int) -> np.ndarray:
     """The centroids of the voxels whose x index (offset as in the keys) lies in [lo, hi), in
     one pass over the points."""
-    dims = points.shape[1]
-    bits = int(np.clip(np.ceil(np.log2(max(len(points), 1) / LOAD)), 16, START_BITS))
+    dims, bits = points.shape[1], 16
     keys, sums = np.full(1 << bits, EMPTY, dtype=np.int64), np.zeros((1 << bits, dims))
     counts, used = np.zeros(1 << bits, dtype=np.int64), 0
     for chunk in _chunks(points, move):
@@ -168,7 +163,7 @@ def _stripe(points: np.ndarray, voxel: float, scale: float,
                 bits += 1
                 keys, sums, counts = _moved(keys, sums, counts, 1 << bits, np.uint64(64 - bits))
     held = np.flatnonzero(keys != EMPTY)
-    return _centroids(sums, counts, held[np.argsort(keys[held])])  # the keys are unique
+    return _centroids(sums, counts, held[np.argsort(keys[held], kind="stable")])
 
 
 @numba.njit(cache=True, nogil=True)
