@@ -142,14 +142,14 @@ def run_mapped(tmp_path_factory) -> Path:
 def test_a_map_built_from_scans_is_cut_into_stretches_of_its_run(run_mapped):
     """``pcmapq map`` writes each point's scan; ``pcmapq eval`` cuts such a map into stretches
     of 4 scans: those of scans 24 on lie 0.3 m low, the others in place, every whole one
-    held; the JSON, the CSV and the terminal name the scans; ``--stretch-3d 0`` cuts it into
-    tiles."""
+    held; the JSON, the CSV and the terminal name the scans, and the map in the truth's frame
+    (``--aligned``) keeps them; ``--stretch-3d 0`` cuts it into tiles."""
     tmp = run_mapped
     scan = read_cloud(tmp / "map.ply")["scan"]  # a voxel's mean scan
     assert scan.min() >= 0 and 28 <= scan.max() <= 29
     proc = run("eval", str(tmp / "map.ply"), str(tmp / "truth.ply"), "--no-noref",
                "--detectors", "harris", "--json", str(tmp / "r.json"), "--regions-3d",
-               str(tmp / "r3.csv"))
+               str(tmp / "r3.csv"), "--aligned", str(tmp / "a.ply"))
     assert proc.returncode == 0, proc.stderr
     block = json.loads((tmp / "r.json").read_text())["consistency_3d"]
     assert block["tile_m"] is None and block["stretch_scans"] == 4
@@ -164,6 +164,8 @@ def test_a_map_built_from_scans_is_cut_into_stretches_of_its_run(run_mapped):
     assert [int(r["first_scan"]) for r in rows] == [r["first_scan"] for r in regions]
     assert re.search(r"largest dz -0\.[23]\d\d m \(too low\) at .*scans 2[48]-", proc.stdout)
     assert Result.from_json(tmp / "r.json").to_dict()["consistency_3d"] == block
+    # the map in the truth's frame keeps each point's scan
+    np.testing.assert_array_equal(read_cloud(tmp / "a.ply")["scan"], scan)
     tiles = run("eval", str(tmp / "map.ply"), str(tmp / "truth.ply"), "--no-noref",
                 "--detectors", "harris", "--stretch-3d", "0", "--json", "-", "-q")
     assert tiles.returncode == 0, tiles.stderr

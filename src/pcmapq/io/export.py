@@ -58,8 +58,8 @@ def records(xyz: np.ndarray, dtype: np.dtype, scalar: np.ndarray | None = None,
 def write_records(path: Path, count: int, chunks: Iterable[np.ndarray], dtype: np.dtype,
                   comment: str = "", outputs: OutputSet | None = None) -> None:
     """Write ``count`` records of ``dtype`` (:func:`record_dtype`), given as chunks, as a binary
-    PLY (every field a vertex property), a binary PCD (x, y, z only) or LAS / LAZ (a scalar
-    an extra dimension named without its ``scalar_`` prefix, colours as RGB), by ``path``'s
+    PLY (every field a vertex property), a binary PCD (every field but colours) or LAS / LAZ (a
+    scalar an extra dimension named without its ``scalar_`` prefix, colours as RGB), by ``path``'s
     extension; ``comment`` (one line) goes into the header; with ``outputs``, the file appears
     when that set is committed."""
     suffix = path.suffix.lower()
@@ -72,9 +72,10 @@ def write_records(path: Path, count: int, chunks: Iterable[np.ndarray], dtype: n
             raise InputError(f"{path}: {written} {plural(written, 'point')} written, {count} "
                              "announced")
         return
-    if suffix == ".pcd" and dtype.names != ("x", "y", "z"):
-        raise InputError(f"{path}: a cloud with a scalar field is written as .ply")
-    header = _ply_header(count, dtype, comment) if suffix == ".ply" else _pcd_header(count)
+    if suffix == ".pcd" and "red" in dtype.names:
+        raise InputError(f"{path}: a cloud with colours is written as .ply")
+    header = (_ply_header(count, dtype, comment) if suffix == ".ply" else
+              _pcd_header(count, dtype))
     written = 0
     with atomic_file(path, outputs) as f:
         f.write(header.encode("ascii"))
@@ -105,10 +106,12 @@ def _ply_header(count: int, dtype: np.dtype, comment: str) -> str:
     return "\n".join([*lines, "end_header"]) + "\n"
 
 
-def _pcd_header(count: int) -> str:
-    """The header of a binary PCD (v0.7) of ``count`` float32 x, y, z points."""
-    return ("# .PCD v0.7 - Point Cloud Data file format\nVERSION 0.7\nFIELDS x y z\n"
-            "SIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\n"
+def _pcd_header(count: int, dtype: np.dtype) -> str:
+    """The header of a binary PCD (v0.7) of ``count`` points of ``dtype``'s float32 fields."""
+    n = len(dtype.names)
+    return ("# .PCD v0.7 - Point Cloud Data file format\nVERSION 0.7\n"
+            f"FIELDS {' '.join(dtype.names)}\nSIZE {' '.join(['4'] * n)}\n"
+            f"TYPE {' '.join(['F'] * n)}\nCOUNT {' '.join(['1'] * n)}\n"
             f"WIDTH {count}\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS {count}\n"
             "DATA binary\n")
 

@@ -33,7 +33,7 @@ from pcmapq.evaluation.inputs import MAP_CROP, TRUTH_CROP, cropped, load_input
 from pcmapq.io import OccupancyMap, PointMap
 from pcmapq.io.export import DISTANCE_FIELD, record_dtype, records, write_matrix, write_records
 from pcmapq.io.ply import CHUNK
-from pcmapq.io.writers import OutputSet, write_ros_map
+from pcmapq.io.writers import SCAN, OutputSet, write_ros_map
 from pcmapq.metrics.distances import accuracy_2d, accuracy_3d, nearest_distance
 from pcmapq.raster.draw import warp_state
 from pcmapq.results.result import Result
@@ -131,14 +131,24 @@ def write_aligned(path: Path, result: Result, source: OccupancyMap | PointMap,
         image[state == FREE], image[state == OCCUPIED] = ROS_FREE, ROS_OCCUPIED
         write_ros_map(path, image, grid.resolution, grid.origin[:2], outputs)
         return [path, path.with_suffix(".yaml")]
-    dtype = record_dtype()
+    dtype = record_dtype(None if source.scan is None else SCAN)
     if source.is_3d:
         chunks = moved(source.points, cloud_matrix(result.frames))
     else:
         chunks = iter([plan_cloud(result.frames.planar.apply(source.points[:, :2]))])
-    write_records(path, len(source.points), (records(c, dtype) for c in chunks), dtype,
+    write_records(path, len(source.points), _with_scans(chunks, source.scan, dtype), dtype,
                   f"pcmapq: {source.path} in the frame of {result.truth_path}, metres", outputs)
     return [path]
+
+
+def _with_scans(chunks: Iterator[np.ndarray], scan: np.ndarray | None,
+                dtype: np.dtype) -> Iterator[np.ndarray]:
+    """Records of ``dtype`` of the points' chunks (n, 3), each with its points' scans taken in
+    turn from ``scan`` (N,) when the map carries them (None: without)."""
+    start = 0
+    for chunk in chunks:
+        yield records(chunk, dtype, None if scan is None else scan[start:start + len(chunk)])
+        start += len(chunk)
 
 
 def accuracy_points(result: Result, source: OccupancyMap | PointMap,

@@ -37,13 +37,29 @@ def test_distance_cloud_has_a_scalar_field_and_colours(tmp_path):
     assert len({tuple(c) for c in back["colors"].tolist()}) == 3
 
 
-def test_a_cloud_with_a_scalar_field_is_not_written_as_pcd(tmp_path):
+def test_a_cloud_with_colours_is_not_written_as_pcd(tmp_path):
     from pcmapq.core.errors import InputError
 
-    dtype = record_dtype(DISTANCE_FIELD)
-    with pytest.raises(InputError, match="d.pcd: a cloud with a scalar field"):
+    dtype = record_dtype(DISTANCE_FIELD, colour=True)
+    with pytest.raises(InputError, match="d.pcd: a cloud with colours"):
         write_records(tmp_path / "d.pcd", 0, [], dtype)
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("suffix", [".ply", ".pcd", ".las"])
+def test_a_scalar_field_is_read_back_by_pcmapq(suffix, tmp_path):
+    """A cloud with a float scalar (a map's ``scan``) written as PLY, PCD or LAS: pcmapq reads
+    its points back, and from PLY and PCD its scans."""
+    from pcmapq.io import load_map
+
+    xyz = np.random.default_rng(1).uniform(-5, 5, size=(50, 3))
+    scan = np.repeat(np.arange(10) + 0.5, 5)
+    dtype = record_dtype("scan")
+    write_records(tmp_path / f"c{suffix}", 50, [records(xyz, dtype, scan)], dtype)
+    back = load_map(tmp_path / f"c{suffix}")
+    np.testing.assert_allclose(back.points, xyz, atol=1e-3 if suffix == ".las" else 1e-5)
+    if suffix != ".las":
+        np.testing.assert_array_equal(back.scan, scan.astype(np.float32))
 
 
 def test_matrix_reads_back_exactly(tmp_path):
