@@ -171,13 +171,15 @@ class Fit(NamedTuple):
 class Nearest:
     """Each source point's nearest target point, kept from pose to pose (module docstring).
 
-    source (N, 3), target (M, 3): metres; tree: small_gicp's KD-tree of the target; threads:
-    threads of the searches. ``searched`` counts the points searched."""
+    source (N, 3), target (M, 3): metres; tree: small_gicp's KD-tree of the target, or of the
+    target moved by ``offset`` (3,) metres (one tree shared by sources worked on about their
+    own centres); threads: threads of the searches. ``searched`` counts the points searched."""
 
     def __init__(self, source: np.ndarray, target: np.ndarray, tree: small_gicp.KdTree,
-                 threads: int = 1) -> None:
+                 threads: int = 1, offset: np.ndarray | None = None) -> None:
         n = len(source)
         self.source, self.target, self.tree, self.threads = source, target, tree, threads
+        self.offset = np.zeros(3) if offset is None else np.asarray(offset, dtype=np.float64)
         self.k = min(CANDIDATES, len(target))
         self.near = np.zeros((n, self.k), np.int64)
         self.reach = np.full(n, -np.inf)  # no candidates yet: every point is searched
@@ -195,7 +197,8 @@ class Nearest:
         if count:
             again = self._again[:count].copy()
             moved = self.source[again] @ rotation.T + shift
-            found, sq = self.tree.batch_knn_search(moved, self.k, num_threads=self.threads)
+            found, sq = self.tree.batch_knn_search(moved + self.offset, self.k,
+                                                   num_threads=self.threads)
             found = found.astype(np.int64)
             self.near[again], self.reach[again] = found, np.sqrt(sq[:, -1])
             self.seen_at[again], self.pair[again] = moved, found[:, 0]

@@ -11,9 +11,11 @@ stretch holds points placed with nearly one error, where a tile of a long-range 
 holds points of every scan that saw it, each put elsewhere. Each region's own map points (at
 ``voxel``) are registered by small_gicp's point-to-plane ICP (as :mod:`pcmapq.align.plane_icp`
 computes it: its loops leave Python's lock to the evaluation's other threads), seeded at
-identity (the global pose), on one thread, against the truth's points within the region's box
-(a tile, a stretch's points' extent) grown by the widest pairing distance on every side (their
-normals and KD-tree small_gicp's), coarse to fine.
+identity (the global pose), on one thread, coarse to fine: a tile against the truth's points
+within the tile grown by the widest pairing distance on every side (their normals and KD-tree
+small_gicp's); a stretch, whose points reach as far as its scans do and overlap the other
+stretches', against all the truth's points, their normals and KD-tree made once for every
+stretch.
 Frame: the truth cloud levelled as its plan is (x, y the truth's plan, the 2D consistency map's
 frame; z up), metres and degrees. ``offset`` is the map's error there: where the map (as the
 global registration placed it) has the region's centroid, from where the region fits the truth
@@ -33,10 +35,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import small_gicp
 from scipy.spatial import cKDTree
 from scipy.spatial.transform import Rotation
 
-from pcmapq.align.plane_icp import plane_icp, prepared
+from pcmapq.align.plane_icp import Nearest, plane_icp, prepared
 from pcmapq.core.transform import affine
 from pcmapq.core.voxels import voxel_centroids
 
@@ -145,12 +148,12 @@ def _in_box(sorted_xy: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray
     return start + np.flatnonzero((y >= lo[1]) & (y < hi[1]))
 
 
-def _register(own: np.ndarray, window: np.ndarray, voxel: float
+def _register(nearest: Nearest, normals: np.ndarray, voxel: float
               ) -> tuple[np.ndarray, np.ndarray]:
-    """Point-to-plane ICP of ``own`` (N, 3) onto ``window`` (M, 3), both centred on ``own``'s
-    centroid, from identity, coarse to fine: the 4x4 move and the last stage's 6 x 6 Hessian
-    (turns about x, y, z, then x, y, z translations) per pair."""
-    nearest, normals = prepared(own, window, NORMAL_NEIGHBOURS)
+    """Point-to-plane ICP of ``nearest``'s source onto its target (both centred on the
+    source's centroid; ``normals`` the target's), from identity, coarse to fine: the 4x4 move
+    and the last stage's 6 x 6 Hessian (turns about x, y, z, then x, y, z translations) per
+    pair."""
     move, hessian = np.eye(4), np.zeros((6, 6))
     for units in STAGES:
         fit = plane_icp(nearest, normals, move, units * voxel, ITERATIONS, SETTLED, SETTLED)
@@ -168,26 +171,45 @@ def _pinned(hessian: np.ndarray, half_side: float) -> float:
 
 class _Truth:
     """The truth's points (M, 3, levelled, at the working voxel) as each region needs them:
-    sorted by x for the window of a box, and a KD-tree for the fit."""
+    sorted by x for a tile's window, a KD-tree for the fit, and for stretches, whose windows
+    overlap, small_gicp's KD-tree and normals of all of them, made once."""
 
     def __init__(self, truth: np.ndarray) -> None:
+        self.points = truth
         self.sorted = truth[np.argsort(truth[:, 0], kind="stable")]
         self.tree = cKDTree(truth)
+        self._whole: tuple[small_gicp.KdTree, np.ndarray] | None = None
+
+    def whole(self) -> tuple[small_gicp.KdTree, np.ndarray]:
+        """small_gicp's KD-tree of all the truth's points and their normals (M, 3)."""
+        if self._whole is None:
+            cloud = small_gicp.PointCloud(self.points)
+            tree = small_gicp.KdTree(cloud, num_threads=1)
+            small_gicp.estimate_normals(cloud, tree, num_neighbors=NORMAL_NEIGHBOURS,
+                                        num_threads=1)
+            self._whole = tree, np.ascontiguousarray(cloud.normals()[:, :3])
+        return self._whole
 
 
 def _row(own: np.ndarray, truth: _Truth, lo: np.ndarray, hi: np.ndarray, half_side: float,
-         voxel: float) -> tuple | None:
+         voxel: float, whole: bool = False) -> tuple | None:
     """The row of one region, its map points ``own`` (N, 3, levelled truth frame, at ``voxel``
     metres) in the box ``lo``-``hi`` (x, y, metres), registered on its own to the truth's
-    points in that box grown by the widest pairing distance: its centroid, offset, turn
-    (degrees), points, fit before and after, and whether it is held (its turns scaled by
-    ``half_side`` metres); None when the truth has too few points there."""
+    points in that box grown by the widest pairing distance (``whole``: to all of them, their
+    normals found once): its centroid, offset, turn (degrees), points, fit before and after,
+    and whether it is held (its turns scaled by ``half_side`` metres); None when the truth has
+    too few points there."""
     tolerance, margin = voxel / 2, STAGES[0] * voxel
     window = truth.sorted[_in_box(truth.sorted[:, :2], lo - margin, hi + margin)]
     if len(window) < NORMAL_NEIGHBOURS:
         return None
     centre = own.mean(axis=0)
-    move, hessian = _register(own - centre, window - centre, voxel)
+    if whole:
+        tree, normals = truth.whole()
+        nearest = Nearest(own - centre, truth.points - centre, tree, offset=centre)
+    else:
+        nearest, normals = prepared(own - centre, window - centre, NORMAL_NEIGHBOURS)
+    move, hessian = _register(nearest, normals, voxel)
     before = truth.tree.query(own, distance_upper_bound=tolerance, workers=1)[0]
     fitted = affine(own - centre, move) + centre
     after = truth.tree.query(fitted, distance_upper_bound=tolerance, workers=1)[0]
@@ -239,7 +261,7 @@ def _stretch_rows(map_xyz: np.ndarray, scan: np.ndarray, stretch: int | None, tr
         if len(own) < MIN_POINTS:
             continue
         lo, hi = own[:, :2].min(axis=0), own[:, :2].max(axis=0)
-        row = _row(own, truth, lo, hi, float(np.max(hi - lo)) / 2, voxel)
+        row = _row(own, truth, lo, hi, float(np.max(hi - lo)) / 2, voxel, whole=True)
         if row is not None:
             rows.append(row)
             spans.append((int(k) * stretch, min(int(k) * stretch + stretch - 1, last)))

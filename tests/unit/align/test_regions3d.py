@@ -120,25 +120,53 @@ def _small_gicps_fit(own, window, voxel):
     return move, hessian
 
 
-def test_the_regions_are_small_gicps(monkeypatch, truth, scan, sank):
-    """Each region's ICP, computed by pcmapq, gives the regions that small_gicp's own
-    ``align`` gives (to the micrometre and 1e-6 degree the regions are kept at), and the
-    same Hessian per pair to 1e-9."""
+def _as_small_gicp(monkeypatch) -> list:
+    """Each region's ICP, once computed by pcmapq, computed again by small_gicp's own ``align``
+    (the regions then small_gicp's); the pairs of Hessians per pair, pcmapq's and its."""
     hessians = []
     real = regions3d._register
 
-    def both(own, window, voxel):
-        ours, theirs = real(own, window, voxel), _small_gicps_fit(own, window, voxel)
+    def both(nearest, normals, voxel):
+        ours = real(nearest, normals, voxel)
+        theirs = _small_gicps_fit(nearest.source, nearest.target, voxel)
         hessians.append((ours[1], theirs[1]))
         return theirs
 
     monkeypatch.setattr(regions3d, "_register", both)
+    return hessians
+
+
+def test_the_regions_are_small_gicps(monkeypatch, truth, scan, sank):
+    """Each region's ICP, computed by pcmapq, gives the regions that small_gicp's own
+    ``align`` gives (to the micrometre and 1e-6 degree the regions are kept at), and the
+    same Hessian per pair to 1e-9."""
+    hessians = _as_small_gicp(monkeypatch)
     b = regions_3d(sunk(scan, 10.0, 0.3), truth, tile_m=TILE, voxel=VOXEL)
     assert len(hessians) == len(b.points) > 0
     for ours, theirs in hessians:
         np.testing.assert_allclose(ours, theirs, rtol=1e-9, atol=1e-12)
     for name in ("centre", "offset", "angles_deg", "fit_before", "fit_after", "held"):
         np.testing.assert_array_equal(getattr(sank, name), getattr(b, name))
+
+
+def test_the_stretches_are_small_gicps_against_the_whole_truth(monkeypatch, truth, scan):
+    """Stretches share one KD-tree and the normals of all the truth's points: each stretch's
+    ICP is small_gicp's ``align`` against all of them, to the same figures and Hessians (to
+    1e-9 of their largest entry: the normals come from the truth's own coordinates, not
+    small_gicp's centred copy)."""
+    seen, poses = street_run(scan, 12, step=2.0)
+    grid = ScanGrid(0.1)
+    for index, (points, pose) in enumerate(zip(seen, poses, strict=True)):
+        grid.add(points + pose[:3, 3], index)
+    built = grid.map()
+    ours = regions_3d(built.points, truth, voxel=VOXEL, scan=built.scan)
+    hessians = _as_small_gicp(monkeypatch)
+    theirs = regions_3d(built.points, truth, voxel=VOXEL, scan=built.scan)
+    assert len(hessians) == len(theirs.points) == 3
+    for mine, its in hessians:
+        np.testing.assert_allclose(mine, its, rtol=1e-9, atol=1e-9 * np.abs(its).max())
+    for name in ("centre", "offset", "angles_deg", "fit_before", "fit_after", "held"):
+        np.testing.assert_array_equal(getattr(ours, name), getattr(theirs, name))
 
 
 def test_a_long_map_gets_larger_tiles():
