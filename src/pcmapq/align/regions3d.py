@@ -254,10 +254,16 @@ def _stretch_rows(map_xyz: np.ndarray, scan: np.ndarray, stretch: int | None, tr
     scan = np.asarray(scan)
     last = int(np.ceil(scan.max()))  # a voxel's scan is a mean: the last scan, rounded up
     stretch = stretch or stretch_scans(last)
-    of = np.floor(scan / stretch).astype(np.int64)
+    # each point's stretch, a small integer: sorted once (stably, so that a stretch's points
+    # keep their order), each stretch's points are one slice of the order
+    of = np.floor(scan / stretch).astype(np.int16 if last // stretch < 2**15 else np.int64)
+    order = np.argsort(of, kind="stable")
+    counts = np.bincount(of)
+    bounds_at = np.concatenate([[0], np.cumsum(counts)])
     rows, spans = [], []
-    for k in np.unique(of):
-        own = levelled(voxel_centroids(np.asarray(map_xyz)[of == k], voxel), level)
+    for k in np.flatnonzero(counts):
+        own = levelled(voxel_centroids(np.asarray(map_xyz)[order[bounds_at[k]:bounds_at[k + 1]]],
+                                       voxel), level)
         if len(own) < MIN_POINTS:
             continue
         lo, hi = own[:, :2].min(axis=0), own[:, :2].max(axis=0)
