@@ -171,3 +171,17 @@ def test_a_map_built_from_scans_is_cut_into_stretches_of_its_run(run_mapped):
     assert tiles.returncode == 0, tiles.stderr
     block = json.loads(tiles.stdout)["consistency_3d"]
     assert block["tile_m"] == 8.0 and "stretch_scans" not in block
+
+
+def test_a_stretch_that_cuts_the_run_too_finely_is_refused_first(run_mapped):
+    """A map whose scans another program numbered by the ten thousand, and a stretch of 4 scans:
+    refused in one line naming the map and the way out, before any work (exit 2)."""
+    tmp = run_mapped
+    cloud = read_cloud(tmp / "map.ply")
+    write_cloud(tmp / "wide.ply", cloud["positions"], scan=cloud["scan"].ravel() * 1e4)
+    proc = run("eval", str(tmp / "wide.ply"), str(tmp / "truth.ply"), "--stretch-3d", "4")
+    assert proc.returncode == 2, proc.stderr
+    assert proc.stderr.strip().count("\n") == 0
+    assert re.search(r"wide\.ply: --stretch-3d 4: the map's scans run from \d+ to \d+: "
+                     r"\d+ stretches of 4, more than 10000; give a larger stretch, or 0 for "
+                     r"tiles", proc.stderr)

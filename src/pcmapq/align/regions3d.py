@@ -54,6 +54,8 @@ MAX_TILES = 32
 #: MAX_STRETCHES stretches, each of the same number of scans.
 STRETCH_SCANS = 4
 MAX_STRETCHES = 32
+#: A stretch asked for (``--stretch-3d``) may cut the run into at most this many stretches.
+MOST_STRETCHES = 10_000
 #: A tile or stretch holding fewer map points than this (at the working voxel) is no region.
 MIN_POINTS = 200
 #: ICP stages: the largest pairing distance of each, in units of the working voxel (wide first:
@@ -237,11 +239,27 @@ def _tile_rows(placed: np.ndarray, truth: _Truth, tile_m: float, voxel: float) -
     return rows
 
 
-def stretch_scans(last_scan: float) -> int:
-    """The scans a stretch of a run holds whose points' scans reach ``last_scan`` (the first
-    is 0): at least STRETCH_SCANS, and as many as cut the run into at most MAX_STRETCHES."""
-    scans = int(np.ceil(last_scan)) + 1
+def stretch_scans(span: float) -> int:
+    """The scans a stretch of a run holds whose points' scans span ``span`` (last less first):
+    at least STRETCH_SCANS, and as many as cut the run into at most MAX_STRETCHES."""
+    scans = int(np.ceil(span)) + 1
     return max(STRETCH_SCANS, -(-scans // MAX_STRETCHES))
+
+
+def run_stretches(scan: np.ndarray, stretch: int | None) -> tuple[int, int, int]:
+    """The run's first and last scan (``scan`` (N,) each point's: a voxel's is a mean, so
+    rounded out) and the scans a stretch holds (``stretch``; None: :func:`stretch_scans`).
+    ValueError, saying why in one line, when that cuts the run into more than
+    MOST_STRETCHES."""
+    scan = np.asarray(scan)
+    first, last = int(np.floor(scan.min())), int(np.ceil(scan.max()))
+    stretch = stretch or stretch_scans(last - first)
+    count = last // stretch - first // stretch + 1
+    if count > MOST_STRETCHES:
+        raise ValueError(f"--stretch-3d {stretch}: the map's scans run from {first} to "
+                         f"{last}: {count} stretches of {stretch}, more than {MOST_STRETCHES}; "
+                         "give a larger stretch, or 0 for tiles")
+    return first, last, stretch
 
 
 def _stretch_rows(map_xyz: np.ndarray, scan: np.ndarray, stretch: int | None, truth: _Truth,
@@ -250,13 +268,14 @@ def _stretch_rows(map_xyz: np.ndarray, scan: np.ndarray, stretch: int | None, tr
     """One row per stretch of ``stretch`` scans (None: :func:`stretch_scans`) of the run of
     the map ``map_xyz`` (N, 3, truth frame; ``scan`` (N,) each point's scan): each stretch's
     points at ``voxel`` metres, levelled by ``level``, registered on their own (:func:`_row`);
-    with each row's first and last scan, and the scans a stretch holds."""
+    with each row's first and last scan, and the scans a stretch holds (ValueError: see
+    :func:`run_stretches`)."""
     scan = np.asarray(scan)
-    last = int(np.ceil(scan.max()))  # a voxel's scan is a mean: the last scan, rounded up
-    stretch = stretch or stretch_scans(last)
+    first, last, stretch = run_stretches(scan, stretch)
+    low = first // stretch
     # each point's stretch, a small integer: sorted once (stably, so that a stretch's points
     # keep their order), each stretch's points are one slice of the order
-    of = np.floor(scan / stretch).astype(np.int16 if last // stretch < 2**15 else np.int64)
+    of = (np.floor(scan / stretch) - low).astype(np.int16)
     order = np.argsort(of, kind="stable")
     counts = np.bincount(of)
     bounds_at = np.concatenate([[0], np.cumsum(counts)])
@@ -270,7 +289,8 @@ def _stretch_rows(map_xyz: np.ndarray, scan: np.ndarray, stretch: int | None, tr
         row = _row(own, truth, lo, hi, float(np.max(hi - lo)) / 2, voxel, whole=True)
         if row is not None:
             rows.append(row)
-            spans.append((int(k) * stretch, min(int(k) * stretch + stretch - 1, last)))
+            start = (int(k) + low) * stretch
+            spans.append((max(start, first), min(start + stretch - 1, last)))
     return rows, spans, stretch
 
 

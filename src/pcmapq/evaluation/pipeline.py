@@ -16,6 +16,7 @@ from pcmapq.evaluation.placing import (
     Progress,
     check_footprint_rule,
     check_init_3d,
+    check_stretch,
     place,
 )
 from pcmapq.evaluation.scoring import score
@@ -40,6 +41,7 @@ def evaluate(map_path: str | Path | PointMap, truth_path: str | Path,
     source, truth = load_pair(map_path, truth_path, settings, memory_limit)
     check_footprint_rule(source, settings)  # before the truth is prepared: a refusal costs nothing
     check_init_3d(source, truth, settings)
+    check_stretch(source, settings)
     prepared = prepare_truth(truth, settings, memory_limit, maps=(0,), loaded=(source,),
                              background=True)
     try:
@@ -76,6 +78,7 @@ def start_evaluation(source: OccupancyMap | PointMap, prepared: PreparedTruth,
     """The first half of :func:`evaluate_prepared`: the rule checked, the early figures
     started, the map placed (its errors raised, the figures' thread stopped)."""
     check_footprint_rule(source, settings)
+    check_stretch(source, settings)
     early = EarlyFigures({"map": source, "truth": prepared.source}, settings)
     try:
         placed = place(source, prepared, settings, progress, early.walls_found)

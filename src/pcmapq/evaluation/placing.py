@@ -16,6 +16,7 @@ from pcmapq.align.free_space import FreeSpace
 from pcmapq.align.parts import place_parts
 from pcmapq.align.plan_guess import guess_from_plans
 from pcmapq.align.planar import RigidTarget
+from pcmapq.align.regions3d import run_stretches
 from pcmapq.align.rigid3d import Registration3D, align_3d, apply
 from pcmapq.core.bounds import bounds, radius
 from pcmapq.core.errors import EvaluationError, InputError, Refused, SettingsRefused
@@ -127,6 +128,19 @@ def check_init_3d(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMa
         raise SettingsRefused(f"{source.path}: --init-3d starts the 3D registration of two 3D "
                               f"clouds; {flat[0].path} is not a 3D cloud (--init x,y,yaw "
                               "places a plan)")
+
+
+def check_stretch(source: OccupancyMap | PointMap, settings: Settings) -> None:
+    """SettingsRefused (one line, naming the map) when the map carries its points' scans and
+    the stretch asked for (``--stretch-3d``) cuts its run into too many stretches
+    (:func:`~pcmapq.align.regions3d.run_stretches`). Found before any work."""
+    stretch = settings.map_3d.stretch
+    if not isinstance(source, PointMap) or source.scan is None or not stretch:
+        return
+    try:
+        run_stretches(source.scan, stretch)
+    except ValueError as err:
+        raise SettingsRefused(f"{source.path}: {err}") from None
 
 
 def map_footprint_rule(source: OccupancyMap | PointMap, settings: Settings) -> str:

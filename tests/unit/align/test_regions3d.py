@@ -225,3 +225,19 @@ def test_a_run_whose_last_scans_sank_is_cut_into_stretches():
     assert regions_3d(built.points, truth, voxel=VOXEL, scan=built.scan, stretch=0).scans is None
     assert regions_3d(built.points, truth, voxel=VOXEL, scan=built.scan,
                       stretch=10).scans.tolist() == [[0, 9], [10, 19], [20, 29]]
+
+
+def test_scans_that_do_not_start_at_0_and_a_stretch_too_small(truth, scan):
+    """Scans numbered from 1000 (another program's): the stretches start at the first; a
+    stretch that would cut the run into more than MOST_STRETCHES is refused in one line."""
+    seen, poses = street_run(scan, 12, step=2.0)
+    grid = ScanGrid(0.1)
+    for index, (points, pose) in enumerate(zip(seen, poses, strict=True)):
+        grid.add(points + pose[:3, 3], index)
+    built = grid.map()
+    c = regions_3d(built.points, truth, voxel=VOXEL, scan=built.scan + 1000.0)
+    assert c.scans.tolist() == [[1000, 1003], [1004, 1007], [1008, 1011]]
+    wide = built.scan * 1e4  # a run of 110,000 "scans"
+    with pytest.raises(ValueError, match=r"--stretch-3d 4: the map's scans run from \d+ to "
+                                         r"110000: 2\d{4} stretches of 4, more than 10000"):
+        regions_3d(built.points, truth, voxel=VOXEL, scan=wide, stretch=4)
