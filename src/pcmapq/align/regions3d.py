@@ -202,15 +202,16 @@ def _row(own: np.ndarray, truth: _Truth, lo: np.ndarray, hi: np.ndarray, half_si
     and whether it is held (its turns scaled by ``half_side`` metres); None when the truth has
     too few points there."""
     tolerance, margin = voxel / 2, STAGES[0] * voxel
-    window = truth.sorted[_in_box(truth.sorted[:, :2], lo - margin, hi + margin)]
-    if len(window) < NORMAL_NEIGHBOURS:
+    near = _in_box(truth.sorted[:, :2], lo - margin, hi + margin)
+    if len(near) < NORMAL_NEIGHBOURS:
         return None
     centre = own.mean(axis=0)
     if whole:
         tree, normals = truth.whole()
         nearest = Nearest(own - centre, truth.points - centre, tree, offset=centre)
     else:
-        nearest, normals = prepared(own - centre, window - centre, NORMAL_NEIGHBOURS)
+        nearest, normals = prepared(own - centre, truth.sorted[near] - centre,
+                                    NORMAL_NEIGHBOURS)
     move, hessian = _register(nearest, normals, voxel)
     before = truth.tree.query(own, distance_upper_bound=tolerance, workers=1)[0]
     fitted = affine(own - centre, move) + centre
