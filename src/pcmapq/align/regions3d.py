@@ -6,16 +6,16 @@ shows what a plan cannot.
 
 Regions are square tiles of the truth's ground plane, or, for a map that carries the scan each
 point came from (a map ``pcmapq map`` built, :mod:`pcmapq.mapping.scan_map`), stretches of the
-run: consecutive scans, their points wherever they lie. A drift builds up along the run, so a
-stretch holds points placed with nearly one error, where a tile of a long-range scanner's map
-holds points of every scan that saw it, each put elsewhere. Each region's own map points (at
-``voxel``) are registered by small_gicp's point-to-plane ICP (as :mod:`pcmapq.align.plane_icp`
-computes it: its loops leave Python's lock to the evaluation's other threads), seeded at
-identity (the global pose), on one thread, coarse to fine: a tile against the truth's points
-within the tile grown by the widest pairing distance on every side (their normals and KD-tree
-small_gicp's); a stretch, whose points reach as far as its scans do and overlap the other
-stretches', against all the truth's points, their normals and KD-tree made once for every
-stretch.
+run (:mod:`pcmapq.align.stretches`): consecutive scans, their points wherever they lie. A drift
+builds up along the run, so a stretch holds points placed with nearly one error, where a tile
+of a long-range scanner's map holds points of every scan that saw it, each put elsewhere.
+Each region's own map points (at ``voxel``) are registered by small_gicp's point-to-plane ICP
+(as :mod:`pcmapq.align.plane_icp` computes it: its loops leave Python's lock to the
+evaluation's other threads), seeded at identity (the global pose), on one thread, coarse to
+fine: a tile against the truth's points within the tile grown by the widest pairing distance
+on every side (their normals and KD-tree small_gicp's); a stretch, whose points reach as far
+as its scans do and overlap the other stretches', against all the truth's points, their
+normals and KD-tree made once for every stretch.
 Frame: the truth cloud levelled as its plan is (x, y the truth's plan, the 2D consistency map's
 frame; z up), metres and degrees. ``offset`` is the map's error there: where the map (as the
 global registration placed it) has the region's centroid, from where the region fits the truth
@@ -25,10 +25,9 @@ and z from its fit, the same way round.
 A region is held when the ICP's information pins all six of its degrees of freedom and it fits:
 the 6 x 6 Hessian of the point-to-plane cost at the fit, per pair and with its turns taken as
 the movement of a point at the region's half side (a tile's; a stretch's points' wider extent
-in the plan), has its smallest eigenvalue at least
-MIN_INFORMATION (a ground alone leaves x, y and yaw free; a straight facade on it, x), and at
-least MIN_FIT of the region's points lie within the tolerance of a truth point once it is
-registered."""
+in the plan), has its smallest eigenvalue at least MIN_INFORMATION (a ground alone leaves x, y
+and yaw free; a straight facade on it, x), and at least MIN_FIT of the region's points lie
+within the tolerance of a truth point once it is registered."""
 
 from __future__ import annotations
 
@@ -40,6 +39,7 @@ from scipy.spatial import cKDTree
 from scipy.spatial.transform import Rotation
 
 from pcmapq.align.plane_icp import Nearest, plane_icp, prepared
+from pcmapq.align.stretches import stretches
 from pcmapq.core.transform import affine
 from pcmapq.core.voxels import voxel_centroids
 
@@ -50,12 +50,6 @@ TILE_M = 8.0
 #: Regions at most this many tiles across the map's larger side (a larger map gets larger
 #: tiles: the cost stays that of a map of this many tiles).
 MAX_TILES = 32
-#: A stretch of the run holds at least this many scans; the run is cut into at most
-#: MAX_STRETCHES stretches, each of the same number of scans.
-STRETCH_SCANS = 4
-MAX_STRETCHES = 32
-#: A stretch asked for (``--stretch-3d``) may cut the run into at most this many stretches.
-MOST_STRETCHES = 10_000
 #: A tile or stretch holding fewer map points than this (at the working voxel) is no region.
 MIN_POINTS = 200
 #: ICP stages: the largest pairing distance of each, in units of the working voxel (wide first:
@@ -240,58 +234,25 @@ def _tile_rows(placed: np.ndarray, truth: _Truth, tile_m: float, voxel: float) -
     return rows
 
 
-def stretch_scans(span: float) -> int:
-    """The scans a stretch of a run holds whose points' scans span ``span`` (last less first):
-    at least STRETCH_SCANS, and as many as cut the run into at most MAX_STRETCHES."""
-    scans = int(np.ceil(span)) + 1
-    return max(STRETCH_SCANS, -(-scans // MAX_STRETCHES))
-
-
-def run_stretches(scan: np.ndarray, stretch: int | None) -> tuple[int, int, int]:
-    """The run's first and last scan (``scan`` (N,) each point's: a voxel's is a mean, so
-    rounded out) and the scans a stretch holds (``stretch``; None: :func:`stretch_scans`).
-    ValueError, saying why in one line, when that cuts the run into more than
-    MOST_STRETCHES."""
-    scan = np.asarray(scan)
-    first, last = int(np.floor(scan.min())), int(np.ceil(scan.max()))
-    stretch = stretch or stretch_scans(last - first)
-    count = last // stretch - first // stretch + 1
-    if count > MOST_STRETCHES:
-        raise ValueError(f"--stretch-3d {stretch}: the map's scans run from {first} to "
-                         f"{last}: {count} stretches of {stretch}, more than {MOST_STRETCHES}; "
-                         "give a larger stretch, or 0 for tiles")
-    return first, last, stretch
-
-
 def _stretch_rows(map_xyz: np.ndarray, scan: np.ndarray, stretch: int | None, truth: _Truth,
                   voxel: float, level: np.ndarray | None
                   ) -> tuple[list[tuple], list[tuple[int, int]], int]:
-    """One row per stretch of ``stretch`` scans (None: :func:`stretch_scans`) of the run of
-    the map ``map_xyz`` (N, 3, truth frame; ``scan`` (N,) each point's scan): each stretch's
-    points at ``voxel`` metres, levelled by ``level``, registered on their own (:func:`_row`);
-    with each row's first and last scan, and the scans a stretch holds (ValueError: see
-    :func:`run_stretches`)."""
-    scan = np.asarray(scan)
-    first, last, stretch = run_stretches(scan, stretch)
-    low = first // stretch
-    # each point's stretch, a small integer: sorted once (stably, so that a stretch's points
-    # keep their order), each stretch's points are one slice of the order
-    of = (np.floor(scan / stretch) - low).astype(np.int16)
-    order = np.argsort(of, kind="stable")
-    counts = np.bincount(of)
-    bounds_at = np.concatenate([[0], np.cumsum(counts)])
+    """One row per stretch of ``stretch`` scans (None: :func:`~pcmapq.align.stretches.
+    stretch_scans`) of the run of the map ``map_xyz`` (N, 3, truth frame; ``scan`` (N,) each
+    point's scan): each stretch's points at ``voxel`` metres, levelled by ``level``,
+    registered on their own (:func:`_row`); with each row's first and last scan, and the scans
+    a stretch holds (ValueError: see :func:`~pcmapq.align.stretches.run_stretches`)."""
+    stretch, each = stretches(scan, stretch)
     rows, spans = [], []
-    for k in np.flatnonzero(counts):
-        own = levelled(voxel_centroids(np.asarray(map_xyz)[order[bounds_at[k]:bounds_at[k + 1]]],
-                                       voxel), level)
+    for index, span in each:
+        own = levelled(voxel_centroids(np.asarray(map_xyz)[index], voxel), level)
         if len(own) < MIN_POINTS:
             continue
         lo, hi = own[:, :2].min(axis=0), own[:, :2].max(axis=0)
         row = _row(own, truth, lo, hi, float(np.max(hi - lo)) / 2, voxel, whole=True)
         if row is not None:
             rows.append(row)
-            start = (int(k) + low) * stretch
-            spans.append((max(start, first), min(start + stretch - 1, last)))
+            spans.append(span)
     return rows, spans, stretch
 
 
@@ -302,7 +263,7 @@ def regions_3d(map_xyz: np.ndarray, truth_xyz: np.ndarray, *, tile_m: float = TI
     registered on its own to ``truth_xyz`` (M, 3), metres.
 
     scan: (N,) each map point's scan (:mod:`pcmapq.mapping.scan_map`): regions are then
-    stretches of the run of ``stretch`` scans each (None: :func:`stretch_scans`; 0: tiles);
+    stretches of the run of ``stretch`` scans each (:mod:`pcmapq.align.stretches`; 0: tiles);
     None: tiles.
     tile_m: a tile's side, metres (grown so that the map spans at most MAX_TILES tiles).
     voxel: both clouds are taken at this voxel (centroids), metres; the pairing distances

@@ -16,8 +16,8 @@ from pcmapq.align.free_space import FreeSpace
 from pcmapq.align.parts import place_parts
 from pcmapq.align.plan_guess import guess_from_plans
 from pcmapq.align.planar import RigidTarget
-from pcmapq.align.regions3d import run_stretches
 from pcmapq.align.rigid3d import Registration3D, align_3d, apply
+from pcmapq.align.stretches import run_stretches
 from pcmapq.core.bounds import bounds, radius
 from pcmapq.core.errors import EvaluationError, InputError, Refused, SettingsRefused
 from pcmapq.core.frames import Levelling
@@ -133,7 +133,7 @@ def check_init_3d(source: OccupancyMap | PointMap, truth: OccupancyMap | PointMa
 def check_stretch(source: OccupancyMap | PointMap, settings: Settings) -> None:
     """SettingsRefused (one line, naming the map) when the map carries its points' scans and
     the stretch asked for (``--stretch-3d``) cuts its run into too many stretches
-    (:func:`~pcmapq.align.regions3d.run_stretches`). Found before any work."""
+    (:func:`~pcmapq.align.stretches.run_stretches`). Found before any work."""
     stretch = settings.map_3d.stretch
     if not isinstance(source, PointMap) or source.scan is None or not stretch:
         return
