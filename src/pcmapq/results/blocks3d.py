@@ -14,8 +14,15 @@ if TYPE_CHECKING:  # the alignment modules load small_gicp; a result only holds 
 
 #: The columns of a 3D region, in the JSON and the ``--regions-3d`` CSV.
 REGION_3D_COLUMNS = tuple(s.Region3D.model_fields)
-#: Of them, the columns of a stretch of the run (null for a tile).
+#: Of them, the columns of a stretch of the run (null for a tile), and those of a tile.
 SCAN_COLUMNS = ("first_scan", "last_scan")
+TILE_COLUMNS = tuple(key for key in REGION_3D_COLUMNS if key not in SCAN_COLUMNS)
+
+
+def region_3d_columns(c: Consistency3D | None) -> tuple[str, ...]:
+    """The columns of the regions of ``c``: a stretch's all of them, a tile's (or none's)
+    TILE_COLUMNS."""
+    return REGION_3D_COLUMNS if c is not None and c.scans is not None else TILE_COLUMNS
 
 
 def _at(c: Consistency3D, k: int | None) -> tuple[float, float, float] | None:
@@ -27,10 +34,8 @@ def consistency_3d_block(c: Consistency3D) -> s.ConsistencyMap3D:
     are, and every region."""
     columns = (*c.centre.T, *c.offset.T, c.offset_m, *c.angles_deg.T)
     # a tile's region and block leave out the stretches' fields: the JSON of tiles is as it was
-    names = REGION_3D_COLUMNS if c.scans is not None else \
-        [key for key in REGION_3D_COLUMNS if key not in SCAN_COLUMNS]
     scans = [()] * len(c.points) if c.scans is None else c.scans.tolist()
-    regions = [s.Region3D(**dict(zip(names, (*row, n, before, after, held, *span),
+    regions = [s.Region3D(**dict(zip(region_3d_columns(c), (*row, n, before, after, held, *span),
                                      strict=True)))
                for row, n, before, after, held, span in zip(
                    np.column_stack(columns).tolist(), c.points.astype(int).tolist(),
@@ -51,9 +56,8 @@ def consistency_3d_of(doc: s.ConsistencyMap3D | None) -> Consistency3D | None:
 
     if doc is None:
         return None
-    columns = [key for key in REGION_3D_COLUMNS if key not in SCAN_COLUMNS]
-    table = np.array([[getattr(r, key) for key in columns] for r in doc.regions],
-                     dtype=np.float64).reshape(-1, len(columns))
+    table = np.array([[getattr(r, key) for key in TILE_COLUMNS] for r in doc.regions],
+                     dtype=np.float64).reshape(-1, len(TILE_COLUMNS))
     scans = None if doc.stretch_scans is None else np.array(
         [[r.first_scan, r.last_scan] for r in doc.regions], dtype=int).reshape(-1, 2)
     return Consistency3D(doc.tile_m, doc.voxel_m, doc.tolerance_m, table[:, 0:3],

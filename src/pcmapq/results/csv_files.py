@@ -8,7 +8,7 @@ import io
 import numpy as np
 
 from pcmapq.results.blocks import DECIMALS, Findings
-from pcmapq.results.blocks3d import REGION_3D_COLUMNS, SCAN_COLUMNS, consistency_3d_block
+from pcmapq.results.blocks3d import consistency_3d_block, region_3d_columns
 from pcmapq.results.document import REGION_COLUMNS, consistency_block
 
 
@@ -46,9 +46,7 @@ def regions_3d_csv(result: Findings) -> str:
     the run's first and last scan when the regions are stretches. The header alone when there
     is none (not two 3D clouds)."""
     c = result.consistency_3d
-    columns = REGION_3D_COLUMNS if c is not None and c.scans is not None else tuple(
-        key for key in REGION_3D_COLUMNS if key not in SCAN_COLUMNS)
-    return _rows(columns, [] if c is None else consistency_3d_block(c).regions)
+    return _rows(region_3d_columns(c), [] if c is None else consistency_3d_block(c).regions)
 
 
 def _rows(columns: tuple[str, ...], regions: list) -> str:
