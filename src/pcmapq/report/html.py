@@ -135,7 +135,8 @@ def _relief(result: Result) -> str:
             f"{html.escape(cut)}, each registered to the truth on its own in 3D. dz: where the "
             "map has a region, from where it fits the truth (below 0: the map lies too low "
             "there). Held: its geometry pins the fit in every direction and it fits; the "
-            "others are hatched (their offset is not sure). Truth frame levelled, metres.</p>")
+            f"others are {'hatched' if c.scans is None else 'hollow'} (their offset is not "
+            "sure). Truth frame levelled, metres.</p>")
 
 
 def report_html(result: Result, scale: float | None = None) -> str:
