@@ -179,7 +179,7 @@ class Nearest:
                  threads: int = 1, offset: np.ndarray | None = None) -> None:
         n = len(source)
         self.source, self.target, self.tree, self.threads = source, target, tree, threads
-        self.offset = np.zeros(3) if offset is None else np.asarray(offset, dtype=np.float64)
+        self.offset = None if offset is None else np.asarray(offset, dtype=np.float64)
         self.k = min(CANDIDATES, len(target))
         self.near = np.zeros((n, self.k), np.int64)
         self.reach = np.full(n, -np.inf)  # no candidates yet: every point is searched
@@ -197,8 +197,8 @@ class Nearest:
         if count:
             again = self._again[:count].copy()
             moved = self.source[again] @ rotation.T + shift
-            found, sq = self.tree.batch_knn_search(moved + self.offset, self.k,
-                                                   num_threads=self.threads)
+            query = moved if self.offset is None else moved + self.offset
+            found, sq = self.tree.batch_knn_search(query, self.k, num_threads=self.threads)
             found = found.astype(np.int64)
             self.near[again], self.reach[again] = found, np.sqrt(sq[:, -1])
             self.seen_at[again], self.pair[again] = moved, found[:, 0]
