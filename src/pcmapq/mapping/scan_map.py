@@ -2,7 +2,7 @@
 
 The scan of a point is the mean index of the scans whose points its voxel holds (0: the first
 scan; a voxel seen by scans 3 and 4 alike is 3.5): a map's points carry where along the run
-they were seen, which :mod:`pcmapq.align.regions3d` cuts into stretches of the run. ``pcmapq
+they were seen, which :mod:`pcmapq.align.stretches` cuts into stretches of the run. ``pcmapq
 map`` writes it as the vertex property ``scan`` (float) of a PLY or the field ``scan`` of a
 PCD.
 """
