@@ -163,7 +163,7 @@ def structures_3d(truth: np.ndarray, map_: np.ndarray, option: StructuresConfig,
     if truth_planes is not None and not truth_planes.cancel():  # running or done
         early = truth_planes.result()
     return compare_structures(truth, map_, plane_params(option), option.line_margin,
-                              option.max_angle, option.max_offset, reach, early)
+                              option.line_length, option.max_angle, option.max_offset, reach, early)
 
 
 def inside(features: Features, area: np.ndarray, grid: MetricGrid,

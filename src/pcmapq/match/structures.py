@@ -175,12 +175,12 @@ def match_structures(name: str, truth: Planes | Lines, map_: Planes | Lines,
 
 
 def compare_structures(truth_points: np.ndarray, map_points: np.ndarray, params: PlaneParams,
-                       line_margin: float, max_angle: float, max_offset: float,
-                       reach: float | None = None,
+                       line_margin: float, line_length: float, max_angle: float,
+                       max_offset: float, reach: float | None = None,
                        truth_planes: Planes | None = None) -> Structures3D:
     """The planes and plane lines of two clouds (N, 3), both in the truth frame, metres,
-    found with ``params`` (lines: extents touching within ``line_margin`` metres, at least as
-    long as the side of the smallest plane, ``sqrt(params.min_area)``) and matched
+    found with ``params`` (lines: extents touching within ``line_margin`` metres, at least
+    ``line_length`` metres long) and matched
     with ``max_angle`` degrees and ``max_offset`` metres, the map's planes moved first by the
     planes' own fit (:mod:`pcmapq.match.plane_fit`) to the planes matched so, when it moves
     none more than ``reach`` metres (None: whatever it moves). ``truth_planes``: the truth's
@@ -194,7 +194,7 @@ def compare_structures(truth_points: np.ndarray, map_points: np.ndarray, params:
     first = match_structures("planes", truth, found, max_angle, max_offset)
     fit = plane_fit(truth, found, first.truth_idx, first.map_idx, reach)
     planes = [truth, moved(found, fit.matrix)]
-    lines = [plane_lines(p, line_margin, np.sqrt(params.min_area)) for p in planes]
+    lines = [plane_lines(p, line_margin, line_length) for p in planes]
     both = {"planes": planes, "plane_lines": lines}
     return Structures3D({name: StructureResult(t, m, match_structures(name, t, m, max_angle,
                                                                       max_offset))

@@ -227,6 +227,9 @@ class StructuresConfig:
     max_offset: the largest distance between them, metres: a plane's along the truth plane's
         normal, a line's from the truth line.
     line_margin: two planes meet in a line where their extents touch within this, metres.
+    line_length: the shortest line counted, metres (its segment, which reaches the margin
+        beyond where the planes end): shorter lines are mostly where small planes (in
+        vegetation, on parked cars) touch, and come and go with each pass of a scanner.
     """
 
     enabled: bool = True
@@ -236,6 +239,7 @@ class StructuresConfig:
     max_angle: float = 5.0
     max_offset: float = 0.5
     line_margin: float = 0.2
+    line_length: float = 1.5
 
 
 @dataclass(frozen=True)

@@ -270,6 +270,9 @@ OPTIONS: tuple[Option, ...] = (
     Option("line_margin", "structures.line_margin", FLOAT,
            "3D structures: two planes meet in a line where their extents touch within this, "
            "metres.", 0.0),
+    Option("line_length", "structures.line_length", FLOAT,
+           "3D structures: the shortest line where two planes meet that is counted, metres "
+           "(shorter ones, where small planes touch, come and go with each pass).", 0.0),
 )
 
 

@@ -10,8 +10,9 @@ from pcmapq.features.planes3d import PlaneParams, find_planes
 from pcmapq.match.structures import compare_structures, match_structures
 from testkit import building3d as b
 
-#: The thresholds of the defaults: 5 degrees, 0.5 m; lines where extents touch within 0.2 m.
-ANGLE, OFFSET, MARGIN = 5.0, 0.5, 0.2
+#: The thresholds of the defaults: 5 degrees, 0.5 m; lines where extents touch within 0.2 m,
+#: at least 1.5 m long.
+ANGLE, OFFSET, MARGIN, LENGTH = 5.0, 0.5, 0.2, 1.5
 
 
 @pytest.fixture(scope="module")
@@ -20,7 +21,7 @@ def truth() -> np.ndarray:
 
 
 def compared(truth: np.ndarray, map_: np.ndarray):
-    return compare_structures(truth, map_, PlaneParams(), MARGIN, ANGLE, OFFSET)
+    return compare_structures(truth, map_, PlaneParams(), MARGIN, LENGTH, ANGLE, OFFSET)
 
 
 def plane_at(planes, point: tuple[float, float, float], normal_axis: int) -> int:
@@ -116,6 +117,6 @@ def test_the_truths_planes_found_beforehand_give_the_same_structures(truth):
     the same matches, as when both clouds' planes are found together."""
     moved = b.cloud(b.changed(b.faces(b_end=b.B_END + 0.3), {"A.floor": 0.05}), seed=2)
     together = compared(truth, moved)
-    before = compare_structures(truth, moved, PlaneParams(), MARGIN, ANGLE, OFFSET,
+    before = compare_structures(truth, moved, PlaneParams(), MARGIN, LENGTH, ANGLE, OFFSET,
                                 truth_planes=find_planes(truth, PlaneParams()))
     b.assert_same_matches(together, before)
