@@ -99,15 +99,18 @@ def section(data: Path, record: Record) -> Section:
             score(res.detectors["harris"].matching.f1, 2),
             score(f_at(res, 0.1, three_d=True), 2)]))
     levels = [r.level for r in rungs]
-    lines_rho = rank_rho(levels, [_f1(r, "plane_lines") or 0.0 for r in rungs])
+    line_f1 = [_f1(r, "plane_lines") or 0.0 for r in rungs]
+    lines_rho = rank_rho(levels, line_f1)
     f1 = [_f1(r, "planes") or 0.0 for r in rungs]
     rho = rank_rho(levels, f1)
     falls = ("falls at every step" if all(a > b for a, b in zip(f1, f1[1:], strict=False))
              else "does not fall at every step")
     last = rungs[-1]
     truth_lines = last.run.result.structures.detectors["plane_lines"].matching.truth_structures
-    lines_words = (f"(rho {lines_rho:.2f}; the truth has {truth_lines}) ranks them too, though "
-                   "not step by step" if lines_rho <= RHO else
+    steps = all(a > b for a, b in zip(line_f1, line_f1[1:], strict=False))
+    lines_words = (f"(rho {lines_rho:.2f}; the truth has {truth_lines}) ranks them too"
+                   f"{', falling at every step' if steps else ', though not step by step'}"
+                   if lines_rho <= RHO else
                    f"does not (rho {lines_rho:.2f}): the truth has {truth_lines}, too few to rank "
                    "the levels")
     on, off = last.run.seconds, last.without.seconds
