@@ -12,6 +12,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from pcmapq.features.lines3d import plane_lines
+from pcmapq.match.structures import match_structures
 from pcmapq.report.text import score
 from testkit.realdata.ladders3d import (
     LEVELS,
@@ -36,6 +38,10 @@ UNIT = {"heading": "deg / scan", "vertical": "deg / scan", "scale": "% longer"}
 NAMES = {"chamfer_3d_m": "Chamfer 3D", "awd_m": "AWD", "scs": "SCS", "planes_f1": "planes f1",
          "plane_lines_f1": "plane lines f1", "largest_dz_m": "largest region |dz|",
          "largest_offset_m": "largest region offset"}
+
+
+#: The shortest lines counted in the table of :func:`_line_lengths`, metres.
+LINE_LENGTHS = (1.0, 1.25, 1.5, 1.75, 2.0)
 
 
 def _level(kind: str, level: float) -> str:
@@ -145,7 +151,8 @@ def section(data: Path, record: Record) -> Section:
         f"{WITHIN_SHARE:.0%} of the injected dz (the last scan's) of the expected; *largest*: "
         "the held region with the largest reported |dz|, and whether it is the far region.",
         "", *_bends(by_kind["vertical"]), "",
-        *_findings(by_kind),
+        *_findings(by_kind), "",
+        *_line_lengths(by_kind),
     ]
     return Section("\n".join(text))
 
@@ -243,3 +250,37 @@ def _findings(by_kind: dict[str, list[Rung]]) -> list[str]:
         "scores maps that do not carry their scans (tiles), each scan cut to 12 m so that no "
         "tile holds every scan.",
 ]
+
+
+def _line_lengths(by_kind: dict[str, list[Rung]]) -> list[str]:
+    """The plane lines' rank correlation on each ladder against the shortest line counted
+    (``--line-length``): the lines of each rung's planes (as the evaluation found them and
+    moved the map's) counted again at each length and matched with the evaluation's
+    thresholds."""
+    option = SETTINGS.structures
+    rows = []
+    for length in LINE_LENGTHS:
+        truth_lines, rhos = 0, []
+        for rungs in by_kind.values():
+            f1 = []
+            for g in rungs:
+                planes = g.run.result.structures.detectors["planes"]
+                t, m = (plane_lines(p, option.line_margin, length)
+                        for p in (planes.truth, planes.map))
+                matching = match_structures("plane_lines", t, m, option.max_angle,
+                                            option.max_offset)
+                f1.append(matching.f1 or 0.0)
+                truth_lines = len(t)
+            rhos.append(rho([g.level for g in rungs], f1))
+        default = " (default)" if length == option.line_length else ""
+        rows.append(row([f"{length:g}{default}", str(truth_lines),
+                         *(f"{r:.2f}" for r in rhos)]))
+    return [
+        "### The shortest plane line counted", "",
+        "The plane lines' Spearman's rho with the level on each ladder when the shortest line "
+        "counted (`--line-length`) is another: each rung's planes as the evaluation found "
+        "them (the map's moved by the planes' own fit), their lines counted at that length and "
+        "matched as the evaluation matches them.", "",
+        header(["shortest line (m)", "truth lines", *(f"rho, {kind}" for kind in by_kind)]),
+        *rows,
+    ]
