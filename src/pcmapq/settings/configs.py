@@ -229,9 +229,9 @@ class StructuresConfig:
         normal, a line's from the truth line.
     line_margin: two planes meet in a line where their extents touch within this, metres.
     line_length: the shortest line counted, metres (its segment, which reaches the margin
-        beyond where the planes end): shorter lines are mostly where small planes touch
-        (on a street, beside the road at the height of parked cars and hedges), and come and
-        go with each pass of a scanner.
+        beyond where the planes end): shorter lines are where two planes barely touch (on a
+        street, mostly two small planes of 1-3 square metres), and come and go with each
+        pass of a scanner.
     """
 
     enabled: bool = True
