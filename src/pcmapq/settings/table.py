@@ -272,7 +272,7 @@ OPTIONS: tuple[Option, ...] = (
            "metres.", 0.0),
     Option("line_length", "structures.line_length", FLOAT,
            "3D structures: the shortest line where two planes meet that is counted, metres "
-           "(shorter ones, where small planes touch, come and go with each pass).", 0.0),
+           "(shorter ones, where two planes barely touch, come and go with each pass).", 0.0),
 )
 
 
