@@ -7,7 +7,6 @@ help, which shows them, loads none of it."""
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -298,12 +297,4 @@ class Settings:
             distances=DistancesConfig(tuple(doc["distances"]["taus"])),
             noref=NoRefConfig(**doc.get("noref", {"enabled": False})),  # saved before noref
             map_3d=Map3DConfig(**doc.get("map_3d", {})),  # absent without two 3D clouds
-            structures=_structures(doc.get("structures", {})))
-
-
-def _structures(doc: dict) -> StructuresConfig:
-    """The structures' settings of a saved result; one saved without ``line_length`` counted
-    lines as long as the side of the smallest plane, ``sqrt(min_area)``."""
-    if doc and "line_length" not in doc:
-        doc = {**doc, "line_length": math.sqrt(doc.get("min_area", StructuresConfig.min_area))}
-    return StructuresConfig(**doc)
+            structures=StructuresConfig(**doc.get("structures", {})))

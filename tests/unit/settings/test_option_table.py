@@ -128,16 +128,3 @@ def test_settings_recorded_without_the_3d_map_group_read_back_with_its_defaults(
     doc = Settings().to_dict()
     del doc["map_3d"]
     assert Settings.from_dict(doc) == Settings()
-
-
-def test_settings_recorded_without_the_line_length_read_back_as_the_rule_they_ran_with():
-    """A result saved before ``structures.line_length`` counted lines as long as the side of
-    its smallest plane: that is the length it reads back with."""
-    doc = Settings().to_dict()
-    del doc["structures"]["line_length"]
-    doc["structures"]["min_area"] = 4.0
-    read = Settings.from_dict(doc).structures
-    assert read.line_length == 2.0 and read.min_area == 4.0
-    doc["structures"]["min_area"] = 1.0
-    assert Settings.from_dict(doc).structures.line_length == 1.0
-    assert Settings.from_dict(Settings().to_dict()) == Settings()
