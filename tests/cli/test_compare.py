@@ -182,3 +182,30 @@ def test_a_batch_result_and_an_eval_result_share_their_truth(saved, tmp_path):
     proc = run("compare", str(saved["a"]), str(tmp_path / "b" / "scan.json"), "--out",
                str(tmp_path / "cmp"))
     assert proc.returncode == 0 and "another truth" not in proc.stderr, proc.stderr
+    assert "other settings" not in proc.stderr, proc.stderr  # batch scores as eval does
+
+
+def test_results_scored_with_other_settings_are_compared_with_a_warning_naming_them(
+        saved, tmp_path):
+    """The sample scored again with a 0.3 m match threshold, and a result saved before a
+    setting was one (its record lacks the footprint's margin): one warning line names each
+    setting that differs, its values and their files; the table is written all the same.
+    Only the detectors run ('a' against 'b') is no difference."""
+    proc = run("eval", str(SAMPLE / "scan.ply"), str(SAMPLE / "truth.yaml"), "--threshold",
+               "0.3", "--json", str(tmp_path / "t.json"), "--quiet")
+    assert proc.returncode == 0, proc.stderr
+    old = json.loads(saved["a"].read_text())
+    del old["settings"]["footprint"]["margin"]
+    (tmp_path / "old.json").write_text(json.dumps(old))
+    proc = run("compare", str(saved["a"]), str(tmp_path / "t.json"), str(tmp_path / "old.json"),
+               "--out", str(tmp_path / "cmp"))
+    assert proc.returncode == 0, proc.stderr
+    lines = [ln for ln in proc.stderr.splitlines() if "other settings" in ln]
+    assert len(lines) == 1, proc.stderr
+    assert f"matching.threshold (0.5 in {saved['a']}, {tmp_path / 'old.json'}; 0.3 in " \
+        f"{tmp_path / 't.json'})" in lines[0], lines[0]
+    assert f"footprint.margin (0.3 in {saved['a']}, {tmp_path / 't.json'}; not recorded in " \
+        f"{tmp_path / 'old.json'})" in lines[0], lines[0]
+    assert [r["name"] for r in table(tmp_path / "cmp")] == ["a", "t", "old"]
+    proc = run("compare", str(saved["a"]), str(saved["b"]), "--out", str(tmp_path / "ab"))
+    assert proc.returncode == 0 and "other settings" not in proc.stderr, proc.stderr

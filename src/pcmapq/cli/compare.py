@@ -33,13 +33,15 @@ def compare_command(
         "--quiet", "-q", help="Print nothing but warnings and errors.")] = False,
 ) -> None:
     from pcmapq.report.summary import print_summary, write_summary
-    from pcmapq.results.compare import check_same_truth, read_results
+    from pcmapq.results.compare import check_same_settings, check_same_truth, read_results
 
     err = Console(stderr=True)
     with report_errors(err), terminal.show_warnings(err):
         saved = read_results(results, None if names is None else names.split(","))
-        if (line := check_same_truth(saved, allow_different_truths)) is not None:
-            warnings.warn(line, stacklevel=1)
+        for line in (check_same_truth(saved, allow_different_truths),
+                     check_same_settings(saved)):
+            if line is not None:
+                warnings.warn(line, stacklevel=1)
         rows = [s.row for s in saved]
         wrote = write_summary(rows, out)
     if not quiet:

@@ -22,6 +22,11 @@ from pcmapq.results.schema import ResultDocument, problem
 
 #: What makes two truths the same, beside their path: the truth grid's keys in the JSON.
 TRUTH_GRID = ("shape", "resolution_m", "origin")
+#: Settings (dotted names, or their groups) that differ between results without changing what
+#: a figure means: each map's own source and pose guess, and which figures were computed.
+OWN_SETTINGS = ("map", "alignment.init", "alignment.init_3d", "matching.detectors")
+#: Settings named in the warning, at most.
+NAMED_SETTINGS = 3
 
 
 @dataclass(frozen=True)
@@ -77,6 +82,51 @@ def check_same_truth(results: Sequence[Saved], allow_different: bool) -> str | N
     if not allow_different:
         raise InputError(line + " (--allow-different-truths to compare them anyway)")
     return line
+
+
+def settings_differences(results: Sequence[Saved]) -> list[str]:
+    """The settings whose recorded values differ among the results, each as 'name (value in
+    files; value in files)', in name order; a setting a result does not record (saved before
+    it was one) is 'not recorded'. Not those of :data:`OWN_SETTINGS` nor the switches
+    (``*.enabled``): they leave every figure's meaning as it is."""
+    flat = [_flat(saved.doc.get("settings", {})) for saved in results]
+    out = []
+    for key in sorted(set().union(*flat)):
+        if key.endswith(".enabled") or any(key == own or key.startswith(own + ".")
+                                           for own in OWN_SETTINGS):
+            continue
+        values = [json.dumps(f[key], sort_keys=True) if key in f else "not recorded"
+                  for f in flat]
+        if len(set(values)) > 1:
+            held = [f"{v} in " + ", ".join(str(saved.path) for saved, w
+                                           in zip(results, values, strict=True) if w == v)
+                    for v in dict.fromkeys(values)]
+            out.append(f"{key} ({'; '.join(held)})")
+    return out
+
+
+def check_same_settings(results: Sequence[Saved]) -> str | None:
+    """A warning line naming the settings the results were scored with that differ (at most
+    :data:`NAMED_SETTINGS` of them; None when they agree): the same figure under other
+    settings may not compare."""
+    differ = settings_differences(results)
+    if not differ:
+        return None
+    more = len(differ) - NAMED_SETTINGS
+    rest = f" and {count(more, 'more setting')}" if more > 0 else ""
+    return (f"results scored with other settings: {', '.join(differ[:NAMED_SETTINGS])}{rest}; "
+            "their figures may not compare")
+
+
+def _flat(doc: dict, prefix: str = "") -> dict[str, object]:
+    """A nested settings record as dotted names and their values (lists kept whole)."""
+    out: dict[str, object] = {}
+    for key, value in doc.items():
+        if isinstance(value, dict):
+            out.update(_flat(value, f"{prefix}{key}."))
+        else:
+            out[f"{prefix}{key}"] = value
+    return out
 
 
 def _read(path: Path, name: str) -> Saved:
