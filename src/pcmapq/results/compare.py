@@ -88,18 +88,22 @@ def settings_differences(results: Sequence[Saved]) -> list[str]:
     """The settings whose recorded values differ among the results, each as 'name (value in
     files; value in files)', in name order; a setting a result does not record (saved before
     it was one) is 'not recorded'. Not those of :data:`OWN_SETTINGS` nor the switches
-    (``*.enabled``): they leave every figure's meaning as it is."""
-    flat = [_flat(saved.doc.get("settings", {})) for saved in results]
+    (``*.enabled``): they leave every figure's meaning as it is. A group a result has none of
+    (``map_3d`` and ``structures`` but for two 3D clouds) is compared among the others."""
+    groups = [saved.doc.get("settings", {}) for saved in results]
+    flat = [_flat(group) for group in groups]
     out = []
     for key in sorted(set().union(*flat)):
         if key.endswith(".enabled") or any(key == own or key.startswith(own + ".")
                                            for own in OWN_SETTINGS):
             continue
+        having = [(saved, f) for saved, f, g in zip(results, flat, groups, strict=True)
+                  if key.split(".")[0] in g]
         values = [json.dumps(f[key], sort_keys=True) if key in f else "not recorded"
-                  for f in flat]
+                  for _, f in having]
         if len(set(values)) > 1:
-            held = [f"{v} in " + ", ".join(str(saved.path) for saved, w
-                                           in zip(results, values, strict=True) if w == v)
+            held = [f"{v} in " + ", ".join(str(saved.path) for (saved, _), w
+                                           in zip(having, values, strict=True) if w == v)
                     for v in dict.fromkeys(values)]
             out.append(f"{key} ({'; '.join(held)})")
     return out
