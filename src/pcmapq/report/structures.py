@@ -38,12 +38,16 @@ def displacement_stats(result: Result) -> dict[str, Stats]:
 
 
 def thresholds(result: Result) -> str:
-    """How the structures were matched, in words ('' without structures)."""
+    """How the structures were matched, in words ('' without structures): the thresholds,
+    the shortest line counted (when the settings record it) and the planes' own fit."""
     s = result.structures
     if s is None:
         return ""
-    return (f"3D planes and plane lines within {s.max_angle:g} deg and {s.max_offset:g} m "
-            f"(a plane's displacement along the truth plane's normal, signed){fit_words(s)}")
+    length = ((result.settings or {}).get("structures") or {}).get("line_length")
+    lines = "" if length is None else f", lines from {length:g} m long"
+    return (f"3D planes and plane lines within {s.max_angle:g} deg and {s.max_offset:g} m"
+            f"{lines} (a plane's displacement along the truth plane's normal, signed)"
+            f"{fit_words(s)}")
 
 
 def fit_words(s: Structures3D) -> str:

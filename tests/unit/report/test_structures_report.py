@@ -42,6 +42,16 @@ def test_the_terminal_table_has_a_row_per_structure_detector(result):
     assert max(len(line) for line in text.splitlines()) <= 100
 
 
+def test_the_thresholds_name_the_shortest_line_the_settings_record(result):
+    """A result of two 3D clouds records the shortest line counted: the words give it; a
+    result whose settings lack it (saved before it was one) says nothing of it."""
+    recorded = {**(result.settings or {}), "structures": {"line_length": 1.5}}
+    words = structures.thresholds(replace(result, settings=recorded))
+    assert words.startswith("3D planes and plane lines within 5 deg and 0.5 m, lines from "
+                            "1.5 m long (a plane's displacement"), words
+    assert "lines from" not in structures.thresholds(result)
+
+
 def test_a_structure_detector_with_nothing_to_find_says_why(result):
     planes = result.structures.detectors["planes"]
     none = StructureMatching(*(planes.matching.truth_idx[:0],) * 2,
