@@ -142,7 +142,7 @@ def _stretches(ax: Axes, c: Consistency3D, colours: ScalarMappable) -> None:
     ax.scatter(*c.centre[c.held, :2].T, s=70, c=rgba[c.held], edgecolors="black",
                linewidths=0.5, zorder=4)
     for k, side in {0: -1, len(c.points) - 1: 1}.items():
-        ax.annotate(f"scans {c.scans[k, 0]}-{c.scans[k, 1]}", tuple(c.centre[k, :2]),
+        ax.annotate(c.scan_span(k), tuple(c.centre[k, :2]),
                     xytext=(6 * side, 6), textcoords="offset points", fontsize=TEXT_PT - 1,
                     ha="left" if side > 0 else "right", zorder=6)
 
