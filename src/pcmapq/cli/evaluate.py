@@ -102,7 +102,7 @@ def eval_command(
     **settings_values: Any,
 ) -> None:
     from pcmapq.evaluation.pipeline import evaluate
-    from pcmapq.io.clouds import PointMap, flat
+    from pcmapq.io.clouds import PointMap
     from pcmapq.mapping import build_map_kiss
     from pcmapq.report.table import print_table
 
@@ -133,8 +133,7 @@ def eval_command(
         else:
             progress("mapping the scans with KISS-ICP")
             built, _ = build_map_kiss(scans, max_scans=max_scans, topic=scan_topic)
-            map_path = PointMap(scans, built.points, not flat(built.points), kind="scans",
-                                scan=built.scan)
+            map_path = PointMap.of_scans(scans, built.points, built.scan)
         limit = memory_limit(max_memory)
         result = replace(evaluate(map_path, truth_path, settings, progress, limit),
                          command=options.command_line(ctx))

@@ -75,7 +75,7 @@ def inspect_command(
     **settings_values: Any,
 ) -> None:
     from pcmapq.evaluation.inspect_map import inspect_map, summary_lines, to_json
-    from pcmapq.io.clouds import PointMap, flat
+    from pcmapq.io.clouds import PointMap
     from pcmapq.mapping import posed_map, read_pose_matrix, read_poses
     from pcmapq.metrics.posed import place_subset, read_orthogonal_subset
 
@@ -101,7 +101,7 @@ def inspect_command(
             trajectory = read_poses(poses)
             first = trajectory[0]
             placed = posed_map(scans, trajectory)
-            source = PointMap(scans, placed, not flat(placed), kind="scans")
+            source = PointMap.of_scans(scans, placed)
         else:
             source = load_map(map_path, settings.map.resolution,
                               memory_limit=memory_limit(max_memory), topic=settings.map.topic,

@@ -79,6 +79,14 @@ class PointMap:
     seen: SeenCells | None = None
     scan: np.ndarray | None = None
 
+    @classmethod
+    def of_scans(cls, path: Path, points: np.ndarray, scan: np.ndarray | None = None,
+                 seen: SeenCells | None = None) -> PointMap:
+        """A map made of the scans at ``path`` (kind ``scans``): its points (N, 3, metres),
+        3D unless they are flat, with each point's scan and the area its scans saw when
+        known."""
+        return cls(path, points, not flat(points), kind="scans", seen=seen, scan=scan)
+
 
 def flat(points: np.ndarray) -> bool:
     """Whether points (N, 3) are a 2D cloud: z constant within :data:`FLAT_TOLERANCE` (a

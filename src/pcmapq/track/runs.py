@@ -41,7 +41,6 @@ from pcmapq.io.carmen import (
     is_carmen,
     read_laser_scans,
 )
-from pcmapq.io.clouds import flat
 from pcmapq.mapping import (
     ScanGrid,
     ScanSequence,
@@ -171,8 +170,7 @@ class ScanRun:
                 wanted.pop(0)
                 seen, views = add_views(seen, np.stack(views)), []
                 built = grid.map()
-                yield (PointMap(self.path, built.points, is_3d=not flat(built.points),
-                                kind="scans", seen=seen, scan=built.scan),
+                yield (PointMap.of_scans(self.path, built.points, built.scan, seen),
                        recent.points())
                 recent = VoxelMap(self.voxel)
             if not wanted:
