@@ -22,6 +22,7 @@ from pcmapq.core.words import count
 from pcmapq.settings import Settings
 from pcmapq.settings.build import build, option_words
 from pcmapq.settings.file import read_settings
+from pcmapq.settings.renamed import renamed_of
 from pcmapq.settings.table import (
     BATCH,
     EVAL,
@@ -31,7 +32,6 @@ from pcmapq.settings.table import (
     Option,
     OptionError,
     options_of,
-    renamed_of,
 )
 
 #: Names a row cannot take: the batch's own table and figure are written beside the rows.

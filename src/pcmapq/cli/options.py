@@ -18,16 +18,15 @@ import typer
 from pcmapq.settings import Settings
 from pcmapq.settings.build import base_settings, build, default_of
 from pcmapq.settings.file import read_settings
+from pcmapq.settings.renamed import Renamed, renamed_of
 from pcmapq.settings.table import (
     FLOAT,
     INT,
     SWITCH,
     Option,
     OptionError,
-    Renamed,
     option_named,
     options_of,
-    renamed_of,
 )
 
 #: Python types of the option kinds, as typer reads them.

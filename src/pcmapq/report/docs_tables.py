@@ -11,7 +11,8 @@ import re
 from pcmapq.results import figures as table
 from pcmapq.results.figures import ALIASES, AT_TAU_COLUMN, MEAN_PRECISION, TAU_FIELDS
 from pcmapq.settings.build import base_settings, get_path
-from pcmapq.settings.table import FLOAT, INT, SWITCH, Option, option_named, options_of, renamed_of
+from pcmapq.settings.renamed import renamed_of
+from pcmapq.settings.table import FLOAT, INT, SWITCH, Option, option_named, options_of
 
 BLOCK = re.compile(r"(<!-- options: (\w+) -->\n).*?(<!-- /options -->)", re.S)
 FIGURE_BLOCK = re.compile(r"(<!-- figures -->\n).*?(<!-- /figures -->)", re.S)
@@ -19,7 +20,7 @@ FIGURE_BLOCK = re.compile(r"(<!-- figures -->\n).*?(<!-- /figures -->)", re.S)
 
 def options_table(command: str) -> str:
     """The settings options of ``command`` as a markdown table, then the former names it
-    still reads (:data:`~pcmapq.settings.table.RENAMED`)."""
+    still reads (:data:`~pcmapq.settings.renamed.RENAMED`)."""
     rows = ["| option | setting | default | meaning |", "| --- | --- | --- | --- |"]
     defaults = base_settings(command)
     for option in options_of(command):

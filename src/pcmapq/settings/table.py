@@ -4,7 +4,8 @@ command-line option, its kind and bounds, its help, the commands that take it an
 settings builder (:mod:`pcmapq.settings.build`) and the settings file
 (:mod:`pcmapq.settings.file`) and the docs' option tables (:mod:`pcmapq.report.docs_tables`)
 all read it: an option added here reaches every one of them. An option has one name on every
-command; :data:`RENAMED` lists the former names still read, with a warning."""
+command; :mod:`pcmapq.settings.renamed` lists the former names still read, with a
+warning."""
 
 from __future__ import annotations
 
@@ -38,9 +39,8 @@ from pcmapq.settings.parsers import (
     show_list,
 )
 
-__all__ = ["BATCH", "EVAL", "FLOAT", "INSPECT", "INT", "OPTIONS", "RENAMED", "SWITCH", "TEXT",
-           "TRACK", "Option", "OptionError", "Renamed", "option_named", "options_of",
-           "parse_box", "renamed_of"]
+__all__ = ["BATCH", "EVAL", "FLOAT", "INSPECT", "INT", "OPTIONS", "SWITCH", "TEXT", "TRACK",
+           "Option", "OptionError", "option_named", "options_of", "parse_box"]
 
 #: Kinds of option: a number, an integer, text read by the option's parser, or a switch
 #: (``--noref/--no-noref``: a yes or no the command line can give either way).
@@ -276,37 +276,6 @@ OPTIONS: tuple[Option, ...] = (
 )
 
 
-@dataclass(frozen=True)
-class Renamed:
-    """An option's former name (``radius``), still read where it was taken: as a command's
-    option (``--radius``, hidden from the help) or a batch manifest's column, with one warning
-    naming the option now (``--noref-radius``). ``commands``: the commands that took it. A
-    switch is not renamed this way."""
-
-    old: str
-    new: str
-    commands: tuple[str, ...]
-
-    @property
-    def option(self) -> str:
-        """The former option as typed: ``--radius``."""
-        return "--" + self.old.replace("_", "-")
-
-
-#: Every renamed option: inspect named its settings apart from eval's until each setting had
-#: one name on every command (the setting's group and key: ``--noref-radius`` for
-#: ``noref.radius``). The docs' option tables list them (:mod:`pcmapq.report.docs_tables`).
-RENAMED: tuple[Renamed, ...] = (
-    Renamed("crop", "map_crop", (INSPECT,)),
-    Renamed("topic", "map_topic", (INSPECT,)),
-    Renamed("radius", "noref_radius", (INSPECT,)),
-    Renamed("voxel", "noref_voxel", (INSPECT,)),
-    Renamed("sample", "noref_sample", (INSPECT,)),
-    Renamed("min_knn", "noref_min_knn", (INSPECT,)),
-    Renamed("max_nn", "noref_max_nn", (INSPECT,)),
-)
-
-
 def options_of(command: str | None = None) -> tuple[Option, ...]:
     """The options ``command`` takes (None: every option), in table order. Read when called,
     not when imported, so that an option added to :data:`OPTIONS` reaches every reader."""
@@ -316,8 +285,3 @@ def options_of(command: str | None = None) -> tuple[Option, ...]:
 def option_named(name: str) -> Option:
     """The option of this name (KeyError when none)."""
     return {o.name: o for o in OPTIONS}[name]
-
-
-def renamed_of(command: str) -> tuple[Renamed, ...]:
-    """The former names ``command`` still reads."""
-    return tuple(r for r in RENAMED if command in r.commands)

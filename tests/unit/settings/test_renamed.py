@@ -1,4 +1,4 @@
-"""An option's former name (:data:`pcmapq.settings.table.RENAMED`) is still read where it was
+"""An option's former name (:data:`pcmapq.settings.renamed.RENAMED`) is still read where it was
 taken, with one warning naming the option now, and recorded under its name: a command's hidden
 option, a batch manifest's column."""
 
@@ -12,13 +12,12 @@ import typer
 from pcmapq.batch.manifest import parse_assignments, read_rows
 from pcmapq.cli import app
 from pcmapq.cli.options import command_line, settings_of
-from pcmapq.settings import table as option_table
+from pcmapq.settings import renamed as renamed_names
+from pcmapq.settings.renamed import RENAMED, Renamed
 from pcmapq.settings.table import (
     BATCH,
     INSPECT,
-    RENAMED,
     SWITCH,
-    Renamed,
     option_named,
     options_of,
 )
@@ -73,7 +72,7 @@ def test_the_help_shows_the_options_and_not_their_former_names():
 
 def test_a_manifest_column_renamed_is_read_with_one_warning(monkeypatch, tmp_path):
     """batch has no former name yet: one is added, and read through the same list."""
-    monkeypatch.setattr(option_table, "RENAMED",
+    monkeypatch.setattr(renamed_names, "RENAMED",
                         (*RENAMED, Renamed("match_distance", "threshold", (BATCH,))))
     manifest = tmp_path / "rows.csv"
     manifest.write_text("map,truth,match_distance\na.png,t.png,0.3\nb.png,t.png,0.4\n")
